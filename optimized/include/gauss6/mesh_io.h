@@ -1,0 +1,39 @@
+// Mesh files (OBJ, OFF, PLY, STL) and the self-intersection test, both through
+// CGAL (optimized/src/cgal/, one translation unit each). Scene-load time only:
+// never called from a real-time loop.
+#pragma once
+
+#include <stdexcept>
+#include <string>
+
+#include "gauss6/mesh.h"
+
+namespace gauss6 {
+
+// Raised for a missing, unreadable or malformed mesh file; what() names the file
+// and the problem ("bunny.obj: face 12 has 4 corners; only triangles are supported").
+class MeshFileError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+// Reads a triangle mesh by extension (.obj .off .ply .stl, case-insensitive).
+// OBJ, OFF and PLY keep the file's vertex numbering; STL corners with exactly equal
+// coordinates are merged into shared vertices. Sets source = path. Throws
+// MeshFileError for a missing or empty file, unparsable content, a face that is not
+// a triangle, a vertex index out of range or a non-finite coordinate. Does not
+// validate the mesh (see validate_mesh() and count_self_intersections()).
+TriangleMesh read_mesh(const std::string& path);
+// Writes by extension (.obj .off .ply .stl). OBJ/OFF are text with 17 significant
+// digits and PLY is binary (both round-trip doubles exactly); binary STL stores
+// 32-bit floats. Throws MeshFileError.
+void write_mesh(const std::string& path, const TriangleMesh& m);
+
+// Number of pairs of triangles that intersect other than along a shared edge or
+// vertex (CGAL exact predicates); a degenerate triangle counts as one pair (f, f).
+// Meant for meshes that pass validate_mesh(): at non-manifold vertices and edges,
+// triangles that only touch there are counted too. Throws std::invalid_argument
+// for a non-finite coordinate or a bad (out-of-range or repeated) index.
+int count_self_intersections(const TriangleMesh& m);
+
+}  // namespace gauss6

@@ -1,0 +1,57 @@
+// Poses, pose difference and pose update: the vocabulary of METHOD.md section 1.
+//
+// Frames (Drake's monogram notation): W is the world, B a body's frame with its
+// origin at the body's reference point G. A Pose X_WB = (p, q) maps a body point
+// r_B to p + R(q) r_B, where R(q) is the *rational* quaternion rotation
+// R(q) = (...)/|q|^2, so that a pose made of doubles has one exact meaning that
+// exact code (reference/) can reproduce, even when |q| != 1 after rounding.
+#pragma once
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+
+namespace gauss6 {
+
+using Vec3 = Eigen::Vector3d;
+using Mat3 = Eigen::Matrix3d;
+// A generalised acceleration a = (aG, alpha) (linear then angular, world frame)
+// or a wrench F = (force, torque about G), world frame.
+using Vec6 = Eigen::Matrix<double, 6, 1>;
+using Mat6 = Eigen::Matrix<double, 6, 6>;
+
+// Quaternion as (w, x, y, z); not necessarily unit.
+struct Quat {
+  double w = 1, x = 0, y = 0, z = 0;
+  Vec3 vec() const { return {x, y, z}; }
+  double norm2() const { return w * w + x * x + y * y + z * z; }
+};
+
+Quat operator*(const Quat& a, const Quat& b);  // Hamilton product
+Quat conjugate(const Quat& q);
+Quat normalized(const Quat& q);
+
+// Pose of a body in the world: position of G and orientation.
+struct Pose {
+  Vec3 p = Vec3::Zero();
+  Quat q;
+};
+
+// The rational rotation matrix of METHOD.md section 1: exact for any q != 0.
+Mat3 rotation_matrix(const Quat& q);
+// r_B (body frame, relative to G) -> world point p + R(q) r_B.
+Vec3 transform_point(const Pose& X_WB, const Vec3& r_B);
+
+// Unit quaternion of the rotation vector v (axis times angle): exp(v).
+Quat quat_exp(const Vec3& v);
+// Rotation vector (axis times angle, angle in [0, pi]) of q, shortest way round.
+Vec3 quat_log(const Quat& q);
+
+// xh (-) xs = (ph - ps, rotation vector of qh * conj(qs)): 6-vector, world frame.
+Vec6 pose_difference(const Pose& xh, const Pose& xs);
+// xs (+) a = (ps + aG, exp(alpha) * qs), the result's quaternion normalised.
+Pose pose_update(const Pose& xs, const Vec6& a);
+
+// True when every coordinate is finite and q is not (numerically) zero.
+bool is_valid_pose(const Pose& x);
+
+}  // namespace gauss6

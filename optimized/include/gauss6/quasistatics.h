@@ -1,0 +1,145 @@
+// The quasi-static projection of METHOD.md sections 2-3 (Gauss' principle of
+// least constraint), for the real-time loops:
+//
+//   ac = argmin 1/2 (a - au)^T M (a - au)   subject to   J a >= b,
+//
+// with multipliers lambda >= 0, M (ac - au) = J^T lambda and complementarity
+// lambda_k (J_k ac - b_k) = 0. b = 0 (the contact cone) unless constraint
+// offsetting (coupling.h) is running, in which case the feasible set is a
+// polyhedron that may be empty.
+//
+// Method: with M = L L^T (cached per M) and y = L^T a, the problem is the
+// Euclidean projection of y_u = L^T au on {y : A y >= b}, A = J L^-T. It is
+// solved by the dual active-set method of Goldfarb and Idnani (Math. Prog. 27,
+// 1983) with identity Hessian: the working set W holds at most 6 linearly
+// independent rows, A_W^T = Q [R; 0] is kept by Givens rotations as rows enter
+// and leave, and every iterate (y, lambda_W >= 0) is optimal for the rows in W,
+// so the method stops as soon as no row is violated. It may start from the
+// previous call's working set (warm start).
+//
+// Real-time contract: project() allocates nothing, takes no lock, throws
+// nothing; every buffer lives in the caller-owned ProjectionWorkspace. Sizes
+// are fixed at compile time (kMaxContacts rows).
+#pragma once
+
+#include <array>
+
+#include "gauss6/pose.h"
+
+namespace gauss6 {
+
+// Most constraint rows one projection accepts (the contact set's size cap).
+inline constexpr int kMaxContacts = 64;
+// Size of a working set: at most 6 linearly independent rows in R^6.
+inline constexpr int kMaxActive = 6;
+
+// Tolerances and limits; defaults suit double-precision haptics.
+struct ProjectionSettings {
+  // A row whose component orthogonal to the working set's rows (in the
+  // M^-1-norm, y-space) is <= dependence_tol times its norm (sin of its angle to
+  // their span) is treated as dependent on them and never joins the working
+  // set. This bounds the condition number of R by about 1/dependence_tol, so
+  // lambda keeps ~eps/dependence_tol (2e-6) relative accuracy in the worst
+  // case, while a skipped row of the cone (b = 0) is violated by at most
+  // dependence_tol * |A_k| |y|, below feasibility_tol: it never re-enters.
+  double dependence_tol = 1e-10;
+  // Row k counts as violated when J_k a - b_k < -feasibility_tol * scale_k,
+  // scale_k = |A_k| max(|y|, |y_u|) + |b_k| (|A_k|^2 = J_k M^-1 J_k^T,
+  // |y| = |a|_M): a relative tolerance, independent of units and row scaling.
+  double feasibility_tol = 1e-9;
+  // Cap on the add/drop steps of one call (typ. <= 2 m are needed).
+  int max_iterations = 200;
+  // Start from the previous call's working set (kept in the workspace).
+  bool warm_start = true;
+  // Fill the KKT residuals of ProjectionResult (about 6 m + 60 flops).
+  bool compute_residuals = true;
+};
+
+enum class ProjectionStatus {
+  kOptimal,            // KKT conditions met within the tolerances.
+  kIterationCap,       // max_iterations reached: ac (finite) is the projection
+                       // on the last working set; the residuals say how far
+                       // from optimal it is.
+  kInfeasibleOffsets,  // {a : J a >= b} is empty, or is reached only through
+                       // rows dependent within dependence_tol (only possible
+                       // with b != 0): ac = au (zero force), lambda = 0.
+  kBadInput,           // non-finite data, M not SPD, num_rows out of [0, cap],
+                       // J null with rows, or settings out of range.
+};
+const char* to_string(ProjectionStatus status) noexcept;
+
+// One projection's data; nothing is copied (pointers must outlive the call).
+struct ProjectionProblem {
+  const Mat6* M = nullptr;   // mass matrix diag(m I3, I_G), world frame, SPD.
+  Vec6 au = Vec6::Zero();    // unconstrained acceleration (linear, angular).
+  const double* J = nullptr; // num_rows x 6, row-major (contact k = J[6k..6k+5]);
+                             // may be null when num_rows == 0.
+  const double* b = nullptr; // num_rows right-hand sides; null means b = 0.
+  int num_rows = 0;          // m, in [0, kMaxContacts].
+};
+
+struct ProjectionResult {
+  Vec6 ac = Vec6::Zero();  // constrained acceleration; on kBadInput ac = au when
+                           // au is finite (zero force), else ac = 0.
+  // Multipliers (units of M * a): entries [0, num_rows) are valid, zero off the
+  // working set.
+  std::array<double, kMaxContacts> lambda{};
+  // Rows of the final working set, in the order they entered it.
+  std::array<int, kMaxActive> active{};
+  int num_active = 0;
+  ProjectionStatus status = ProjectionStatus::kBadInput;
+  int iterations = 0;  // add/drop steps taken (0 when the warm start was exact)
+  // KKT residuals, measured on the input data (a-space), filled when
+  // settings.compute_residuals (else left at 0):
+  double stationarity = 0;          // max_i |M (ac - au) - J^T lambda|_i
+  double primal_infeasibility = 0;  // max_k (b_k - J_k ac)+
+  double dual_infeasibility = 0;    // max_k (-lambda_k)+
+  double complementarity = 0;       // max_k |lambda_k (J_k ac - b_k)|
+};
+
+// Caller-owned state of project(): every buffer is preallocated here. One
+// workspace per loop (not shared between threads). It caches the Cholesky
+// factor of M and the rows A = J L^-T (recomputed only when M or J changes,
+// detected by comparing their bytes), and the working set with its QR factors
+// for the next warm start. The members are internal: callers only construct
+// it and may call reset().
+struct ProjectionWorkspace {
+  // Forget the caches and the warm start.
+  void reset() noexcept;
+
+  // Cache of M: its copy, lower Cholesky factor L (M = L L^T) and L^-1.
+  bool has_M = false;
+  Mat6 M = Mat6::Zero();
+  Mat6 L = Mat6::Identity();
+  Mat6 L_inv = Mat6::Identity();
+  // Cache of J (valid for has_M and M): its copy, A = J L^-T, 1/|A_k|.
+  int num_rows = -1;
+  std::array<double, kMaxContacts * 6> J{};
+  std::array<double, kMaxContacts * 6> A{};   // row-major: row k at 6 k
+  std::array<double, kMaxContacts * 6> A_t{};  // column-major: column j at kMaxContacts j
+  std::array<double, kMaxContacts> row_norm{};
+  std::array<double, kMaxContacts> inv_row_norm{};
+  // Working set: A_W^T = Q(:, 0:q) R(0:q, 0:q), q = num_active, Q orthogonal.
+  bool factor_matches_cache = false;  // Q, R are for the cached A
+  int num_active = 0;
+  std::array<int, kMaxActive> active{};
+  Mat6 Q = Mat6::Identity();
+  Mat6 R = Mat6::Zero();
+  // Givens rotations applied to Q since it was last rebuilt from scratch; the
+  // factors are rebuilt past a bound so that rounding cannot accumulate.
+  long rotations_since_rebuild = 0;
+  // Scratch.
+  std::array<double, kMaxActive> lambda_active{};
+  std::array<double, kMaxContacts> slack{};
+  std::array<unsigned char, kMaxContacts> in_active{};
+};
+
+// Solves the projection (see the top of this file). Fills *result (always: ac
+// is finite whatever the input) and returns result->status. Uses and updates
+// *workspace (caches; warm start when settings.warm_start).
+ProjectionStatus project(const ProjectionProblem& problem,
+                         const ProjectionSettings& settings,
+                         ProjectionWorkspace* workspace,
+                         ProjectionResult* result) noexcept;
+
+}  // namespace gauss6

@@ -1,0 +1,117 @@
+// The scene: an immutable model built once from a TOML file (docs/scene-format.md)
+// and shared read-only by every loop (MuJoCo's mjModel). Loading validates every
+// key and value, reads and validates the meshes, and computes the god-object's
+// mass properties once. Errors are SceneError exceptions (load time only) whose
+// message names the file, line, column and key.
+#pragma once
+
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "gauss6/mass_properties.h"
+#include "gauss6/mesh.h"
+#include "gauss6/pose.h"
+
+namespace gauss6 {
+
+inline constexpr int kSceneFormatVersion = 1;
+
+class SceneError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+enum class BodyRole { kObstacle, kGodObject };
+enum class SurfaceKind { kNone, kForceShading, kTexture };
+enum class DeviceKind { kSimulated, kReplay, kHid };
+const char* to_string(BodyRole r);
+const char* to_string(SurfaceKind k);
+const char* to_string(DeviceKind k);
+
+struct Body {
+  std::string name;
+  BodyRole role = BodyRole::kObstacle;
+  std::string mesh_path;   // as resolved (absolute or relative to the working directory)
+  TriangleMesh mesh;       // body frame B: origin at the reference point G (god-object),
+                           // or the mesh's own frame (obstacles)
+  Pose pose;               // X_WB: obstacles' fixed pose; the god-object's initial pose of G
+  MeshReport report;       // validation at load (self-intersections not checked: -1)
+};
+
+struct GodObjectMass {
+  bool from_density = true;
+  double density = 0;      // when from_density
+  MassProperties mass;     // body frame B (centre of mass relative to G; inertia about the COM)
+  Vec3 mesh_to_body = Vec3::Zero();  // r_B = r_mesh - mesh_to_body (G in the mesh's frame)
+};
+
+struct Gains {
+  double ks = 0.5;   // au = ks (xh (-) xs)
+  double kh = 0;     // Fc = kh M (ac - au)
+};
+
+struct ContactParameters {
+  double delta = 0;        // separation kept before contact (scene units)
+  double offset_eps = 0;   // new rows with J_k au < offset_eps are offset (< 0)
+  double offset_time = 0;  // time T of an offset's return to 0 (s)
+};
+
+struct SurfaceSettings {
+  SurfaceKind kind = SurfaceKind::kNone;
+  double amplitude = 0;    // texture: perturbation as a fraction of the force
+  double wavelength = 0;   // texture: period along the axis (scene units)
+  int axis = 0;            // texture: 0 = x, 1 = y, 2 = z
+};
+
+struct DeviceSettings {
+  DeviceKind kind = DeviceKind::kSimulated;
+  double rate_hz = 1000;
+  double max_force = 20;   // N
+  double max_torque = 1;   // N m
+  std::string script;      // simulated: scripted hand trajectory's name
+  std::string trace;       // replay: trace file (resolved)
+  int vendor_id = -1, product_id = -1;  // hid: -1 = any
+  std::string serial, path;             // hid: empty = any
+};
+
+struct Scene {
+  std::string path;        // the scene file
+  std::string name;
+  int version = kSceneFormatVersion;
+  std::vector<Body> obstacles;
+  Body god_object;
+  GodObjectMass god_mass;
+  Gains gains;
+  ContactParameters contact;
+  SurfaceSettings surface;
+  DeviceSettings device;
+};
+
+// Loads and validates a scene file. Throws SceneError.
+Scene load_scene(const std::string& path);
+
+// What `gauss6 scene info` prints for one body, world frame.
+struct BodySummary {
+  std::string name;
+  BodyRole role = BodyRole::kObstacle;
+  int num_triangles = 0, num_vertices = 0;
+  bool closed = false, manifold = false;
+  int num_self_intersections = -1;  // -1: not checked
+  // God-object: its mass properties. Obstacles have no density: their mass is
+  // reported at density 1 (that is, their volume); NaN when the mesh is open.
+  double mass = 0;
+  Vec3 center_of_mass_W = Vec3::Zero();
+  Mat3 inertia_W = Mat3::Zero();    // about the centre of mass, world axes
+  Vec3 bbox_min_W = Vec3::Zero(), bbox_max_W = Vec3::Zero();
+};
+
+// Summaries of every body (obstacles first, then the god-object) at their scene
+// poses. The exact self-intersection test runs only when asked (it is slow on
+// large meshes).
+std::vector<BodySummary> summarize_scene(const Scene& scene, bool count_self_intersections);
+
+// The god-object's 6x6 mass matrix M at orientation q (world frame, about G).
+Mat6 god_object_mass_matrix(const Scene& scene, const Quat& q);
+
+}  // namespace gauss6

@@ -1,0 +1,432 @@
+// The TOML scene loader (docs/scene-format.md, version 1), with toml++. Every
+// error names the file, the line and column, and the key.
+#include "gauss6/scene.h"
+
+#include <cmath>
+#include <filesystem>
+#include <initializer_list>
+#include <set>
+#include <sstream>
+
+#include <Eigen/Eigenvalues>
+#include <toml++/toml.h>
+
+#include "gauss6/mesh_io.h"
+
+namespace gauss6 {
+
+const char* to_string(BodyRole r) { return r == BodyRole::kObstacle ? "obstacle" : "god_object"; }
+const char* to_string(SurfaceKind k) {
+  switch (k) {
+    case SurfaceKind::kNone: return "none";
+    case SurfaceKind::kForceShading: return "force_shading";
+    case SurfaceKind::kTexture: return "texture";
+  }
+  return "unknown";
+}
+const char* to_string(DeviceKind k) {
+  switch (k) {
+    case DeviceKind::kSimulated: return "simulated";
+    case DeviceKind::kReplay: return "replay";
+    case DeviceKind::kHid: return "hid";
+  }
+  return "unknown";
+}
+
+namespace {
+
+namespace fs = std::filesystem;
+
+// Reads typed values out of one TOML table, naming file:line:col and the dotted key in errors.
+class TableReader {
+ public:
+  TableReader(const std::string& file, const toml::table& table, std::string prefix)
+      : file_(file), table_(table), prefix_(std::move(prefix)) {}
+
+  [[noreturn]] void fail(const toml::source_region& where, const std::string& key,
+                         const std::string& message) const {
+    std::ostringstream os;
+    os << file_ << ":" << where.begin.line << ":" << where.begin.column << ": " << prefix_ << key
+       << ": " << message;
+    throw SceneError(os.str());
+  }
+  [[noreturn]] void fail_missing(const std::string& key, const std::string& what) const {
+    fail(table_.source(), key, "missing (" + what + ")");
+  }
+
+  // Unknown keys are errors: a misspelt key must not be silently ignored.
+  void allow_only(std::initializer_list<const char*> keys) const {
+    const std::set<std::string> allowed(keys.begin(), keys.end());
+    for (const auto& [k, node] : table_) {
+      (void)node;
+      if (!allowed.count(std::string(k.str()))) {
+        std::string list;
+        for (const char* a : keys) list += std::string(list.empty() ? "" : ", ") + a;
+        fail(k.source(), std::string(k.str()), "unknown key (allowed here: " + list + ")");
+      }
+    }
+  }
+
+  bool has(const char* key) const { return table_.contains(key); }
+  const toml::node* node(const char* key) const { return table_.get(key); }
+
+  std::string string(const char* key, const std::string* fallback = nullptr) const {
+    const toml::node* n = table_.get(key);
+    if (!n) {
+      if (fallback) return *fallback;
+      fail_missing(key, "a string");
+    }
+    if (!n->is_string()) fail(n->source(), key, "must be a string");
+    return n->as_string()->get();
+  }
+
+  double number(const char* key, const double* fallback = nullptr) const {
+    const toml::node* n = table_.get(key);
+    if (!n) {
+      if (fallback) return *fallback;
+      fail_missing(key, "a number");
+    }
+    return as_number(*n, key);
+  }
+
+  double as_number(const toml::node& n, const std::string& key) const {
+    double v;
+    if (n.is_floating_point()) v = n.as_floating_point()->get();
+    else if (n.is_integer()) v = static_cast<double>(n.as_integer()->get());
+    else fail(n.source(), key, "must be a number");
+    if (!std::isfinite(v)) fail(n.source(), key, "must be finite");
+    return v;
+  }
+
+  int64_t integer(const char* key, const int64_t* fallback = nullptr) const {
+    const toml::node* n = table_.get(key);
+    if (!n) {
+      if (fallback) return *fallback;
+      fail_missing(key, "an integer");
+    }
+    if (!n->is_integer()) fail(n->source(), key, "must be an integer");
+    return n->as_integer()->get();
+  }
+
+  // A fixed-length array of numbers.
+  template <int N>
+  Eigen::Matrix<double, N, 1> vector(const char* key, const Eigen::Matrix<double, N, 1>* fallback) const {
+    const toml::node* n = table_.get(key);
+    if (!n) {
+      if (fallback) return *fallback;
+      fail_missing(key, "an array of " + std::to_string(N) + " numbers");
+    }
+    const toml::array* a = n->as_array();
+    if (!a || static_cast<int>(a->size()) != N)
+      fail(n->source(), key, "must be an array of " + std::to_string(N) + " numbers");
+    Eigen::Matrix<double, N, 1> v;
+    for (int i = 0; i < N; ++i) v[i] = as_number(*a->get(i), key + std::string("[") + std::to_string(i) + "]");
+    return v;
+  }
+
+  Mat3 matrix3(const char* key) const {
+    const toml::node* n = table_.get(key);
+    if (!n) fail_missing(key, "a 3x3 array of numbers");
+    const toml::array* rows = n->as_array();
+    if (!rows || rows->size() != 3) fail(n->source(), key, "must be a 3x3 array of numbers");
+    Mat3 m;
+    for (int i = 0; i < 3; ++i) {
+      const toml::array* row = rows->get(i)->as_array();
+      if (!row || row->size() != 3) fail(rows->get(i)->source(), key, "must be a 3x3 array of numbers");
+      for (int j = 0; j < 3; ++j) m(i, j) = as_number(*row->get(j), key);
+    }
+    return m;
+  }
+
+  const toml::table& table() const { return table_; }
+  const std::string& file() const { return file_; }
+
+ private:
+  const std::string& file_;
+  const toml::table& table_;
+  std::string prefix_;
+};
+
+const toml::table& sub_table(const TableReader& parent, const char* key, bool required,
+                             const toml::table& empty) {
+  const toml::node* n = parent.node(key);
+  if (!n) {
+    if (required) parent.fail_missing(key, "a table [" + std::string(key) + "]");
+    return empty;
+  }
+  if (!n->is_table()) parent.fail(n->source(), key, "must be a table [" + std::string(key) + "]");
+  return *n->as_table();
+}
+
+void require(bool ok, const TableReader& r, const char* key, const std::string& message) {
+  if (!ok) r.fail(r.node(key) ? r.node(key)->source() : r.table().source(), key, message);
+}
+
+// Pose of the mesh's own frame in the world: position and (w, x, y, z) orientation.
+Pose read_pose(const TableReader& r) {
+  const Vec3 zero = Vec3::Zero();
+  const Eigen::Vector4d identity(1, 0, 0, 0);
+  Pose x;
+  x.p = r.vector<3>("position", &zero);
+  const Eigen::Vector4d q = r.vector<4>("orientation", &identity);
+  require(q.norm() > 1e-12, r, "orientation", "must be a non-zero quaternion (w, x, y, z)");
+  x.q = normalized(Quat{q[0], q[1], q[2], q[3]});
+  return x;
+}
+
+// Reads and validates a body's mesh; the path is relative to the scene file.
+void read_body_mesh(const TableReader& r, Body* body) {
+  const std::string rel = r.string("mesh");
+  const fs::path scene_dir = fs::path(r.file()).parent_path();
+  body->mesh_path = (scene_dir / rel).lexically_normal().string();
+  try {
+    body->mesh = read_mesh(body->mesh_path);
+  } catch (const MeshFileError& e) {
+    r.fail(r.node("mesh")->source(), "mesh", e.what());
+  }
+  body->report = validate_mesh(body->mesh);
+  const MeshReport& rep = body->report;
+  if (rep.num_nonfinite_vertices || rep.num_bad_indices || rep.num_degenerate_triangles)
+    r.fail(r.node("mesh")->source(), "mesh", body->mesh_path + ": unusable mesh:\n" + rep.describe());
+  build_adjacency(&body->mesh);
+  compute_vertex_normals(&body->mesh);
+}
+
+}  // namespace
+
+Scene load_scene(const std::string& path) {
+  Scene scene;
+  scene.path = path;
+  toml::table root;
+  try {
+    root = toml::parse_file(path);
+  } catch (const toml::parse_error& e) {
+    std::ostringstream os;
+    os << path << ":" << e.source().begin.line << ":" << e.source().begin.column << ": " << e.description();
+    throw SceneError(os.str());
+  } catch (const std::exception& e) {
+    throw SceneError(path + ": " + e.what());
+  }
+  const toml::table empty;
+  TableReader top(path, root, "");
+  top.allow_only({"format", "version", "name", "gains", "contact", "obstacle", "god_object", "surface", "device"});
+  require(top.string("format") == "gauss6-scene", top, "format", "must be \"gauss6-scene\"");
+  scene.version = static_cast<int>(top.integer("version"));
+  require(scene.version == kSceneFormatVersion, top, "version",
+          "unsupported version " + std::to_string(scene.version) + " (this build reads version " +
+              std::to_string(kSceneFormatVersion) + ")");
+  scene.name = top.string("name");
+
+  // [gains]
+  TableReader gains(path, sub_table(top, "gains", true, empty), "gains.");
+  gains.allow_only({"ks", "kh"});
+  scene.gains.ks = gains.number("ks");
+  require(scene.gains.ks > 0 && scene.gains.ks <= 1, gains, "ks", "must be in (0, 1]");
+  scene.gains.kh = gains.number("kh");
+  require(scene.gains.kh > 0, gains, "kh", "must be > 0");
+
+  // [contact]
+  TableReader contact(path, sub_table(top, "contact", true, empty), "contact.");
+  contact.allow_only({"delta", "offset_eps", "offset_time"});
+  scene.contact.delta = contact.number("delta");
+  require(scene.contact.delta > 0, contact, "delta", "must be > 0");
+  const double default_eps = -10.0 * scene.contact.delta, default_T = 0.05;
+  scene.contact.offset_eps = contact.number("offset_eps", &default_eps);
+  require(scene.contact.offset_eps < 0, contact, "offset_eps", "must be < 0");
+  scene.contact.offset_time = contact.number("offset_time", &default_T);
+  require(scene.contact.offset_time > 0, contact, "offset_time", "must be > 0");
+
+  std::set<std::string> names;
+  auto claim_name = [&](const TableReader& r, const std::string& name) {
+    require(!name.empty(), r, "name", "must not be empty");
+    require(names.insert(name).second, r, "name", "\"" + name + "\" is already the name of another body");
+  };
+
+  // [[obstacle]]
+  if (const toml::node* n = root.get("obstacle")) {
+    const toml::array* arr = n->as_array();
+    if (!arr || !arr->is_array_of_tables()) top.fail(n->source(), "obstacle", "must be an array of tables [[obstacle]]");
+    for (size_t i = 0; i < arr->size(); ++i) {
+      TableReader r(path, *arr->get(i)->as_table(), "obstacle[" + std::to_string(i) + "].");
+      r.allow_only({"name", "mesh", "position", "orientation"});
+      Body b;
+      b.role = BodyRole::kObstacle;
+      b.name = r.string("name");
+      claim_name(r, b.name);
+      b.pose = read_pose(r);
+      read_body_mesh(r, &b);
+      scene.obstacles.push_back(std::move(b));
+    }
+  }
+
+  // [god_object]
+  {
+    TableReader r(path, sub_table(top, "god_object", true, empty), "god_object.");
+    r.allow_only({"name", "mesh", "position", "orientation", "density", "mass", "center_of_mass", "inertia",
+                  "reference_point"});
+    Body& b = scene.god_object;
+    b.role = BodyRole::kGodObject;
+    b.name = r.string("name");
+    claim_name(r, b.name);
+    const Pose X_WM = read_pose(r);  // pose of the mesh's own frame
+    read_body_mesh(r, &b);
+    GodObjectMass& gm = scene.god_mass;
+    const bool has_density = r.has("density");
+    const bool has_given = r.has("mass") || r.has("center_of_mass") || r.has("inertia");
+    if (has_density == has_given)
+      r.fail(r.table().source(), "density",
+             "give either density, or all of mass, center_of_mass and inertia (not both, not neither)");
+    MassProperties mp;
+    if (has_density) {
+      gm.from_density = true;
+      gm.density = r.number("density");
+      require(gm.density > 0, r, "density", "must be > 0");
+      if (!b.report.closed())
+        r.fail(r.node("mesh")->source(), "mesh",
+               b.mesh_path + ": a mass from a density needs a closed mesh:\n" + b.report.describe());
+      std::string error;
+      if (!compute_mass_properties(b.mesh, gm.density, &mp, &error))
+        r.fail(r.node("mesh")->source(), "mesh", b.mesh_path + ": " + error);
+    } else {
+      gm.from_density = false;
+      mp.mass = r.number("mass");
+      require(mp.mass > 0, r, "mass", "must be > 0");
+      const Vec3 c = r.vector<3>("center_of_mass", nullptr);
+      mp.center_of_mass = c;
+      mp.inertia = r.matrix3("inertia");
+      require((mp.inertia - mp.inertia.transpose()).norm() <= 1e-12 * mp.inertia.norm(), r, "inertia",
+              "must be symmetric");
+      Eigen::SelfAdjointEigenSolver<Mat3> eig(mp.inertia);
+      require(eig.eigenvalues().minCoeff() > 0, r, "inertia", "must be positive definite");
+    }
+    // Body frame B: origin at G (the centre of mass unless reference_point is given).
+    const Vec3 G = r.vector<3>("reference_point", &mp.center_of_mass);
+    gm.mesh_to_body = G;
+    for (int v = 0; v < b.mesh.V.rows(); ++v) b.mesh.V.row(v) -= G.transpose();
+    mp.center_of_mass -= G;
+    gm.mass = mp;
+    b.pose = {transform_point(X_WM, G), X_WM.q};
+  }
+
+  // [surface] (optional)
+  {
+    TableReader r(path, sub_table(top, "surface", false, empty), "surface.");
+    r.allow_only({"kind", "amplitude", "wavelength", "axis"});
+    const std::string none = "none";
+    const std::string kind = r.string("kind", &none);
+    if (kind == "none") scene.surface.kind = SurfaceKind::kNone;
+    else if (kind == "force_shading") scene.surface.kind = SurfaceKind::kForceShading;
+    else if (kind == "texture") scene.surface.kind = SurfaceKind::kTexture;
+    else r.fail(r.node("kind")->source(), "kind", "must be \"none\", \"force_shading\" or \"texture\"");
+    if (scene.surface.kind == SurfaceKind::kTexture) {
+      scene.surface.amplitude = r.number("amplitude");
+      require(scene.surface.amplitude > 0 && scene.surface.amplitude <= 1, r, "amplitude", "must be in (0, 1]");
+      scene.surface.wavelength = r.number("wavelength");
+      require(scene.surface.wavelength > 0, r, "wavelength", "must be > 0");
+      const std::string x = "x";
+      const std::string axis = r.string("axis", &x);
+      if (axis != "x" && axis != "y" && axis != "z") r.fail(r.node("axis")->source(), "axis", "must be x, y or z");
+      scene.surface.axis = axis[0] - 'x';
+    } else {
+      for (const char* k : {"amplitude", "wavelength", "axis"})
+        if (r.has(k)) r.fail(r.node(k)->source(), k, "only for kind = \"texture\"");
+    }
+  }
+
+  // [device]
+  {
+    TableReader r(path, sub_table(top, "device", true, empty), "device.");
+    r.allow_only({"kind", "rate_hz", "max_force", "max_torque", "script", "trace", "vendor_id", "product_id",
+                  "serial", "path"});
+    DeviceSettings& d = scene.device;
+    const std::string kind = r.string("kind");
+    std::vector<std::string> own;
+    if (kind == "simulated") {
+      d.kind = DeviceKind::kSimulated;
+      d.script = r.string("script");
+      own = {"script"};
+    } else if (kind == "replay") {
+      d.kind = DeviceKind::kReplay;
+      d.trace = (fs::path(path).parent_path() / r.string("trace")).lexically_normal().string();
+      own = {"trace"};
+    } else if (kind == "hid") {
+      d.kind = DeviceKind::kHid;
+      const int64_t any = -1;
+      d.vendor_id = static_cast<int>(r.integer("vendor_id", &any));
+      d.product_id = static_cast<int>(r.integer("product_id", &any));
+      const std::string blank;
+      d.serial = r.string("serial", &blank);
+      d.path = r.string("path", &blank);
+      own = {"vendor_id", "product_id", "serial", "path"};
+    } else {
+      r.fail(r.node("kind")->source(), "kind", "must be \"simulated\", \"replay\" or \"hid\"");
+    }
+    // Keys of another device kind are errors, not silently ignored.
+    for (const char* k : {"script", "trace", "vendor_id", "product_id", "serial", "path"}) {
+      bool mine = false;
+      for (const std::string& o : own) mine |= o == k;
+      if (!mine && r.has(k)) r.fail(r.node(k)->source(), k, "not a key of a \"" + kind + "\" device");
+    }
+    const double rate = 1000, fmax = 20, tmax = 1;
+    d.rate_hz = r.number("rate_hz", &rate);
+    require(d.rate_hz >= 100 && d.rate_hz <= 10000, r, "rate_hz", "must be in [100, 10000]");
+    d.max_force = r.number("max_force", &fmax);
+    require(d.max_force > 0, r, "max_force", "must be > 0");
+    d.max_torque = r.number("max_torque", &tmax);
+    require(d.max_torque > 0, r, "max_torque", "must be > 0");
+  }
+  return scene;
+}
+
+std::vector<BodySummary> summarize_scene(const Scene& scene, bool check_self_intersections) {
+  std::vector<BodySummary> out;
+  std::vector<const Body*> bodies;
+  for (const Body& b : scene.obstacles) bodies.push_back(&b);
+  bodies.push_back(&scene.god_object);
+  for (const Body* b : bodies) {
+    BodySummary s;
+    s.name = b->name;
+    s.role = b->role;
+    s.num_triangles = num_triangles(b->mesh);
+    s.num_vertices = num_vertices(b->mesh);
+    s.closed = b->report.closed();
+    s.manifold = b->report.manifold();
+    if (check_self_intersections) s.num_self_intersections = count_self_intersections(b->mesh);
+    const Mat3 R = rotation_matrix(b->pose.q);
+    MassProperties mp;
+    if (b->role == BodyRole::kGodObject) {
+      mp = scene.god_mass.mass;
+    } else {
+      std::string error;
+      if (!s.closed || !compute_mass_properties(b->mesh, /*density=*/1.0, &mp, &error)) {
+        mp.mass = std::nan("");
+        mp.center_of_mass.setConstant(std::nan(""));
+        mp.inertia.setConstant(std::nan(""));
+      }
+    }
+    s.mass = mp.mass;
+    s.center_of_mass_W = transform_point(b->pose, mp.center_of_mass);
+    s.inertia_W = R * mp.inertia * R.transpose();
+    s.bbox_min_W.setConstant(INFINITY);
+    s.bbox_max_W.setConstant(-INFINITY);
+    for (int v = 0; v < b->mesh.V.rows(); ++v) {
+      const Vec3 p = transform_point(b->pose, b->mesh.V.row(v).transpose());
+      s.bbox_min_W = s.bbox_min_W.cwiseMin(p);
+      s.bbox_max_W = s.bbox_max_W.cwiseMax(p);
+    }
+    out.push_back(std::move(s));
+  }
+  return out;
+}
+
+Mat6 god_object_mass_matrix(const Scene& scene, const Quat& q) {
+  // Inertia about G by the parallel-axis theorem (G is the centre of mass unless the scene says otherwise).
+  const MassProperties& mp = scene.god_mass.mass;
+  const Vec3 c = mp.center_of_mass;
+  const Mat3 I_G = mp.inertia + mp.mass * (c.squaredNorm() * Mat3::Identity() - c * c.transpose());
+  MassProperties about_G = mp;
+  about_G.inertia = I_G;
+  return mass_matrix(about_G, rotation_matrix(q));
+}
+
+}  // namespace gauss6

@@ -1,0 +1,449 @@
+// The quasi-static projection (METHOD.md sections 2-3): Goldfarb-Idnani dual
+// active-set method in Cholesky coordinates y = L^T a, where the objective is
+// 1/2 |y - y_u|^2 and row k reads A_k y >= b_k, A = J L^-T. See quasistatics.h.
+//
+// Invariants between steps (q = num_active, W = active rows, in entry order):
+//   A_W^T = Q(:, 0:q) R(0:q, 0:q), Q orthogonal, R upper triangular;
+//   y = y_u + A_W^T lambda_W with lambda_W >= 0 and A_W y = b_W, i.e. y is the
+//   projection of y_u on the affine set of W and dual feasible. Adding the most
+//   violated row strictly increases the dual objective, so no working set
+//   repeats (no cycling); ties are broken by the smallest row index.
+#include "gauss6/quasistatics.h"
+
+#include <Eigen/Cholesky>
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <limits>
+
+namespace gauss6 {
+
+namespace {
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+// M must be symmetric to this relative tolerance (of its largest entry): mass
+// properties computed in double are symmetric to a few ulps.
+constexpr double kSymmetryTol = 1e-9;
+// Smallest accepted Cholesky pivot L_ii^2 relative to max_i M_ii: M with
+// cond(M) beyond ~1e14 is treated as not positive definite.
+constexpr double kMinPivotRatio = 1e-14;
+// Relative size of rounding noise in a multiplier's correction (a few dozen ulps).
+constexpr double kRoundoff = 64 * std::numeric_limits<double>::epsilon();
+// Rebuild Q and R from the working set's rows after this many rotations.
+constexpr long kMaxRotationsBeforeRebuild = 10000;
+
+bool all_finite(const double* p, int n) noexcept {
+  double acc = 0;
+  for (int i = 0; i < n; ++i) acc += p[i] * 0.0;  // NaN iff some p[i] is not finite
+  return acc == 0;
+}
+
+// Validates M and J and refreshes the cached L, A, row norms when either
+// changed (bytewise). Returns false when M is not finite/symmetric/SPD or J is
+// not finite.
+bool update_cache(const ProjectionProblem& pb, ProjectionWorkspace& ws) noexcept {
+  const Mat6& M = *pb.M;
+  const int m = pb.num_rows;
+  const bool same_M = ws.has_M && std::memcmp(M.data(), ws.M.data(), sizeof(double) * 36) == 0;
+  const bool same_J = same_M && ws.num_rows == m &&
+                      (m == 0 || std::memcmp(pb.J, ws.J.data(), sizeof(double) * 6 * m) == 0);
+  if (same_J) return true;
+
+  ws.factor_matches_cache = false;
+  if (!same_M) {
+    ws.has_M = false;
+    ws.num_rows = -1;
+    if (!all_finite(M.data(), 36)) return false;
+    const double max_entry = M.cwiseAbs().maxCoeff();
+    if ((M - M.transpose()).cwiseAbs().maxCoeff() > kSymmetryTol * max_entry) return false;
+    Eigen::LLT<Mat6> llt(M);
+    if (llt.info() != Eigen::Success) return false;
+    const Mat6 L = llt.matrixL();
+    const double max_diag = M.diagonal().maxCoeff();
+    for (int i = 0; i < 6; ++i)
+      if (!(L(i, i) * L(i, i) > kMinPivotRatio * max_diag)) return false;
+    ws.M = M;
+    ws.L = L;
+    // L^-1, lower triangular, column by column (forward substitution on e_j).
+    ws.L_inv.setZero();
+    for (int j = 0; j < 6; ++j) {
+      ws.L_inv(j, j) = 1.0 / L(j, j);
+      for (int i = j + 1; i < 6; ++i) {
+        double v = 0;
+        for (int k = j; k < i; ++k) v -= L(i, k) * ws.L_inv(k, j);
+        ws.L_inv(i, j) = v / L(i, i);
+      }
+    }
+    ws.has_M = true;
+  }
+  if (m > 0 && !all_finite(pb.J, 6 * m)) {
+    ws.num_rows = -1;
+    return false;
+  }
+  // A_k^T = L^-1 J_k^T (a product with the cached inverse: no dependency chain).
+  for (int k = 0; k < m; ++k) {
+    Eigen::Map<Vec6> Ak(ws.A.data() + 6 * k);
+    Ak.noalias() = ws.L_inv * Eigen::Map<const Vec6>(pb.J + 6 * k);  // dense 6x6: fastest here
+    const double norm2 = Ak.squaredNorm();
+    ws.row_norm[k] = std::sqrt(norm2);
+    ws.inv_row_norm[k] = norm2 > 0 ? 1.0 / ws.row_norm[k] : 1.0;
+    for (int j = 0; j < 6; ++j) ws.A_t[kMaxContacts * j + k] = Ak[j];
+  }
+  if (m > 0) std::memcpy(ws.J.data(), pb.J, sizeof(double) * 6 * m);
+  ws.num_rows = m;
+  return true;
+}
+
+// The m x 6 matrix A stored column by column with stride kMaxContacts.
+using ColumnsOfA = Eigen::Map<const Eigen::Matrix<double, Eigen::Dynamic, 6>, 0, Eigen::OuterStride<>>;
+
+inline Eigen::Map<const Vec6> row(const ProjectionWorkspace& ws, int k) noexcept {
+  return Eigen::Map<const Vec6>(ws.A.data() + 6 * k);
+}
+
+// |d(q:6)|^2: the part of a row orthogonal to the q working-set rows.
+inline double tail_squared_norm(const Vec6& d, int q) noexcept {
+  double sum = 0;
+  for (int i = q; i < 6; ++i) sum += d[i] * d[i];
+  return sum;
+}
+
+// Rotates columns i, j of Q by (c, s): Q_i <- c Q_i + s Q_j, Q_j <- c Q_j - s Q_i.
+inline void rotate_Q(Mat6& Q, int i, int j, double c, double s) noexcept {
+  for (int r = 0; r < 6; ++r) {
+    const double u = Q(r, i), v = Q(r, j);
+    Q(r, i) = c * u + s * v;
+    Q(r, j) = c * v - s * u;
+  }
+}
+
+// Appends the row whose d = Q^T A_p is given (|d(q:6)| > 0) to the factors.
+void factor_add(ProjectionWorkspace& ws, Vec6 d, int p) noexcept {
+  const int q = ws.num_active;
+  // Rotate d(q+1:6) into d(q), bottom up, carrying Q along.
+  for (int i = 5; i > q; --i) {
+    if (d[i] == 0) continue;
+    const double h = std::sqrt(d[i - 1] * d[i - 1] + d[i] * d[i]);
+    const double c = d[i - 1] / h, s = d[i] / h;
+    d[i - 1] = h;
+    d[i] = 0;
+    rotate_Q(ws.Q, i - 1, i, c, s);
+    ++ws.rotations_since_rebuild;
+  }
+  for (int i = 0; i <= q; ++i) ws.R(i, q) = d[i];
+  ws.active[q] = p;
+  ws.in_active[p] = 1;
+  ws.num_active = q + 1;
+}
+
+// Removes the working-set entry at position pos and restores R's triangle.
+void factor_drop(ProjectionWorkspace& ws, int pos) noexcept {
+  const int q = ws.num_active;
+  ws.in_active[ws.active[pos]] = 0;
+  for (int c = pos; c + 1 < q; ++c) {
+    ws.R.col(c) = ws.R.col(c + 1);
+    ws.active[c] = ws.active[c + 1];
+    ws.lambda_active[c] = ws.lambda_active[c + 1];
+  }
+  // R(0:q, 0:q-1) is now upper Hessenberg from column pos: zero R(k+1, k).
+  for (int k = pos; k + 1 < q; ++k) {
+    const double x = ws.R(k, k), y = ws.R(k + 1, k);
+    if (y == 0) continue;
+    const double h = std::sqrt(x * x + y * y);
+    const double c = x / h, s = y / h;
+    for (int j = k; j + 1 < q; ++j) {
+      const double u = ws.R(k, j), v = ws.R(k + 1, j);
+      ws.R(k, j) = c * u + s * v;
+      ws.R(k + 1, j) = c * v - s * u;
+    }
+    ws.R(k + 1, k) = 0;
+    rotate_Q(ws.Q, k, k + 1, c, s);
+    ++ws.rotations_since_rebuild;
+  }
+  ws.R.col(q - 1).setZero();
+  ws.num_active = q - 1;
+}
+
+// Adds each row of ws.active[0:count) to empty factors when it is independent of
+// those already added (rows >= m are dropped).
+void rebuild_factors(ProjectionWorkspace& ws, int count, int m, double dependence_tol) noexcept {
+  std::array<int, kMaxActive> rows = ws.active;
+  ws.Q.setIdentity();
+  ws.R.setZero();
+  ws.num_active = 0;
+  ws.rotations_since_rebuild = 0;
+  for (int i = 0; i < count; ++i) {
+    const int p = rows[i];
+    if (p < 0 || p >= m || ws.in_active[p]) continue;
+    const Vec6 d = ws.Q.transpose() * row(ws, p);
+    if (std::sqrt(tail_squared_norm(d, ws.num_active)) > dependence_tol * ws.row_norm[p])
+      factor_add(ws, d, p);
+  }
+}
+
+// The projection of y_u on the affine set {A_W y = b_W} and its multipliers:
+// c = R^-T b_W - Q1^T y_u, lambda_W = R^-1 c, y = y_u + Q1 c.
+void solve_working_set(ProjectionWorkspace& ws, const Vec6& yu, const double* b, Vec6* y) noexcept {
+  const int q = ws.num_active;
+  std::array<double, kMaxActive> c{};
+  for (int i = 0; i < q; ++i) {
+    double w = b ? b[ws.active[i]] : 0.0;
+    for (int j = 0; j < i; ++j) w -= ws.R(j, i) * c[j];
+    c[i] = w / ws.R(i, i);
+  }
+  *y = yu;
+  for (int i = 0; i < q; ++i) {
+    const double ci = c[i] - ws.Q.col(i).dot(yu);
+    *y += ci * ws.Q.col(i);
+    c[i] = ci;
+  }
+  for (int i = q - 1; i >= 0; --i) {
+    double v = c[i];
+    for (int j = i + 1; j < q; ++j) v -= ws.R(i, j) * ws.lambda_active[j];
+    ws.lambda_active[i] = v / ws.R(i, i);
+  }
+}
+
+bool valid_settings(const ProjectionSettings& s) noexcept {
+  return std::isfinite(s.dependence_tol) && s.dependence_tol >= 0 && s.dependence_tol < 1 &&
+         std::isfinite(s.feasibility_tol) && s.feasibility_tol >= 0 && s.max_iterations >= 0;
+}
+
+// A result that makes no force: ac = au (or 0 when au is not finite).
+ProjectionStatus zero_force_result(const ProjectionProblem& pb, ProjectionStatus status,
+                                   int iterations, ProjectionResult* res) noexcept {
+  res->ac = all_finite(pb.au.data(), 6) ? pb.au : Vec6::Zero();
+  res->lambda.fill(0.0);
+  res->num_active = 0;
+  res->status = status;
+  res->iterations = iterations;
+  res->stationarity = res->primal_infeasibility = 0;
+  res->dual_infeasibility = res->complementarity = 0;
+  return status;
+}
+
+void compute_residuals(const ProjectionProblem& pb, ProjectionResult* res) noexcept {
+  const int m = pb.num_rows;
+  Vec6 r = (*pb.M) * (res->ac - pb.au);
+  double dual = 0, comp = 0, primal = 0;
+  for (int k = 0; k < m; ++k) {
+    const Eigen::Map<const Vec6> Jk(pb.J + 6 * k);
+    const double lam = res->lambda[k];
+    const double s = Jk.dot(res->ac) - (pb.b ? pb.b[k] : 0.0);
+    if (lam != 0) {
+      r -= lam * Jk;
+      comp = std::max(comp, std::abs(lam * s));
+      dual = std::max(dual, -lam);
+    }
+    primal = std::max(primal, -s);
+  }
+  res->stationarity = r.cwiseAbs().maxCoeff();
+  res->primal_infeasibility = primal;
+  res->dual_infeasibility = dual;
+  res->complementarity = comp;
+}
+
+}  // namespace
+
+const char* to_string(ProjectionStatus status) noexcept {
+  switch (status) {
+    case ProjectionStatus::kOptimal: return "optimal";
+    case ProjectionStatus::kIterationCap: return "iteration cap";
+    case ProjectionStatus::kInfeasibleOffsets: return "infeasible offsets";
+    case ProjectionStatus::kBadInput: return "bad input";
+  }
+  return "unknown";
+}
+
+void ProjectionWorkspace::reset() noexcept {
+  has_M = false;
+  num_rows = -1;
+  factor_matches_cache = false;
+  num_active = 0;
+  Q.setIdentity();
+  R.setZero();
+  rotations_since_rebuild = 0;
+  in_active.fill(0);
+}
+
+ProjectionStatus project(const ProjectionProblem& pb, const ProjectionSettings& settings,
+                         ProjectionWorkspace* workspace, ProjectionResult* res) noexcept {
+  if (res == nullptr) return ProjectionStatus::kBadInput;
+  const int m = pb.num_rows;
+  if (workspace == nullptr || !valid_settings(settings) || pb.M == nullptr || m < 0 ||
+      m > kMaxContacts || (m > 0 && pb.J == nullptr) || !all_finite(pb.au.data(), 6) ||
+      (pb.b != nullptr && !all_finite(pb.b, m)))
+    return zero_force_result(pb, ProjectionStatus::kBadInput, 0, res);
+  ProjectionWorkspace& ws = *workspace;
+  if (!update_cache(pb, ws)) {
+    ws.num_active = 0;
+    return zero_force_result(pb, ProjectionStatus::kBadInput, 0, res);
+  }
+  const double* b = pb.b;
+  const double dep_tol = settings.dependence_tol;
+  const double feas_tol = settings.feasibility_tol;
+
+  // Target in Cholesky coordinates: y_u = L^T au.
+  const Vec6 yu = ws.L.transpose() * pb.au;
+  const double yu_norm = yu.norm();
+
+  // Starting working set: empty (cold) or the previous one, whose factors are
+  // reused when M and J did not change, else rebuilt from its rows.
+  std::fill_n(ws.in_active.begin(), m, static_cast<unsigned char>(0));
+  if (!settings.warm_start) {
+    ws.num_active = 0;
+  } else if (!ws.factor_matches_cache || ws.rotations_since_rebuild > kMaxRotationsBeforeRebuild) {
+    rebuild_factors(ws, ws.num_active, m, dep_tol);
+  } else {
+    for (int i = 0; i < ws.num_active; ++i) ws.in_active[ws.active[i]] = 1;
+  }
+  if (ws.num_active == 0) {
+    ws.Q.setIdentity();
+    ws.rotations_since_rebuild = 0;
+  }
+  ws.factor_matches_cache = true;
+
+  int iterations = 0;
+  ProjectionStatus status = ProjectionStatus::kOptimal;
+  Vec6 y;
+  // Make the start dual feasible: drop the most negative multiplier until none
+  // is. A multiplier whose correction lambda_i |A_i| is rounding noise
+  // (< kRoundoff of the row's scale) counts as zero and is dropped too, so that
+  // a warm start never leaves a spurious active row (J au >= b => ac = au).
+  for (;;) {
+    solve_working_set(ws, yu, b, &y);
+    const double y_scale = std::max(y.norm(), yu_norm);
+    int worst = -1;
+    double worst_value = 0;
+    for (int i = 0; i < ws.num_active; ++i) {
+      const int k = ws.active[i];
+      const double value = ws.lambda_active[i] * ws.row_norm[k];  // length of its correction
+      const double noise = kRoundoff * (y_scale + (b ? std::abs(b[k]) * ws.inv_row_norm[k] : 0.0));
+      if (value <= noise && (worst < 0 || value < worst_value ||
+                             (value == worst_value && k < ws.active[worst]))) {
+        worst = i;
+        worst_value = value;
+      }
+    }
+    if (worst < 0) break;
+    factor_drop(ws, worst);
+    ++iterations;
+  }
+
+  for (;;) {
+    // Most violated row (largest distance to its hyperplane, smallest index on ties).
+    const double y_scale = std::max(y.norm(), yu_norm);
+    // Slacks s = A y - b: one matrix-vector product on the column-major copy
+    // of A (Eigen's vectorised kernel; y is contiguous, so no temporary).
+    double* slack = ws.slack.data();
+    {
+      Eigen::Map<Eigen::VectorXd> s_map(slack, m);
+      s_map.noalias() = ColumnsOfA(ws.A_t.data(), m, 6, Eigen::OuterStride<>(kMaxContacts)) * y;
+      if (b) s_map -= Eigen::Map<const Eigen::VectorXd>(b, m);
+    }
+    int p = -1;
+    double best = 0, s_p = 0;
+    for (int k = 0; k < m; ++k) {
+      const double s = slack[k];
+      if (ws.in_active[k] || s >= 0) continue;
+      const double bk = b ? b[k] : 0.0;
+      if (s < -feas_tol * (ws.row_norm[k] * y_scale + std::abs(bk))) {
+        const double v = -s * ws.inv_row_norm[k];
+        if (v > best) {
+          best = v;
+          p = k;
+          s_p = s;
+        }
+      }
+    }
+    if (p < 0) break;
+
+    // Step towards row p until it is satisfied (full step: p joins W) or a row
+    // of W reaches a zero multiplier (partial step: that row leaves W).
+    double lambda_p = 0;
+    const Eigen::Map<const Vec6> n = row(ws, p);
+    for (;;) {
+      if (iterations >= settings.max_iterations) {
+        status = ProjectionStatus::kIterationCap;
+        break;
+      }
+      ++iterations;
+      const int q = ws.num_active;
+      const Vec6 d = ws.Q.transpose() * n;
+      const double z2 = tail_squared_norm(d, q);
+      const bool dependent = std::sqrt(z2) <= dep_tol * ws.row_norm[p];
+      // r = R^-1 d(0:q): how n is spanned by W's rows; multipliers fall as t r.
+      std::array<double, kMaxActive> r{};
+      for (int i = q - 1; i >= 0; --i) {
+        double v = d[i];
+        for (int j = i + 1; j < q; ++j) v -= ws.R(i, j) * r[j];
+        r[i] = v / ws.R(i, i);
+      }
+      double t1 = kInf;
+      int block = -1;
+      for (int i = 0; i < q; ++i) {
+        if (r[i] <= 0) continue;
+        const double ratio = ws.lambda_active[i] / r[i];
+        if (ratio < t1 || (ratio == t1 && ws.active[i] < ws.active[block])) {
+          t1 = ratio;
+          block = i;
+        }
+      }
+      const double t2 = dependent ? kInf : -s_p / z2;
+      if (t1 == kInf && t2 == kInf) {
+        status = ProjectionStatus::kInfeasibleOffsets;
+        break;
+      }
+      const double t = std::min(t1, t2);
+      for (int i = 0; i < q; ++i) ws.lambda_active[i] -= t * r[i];
+      lambda_p += t;
+      if (!dependent) {
+        // Primal step along z = Q(:, q:6) d(q:6), the part of n orthogonal to W.
+        for (int i = q; i < 6; ++i) y += (t * d[i]) * ws.Q.col(i);
+        s_p += t * z2;
+      }
+      if (t2 <= t1) {
+        ws.lambda_active[q] = lambda_p;
+        factor_add(ws, d, p);
+        break;
+      }
+      ws.lambda_active[block] = 0;
+      factor_drop(ws, block);
+    }
+    if (status != ProjectionStatus::kOptimal) break;
+  }
+
+  if (status == ProjectionStatus::kInfeasibleOffsets) {
+    ws.num_active = 0;
+    ws.factor_matches_cache = false;
+    return zero_force_result(pb, status, iterations, res);
+  }
+
+  // Final iterate recomputed from the working set (removes the drift of the
+  // incremental updates), back to a-space: L^T ac = y.
+  const int q = ws.num_active;
+  if (q == 0) {
+    res->ac = pb.au;  // no active row: exactly no force
+  } else {
+    if (iterations > 0) solve_working_set(ws, yu, b, &y);  // else y is already fresh
+    res->ac.noalias() = ws.L_inv.transpose() * y;  // ac = L^-T y
+  }
+  std::fill_n(res->lambda.begin(), m, 0.0);
+  for (int i = 0; i < q; ++i) {
+    res->lambda[ws.active[i]] = ws.lambda_active[i];
+    res->active[i] = ws.active[i];
+  }
+  res->num_active = q;
+  res->status = status;
+  res->iterations = iterations;
+  if (settings.compute_residuals) {
+    compute_residuals(pb, res);
+  } else {
+    res->stationarity = res->primal_infeasibility = 0;
+    res->dual_infeasibility = res->complementarity = 0;
+  }
+  return status;
+}
+
+}  // namespace gauss6

@@ -1,0 +1,684 @@
+// Tests of the quasi-static projection (quasistatics.h): KKT conditions and the
+// properties of METHOD.md section 5 (orthogonality, force in the normal cone,
+// no force when moving away, dissipativity) on random SPD M (cond 1 to 1e6) and
+// contact rows, with redundant and nearly parallel rows, against an independent
+// brute-force enumeration of active sets, warm against cold starts, offsets
+// (b != 0, infeasible sets), bad input, and a RapidCheck property.
+//
+// Tolerances are relative to the problem's own scales: |au|_M, |ac|_M (M-norm
+// |x|_M = sqrt(x^T M x)), |A_k| = sqrt(J_k M^-1 J_k^T) (the M^-1-norm of a row),
+// and machine epsilon times a condition factor sqrt(cond(M)) = cond(L): the
+// solver works in y = L^T a and returns to a-space by a triangular solve with
+// L^T, which loses at most cond(L) in relative accuracy.
+#include <catch2/catch.hpp>
+#include <rapidcheck.h>
+
+#include <Eigen/Dense>
+
+#include <algorithm>
+#include <array>
+#include <cstdint>
+#include <string>
+#include <cmath>
+#include <limits>
+#include <optional>
+#include <random>
+#include <vector>
+
+#include "gauss6/coupling.h"
+#include "gauss6/quasistatics.h"
+
+namespace {
+
+using gauss6::kMaxContacts;
+using gauss6::Mat6;
+using gauss6::ProjectionProblem;
+using gauss6::ProjectionResult;
+using gauss6::ProjectionSettings;
+using gauss6::ProjectionStatus;
+using gauss6::ProjectionWorkspace;
+using gauss6::Vec6;
+using Vec3 = Eigen::Vector3d;
+
+constexpr double kEps = std::numeric_limits<double>::epsilon();
+
+// A row-major m x 6 constraint set with its right-hand side.
+struct Rows {
+  std::vector<double> J;  // 6 m
+  std::vector<double> b;  // m, or empty for b = 0
+  int m() const { return static_cast<int>(J.size() / 6); }
+  Eigen::Map<const Vec6> row(int k) const { return Eigen::Map<const Vec6>(J.data() + 6 * k); }
+  void add(const Vec6& r, double bk = 0) {
+    J.insert(J.end(), r.data(), r.data() + 6);
+    if (!b.empty() || bk != 0) {
+      b.resize(m() - 1, 0.0);
+      b.push_back(bk);
+    }
+  }
+  double bk(int k) const { return b.empty() ? 0.0 : b[k]; }
+};
+
+// SPD M = U diag(e) U^T, U random orthogonal, eigenvalues log-spaced in [1, cond]
+// (random order), times a random overall scale in [1e-2, 1e2].
+Mat6 random_spd(std::mt19937_64& rng, double cond) {
+  std::normal_distribution<double> g;
+  std::uniform_real_distribution<double> u01(0, 1);
+  Mat6 X;
+  for (int i = 0; i < 36; ++i) X.data()[i] = g(rng);
+  Eigen::HouseholderQR<Mat6> qr(X);
+  const Mat6 U = qr.householderQ();
+  Vec6 e;
+  for (int i = 0; i < 6; ++i) e[i] = std::pow(cond, i / 5.0);
+  std::shuffle(e.data(), e.data() + 6, rng);
+  const double scale = std::pow(10.0, -2 + 4 * u01(rng));
+  Mat6 M = scale * U * e.asDiagonal() * U.transpose();
+  return 0.5 * (M + M.transpose());
+}
+
+// A contact row [n, (r x n)] with n a unit normal and r a lever of length <= 1.
+Vec6 random_contact_row(std::mt19937_64& rng) {
+  std::normal_distribution<double> g;
+  std::uniform_real_distribution<double> u01(0, 1);
+  Vec3 n(g(rng), g(rng), g(rng));
+  n.normalize();
+  const Vec3 r = u01(rng) * Vec3(g(rng), g(rng), g(rng)).normalized();
+  Vec6 row;
+  row << n, r.cross(n);
+  return row;
+}
+
+enum class Push { kNone, kSome, kAll };
+
+// m contact rows oriented so that au pushes into none, some (random) or all of them.
+Rows random_rows(std::mt19937_64& rng, int m, const Vec6& au, Push push) {
+  Rows rows;
+  std::bernoulli_distribution coin(0.5);
+  for (int k = 0; k < m; ++k) {
+    Vec6 r = random_contact_row(rng);
+    const double d = r.dot(au);
+    if ((push == Push::kNone && d < 0) || (push == Push::kAll && d > 0)) r = -r;
+    if (push == Push::kSome && coin(rng)) r = -r;
+    rows.add(r);
+  }
+  return rows;
+}
+
+Vec6 random_vec(std::mt19937_64& rng, double scale = 1) {
+  std::normal_distribution<double> g;
+  Vec6 v;
+  for (int i = 0; i < 6; ++i) v[i] = scale * g(rng);
+  return v;
+}
+
+double m_norm(const Mat6& M, const Vec6& x) { return std::sqrt(std::max(0.0, x.dot(M * x))); }
+double cond_of(const Mat6& M) {
+  Eigen::SelfAdjointEigenSolver<Mat6> es(M);
+  return es.eigenvalues().maxCoeff() / es.eigenvalues().minCoeff();
+}
+
+ProjectionProblem make_problem(const Mat6& M, const Vec6& au, const Rows& rows) {
+  ProjectionProblem pb;
+  pb.M = &M;
+  pb.au = au;
+  pb.J = rows.J.empty() ? nullptr : rows.J.data();
+  pb.b = rows.b.empty() ? nullptr : rows.b.data();
+  pb.num_rows = rows.m();
+  return pb;
+}
+
+// Independent ground truth by enumeration: for every subset S of at most 6
+// rows, the equality-constrained minimiser a = au + M^-1 J_S^T lambda_S with
+// (J_S M^-1 J_S^T) lambda_S = b_S - J_S au, in long double (M^-1 from an LDLT
+// of M, the Schur system by FullPivLU, rank-checked), kept if feasible. The
+// feasible candidate of least objective is the projection (the optimum's own
+// face is among the candidates, and every feasible candidate's objective is
+// >= the optimum). nullopt: no feasible candidate, i.e. {J a >= b} is empty.
+std::optional<Vec6> brute_force(const Mat6& M, const Vec6& au, const Rows& rows) {
+  using MatL = Eigen::Matrix<long double, Eigen::Dynamic, Eigen::Dynamic>;
+  using VecL = Eigen::Matrix<long double, Eigen::Dynamic, 1>;
+  using Mat6L = Eigen::Matrix<long double, 6, 6>;
+  using Vec6L = Eigen::Matrix<long double, 6, 1>;
+  const int m = rows.m();
+  const Mat6L Ml = M.cast<long double>();
+  const Mat6L Minv = Ml.ldlt().solve(Mat6L::Identity());
+  const Vec6L aul = au.cast<long double>();
+  MatL J(m, 6);
+  VecL b(m), tol(m);
+  for (int k = 0; k < m; ++k) {
+    J.row(k) = rows.row(k).transpose().cast<long double>();
+    b[k] = rows.bk(k);
+  }
+  // Feasibility of a candidate, relative to the row's scale (see check_kkt).
+  const long double au_M = std::sqrt(aul.dot(Ml * aul));
+  for (int k = 0; k < m; ++k)
+    tol[k] = 1e-12L * (std::sqrt(J.row(k).dot(Minv * J.row(k).transpose())) * au_M + std::abs(b[k]));
+  std::optional<Vec6> best;
+  long double best_f = std::numeric_limits<long double>::infinity();
+  std::vector<int> S;
+  auto visit = [&](auto&& self, int next) -> void {
+    const int s = static_cast<int>(S.size());
+    MatL JS(s, 6);
+    VecL rhs(s);
+    for (int i = 0; i < s; ++i) {
+      JS.row(i) = J.row(S[i]);
+      rhs[i] = b[S[i]] - J.row(S[i]).dot(aul);
+    }
+    const MatL MinvJt = Minv * JS.transpose();
+    Eigen::FullPivLU<MatL> lu(JS * MinvJt);
+    lu.setThreshold(1e-14L);
+    if (lu.rank() == s) {
+      const Vec6L a = aul + MinvJt * lu.solve(rhs);
+      bool feasible = true;
+      for (int k = 0; k < m && feasible; ++k) feasible = J.row(k).dot(a) - b[k] >= -tol[k];
+      const Vec6L d = a - aul;
+      const long double f = 0.5L * d.dot(Ml * d);
+      if (feasible && f < best_f) {
+        best_f = f;
+        best = a.cast<double>();
+      }
+    }
+    if (s == 6) return;
+    for (int k = next; k < m; ++k) {
+      S.push_back(k);
+      self(self, k + 1);
+      S.pop_back();
+    }
+  };
+  visit(visit, 0);
+  return best;
+}
+
+// Checks the KKT conditions and the section-5 properties of one result.
+// cond = cond(M); kappa = sqrt(cond) = cond(L).
+void check_kkt(const Mat6& M, const Vec6& au, const Rows& rows, const ProjectionResult& res,
+               const ProjectionSettings& settings) {
+  const int m = rows.m();
+  const double kappa = std::sqrt(cond_of(M));
+  const Mat6 Minv = M.llt().solve(Mat6::Identity());
+  const double M2 = Eigen::SelfAdjointEigenSolver<Mat6>(M).eigenvalues().maxCoeff();
+  REQUIRE(res.status == ProjectionStatus::kOptimal);
+  REQUIRE(res.ac.allFinite());
+  const Vec6 dc = res.ac - au;
+  const double y_scale = std::max(m_norm(M, au), m_norm(M, res.ac));
+  const bool cone = rows.b.empty();
+
+  // Stationarity, measured here independently of the solver's residual. The
+  // terms are sums of 6 (M x) and m (J^T lambda) products: a rounding bound is
+  // eps times the sums of magnitudes, times 1e2 for the Givens sequence and
+  // kappa for the triangular solve back to a-space.
+  Vec6 Fc = Vec6::Zero();
+  double lam_mag = 0;
+  for (int k = 0; k < m; ++k) {
+    Fc += res.lambda[k] * rows.row(k);
+    lam_mag += std::abs(res.lambda[k]) * rows.row(k).cwiseAbs().maxCoeff();
+  }
+  const double stat = (M * dc - Fc).cwiseAbs().maxCoeff();
+  const double stat_tol = 1e2 * kEps * kappa * (M2 * (res.ac.norm() + au.norm()) + lam_mag);
+  CHECK(stat <= stat_tol);
+  CHECK(res.stationarity <= stat_tol);
+
+  for (int k = 0; k < m; ++k) {
+    const double Ak = std::sqrt(rows.row(k).dot(Minv * rows.row(k)));
+    const double s = rows.row(k).dot(res.ac) - rows.bk(k);
+    const double scale_k = Ak * y_scale + std::abs(rows.bk(k));
+    // Primal feasibility: the solver accepts violations below feasibility_tol *
+    // scale_k; the a-space evaluation adds a rounding of eps kappa scale_k.
+    CHECK(s >= -(settings.feasibility_tol + 1e2 * kEps * kappa) * scale_k);
+    // Dual feasibility: lambda comes from a triangular solve (R), exact sign
+    // up to eps times the sum of multipliers.
+    CHECK(res.lambda[k] >= -1e2 * kEps * lam_mag / std::max(1e-300, rows.row(k).cwiseAbs().maxCoeff()));
+    // Complementarity: active rows hold with equality up to rounding.
+    if (res.lambda[k] != 0) CHECK(std::abs(s) <= 1e3 * kEps * kappa * scale_k);
+  }
+
+  if (cone) {
+    // Orthogonality (ac - au)^T M ac = 0 and Fc . ac = 0. It holds in y = L^T a
+    // up to eps |y - y_u| |y|; y itself carries an absolute rounding error of a
+    // few eps |y_u| (Givens sequence), and returning to a-space by the
+    // triangular solve with L^T amplifies it by cond(L) = kappa: ac is off by
+    // ~eps kappa (|ac| + |au|) (Euclidean), which moves the form by that times
+    // |M|_2 (|ac| + |ac - au|). Tolerance: 1e2 eps kappa |M|_2 (|ac| + |au|)^2.
+    const double a_scale = res.ac.norm() + au.norm();
+    const double orth_tol = 1e2 * kEps * kappa * M2 * a_scale * a_scale;
+    CHECK(std::abs(dc.dot(M * res.ac)) <= orth_tol);
+    const double kh = 3.7;
+    const Vec6 F = gauss6::coupling_force(M, au, res.ac, kh);
+    CHECK(std::abs(F.dot(res.ac)) <= kh * orth_tol);
+    // Force in the normal cone: Fc = kh J^T lambda, lambda >= 0 (checked above).
+    CHECK((F - kh * Fc).cwiseAbs().maxCoeff() <= kh * stat_tol);
+    // Dissipativity: (M au)^T ac <= (M au)^T au, with the same rounding bound
+    // (ac perturbed by eps kappa (|ac| + |au|)).
+    const Vec6 Fu = M * au;
+    CHECK(Fu.dot(res.ac) <= Fu.dot(au) + orth_tol);
+  }
+  // With J au >= b (au feasible) nothing is active and ac = au exactly.
+  bool au_feasible = true;
+  for (int k = 0; k < m; ++k) au_feasible = au_feasible && rows.row(k).dot(au) >= rows.bk(k);
+  if (au_feasible) {
+    CHECK(res.num_active == 0);
+    CHECK(res.ac == au);
+    CHECK(gauss6::coupling_force(M, au, res.ac, 2.0) == Vec6::Zero());
+  }
+}
+
+ProjectionResult solve_cold(const Mat6& M, const Vec6& au, const Rows& rows,
+                            const ProjectionSettings& settings = {}) {
+  ProjectionWorkspace ws;
+  ProjectionResult res;
+  ProjectionSettings s = settings;
+  s.warm_start = false;
+  gauss6::project(make_problem(M, au, rows), s, &ws, &res);
+  return res;
+}
+
+// The comparison with the ground truth: 1e-9 relative in the M-norm.
+void check_same(const Mat6& M, const Vec6& au, const Vec6& a, const Vec6& b, double rel = 1e-9) {
+  CHECK(m_norm(M, a - b) <= rel * std::max(m_norm(M, au), 1e-300));
+}
+
+}  // namespace
+
+TEST_CASE("projection status names", "[qp]") {
+  CHECK(std::string(gauss6::to_string(ProjectionStatus::kOptimal)) == "optimal");
+  CHECK(std::string(gauss6::to_string(ProjectionStatus::kIterationCap)) == "iteration cap");
+  CHECK(std::string(gauss6::to_string(ProjectionStatus::kInfeasibleOffsets)) == "infeasible offsets");
+  CHECK(std::string(gauss6::to_string(ProjectionStatus::kBadInput)) == "bad input");
+}
+
+TEST_CASE("projection meets KKT and matches brute force on random problems", "[qp]") {
+  std::mt19937_64 rng(20070301);
+  const ProjectionSettings settings;
+  int compared = 0, active_total = 0;
+  for (double cond : {1.0, 1e2, 1e4, 1e6}) {
+    for (int m = 0; m <= 12; ++m) {
+      for (Push push : {Push::kNone, Push::kSome, Push::kAll}) {
+        const int trials = m <= 9 ? 3 : 1;
+        for (int t = 0; t < trials; ++t) {
+          const Mat6 M = random_spd(rng, cond);
+          const Vec6 au = random_vec(rng, std::pow(10.0, std::uniform_int_distribution<int>(-3, 3)(rng)));
+          const Rows rows = random_rows(rng, m, au, push);
+          const ProjectionResult res = solve_cold(M, au, rows, settings);
+          INFO("cond " << cond << " m " << m << " push " << int(push));
+          check_kkt(M, au, rows, res, settings);
+          active_total += res.num_active;
+          if (push == Push::kNone) CHECK(res.ac == au);
+          if (push == Push::kAll && m > 0) CHECK(res.num_active > 0);
+          const auto truth = brute_force(M, au, rows);
+          REQUIRE(truth.has_value());
+          check_same(M, au, res.ac, *truth);
+          ++compared;
+        }
+      }
+    }
+  }
+  CHECK(compared > 300);
+  CHECK(active_total > 200);  // the set exercises non-trivial working sets
+}
+
+TEST_CASE("projection with 50 rows meets KKT", "[qp]") {
+  std::mt19937_64 rng(50);
+  const ProjectionSettings settings;
+  for (double cond : {1.0, 1e3, 1e6}) {
+    for (Push push : {Push::kNone, Push::kSome, Push::kAll}) {
+      for (int t = 0; t < 5; ++t) {
+        const Mat6 M = random_spd(rng, cond);
+        const Vec6 au = random_vec(rng);
+        const Rows rows = random_rows(rng, 50, au, push);
+        const ProjectionResult res = solve_cold(M, au, rows, settings);
+        check_kkt(M, au, rows, res, settings);
+        CHECK(res.num_active <= gauss6::kMaxActive);
+      }
+    }
+  }
+}
+
+TEST_CASE("redundant rows: duplicates, scaled copies and averages", "[qp]") {
+  // With b = 0, exact duplicates, positive multiples and averages of rows leave
+  // the feasible cone unchanged: the answer must equal the brute-force answer of
+  // the distinct rows alone (1e-9 relative in the M-norm).
+  std::mt19937_64 rng(7);
+  std::uniform_real_distribution<double> u01(0, 1);
+  const ProjectionSettings settings;
+  for (double cond : {1.0, 1e3, 1e6}) {
+    for (int base_m : {1, 2, 3, 5, 7}) {
+      for (int total : {base_m + 3, 20, 50}) {
+        const Mat6 M = random_spd(rng, cond);
+        const Vec6 au = random_vec(rng);
+        const Rows base = random_rows(rng, base_m, au, Push::kSome);
+        Rows rows = base;
+        std::uniform_int_distribution<int> pick(0, base_m - 1);
+        while (rows.m() < total) {
+          const int kind = rows.m() % 3;
+          const Vec6 r = base.row(pick(rng));
+          if (kind == 0) rows.add(r);                                           // exact duplicate
+          if (kind == 1) rows.add(std::pow(10.0, -1 + 2 * u01(rng)) * r);       // scaled copy
+          if (kind == 2) rows.add(0.5 * (r + base.row(pick(rng))));             // average of two
+        }
+        // Shuffle the rows (so that copies may come before their originals).
+        std::vector<int> order(total);
+        for (int i = 0; i < total; ++i) order[i] = i;
+        std::shuffle(order.begin(), order.end(), rng);
+        Rows shuffled;
+        for (int i : order) shuffled.add(rows.row(i));
+        const ProjectionResult res = solve_cold(M, au, shuffled, settings);
+        INFO("cond " << cond << " base " << base_m << " total " << total);
+        check_kkt(M, au, shuffled, res, settings);
+        const auto truth = brute_force(M, au, base);
+        REQUIRE(truth.has_value());
+        check_same(M, au, res.ac, *truth);
+      }
+    }
+  }
+}
+
+TEST_CASE("nearly parallel rows: copies perturbed by 1e-6 to 1e-12", "[qp]") {
+  // Nearly parallel rows make the multipliers ill-conditioned (they may be as
+  // large as 1/perturbation), but the KKT conditions, measured with the
+  // multipliers' own magnitude, must hold; copies closer than dependence_tol
+  // are treated as dependent and stay within feasibility_tol.
+  std::mt19937_64 rng(11);
+  const ProjectionSettings settings;
+  for (double delta : {1e-6, 1e-8, 1e-9, 1e-10, 1e-11, 1e-12}) {
+    for (double cond : {1.0, 1e4}) {
+      for (int t = 0; t < 8; ++t) {
+        const Mat6 M = random_spd(rng, cond);
+        const Vec6 au = random_vec(rng);
+        const Rows base = random_rows(rng, 4, au, Push::kAll);
+        Rows rows = base;
+        for (int k = 0; k < base.m(); ++k) rows.add(base.row(k) + delta * random_vec(rng));
+        for (int k = 0; k < base.m(); ++k) rows.add(base.row(k) + delta * random_vec(rng));
+        const ProjectionResult res = solve_cold(M, au, rows, settings);
+        INFO("delta " << delta << " cond " << cond);
+        check_kkt(M, au, rows, res, settings);
+      }
+    }
+  }
+}
+
+TEST_CASE("warm starts along drifting au give the cold answers", "[qp]") {
+  std::mt19937_64 rng(3);
+  ProjectionWorkspace ws;
+  ProjectionSettings warm;
+  warm.warm_start = true;
+  Mat6 M = random_spd(rng, 1e3);
+  Vec6 au = random_vec(rng);
+  Rows rows = random_rows(rng, 8, au, Push::kSome);
+  int warm_iterations = 0, cold_iterations = 0;
+  for (int step = 0; step < 600; ++step) {
+    // Every 100 steps a new contact set (and every 200 a new M) arrives.
+    if (step % 100 == 0 && step > 0) {
+      const int m = std::array<int, 6>{3, 6, 12, 50, 1, 9}[(step / 100) % 6];
+      rows = random_rows(rng, m, au, Push::kSome);
+      if (step % 200 == 0) M = random_spd(rng, 1e3);
+    }
+    au += random_vec(rng, 0.05);
+    ProjectionResult w, c;
+    REQUIRE(gauss6::project(make_problem(M, au, rows), warm, &ws, &w) == ProjectionStatus::kOptimal);
+    c = solve_cold(M, au, rows);
+    INFO("step " << step);
+    check_same(M, au, w.ac, c.ac);
+    warm_iterations += w.iterations;
+    cold_iterations += c.iterations;
+    // The same input again: the warm start is exact, no step, same bits.
+    ProjectionResult again;
+    gauss6::project(make_problem(M, au, rows), warm, &ws, &again);
+    CHECK(again.iterations == 0);
+    CHECK(again.ac == w.ac);
+  }
+  CHECK(warm_iterations < cold_iterations);
+}
+
+TEST_CASE("warm start survives rows leaving the problem", "[qp]") {
+  std::mt19937_64 rng(5);
+  ProjectionWorkspace ws;
+  const ProjectionSettings settings;
+  const Mat6 M = random_spd(rng, 10);
+  const Vec6 au = random_vec(rng);
+  const Rows rows = random_rows(rng, 12, au, Push::kAll);
+  ProjectionResult res;
+  gauss6::project(make_problem(M, au, rows), settings, &ws, &res);
+  REQUIRE(res.num_active > 0);
+  // Keep only the first 2 rows: working-set rows >= 2 must be dropped.
+  Rows fewer;
+  for (int k = 0; k < 2; ++k) fewer.add(rows.row(k));
+  ProjectionResult w;
+  REQUIRE(gauss6::project(make_problem(M, au, fewer), settings, &ws, &w) == ProjectionStatus::kOptimal);
+  check_kkt(M, au, fewer, w, settings);
+  check_same(M, au, w.ac, solve_cold(M, au, fewer).ac);
+  // And none at all.
+  ProjectionResult none;
+  REQUIRE(gauss6::project(make_problem(M, au, Rows{}), settings, &ws, &none) == ProjectionStatus::kOptimal);
+  CHECK(none.ac == au);
+  CHECK(none.num_active == 0);
+}
+
+TEST_CASE("offsets: b != 0 meets KKT and matches brute force", "[qp]") {
+  std::mt19937_64 rng(13);
+  std::uniform_real_distribution<double> u01(0, 1);
+  const ProjectionSettings settings;
+  int infeasible = 0, feasible = 0;
+  for (double cond : {1.0, 1e3, 1e6}) {
+    for (int m = 1; m <= 10; ++m) {
+      for (int sign : {-1, +1}) {
+        for (int t = 0; t < 2; ++t) {
+          const Mat6 M = random_spd(rng, cond);
+          const Vec6 au = random_vec(rng);
+          Rows rows = random_rows(rng, m, au, Push::kSome);
+          rows.b.resize(m);
+          // sign < 0: offsets (b <= 0, always feasible); sign > 0: b >= 0,
+          // which may be empty for m > 6.
+          for (int k = 0; k < m; ++k) rows.b[k] = sign * u01(rng) * m_norm(M, au) * 0.3;
+          ProjectionWorkspace ws;
+          ProjectionResult res;
+          const auto status = gauss6::project(make_problem(M, au, rows), settings, &ws, &res);
+          const auto truth = brute_force(M, au, rows);
+          INFO("cond " << cond << " m " << m << " sign " << sign);
+          if (!truth) {
+            CHECK(status == ProjectionStatus::kInfeasibleOffsets);
+            CHECK(res.ac == au);
+            ++infeasible;
+            continue;
+          }
+          ++feasible;
+          check_kkt(M, au, rows, res, settings);
+          check_same(M, au, res.ac, *truth);
+        }
+      }
+    }
+  }
+  CHECK(feasible > 50);
+  CHECK(infeasible > 0);
+}
+
+TEST_CASE("offsets: empty feasible sets are reported", "[qp]") {
+  const Mat6 M = Mat6::Identity() * 2;
+  const Vec6 au = (Vec6() << 0.1, -0.2, 0.3, 0, 0.01, 0).finished();
+  ProjectionWorkspace ws;
+  ProjectionResult res;
+  SECTION("opposite rows with b = 1: n.a >= 1 and -n.a >= 1") {
+    Rows rows;
+    const Vec6 n = (Vec6() << 1, 0, 0, 0, 0.2, 0).finished();
+    rows.add(n, 1.0);
+    rows.add(-n, 1.0);
+    CHECK(gauss6::project(make_problem(M, au, rows), {}, &ws, &res) == ProjectionStatus::kInfeasibleOffsets);
+    CHECK(res.ac == au);
+  }
+  SECTION("three normals summing to zero with b > 0, plus redundant copies") {
+    Rows rows;
+    const double s3 = std::sqrt(3.0) / 2;
+    rows.add((Vec6() << 1, 0, 0, 0, 0, 0).finished(), 0.1);
+    rows.add((Vec6() << -0.5, s3, 0, 0, 0, 0).finished(), 0.1);
+    rows.add((Vec6() << 1, 0, 0, 0, 0, 0).finished(), 0.05);
+    rows.add((Vec6() << -0.5, -s3, 0, 0, 0, 0).finished(), 0.1);
+    CHECK(gauss6::project(make_problem(M, au, rows), {}, &ws, &res) == ProjectionStatus::kInfeasibleOffsets);
+    CHECK(res.ac == au);
+    for (int k = 0; k < rows.m(); ++k) CHECK(res.lambda[k] == 0);
+    // The workspace recovers: the same rows with b = 0 are a cone.
+    rows.b.clear();
+    CHECK(gauss6::project(make_problem(M, au, rows), {}, &ws, &res) == ProjectionStatus::kOptimal);
+    check_kkt(M, au, rows, res, {});
+  }
+}
+
+TEST_CASE("bad input gives kBadInput and a finite zero-force ac", "[qp]") {
+  std::mt19937_64 rng(17);
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  const double inf = std::numeric_limits<double>::infinity();
+  const Mat6 M_good = random_spd(rng, 100);
+  const Vec6 au_good = random_vec(rng);
+  const Rows rows_good = random_rows(rng, 5, au_good, Push::kAll);
+  ProjectionWorkspace ws;
+  ProjectionSettings settings;
+
+  auto expect_bad = [&](const ProjectionProblem& pb, const ProjectionSettings& s) {
+    ProjectionResult res;
+    res.lambda.fill(42.0);
+    CHECK(gauss6::project(pb, s, &ws, &res) == ProjectionStatus::kBadInput);
+    CHECK(res.status == ProjectionStatus::kBadInput);
+    CHECK(res.ac.allFinite());
+    if (pb.au.allFinite()) CHECK(res.ac == pb.au);
+    CHECK(res.num_active == 0);
+    for (double l : res.lambda) CHECK(l == 0);
+    // Zero force whatever the input.
+    CHECK(gauss6::coupling_force(pb.M ? *pb.M : M_good, pb.au, res.ac, 1.0) == Vec6::Zero());
+    // And the workspace still solves a good problem right after.
+    ProjectionResult ok;
+    REQUIRE(gauss6::project(make_problem(M_good, au_good, rows_good), settings, &ws, &ok) ==
+            ProjectionStatus::kOptimal);
+    check_kkt(M_good, au_good, rows_good, ok, settings);
+  };
+
+  for (double bad : {nan, inf, -inf}) {
+    Mat6 M = M_good;
+    M(2, 4) = M(4, 2) = bad;
+    expect_bad(make_problem(M, au_good, rows_good), settings);
+    Vec6 au = au_good;
+    au[3] = bad;
+    expect_bad(make_problem(M_good, au, rows_good), settings);
+    Rows rows = rows_good;
+    rows.J[13] = bad;
+    expect_bad(make_problem(M_good, au_good, rows), settings);
+    rows = rows_good;
+    rows.b.assign(rows.m(), 0.0);
+    rows.b[2] = bad;
+    expect_bad(make_problem(M_good, au_good, rows), settings);
+  }
+  // M not SPD: an eigenvalue negative, zero, or M not symmetric.
+  Eigen::SelfAdjointEigenSolver<Mat6> es(M_good);
+  Vec6 e = es.eigenvalues();
+  e[0] = -1;
+  Mat6 M = es.eigenvectors() * e.asDiagonal() * es.eigenvectors().transpose();
+  expect_bad(make_problem(M, au_good, rows_good), settings);
+  e[0] = 0;
+  M = es.eigenvectors() * e.asDiagonal() * es.eigenvectors().transpose();
+  expect_bad(make_problem(M, au_good, rows_good), settings);
+  M = M_good;
+  M(0, 5) += 0.1 * M.norm();
+  expect_bad(make_problem(M, au_good, rows_good), settings);
+  // Row counts out of range, missing pointers.
+  Rows many;
+  for (int k = 0; k <= kMaxContacts; ++k) many.add(random_contact_row(rng));
+  expect_bad(make_problem(M_good, au_good, many), settings);
+  ProjectionProblem pb = make_problem(M_good, au_good, rows_good);
+  pb.num_rows = -1;
+  expect_bad(pb, settings);
+  pb = make_problem(M_good, au_good, rows_good);
+  pb.J = nullptr;
+  expect_bad(pb, settings);
+  pb = make_problem(M_good, au_good, rows_good);
+  pb.M = nullptr;
+  expect_bad(pb, settings);
+  // Settings out of range.
+  ProjectionSettings s = settings;
+  s.feasibility_tol = nan;
+  expect_bad(make_problem(M_good, au_good, rows_good), s);
+  s = settings;
+  s.dependence_tol = -1;
+  expect_bad(make_problem(M_good, au_good, rows_good), s);
+  s = settings;
+  s.max_iterations = -3;
+  expect_bad(make_problem(M_good, au_good, rows_good), s);
+  // A null workspace.
+  ProjectionResult res;
+  CHECK(gauss6::project(make_problem(M_good, au_good, rows_good), settings, nullptr, &res) ==
+        ProjectionStatus::kBadInput);
+  CHECK(res.ac == au_good);
+}
+
+TEST_CASE("iteration cap is reported with a finite answer", "[qp]") {
+  std::mt19937_64 rng(19);
+  const Mat6 M = random_spd(rng, 10);
+  const Vec6 au = random_vec(rng);
+  const Rows rows = random_rows(rng, 12, au, Push::kAll);
+  ProjectionSettings s;
+  s.max_iterations = 1;
+  s.warm_start = false;
+  ProjectionWorkspace ws;
+  ProjectionResult res;
+  const ProjectionResult full = solve_cold(M, au, rows);
+  REQUIRE(full.iterations > 1);
+  CHECK(gauss6::project(make_problem(M, au, rows), s, &ws, &res) == ProjectionStatus::kIterationCap);
+  CHECK(res.ac.allFinite());
+  CHECK(res.iterations == 1);
+  CHECK(res.primal_infeasibility > 0);
+  CHECK(res.dual_infeasibility == 0);
+}
+
+TEST_CASE("physical mass matrices: force in the normal cone", "[qp]") {
+  // M = diag(m I3, I_G) of a box of mass m; inertia ratio up to 1e6 between
+  // the mass and the smallest principal moment.
+  std::mt19937_64 rng(23);
+  std::uniform_real_distribution<double> u01(0, 1);
+  for (double ratio : {1.0, 1e2, 1e4, 1e6}) {
+    for (int t = 0; t < 10; ++t) {
+      const double mass = 0.1 + u01(rng);
+      Mat6 M = Mat6::Zero();
+      M.topLeftCorner<3, 3>() = mass * Eigen::Matrix3d::Identity();
+      const Eigen::Matrix3d Rot = Eigen::Quaterniond::UnitRandom().toRotationMatrix();
+      const Eigen::Vector3d moments(mass, mass / std::sqrt(ratio), mass / ratio);
+      M.bottomRightCorner<3, 3>() = Rot * moments.asDiagonal() * Rot.transpose();
+      M = 0.5 * (M + M.transpose()).eval();
+      const Vec6 au = random_vec(rng, 1e-3);
+      const Rows rows = random_rows(rng, 6, au, Push::kSome);
+      const ProjectionResult res = solve_cold(M, au, rows);
+      check_kkt(M, au, rows, res, {});
+      const auto truth = brute_force(M, au, rows);
+      REQUIRE(truth.has_value());
+      check_same(M, au, res.ac, *truth);
+    }
+  }
+}
+
+TEST_CASE("property: KKT, orthogonality, dissipativity, warm = cold", "[qp]") {
+  const bool ok = rc::check("projection properties", [] {
+    const int cond_exp = *rc::gen::inRange(0, 7);
+    const int m = *rc::gen::inRange(0, 14);
+    const auto seed = *rc::gen::inRange<std::uint64_t>(0, 1u << 30);
+    const int push = *rc::gen::inRange(0, 3);
+    std::mt19937_64 rng(seed);
+    const Mat6 M = random_spd(rng, std::pow(10.0, cond_exp));
+    const Vec6 au = random_vec(rng);
+    const Rows rows = random_rows(rng, m, au, static_cast<Push>(push));
+    const ProjectionSettings settings;
+    ProjectionWorkspace ws;
+    ProjectionResult warm, cold;
+    // A first solve on a perturbed au leaves a working set to start from.
+    gauss6::project(make_problem(M, au + random_vec(rng, 0.3), rows), settings, &ws, &warm);
+    RC_ASSERT(gauss6::project(make_problem(M, au, rows), settings, &ws, &warm) ==
+              ProjectionStatus::kOptimal);
+    cold = solve_cold(M, au, rows);
+    const double nu = m_norm(M, au);
+    const double kappa = std::sqrt(cond_of(M));
+    const Vec6 dc = warm.ac - au;
+    const double M2 = Eigen::SelfAdjointEigenSolver<Mat6>(M).eigenvalues().maxCoeff();
+    // Same rounding bounds as check_kkt.
+    RC_ASSERT(m_norm(M, warm.ac - cold.ac) <= 1e-9 * nu);
+    const double tol = 1e2 * kEps * kappa * M2 * (warm.ac.norm() + au.norm()) * (warm.ac.norm() + au.norm());
+    RC_ASSERT(std::abs(dc.dot(M * warm.ac)) <= tol);
+    RC_ASSERT((M * au).dot(warm.ac) <= (M * au).dot(au) + tol);
+    // Multipliers from a triangular solve: non-negative up to eps times their size.
+    const double lam_max = *std::max_element(warm.lambda.begin(), warm.lambda.begin() + std::max(m, 1));
+    RC_ASSERT(warm.dual_infeasibility <= 1e2 * kEps * std::max(lam_max, 0.0));
+  });
+  REQUIRE(ok);
+}

@@ -1,0 +1,168 @@
+// Tests of the TOML scene loader (scene.h, docs/scene-format.md): a valid scene
+// loads with its mass properties, and every kind of bad input is an error that
+// names the file, the line and the key.
+#include <catch2/catch.hpp>
+
+#include <filesystem>
+#include <fstream>
+#include <string>
+
+#include "gauss6/scene.h"
+
+using namespace gauss6;
+namespace fs = std::filesystem;
+
+namespace {
+
+// A 2 x 1 x 0.5 box centred at (1, 0.5, 0.25) (its corner at the origin), outward triangles.
+const char* kBoxObj =
+    "v 0 0 0\nv 2 0 0\nv 2 1 0\nv 0 1 0\nv 0 0 0.5\nv 2 0 0.5\nv 2 1 0.5\nv 0 1 0.5\n"
+    "f 1 3 2\nf 1 4 3\nf 5 6 7\nf 5 7 8\nf 1 2 6\nf 1 6 5\nf 2 3 7\nf 2 7 6\n"
+    "f 3 4 8\nf 3 8 7\nf 4 1 5\nf 4 5 8\n";
+
+const char* kScene = R"(format = "gauss6-scene"
+version = 1
+name = "test"
+
+[gains]
+ks = 0.5
+kh = 100.0
+
+[contact]
+delta = 1e-5
+
+[[obstacle]]
+name = "floor"
+mesh = "box.obj"
+position = [0.0, 0.0, -1.0]
+
+[god_object]
+name = "brick"
+mesh = "box.obj"
+position = [0.0, 0.0, 1.0]
+orientation = [1.0, 0.0, 0.0, 1.0]
+density = 2.0
+
+[device]
+kind = "simulated"
+script = "none"
+)";
+
+struct TempScene {
+  fs::path dir;
+  explicit TempScene(const std::string& scene_text) {
+    dir = fs::temp_directory_path() / ("gauss6_scene_test_" + std::to_string(std::hash<std::string>{}(scene_text)));
+    fs::create_directories(dir);
+    std::ofstream(dir / "box.obj") << kBoxObj;
+    std::ofstream(dir / "scene.toml") << scene_text;
+  }
+  ~TempScene() { fs::remove_all(dir); }
+  std::string path() const { return (dir / "scene.toml").string(); }
+};
+
+// Replaces the first occurrence of `from` in the valid scene.
+std::string edited(const std::string& from, const std::string& to) {
+  std::string s = kScene;
+  const size_t at = s.find(from);
+  REQUIRE(at != std::string::npos);
+  return s.replace(at, from.size(), to);
+}
+
+// The loader's error message for a scene text (fails the test when it loads).
+std::string load_error(const std::string& text) {
+  TempScene t(text);
+  try {
+    load_scene(t.path());
+  } catch (const SceneError& e) {
+    return e.what();
+  }
+  FAIL("the scene loaded but should not have");
+  return "";
+}
+
+}  // namespace
+
+TEST_CASE("a valid scene loads with its mass properties computed once", "[scene]") {
+  TempScene t(kScene);
+  const Scene s = load_scene(t.path());
+  CHECK(s.name == "test");
+  REQUIRE(s.obstacles.size() == 1);
+  CHECK(s.obstacles[0].name == "floor");
+  CHECK(s.gains.kh == 100.0);
+  CHECK(s.contact.offset_eps == Approx(-1e-4));  // default -10 delta
+  CHECK(s.contact.offset_time == 0.05);
+  CHECK(s.device.rate_hz == 1000.0);
+  CHECK(s.surface.kind == SurfaceKind::kNone);
+  // Box 2 x 1 x 0.5 at density 2: mass 2, inertia m/12 (b^2 + c^2) etc. (rounding only).
+  const MassProperties& mp = s.god_mass.mass;
+  CHECK(mp.mass == Approx(2.0).epsilon(1e-14));
+  CHECK(mp.inertia(0, 0) == Approx(2.0 / 12 * (1 + 0.25)).epsilon(1e-12));
+  CHECK(mp.inertia(1, 1) == Approx(2.0 / 12 * (4 + 0.25)).epsilon(1e-12));
+  CHECK(mp.inertia(2, 2) == Approx(2.0 / 12 * (4 + 1)).epsilon(1e-12));
+  // The body frame's origin is the centre of mass; the pose is the pose of G:
+  // the mesh frame sits at (0, 0, 1) rotated 90 degrees about z, so G = (0, 0, 1) + Rz (1, 0.5, 0.25).
+  CHECK(mp.center_of_mass.norm() < 1e-14);
+  CHECK((s.god_object.pose.p - Vec3(-0.5, 1.0, 1.25)).norm() < 1e-14);
+  // M = diag(m I, R I R^T): the 90-degree turn swaps the x and y inertias.
+  const Mat6 M = god_object_mass_matrix(s, s.god_object.pose.q);
+  CHECK(M(0, 0) == Approx(2.0));
+  CHECK(M(3, 3) == Approx(mp.inertia(1, 1)).epsilon(1e-12));
+  CHECK(M(4, 4) == Approx(mp.inertia(0, 0)).epsilon(1e-12));
+}
+
+TEST_CASE("scene summaries report world-frame bounding boxes and mass properties", "[scene]") {
+  TempScene t(kScene);
+  const Scene s = load_scene(t.path());
+  const auto sum = summarize_scene(s, /*count_self_intersections=*/true);
+  REQUIRE(sum.size() == 2);
+  CHECK(sum[0].role == BodyRole::kObstacle);
+  CHECK(sum[0].mass == Approx(1.0));  // volume, at density 1
+  CHECK((sum[0].bbox_min_W - Vec3(0, 0, -1)).norm() < 1e-15);
+  CHECK((sum[0].bbox_max_W - Vec3(2, 1, -0.5)).norm() < 1e-15);
+  CHECK(sum[1].num_triangles == 12);
+  CHECK(sum[1].closed);
+  CHECK(sum[1].manifold);
+  CHECK(sum[1].num_self_intersections == 0);
+  CHECK((sum[1].bbox_min_W - Vec3(-1, 0, 1)).norm() < 1e-14);
+  CHECK((sum[1].bbox_max_W - Vec3(0, 2, 1.5)).norm() < 1e-14);
+}
+
+TEST_CASE("bad scenes are errors that name the file, line and key", "[scene]") {
+  using Catch::Matchers::Contains;
+  // Unknown key, with its line.
+  CHECK_THAT(load_error(edited("ks = 0.5", "ks = 0.5\nkd = 3.0")), Contains("scene.toml:7:1: gains.kd: unknown key"));
+  // Missing key.
+  CHECK_THAT(load_error(edited("kh = 100.0\n", "")), Contains("gains.kh: missing"));
+  // Bad values.
+  CHECK_THAT(load_error(edited("delta = 1e-5", "delta = -1.0")), Contains("contact.delta: must be > 0"));
+  CHECK_THAT(load_error(edited("density = 2.0", "density = \"heavy\"")), Contains("god_object.density: must be a number"));
+  CHECK_THAT(load_error(edited("position = [0.0, 0.0, 1.0]", "position = [0.0, 1.0]")),
+             Contains("god_object.position: must be an array of 3 numbers"));
+  CHECK_THAT(load_error(edited("version = 1", "version = 2")), Contains("version: unsupported version 2"));
+  CHECK_THAT(load_error(edited("kind = \"simulated\"", "kind = \"telepathic\"")), Contains("device.kind: must be"));
+  CHECK_THAT(load_error(edited("script = \"none\"", "script = \"none\"\ntrace = \"x.g6t\"")),
+             Contains("device.trace: not a key of a \"simulated\" device"));
+  CHECK_THAT(load_error(edited("density = 2.0", "density = 2.0\nmass = 1.0")), Contains("give either density"));
+  CHECK_THAT(load_error(edited("name = \"brick\"", "name = \"floor\"")), Contains("already the name of another body"));
+  CHECK_THAT(load_error(edited("orientation = [1.0, 0.0, 0.0, 1.0]", "orientation = [0.0, 0.0, 0.0, 0.0]")),
+             Contains("god_object.orientation: must be a non-zero quaternion"));
+  // A missing mesh file names the mesh key and the file.
+  CHECK_THAT(load_error(edited("mesh = \"box.obj\"", "mesh = \"nowhere.obj\"")),
+             Contains("obstacle[0].mesh") && Contains("nowhere.obj"));
+  // TOML syntax errors carry the parser's line.
+  CHECK_THAT(load_error(edited("ks = 0.5", "ks = = 0.5")), Contains("scene.toml:6:"));
+}
+
+TEST_CASE("given mass properties are validated", "[scene]") {
+  using Catch::Matchers::Contains;
+  const std::string given = "mass = 1.0\ncenter_of_mass = [1.0, 0.5, 0.25]\n";
+  CHECK_THAT(load_error(edited("density = 2.0", given + "inertia = [[1.0, 0.0, 0.0], [0.0, -1.0, 0.0], [0.0, 0.0, 1.0]]")),
+             Contains("god_object.inertia: must be positive definite"));
+  CHECK_THAT(load_error(edited("density = 2.0", given + "inertia = [[1.0, 0.5, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]]")),
+             Contains("god_object.inertia: must be symmetric"));
+  TempScene t(edited("density = 2.0", given + "inertia = [[1.0, 0.0, 0.0], [0.0, 2.0, 0.0], [0.0, 0.0, 3.0]]"));
+  const Scene s = load_scene(t.path());
+  CHECK_FALSE(s.god_mass.from_density);
+  CHECK(s.god_mass.mass.mass == 1.0);
+  CHECK(s.god_mass.mass.inertia(2, 2) == 3.0);
+}

@@ -1,0 +1,21 @@
+"""gauss6: six-DoF god-object haptic rendering of rigid bodies (Ortega, Redon, Coquillart 2007).
+
+The C++ core is the extension module gauss6._gauss6; this package adds the
+`gauss6` command (gauss6.cli), the dataset generators, the cross-checks and plots.
+"""
+from __future__ import annotations
+
+from . import _gauss6  # noqa: F401  (the C++ core; built by CMake)
+from ._gauss6 import (  # noqa: F401
+    MeshFileError,
+    ProjectionSettings,
+    Projector,
+    SceneError,
+    coupling_force,
+    mass_properties,
+    project,
+    read_mesh,
+    validate_mesh,
+)
+
+__version__ = "0.1.0"

@@ -1,0 +1,134 @@
+"""The `gauss6` command: one entry point for scenes, datasets, cross-checks and reproduction.
+
+    gauss6 scene info SCENE [--json]
+    gauss6 datasets generate | check
+    gauss6 crosscheck qp [--family NAME] [--json]
+    gauss6 reproduce peg|bunny|all --out DIR
+
+Every subcommand exits non-zero on a failed check, with a message naming the problem.
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+from pathlib import Path
+
+from . import paths
+
+SCENES = {
+    "peg": paths.DATASETS_DIR / "scenes" / "peg_in_hole.toml",
+    "bunny": paths.DATASETS_DIR / "scenes" / "bunnies.toml",
+}
+
+
+def _error(message: str) -> int:
+    print(f"gauss6: error: {message}", file=sys.stderr)
+    return 2
+
+
+def cmd_scene_info(args: argparse.Namespace) -> int:
+    from . import SceneError
+    from .scene import format_scene_info, scene_info
+
+    try:
+        info = scene_info(args.scene, self_intersections=not args.no_self_intersections)
+    except SceneError as e:
+        return _error(str(e))
+    print(json.dumps(info, indent=2) if args.json else format_scene_info(info))
+    return 0
+
+
+def cmd_datasets(args: argparse.Namespace) -> int:
+    from . import datasets, qp_instances
+
+    if args.action == "generate":
+        datasets.generate_all()
+        qp_instances.generate()  # sampled on the meshes above: after them
+        print(f"datasets written to {paths.DATASETS_DIR}")
+        return 0
+    problems = datasets.check_all() + qp_instances.check_all()
+    for p in problems:
+        print(f"MISMATCH {p}")
+    print("datasets: all checksums match" if not problems else f"datasets: {len(problems)} mismatches")
+    return 1 if problems else 0
+
+
+def cmd_reproduce(args: argparse.Namespace) -> int:
+    from . import SceneError
+    from .scene import format_scene_info, scene_info
+
+    from . import datasets, qp_instances
+
+    out = Path(args.out)
+    out.mkdir(parents=True, exist_ok=True)
+    # The datasets are deterministic: regenerating them in place leaves them byte-identical
+    # (`gauss6 datasets check`, run by `make test`, proves it).
+    datasets.generate_all()
+    qp_instances.generate()
+    names = ["peg", "bunny"] if args.scenario == "all" else [args.scenario]
+    for name in names:
+        try:
+            info = scene_info(SCENES[name])
+        except SceneError as e:
+            return _error(str(e))
+        (out / f"scene_{name}.json").write_text(json.dumps(info, indent=2) + "\n")
+        print(format_scene_info(info))
+    print(f"scene summaries written to {out}/")
+    return 0
+
+
+def cmd_crosscheck_qp(args: argparse.Namespace) -> int:
+    from .crosscheck_qp import crosscheck, format_table
+
+    result, failures, reports = crosscheck([args.family] if args.family else None, tolerance=args.tolerance,
+                                  with_osqp=not args.no_osqp, show_progress=not args.json)
+    if args.json:
+        print(json.dumps(result))
+    else:
+        print(format_table(result, reports))
+    for f in failures[:50]:
+        print(f"FAIL {f}", file=sys.stderr)
+    return 0 if result["ok"] else 1
+
+
+def build_parser() -> argparse.ArgumentParser:
+    p = argparse.ArgumentParser(prog="gauss6", description=__doc__.splitlines()[0])
+    sub = p.add_subparsers(dest="command", required=True)
+
+    scene = sub.add_parser("scene", help="scene files").add_subparsers(dest="action", required=True)
+    info = scene.add_parser("info", help="per body: triangles, closed, manifold, mass, inertia, bbox")
+    info.add_argument("scene", help="scene TOML file")
+    info.add_argument("--json", action="store_true", help="machine-readable output")
+    info.add_argument("--no-self-intersections", action="store_true",
+                      help="skip the exact self-intersection test (reported as -1)")
+    info.set_defaults(func=cmd_scene_info)
+
+    ds = sub.add_parser("datasets", help="the seeded dataset generators")
+    ds.add_argument("action", choices=["generate", "check"],
+                    help="generate: write in place; check: regenerate and compare checksums")
+    ds.set_defaults(func=cmd_datasets)
+
+    cc = sub.add_parser("crosscheck", help="optimized against exact (and peers)").add_subparsers(
+        dest="what", required=True)
+    ccq = cc.add_parser("qp", help="the projection: certificate on every instance, exact solve on a sample, OSQP")
+    ccq.add_argument("--family", help="one instance family (default: all)")
+    ccq.add_argument("--json", action="store_true", help="machine-readable output")
+    ccq.add_argument("--tolerance", type=float, default=1e-9, help="max relative error in the M-norm (default 1e-9)")
+    ccq.add_argument("--no-osqp", action="store_true", help="skip the OSQP cross-check")
+    ccq.set_defaults(func=cmd_crosscheck_qp)
+
+    rep = sub.add_parser("reproduce", help="run the paper's scenarios and write figures and summaries")
+    rep.add_argument("scenario", choices=["peg", "bunny", "all"])
+    rep.add_argument("--out", required=True, help="output directory")
+    rep.set_defaults(func=cmd_reproduce)
+    return p
+
+
+def main(argv: list[str] | None = None) -> int:
+    args = build_parser().parse_args(argv)
+    return args.func(args)
+
+
+if __name__ == "__main__":
+    sys.exit(main())

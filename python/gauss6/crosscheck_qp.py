@@ -1,0 +1,212 @@
+"""`gauss6 crosscheck qp`: the optimized projection against the exact reference and OSQP.
+
+For every instance of every family (datasets_generated/qp/): the optimized
+solver's answer (cold start; warm starts along the "warm" family's sequences),
+the exact certificate of its active set (reference/: the exact KKT point of the
+active set, checked exactly for lambda >= 0 and J a >= b), a full exact solve
+(CGAL's QP solver) on a sample, and OSQP (eps 1e-10, polished) as an independent
+floating-point check.
+
+Errors are measured in the M-norm |x|_M = sqrt(x^T M x), the norm in which the
+projection is defined:
+- rel_err_ac    = |ac - ac*|_M / |au|_M   (|ac*|_M <= |au|_M when b = 0: the
+  natural scale of the answer, defined even when ac* = 0);
+- rel_err_force = |ac - ac*|_M / |ac* - au|_M, the force error relative to the
+  exact force in its own (M^-1) norm, since |Fc - Fc*|_{M^-1} = kh |ac - ac*|_M;
+  where the exact force is zero, relative to |au|_M.
+- certificate: the exact KKT point of the optimized active set must satisfy
+  lambda >= 0 and J a >= b exactly; where it fails by at most CERTIFICATE_TOL of
+  the row's scale (a weakly active row decided the other way by rounding), the
+  error is measured against a full exact solve instead, and counted apart
+  (near-degenerate) in the table; a larger failure is a certificate failure.
+- kkt residual: the solver's own KKT residuals made relative: stationarity over
+  |M au|_inf, primal infeasibility over |J|_inf |au|_inf + |b|_inf, complementarity
+  over the product of both scales.
+"""
+from __future__ import annotations
+
+import math
+from collections import Counter
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from . import _gauss6, qp_instances
+
+DEFAULT_TOLERANCE = 1e-9
+# An exact certificate that fails by at most this much, relative to the row's
+# scale (|J_k| |au| + |b_k| for a constraint, |M au| for a multiplier), is a
+# near-degenerate instance, resolved by a full exact solve (see check_instance).
+CERTIFICATE_TOL = 1e-12
+EXACT_SAMPLE_EVERY = 10  # a full exact solve on one instance in ten
+
+
+def m_norm(M: np.ndarray, x: np.ndarray) -> float:
+    return math.sqrt(max(float(x @ M @ x), 0.0))
+
+
+def solve_osqp(M: np.ndarray, au: np.ndarray, J: np.ndarray, b: np.ndarray) -> np.ndarray | None:
+    """OSQP at eps 1e-10, polished: the independent floating-point cross-check."""
+    import osqp
+    import scipy.sparse as sp
+
+    m = J.shape[0]
+    if m == 0:
+        return au.copy()
+    solver = osqp.OSQP()
+    solver.setup(sp.csc_matrix(np.triu(M)), -M @ au, sp.csc_matrix(J), b, np.full(m, np.inf),
+                 eps_abs=1e-10, eps_rel=1e-10, polishing=True, verbose=False, max_iter=200000)
+    r = solver.solve()
+    return None if r.info.status not in ("solved", "solved inaccurate") else np.asarray(r.x)
+
+
+@dataclass
+class FamilyReport:
+    name: str
+    count: int = 0
+    max_rel_err_ac: float = 0.0
+    max_rel_err_force: float = 0.0
+    max_kkt_residual: float = 0.0
+    certificate_failures: int = 0
+    osqp_max_rel_err_ac: float = 0.0
+    statuses: Counter = field(default_factory=Counter)
+    exact_solves: int = 0
+    near_degenerate: int = 0
+    failures: list[str] = field(default_factory=list)
+
+    def as_json(self) -> dict:
+        return {"name": self.name, "count": self.count, "max_rel_err_ac": self.max_rel_err_ac,
+                "max_rel_err_force": self.max_rel_err_force, "max_kkt_residual": self.max_kkt_residual,
+                "certificate_failures": self.certificate_failures,
+                "osqp_max_rel_err_ac": self.osqp_max_rel_err_ac, "statuses": dict(sorted(self.statuses.items()))}
+
+
+def certificate_scale(M, au, J, b, cert) -> float:
+    """The scale against which a failed certificate's amount is judged (see CERTIFICATE_TOL)."""
+    if cert["failure"] == "negative_multiplier":
+        return float(np.linalg.norm(M @ au))
+    k = cert["row"]
+    return float(np.linalg.norm(J[k]) * np.linalg.norm(au) + abs(b[k]))
+
+
+def relative_kkt(res, M, au, J, b) -> float:
+    """The solver's KKT residuals made relative to the problem's scales (see the module doc)."""
+    force_scale = float(np.abs(M @ au).max()) or 1.0
+    row_scale = (float(np.abs(J).max()) if J.size else 0.0) * float(np.abs(au).max()) + (
+        float(np.abs(b).max()) if b.size else 0.0) or 1.0
+    return max(res.stationarity / force_scale, res.primal_infeasibility / row_scale,
+               res.dual_infeasibility / force_scale, res.complementarity / (force_scale * row_scale))
+
+
+def check_instance(rep: FamilyReport, inst, res, index: int, with_osqp: bool) -> None:
+    M, au, J, b = inst.M, inst.au, inst.J, inst.b
+    rep.count += 1
+    rep.statuses[res.status] += 1
+    au_norm = m_norm(M, au) or 1.0
+    if res.status == "infeasible_offsets":
+        # Only an exact solve can certify infeasibility.
+        exact = _gauss6.reference.project(M, au, J, b)
+        rep.exact_solves += 1
+        if exact["status"] != "infeasible":
+            rep.certificate_failures += 1
+            rep.failures.append(f"{inst.id}: optimized says infeasible, exact says {exact['status']}")
+        return
+    if res.status != "optimal":
+        rep.certificate_failures += 1
+        rep.failures.append(f"{inst.id}: status {res.status}")
+        return
+    rep.max_kkt_residual = max(rep.max_kkt_residual, relative_kkt(res, M, au, J, b))
+    cert = _gauss6.reference.check_certificate(M, au, J, b, list(res.active))
+    if cert["pass"]:
+        ac_star = np.asarray(cert["ac"])  # the exact optimum (certified), rounded to doubles
+    elif (cert["failure"] in ("violated_constraint", "negative_multiplier")
+          and cert["amount"] <= CERTIFICATE_TOL * certificate_scale(M, au, J, b, cert)):
+        # Near-degenerate: the active set is right up to rounding (a row tight at
+        # the optimum, or a zero multiplier, decided the other way by 1e-12 of the
+        # problem's scale). Its exact KKT point is then not the exact optimum, so
+        # the error is measured against a full exact solve instead.
+        exact = _gauss6.reference.project(M, au, J, b)
+        rep.exact_solves += 1
+        rep.near_degenerate += 1
+        if exact["status"] != "optimal":
+            rep.certificate_failures += 1
+            rep.failures.append(f"{inst.id}: exact solve says {exact['status']}")
+            return
+        ac_star = np.asarray(exact["ac"])
+    else:
+        rep.certificate_failures += 1
+        rep.failures.append(f"{inst.id}: certificate failed: {cert['failure']} at row {cert['row']} "
+                            f"by {cert['amount']:.3g}")
+        return
+    err = m_norm(M, res.ac - ac_star)
+    rep.max_rel_err_ac = max(rep.max_rel_err_ac, err / au_norm)
+    force_norm = m_norm(M, ac_star - au)
+    rep.max_rel_err_force = max(rep.max_rel_err_force, err / (force_norm if force_norm > 0 else au_norm))
+    if index % EXACT_SAMPLE_EVERY == 0:
+        # A full exact solve on a sample: it must agree with the certified optimum.
+        exact = _gauss6.reference.project(M, au, J, b)
+        rep.exact_solves += 1
+        if exact["status"] != "optimal" or m_norm(M, np.asarray(exact["ac"]) - ac_star) > 1e-15 * au_norm:
+            rep.certificate_failures += 1
+            rep.failures.append(f"{inst.id}: exact solve disagrees with the certificate ({exact['status']})")
+    if with_osqp:
+        x = solve_osqp(M, au, J, b)
+        e = math.inf if x is None else m_norm(M, x - ac_star) / au_norm
+        rep.osqp_max_rel_err_ac = max(rep.osqp_max_rel_err_ac, e)
+
+
+def crosscheck_family(name: str, with_osqp: bool = True, progress=None) -> FamilyReport:
+    from . import project, Projector
+
+    rep = FamilyReport(name)
+    instances = qp_instances.load_family(name)
+    if name == "warm":
+        # Warm starts along each sequence, in step order, one projector per sequence.
+        projectors: dict[int, Projector] = {}
+        for i, inst in enumerate(sorted(instances, key=lambda x: (x.sequence, x.step))):
+            proj = projectors.setdefault(inst.sequence, Projector())
+            check_instance(rep, inst, proj.project(inst.M, inst.au, inst.J, inst.b), i, with_osqp)
+            if progress:
+                progress.update(1)
+    else:
+        for i, inst in enumerate(instances):
+            check_instance(rep, inst, project(inst.M, inst.au, inst.J, inst.b), i, with_osqp)
+            if progress:
+                progress.update(1)
+    return rep
+
+
+def crosscheck(families: list[str] | None = None, tolerance: float = DEFAULT_TOLERANCE,
+               with_osqp: bool = True, show_progress: bool = True) -> tuple[dict, list[str]]:
+    """Runs the crosscheck; returns (the JSON object, the failure messages)."""
+    from tqdm import tqdm
+
+    names = families or qp_instances.family_names()
+    total = sum(len(qp_instances.load_family(n)) for n in names)
+    reports = []
+    with tqdm(total=total, desc="crosscheck qp", disable=not show_progress, unit="qp") as bar:
+        for n in names:
+            reports.append(crosscheck_family(n, with_osqp, bar))
+    failures = [f for r in reports for f in r.failures]
+    for r in reports:
+        if r.max_rel_err_ac > tolerance:
+            failures.append(f"{r.name}: max_rel_err_ac {r.max_rel_err_ac:.3g} > {tolerance:g}")
+        if r.max_rel_err_force > tolerance:
+            failures.append(f"{r.name}: max_rel_err_force {r.max_rel_err_force:.3g} > {tolerance:g}")
+    ok = not failures
+    result = {"ok": ok, "tolerance": tolerance, "families": [r.as_json() for r in reports]}
+    return result, failures, reports
+
+
+def format_table(result: dict, reports: list[FamilyReport]) -> str:
+    head = (f"{'family':<10} {'count':>6} {'err ac':>10} {'err force':>10} {'kkt':>10} {'cert fail':>9} "
+            f"{'near-deg':>8} {'exact':>6} {'osqp err':>10}  statuses")
+    lines = [head, "-" * len(head)]
+    for f, r in zip(result["families"], reports):
+        f = dict(f, near_degenerate=r.near_degenerate, exact_solves=r.exact_solves)
+        st = ", ".join(f"{k} {v}" for k, v in f["statuses"].items())
+        lines.append(f"{f['name']:<10} {f['count']:>6} {f['max_rel_err_ac']:>10.2e} {f['max_rel_err_force']:>10.2e} "
+                     f"{f['max_kkt_residual']:>10.2e} {f['certificate_failures']:>9} {f['near_degenerate']:>8} "
+                     f"{f['exact_solves']:>6} {f['osqp_max_rel_err_ac']:>10.2e}  {st}")
+    lines.append(f"tolerance {result['tolerance']:g}: {'OK' if result['ok'] else 'FAILED'}")
+    return "\n".join(lines)

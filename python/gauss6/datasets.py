@@ -1,0 +1,162 @@
+"""The generated datasets (METHOD.md section 7): making them and checking them.
+
+Each dataset lives in datasets_generated/<name>/ with a MANIFEST.json:
+
+    {"generator": path of the generator source, relative to the repository,
+     "generator_version": "1",
+     "parameters": {...},
+     "source_sha256": sha256 of the generator source,
+     "outputs": {filename: sha256}}
+
+and every OFF file it holds starts with the same fields as '#' comment lines.
+Generation is deterministic: the same parameters give byte-identical files, so
+`check_all()` can regenerate each dataset and compare checksums.
+
+- peg_in_hole: peg.off (288 triangles) and box_with_hole.off (280 triangles),
+  from datasets_generated/generators/peg_in_hole.py (Python, numpy).
+- bunny: bunny.off (about 27,000 triangles, 15 cm tall, metres), from
+  glmark2-data's bunny.obj by the CGAL program gauss6_make_bunny
+  (datasets_generated/generators/make_bunny.cpp, built by CMake).
+"""
+from __future__ import annotations
+
+import hashlib
+import importlib.util
+import json
+import subprocess
+import sys
+import tempfile
+from pathlib import Path
+from types import ModuleType
+
+from tqdm import tqdm
+
+from . import paths
+
+DATASETS = ("peg_in_hole", "bunny")
+GENERATORS_DIR = paths.DATASETS_DIR / "generators"
+
+# The bunny: the Stanford bunny as glmark2-data ships it (34,835 vertices, 69,666
+# triangles, arbitrary units, Y up), decimated and scaled to 15 cm along Y.
+BUNNY_INPUT = Path("/usr/share/glmark2/models/bunny.obj")
+BUNNY_TARGET_FACES = 27000
+BUNNY_HEIGHT = 0.15  # metres
+BUNNY_TOOL = "datasets_generated/gauss6_make_bunny"
+
+
+def sha256_file(path: Path) -> str:
+    return hashlib.sha256(Path(path).read_bytes()).hexdigest()
+
+
+def peg_in_hole_generator() -> ModuleType:
+    """The peg-in-a-hole generator module (datasets_generated/generators/peg_in_hole.py)."""
+    name, path = "gauss6_generators_peg_in_hole", GENERATORS_DIR / "peg_in_hole.py"
+    if name in sys.modules:
+        return sys.modules[name]
+    spec = importlib.util.spec_from_file_location(name, path)
+    if spec is None or spec.loader is None:
+        raise ImportError(f"{path}: cannot load the generator")
+    module = importlib.util.module_from_spec(spec)
+    sys.modules[name] = module  # dataclasses look their module up there
+    try:
+        spec.loader.exec_module(module)
+    except BaseException:
+        del sys.modules[name]
+        raise
+    return module
+
+
+def _relative(path: Path) -> str:
+    return path.resolve().relative_to(paths.REPO_ROOT).as_posix()
+
+
+def _write_manifest(out: Path, generator: Path, version: str, parameters: dict, files: list[str]) -> dict:
+    manifest = {
+        "generator": _relative(generator),
+        "generator_version": version,
+        "parameters": parameters,
+        "source_sha256": sha256_file(generator),
+        "outputs": {f: sha256_file(out / f) for f in sorted(files)},
+    }
+    (out / "MANIFEST.json").write_text(json.dumps(manifest, indent=2) + "\n", encoding="ascii")
+    return manifest
+
+
+def _generate_peg_in_hole(out: Path) -> dict:
+    gen = peg_in_hole_generator()
+    params = gen.PegInHoleParams()
+    files = gen.generate(out, params)
+    return _write_manifest(out, GENERATORS_DIR / "peg_in_hole.py", gen.GENERATOR_VERSION, params.to_json(), list(files))
+
+
+def _generate_bunny(out: Path) -> dict:
+    gen = peg_in_hole_generator()  # owns the OFF provenance header's format
+    source = GENERATORS_DIR / "make_bunny.cpp"
+    if not BUNNY_INPUT.exists():
+        raise FileNotFoundError(f"{BUNNY_INPUT}: missing; install the Debian package glmark2-data")
+    parameters = {
+        "input": str(BUNNY_INPUT),
+        "input_sha256": sha256_file(BUNNY_INPUT),
+        "target_faces": BUNNY_TARGET_FACES,
+        "height": BUNNY_HEIGHT,
+    }
+    header = gen.provenance_header(_relative(source), parameters, sha256_file(source))
+    cmd = [str(paths.tool(BUNNY_TOOL)), str(BUNNY_INPUT), str(out / "bunny.off"),
+           str(BUNNY_TARGET_FACES), repr(BUNNY_HEIGHT)]
+    for line in header:
+        cmd += ["--comment", line]
+    r = subprocess.run(cmd, capture_output=True, text=True)
+    if r.returncode != 0:
+        raise RuntimeError(f"{' '.join(cmd[:5])} failed (exit {r.returncode}): {r.stderr.strip()}")
+    return _write_manifest(out, source, gen.GENERATOR_VERSION, parameters, ["bunny.off"])
+
+
+def generate(name: str, out_dir: Path) -> dict:
+    """Generates dataset `name` ("peg_in_hole" or "bunny") into out_dir/<name>/ (its files
+    and MANIFEST.json); returns the manifest. Raises ValueError for an unknown name,
+    FileNotFoundError when the bunny tool is not built, RuntimeError when a generator's
+    own checks fail."""
+    makers = {"peg_in_hole": _generate_peg_in_hole, "bunny": _generate_bunny}
+    if name not in makers:
+        raise ValueError(f"unknown dataset {name!r}; expected one of {', '.join(DATASETS)}")
+    out = Path(out_dir) / name
+    out.mkdir(parents=True, exist_ok=True)
+    return makers[name](out)
+
+
+def generate_all(out_dir: Path | None = None) -> dict[str, dict]:
+    """Generates every dataset into out_dir (default: in place, datasets_generated/)."""
+    root = Path(out_dir) if out_dir is not None else paths.DATASETS_DIR
+    return {name: generate(name, root) for name in tqdm(DATASETS, desc="datasets", unit="dataset", disable=None)}
+
+
+def check_all() -> list[str]:
+    """Regenerates every dataset into a temporary directory and compares it with the
+    committed one (MANIFEST.json and the files it lists). Returns one human-readable
+    message per mismatch; empty when everything matches."""
+    problems: list[str] = []
+    with tempfile.TemporaryDirectory(prefix="gauss6-datasets-") as tmp:
+        for name in tqdm(DATASETS, desc="datasets check", unit="dataset", disable=None):
+            committed_dir = paths.DATASETS_DIR / name
+            manifest_path = committed_dir / "MANIFEST.json"
+            if not manifest_path.exists():
+                problems.append(f"{name}: {manifest_path} is missing (run `gauss6 datasets generate`)")
+                continue
+            committed = json.loads(manifest_path.read_text())
+            try:
+                fresh = generate(name, Path(tmp))
+            except (OSError, RuntimeError) as e:
+                problems.append(f"{name}: cannot regenerate: {e}")
+                continue
+            for key in ("generator", "generator_version", "parameters", "source_sha256"):
+                if committed.get(key) != fresh[key]:
+                    problems.append(f"{name}: MANIFEST.json {key} is {committed.get(key)!r}, "
+                                    f"the generator now gives {fresh[key]!r}")
+            for filename in sorted(set(committed.get("outputs", {})) | set(fresh["outputs"])):
+                want, got = committed.get("outputs", {}).get(filename), fresh["outputs"].get(filename)
+                if want != got:
+                    problems.append(f"{name}/{filename}: committed sha256 {want}, regenerated {got}")
+                path = committed_dir / filename
+                if want is not None and (not path.exists() or sha256_file(path) != want):
+                    problems.append(f"{name}/{filename}: the committed file does not match MANIFEST.json")
+    return problems

@@ -1,0 +1,160 @@
+"""Reader of the projection-instance families (datasets_generated/qp/, format in its README.md).
+
+An instance is one quasi-static projection (METHOD.md sections 2-3):
+    ac = argmin 1/2 (a - au)^T M (a - au)   s.t.   J a >= b,
+M (6, 6) the god-object's generalised mass (world frame), J (m, 6) the contact rows,
+au (6,) the unconstrained step, b (m,) the offsets. `load_family("box")` returns the
+instances of datasets_generated/qp/box.json; `check_all()` regenerates every family in a
+temporary directory and compares it with MANIFEST.json.
+"""
+from __future__ import annotations
+
+import hashlib
+import importlib.util
+import json
+import sys
+import tempfile
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from .paths import DATASETS_DIR
+
+FAMILIES_DIR = DATASETS_DIR / "qp"
+FORMAT = "gauss6-qp-instances"
+FORMAT_VERSION = 1
+PUSH_LABELS = ("all", "some", "none")
+
+
+@dataclass
+class Instance:
+    """One projection problem. push: 'all' (every J_k au < 0), 'none' (J au >= 0) or
+    'some'; sequence/step: position in a warm-start sequence, -1 outside one."""
+    id: str
+    M: np.ndarray    # (6, 6) symmetric positive definite, kg and kg m^2, world frame
+    au: np.ndarray   # (6,) linear (m) then angular (rad), world frame
+    J: np.ndarray    # (m, 6), m >= 0
+    b: np.ndarray    # (m,), m
+    push: str
+    sequence: int = -1
+    step: int = -1
+    tags: dict = field(default_factory=dict)
+
+    @property
+    def num_rows(self) -> int:
+        return len(self.J)
+
+
+def family_names() -> list[str]:
+    """The families listed in MANIFEST.json, in generation order."""
+    manifest = json.loads((FAMILIES_DIR / "MANIFEST.json").read_text())
+    return [Path(f).stem for f in manifest["outputs"]]
+
+
+def _family_path(name_or_path: str | Path) -> Path:
+    """A bare name ('box') is a family of FAMILIES_DIR; anything else is a path."""
+    if isinstance(name_or_path, str) and name_or_path.isidentifier():
+        return FAMILIES_DIR / f"{name_or_path}.json"
+    return Path(name_or_path)
+
+
+def _int(path: Path, iid: str, key: str, value) -> int:
+    if not isinstance(value, int) or isinstance(value, bool):
+        raise ValueError(f"{path}: instance {iid}: '{key}' is not an integer")
+    return value
+
+
+def _array(path: Path, iid: str, key: str, value, shape: tuple[int, ...]) -> np.ndarray:
+    """value as a float array of the given shape (-1: any length), or ValueError naming the place."""
+    try:
+        a = np.array(value, dtype=float)
+    except (TypeError, ValueError) as e:
+        raise ValueError(f"{path}: instance {iid}: '{key}' is not an array of numbers") from e
+    if key == "J" and a.size == 0:
+        a = a.reshape(0, 6)
+    if a.ndim != len(shape) or any(s != -1 and s != n for s, n in zip(shape, a.shape)):
+        raise ValueError(f"{path}: instance {iid}: '{key}' has shape {a.shape}, expected {shape}")
+    if not np.all(np.isfinite(a)):
+        raise ValueError(f"{path}: instance {iid}: '{key}' has a non-finite value")
+    return a
+
+
+def load_family(name_or_path: str | Path) -> list[Instance]:
+    """The instances of one family: a name ('box', 'peg', ...) or a path to a family file.
+
+    Raises ValueError naming the file and the problem for a malformed file."""
+    path = _family_path(name_or_path)
+    try:
+        doc = json.loads(path.read_text())
+    except json.JSONDecodeError as e:
+        raise ValueError(f"{path}: not valid JSON: {e}") from None
+    if not isinstance(doc, dict) or doc.get("format") != FORMAT:
+        raise ValueError(f"{path}: not a {FORMAT} file")
+    if doc.get("version") != FORMAT_VERSION:
+        raise ValueError(f"{path}: format version {doc.get('version')!r}, this reader knows {FORMAT_VERSION}")
+    out = []
+    for k, rec in enumerate(doc.get("instances", [])):
+        iid = str(rec.get("id", f"#{k}"))
+        try:
+            J = _array(path, iid, "J", rec["J"], (-1, 6))
+            inst = Instance(
+                id=iid,
+                M=_array(path, iid, "M", rec["M"], (6, 6)),
+                au=_array(path, iid, "au", rec["au"], (6,)),
+                J=J,
+                b=_array(path, iid, "b", rec["b"], (len(J),)),
+                push=rec["push"],
+                sequence=_int(path, iid, "sequence", rec["sequence"]),
+                step=_int(path, iid, "step", rec["step"]),
+                tags=rec.get("tags", {}),
+            )
+        except KeyError as e:
+            raise ValueError(f"{path}: instance {iid}: missing key {e}") from None
+        if inst.push not in PUSH_LABELS:
+            raise ValueError(f"{path}: instance {iid}: push {inst.push!r} is not one of {PUSH_LABELS}")
+        out.append(inst)
+    return out
+
+
+def _sha256(path: Path) -> str:
+    return hashlib.sha256(path.read_bytes()).hexdigest()
+
+
+def generate(out_dir: Path | None = None) -> None:
+    """Run the generator (datasets_generated/qp/generate.py): every family and
+    MANIFEST.json into out_dir (default: in place)."""
+    gen_path = FAMILIES_DIR / "generate.py"
+    # Load the generator by path (datasets_generated/ is not a package); it must be in
+    # sys.modules while it runs, for its dataclasses.
+    spec = importlib.util.spec_from_file_location("gauss6_qp_generate", gen_path)
+    gen = importlib.util.module_from_spec(spec)
+    sys.modules[spec.name] = gen
+    try:
+        spec.loader.exec_module(gen)
+        gen.main(["--out", str(out_dir if out_dir is not None else FAMILIES_DIR)])
+    finally:
+        sys.modules.pop(spec.name, None)
+
+
+def check_all() -> list[str]:
+    """Regenerate every family in a temporary directory and compare with MANIFEST.json.
+
+    Returns one line per problem (a generator source, committed file or regenerated file
+    whose checksum differs from the manifest); an empty list when everything matches."""
+    manifest = json.loads((FAMILIES_DIR / "MANIFEST.json").read_text())
+    gen_path = FAMILIES_DIR / "generate.py"
+    problems = []
+    if _sha256(gen_path) != manifest["source_sha256"]:
+        problems.append(f"{gen_path}: source changed since MANIFEST.json was written")
+    with tempfile.TemporaryDirectory() as tmp:
+        generate(Path(tmp))
+        for name, want in manifest["outputs"].items():
+            committed, fresh = FAMILIES_DIR / name, Path(tmp) / name
+            if not committed.exists():
+                problems.append(f"{committed}: missing")
+            elif _sha256(committed) != want:
+                problems.append(f"{committed}: checksum differs from MANIFEST.json")
+            if not fresh.exists() or _sha256(fresh) != want:
+                problems.append(f"{name}: regenerated file differs from MANIFEST.json")
+    return problems

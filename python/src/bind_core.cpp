@@ -1,0 +1,145 @@
+// Bindings of the core vocabulary: poses, the Cayley motion, meshes, mass
+// properties and scenes. numpy arrays in and out (Eigen types by value).
+#include <pybind11/eigen.h>
+#include <pybind11/stl.h>
+
+#include "gauss6/mass_properties.h"
+#include "gauss6/mesh.h"
+#include "gauss6/mesh_io.h"
+#include "gauss6/pose.h"
+#include "gauss6/qp_instances.h"
+#include "gauss6/scene.h"
+#include "module.h"
+
+namespace py = pybind11;
+
+namespace gauss6::python {
+
+namespace {
+Quat quat_from(const Eigen::Vector4d& q) { return {q[0], q[1], q[2], q[3]}; }
+Eigen::Vector4d quat_to(const Quat& q) { return {q.w, q.x, q.y, q.z}; }
+Pose pose_from(const Eigen::Vector3d& p, const Eigen::Vector4d& q) { return {p, quat_from(q)}; }
+
+py::dict summary_dict(const BodySummary& s) {
+  py::dict d;
+  d["name"] = s.name;
+  d["role"] = to_string(s.role);
+  d["triangles"] = s.num_triangles;
+  d["vertices"] = s.num_vertices;
+  d["closed"] = s.closed;
+  d["manifold"] = s.manifold;
+  d["self_intersections"] = s.num_self_intersections;
+  d["mass"] = s.mass;
+  d["center_of_mass"] = s.center_of_mass_W;
+  d["inertia"] = s.inertia_W;
+  d["bbox_min"] = s.bbox_min_W;
+  d["bbox_max"] = s.bbox_max_W;
+  return d;
+}
+}  // namespace
+
+void bind_core(py::module_& m) {
+  // Errors at the edges become Python exceptions naming the problem.
+  py::register_exception<MeshFileError>(m, "MeshFileError", PyExc_ValueError);
+  py::register_exception<SceneError>(m, "SceneError", PyExc_ValueError);
+
+  // Poses: p (3,), q (4,) as (w, x, y, z).
+  m.def("rotation_matrix", [](const Eigen::Vector4d& q) { return rotation_matrix(quat_from(q)); }, py::arg("q"),
+        "Rational rotation matrix R(q) = (...)/|q|^2 of METHOD.md section 1.");
+  m.def("pose_difference",
+        [](const Eigen::Vector3d& ph, const Eigen::Vector4d& qh, const Eigen::Vector3d& ps, const Eigen::Vector4d& qs) {
+          return pose_difference(pose_from(ph, qh), pose_from(ps, qs));
+        },
+        py::arg("ph"), py::arg("qh"), py::arg("ps"), py::arg("qs"), "xh (-) xs as a 6-vector (linear, angular).");
+  m.def("pose_update",
+        [](const Eigen::Vector3d& p, const Eigen::Vector4d& q, const Vec6& a) {
+          const Pose x = pose_update(pose_from(p, q), a);
+          return py::make_tuple(Eigen::Vector3d(x.p), quat_to(x.q));
+        },
+        py::arg("p"), py::arg("q"), py::arg("a"), "xs (+) a: returns (p, q).");
+
+  // Meshes.
+  py::class_<MeshReport>(m, "MeshReport")
+      .def_readonly("num_vertices", &MeshReport::num_vertices)
+      .def_readonly("num_triangles", &MeshReport::num_triangles)
+      .def_readonly("num_edges", &MeshReport::num_edges)
+      .def_readonly("num_nonfinite_vertices", &MeshReport::num_nonfinite_vertices)
+      .def_readonly("num_bad_indices", &MeshReport::num_bad_indices)
+      .def_readonly("num_degenerate_triangles", &MeshReport::num_degenerate_triangles)
+      .def_readonly("num_boundary_edges", &MeshReport::num_boundary_edges)
+      .def_readonly("num_nonmanifold_edges", &MeshReport::num_nonmanifold_edges)
+      .def_readonly("num_nonmanifold_vertices", &MeshReport::num_nonmanifold_vertices)
+      .def_readonly("num_self_intersections", &MeshReport::num_self_intersections)
+      .def_property_readonly("closed", &MeshReport::closed)
+      .def_property_readonly("manifold", &MeshReport::manifold)
+      .def("ok", &MeshReport::ok)
+      .def("describe", &MeshReport::describe);
+  m.def("read_mesh",
+        [](const std::string& path) {
+          const TriangleMesh mesh = read_mesh(path);
+          return py::make_tuple(mesh.V, mesh.F);
+        },
+        py::arg("path"), "Reads an OBJ/OFF/PLY/STL triangle mesh: returns (V #Vx3 float64, F #Fx3 int32).");
+  m.def("validate_mesh",
+        [](const MatrixX3d& V, const MatrixX3i& F, bool self_intersections) {
+          TriangleMesh mesh;
+          mesh.V = V;
+          mesh.F = F;
+          MeshReport r = validate_mesh(mesh);
+          if (self_intersections && r.num_bad_indices == 0) r.num_self_intersections = count_self_intersections(mesh);
+          return r;
+        },
+        py::arg("V"), py::arg("F"), py::arg("self_intersections") = false);
+  m.def("mass_properties",
+        [](const MatrixX3d& V, const MatrixX3i& F, double density) {
+          TriangleMesh mesh;
+          mesh.V = V;
+          mesh.F = F;
+          MassProperties mp;
+          std::string error;
+          if (!compute_mass_properties(mesh, density, &mp, &error)) throw py::value_error(error);
+          py::dict d;
+          d["volume"] = mp.volume;
+          d["mass"] = mp.mass;
+          d["center_of_mass"] = mp.center_of_mass;
+          d["inertia"] = mp.inertia;
+          return d;
+        },
+        py::arg("V"), py::arg("F"), py::arg("density"),
+        "Volume, mass, centre of mass and inertia about it (mesh frame) of a closed mesh.");
+
+  // Projection instances (datasets_generated/qp/), read by the C++ reader.
+  py::class_<QpInstance>(m, "QpInstance")
+      .def_readonly("id", &QpInstance::id)
+      .def_readonly("M", &QpInstance::M)
+      .def_readonly("au", &QpInstance::au)
+      .def_readonly("J", &QpInstance::J)
+      .def_readonly("b", &QpInstance::b)
+      .def_readonly("push", &QpInstance::push)
+      .def_readonly("sequence", &QpInstance::sequence)
+      .def_readonly("step", &QpInstance::step);
+  m.def("read_qp_instances", &read_qp_instances, py::arg("path"),
+        "Reads a projection-instance family file (datasets_generated/qp/README.md).");
+
+  // Scenes.
+  m.def("scene_summary",
+        [](const std::string& path, bool self_intersections) {
+          const Scene scene = load_scene(path);
+          py::list bodies;
+          for (const BodySummary& s : summarize_scene(scene, self_intersections)) bodies.append(summary_dict(s));
+          py::dict d;
+          d["name"] = scene.name;
+          d["bodies"] = bodies;
+          d["gains"] = py::dict(py::arg("ks") = scene.gains.ks, py::arg("kh") = scene.gains.kh);
+          d["contact"] = py::dict(py::arg("delta") = scene.contact.delta,
+                                  py::arg("offset_eps") = scene.contact.offset_eps,
+                                  py::arg("offset_time") = scene.contact.offset_time);
+          d["surface"] = to_string(scene.surface.kind);
+          d["device"] = to_string(scene.device.kind);
+          return d;
+        },
+        py::arg("path"), py::arg("self_intersections") = true,
+        "Loads a scene (raises SceneError naming file, line and key) and summarises its bodies.");
+}
+
+}  // namespace gauss6::python

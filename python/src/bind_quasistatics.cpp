@@ -1,0 +1,138 @@
+// Bindings of the quasi-static projection and the coupling force (quasistatics.h,
+// coupling.h): gauss6.project(M, au, J, b=None) and gauss6.coupling_force(...).
+// numpy arrays in, numpy arrays out; one workspace per call (cold start) unless
+// a Projector object is used, which keeps its workspace for warm starts.
+#include <pybind11/eigen.h>
+#include <pybind11/numpy.h>
+#include <pybind11/stl.h>
+
+#include <algorithm>
+#include <optional>
+#include <string>
+
+#include "gauss6/coupling.h"
+#include "gauss6/quasistatics.h"
+#include "module.h"
+
+namespace py = pybind11;
+
+namespace gauss6::python {
+
+namespace {
+
+using RowsX6 = Eigen::Matrix<double, Eigen::Dynamic, 6, Eigen::RowMajor>;
+
+struct PyProjection {
+  Vec6 ac;
+  Eigen::VectorXd lam;
+  std::vector<int> active;
+  std::string status;
+  int iterations;
+  double stationarity, primal_infeasibility, dual_infeasibility, complementarity;
+};
+
+// Checks shapes at the edge (the C++ solver takes raw row-major pointers).
+void check_shapes(const RowsX6& J, const std::optional<Eigen::VectorXd>& b) {
+  if (J.rows() > kMaxContacts)
+    throw py::value_error("J has " + std::to_string(J.rows()) + " rows; at most " + std::to_string(kMaxContacts));
+  if (b && b->size() != J.rows())
+    throw py::value_error("b has " + std::to_string(b->size()) + " entries; J has " + std::to_string(J.rows()) +
+                          " rows");
+}
+
+PyProjection run(const Mat6& M, const Vec6& au, const RowsX6& J, const std::optional<Eigen::VectorXd>& b,
+                 const ProjectionSettings& settings, ProjectionWorkspace* ws) {
+  check_shapes(J, b);
+  ProjectionProblem problem;
+  problem.M = &M;
+  problem.au = au;
+  problem.J = J.rows() ? J.data() : nullptr;
+  problem.b = b ? b->data() : nullptr;
+  problem.num_rows = static_cast<int>(J.rows());
+  ProjectionResult r;
+  project(problem, settings, ws, &r);
+  PyProjection out;
+  out.ac = r.ac;
+  out.lam = Eigen::Map<const Eigen::VectorXd>(r.lambda.data(), J.rows());
+  out.active.assign(r.active.begin(), r.active.begin() + r.num_active);
+  // Status names as Python identifiers: "optimal", "iteration_cap", "infeasible_offsets", "bad_input".
+  out.status = to_string(r.status);
+  std::replace(out.status.begin(), out.status.end(), ' ', '_');
+  out.iterations = r.iterations;
+  out.stationarity = r.stationarity;
+  out.primal_infeasibility = r.primal_infeasibility;
+  out.dual_infeasibility = r.dual_infeasibility;
+  out.complementarity = r.complementarity;
+  return out;
+}
+
+// A projector that keeps its workspace between calls: warm starts, as in the loops.
+class Projector {
+ public:
+  explicit Projector(const ProjectionSettings& s) : settings_(s) {}
+  PyProjection project(const Mat6& M, const Vec6& au, const RowsX6& J, const std::optional<Eigen::VectorXd>& b) {
+    return run(M, au, J, b, settings_, &ws_);
+  }
+  void reset() { ws_.reset(); }
+
+ private:
+  ProjectionSettings settings_;
+  ProjectionWorkspace ws_;
+};
+
+}  // namespace
+
+void bind_quasistatics(py::module_& m) {
+  py::class_<ProjectionSettings>(m, "ProjectionSettings")
+      .def(py::init<>())
+      .def_readwrite("dependence_tol", &ProjectionSettings::dependence_tol)
+      .def_readwrite("feasibility_tol", &ProjectionSettings::feasibility_tol)
+      .def_readwrite("max_iterations", &ProjectionSettings::max_iterations)
+      .def_readwrite("warm_start", &ProjectionSettings::warm_start)
+      .def_readwrite("compute_residuals", &ProjectionSettings::compute_residuals);
+
+  py::class_<PyProjection>(m, "Projection")
+      .def_readonly("ac", &PyProjection::ac)
+      .def_readonly("lam", &PyProjection::lam)
+      .def_readonly("active", &PyProjection::active)
+      .def_readonly("status", &PyProjection::status)
+      .def_readonly("iterations", &PyProjection::iterations)
+      .def_readonly("stationarity", &PyProjection::stationarity)
+      .def_readonly("primal_infeasibility", &PyProjection::primal_infeasibility)
+      .def_readonly("dual_infeasibility", &PyProjection::dual_infeasibility)
+      .def_readonly("complementarity", &PyProjection::complementarity)
+      .def("__repr__", [](const PyProjection& p) {
+        return "<Projection status=" + p.status + " active=" + std::to_string(p.active.size()) +
+               " iterations=" + std::to_string(p.iterations) + ">";
+      });
+
+  m.def("project",
+        [](const Mat6& M, const Vec6& au, const RowsX6& J, const std::optional<Eigen::VectorXd>& b,
+           std::optional<ProjectionSettings> settings) {
+          ProjectionWorkspace ws;
+          ProjectionSettings s = settings.value_or(ProjectionSettings{});
+          s.warm_start = false;
+          return run(M, au, J, b, s, &ws);
+        },
+        py::arg("M"), py::arg("au"), py::arg("J"), py::arg("b") = py::none(), py::arg("settings") = py::none(),
+        "ac = argmin 1/2 (a-au)^T M (a-au) s.t. J a >= b (b=None: 0). M (6,6) SPD, au (6,), J (m,6).\n"
+        "Returns a Projection with .ac, .lam, .active, .status, .iterations and the KKT residuals.");
+
+  py::class_<Projector>(m, "Projector", "A projection that keeps its workspace between calls (warm starts).")
+      .def(py::init<const ProjectionSettings&>(), py::arg("settings") = ProjectionSettings{})
+      .def("project", &Projector::project, py::arg("M"), py::arg("au"), py::arg("J"), py::arg("b") = py::none())
+      .def("reset", &Projector::reset);
+
+  m.def("coupling_force",
+        [](const Mat6& M, const Vec6& au, const RowsX6& J, double kh, const std::optional<Eigen::VectorXd>& b) {
+          ProjectionWorkspace ws;
+          ProjectionSettings s;
+          s.warm_start = false;
+          const PyProjection p = run(M, au, J, b, s, &ws);
+          return Vec6(coupling_force(M, au, p.ac, kh));
+        },
+        py::arg("M"), py::arg("au"), py::arg("J"), py::arg("kh"), py::arg("b") = py::none(),
+        "Fc = kh M (ac - au) (force, torque), with ac the projection of au.");
+}
+
+}  // namespace gauss6::python

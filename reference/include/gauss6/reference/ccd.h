@@ -1,0 +1,180 @@
+// Exact continuous collision detection: the reference of METHOD.md section 4.
+//
+// Every answer is exact for the exact meaning of the inputs: doubles are taken
+// as the rationals they denote, poses as in METHOD.md section 1 (R(q) is the
+// rational quaternion rotation over |q|^2), and the in-between motion is the
+// Cayley motion of METHOD.md section 4, built in exact arithmetic from the two
+// poses' doubles. Times of impact are algebraic numbers, isolated exactly
+// (CGAL's Algebraic_kernel_d_1 over GMP integers); contact tests at those times
+// are exact sign evaluations of polynomials at algebraic numbers.
+//
+// Contact means distance exactly zero: a vertex in the closed triangle, or two
+// closed segments sharing a point. Degenerate inputs (coplanar motion, parallel
+// or zero-length edges, collinear triangles, contact at u = 0) are handled.
+//
+// Polynomial degrees (checked by the tests): a body point moves on
+// x(u) = N(u) / W(u), N cubic, W(u) = |q0|^2 (s^2 + u^2 |v|^2) > 0 (qr = (s, v));
+// after the positive factors W are divided out, every vertex/face and edge/edge
+// coplanarity condition is a polynomial of degree <= 3 in u.
+//
+// Slow by design (GMP, CGAL): for checks, tests and certificates, not for the
+// real-time loops. Functions allocate and may throw.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <vector>
+
+#include <gmpxx.h>
+
+#include "gauss6/ccd_queries.h"
+#include "gauss6/mesh.h"
+#include "gauss6/pose.h"
+
+namespace gauss6::reference {
+
+// ---------------------------------------------------------------------------
+// Exact time of impact.
+
+// u* in [0, 1] when hit. u* is the unique root in [isolating_lower,
+// isolating_upper] of the square-free integer polynomial `poly` (poly[i] is the
+// coefficient of u^i); isolating_lower == isolating_upper when u* is rational.
+// Double bracket: lower <= u* <= upper, with either lower == upper == u*
+// exactly, or upper = nextafter(lower, 2) and lower < u* < upper (the tightest
+// possible), so that compare_toi(toi, u) is exact for every double u.
+struct ExactToi {
+  bool hit = false;
+  double lower = 0, upper = 0;
+  std::vector<mpz_class> poly;
+  mpq_class isolating_lower, isolating_upper;
+};
+
+// Exact sign of u - u* (-1, 0, +1). A miss counts as u* = +infinity (-1).
+inline int compare_toi(const ExactToi& toi, double u) {
+  if (!toi.hit || u < toi.lower) return -1;
+  if (u > toi.upper) return +1;
+  if (toi.lower == toi.upper) return 0;  // u* is the double lower itself
+  return u == toi.lower ? -1 : +1;       // lower < u* < upper, adjacent doubles
+}
+// Exact sign of a* - b*; a miss counts as +infinity (two misses compare equal).
+int compare_toi(const ExactToi& a, const ExactToi& b);
+
+// ---------------------------------------------------------------------------
+// Linear per-vertex motion x(t) = x0 + t (x1 - x0), t in [0, 1] (the query files).
+
+using ExactPoint = std::array<mpq_class, 3>;
+
+// Vertex/face: points in the order v, f0, f1, f2; x0 at t = 0, x1 at t = 1.
+ExactToi vertex_face_toi_linear(const std::array<ExactPoint, 4>& x0, const std::array<ExactPoint, 4>& x1);
+// Edge/edge: points in the order a0, a1, b0, b1.
+ExactToi edge_edge_toi_linear(const std::array<ExactPoint, 4>& x0, const std::array<ExactPoint, 4>& x1);
+// A query of the shared file format (gauss6/ccd_queries.h), by its kind.
+ExactToi query_toi(const CcdQuery& query);
+ExactPoint to_exact(const RationalPoint& p);
+
+// ---------------------------------------------------------------------------
+// Cayley rigid motion of a body from X0 = (p0, q0) to X1 = (p1, q1) (world frame).
+
+// Exact data of the motion. The quaternions are kept as integers scaled by
+// powers of two, which changes neither R(q0) nor g = v / s.
+struct ExactCayleyMotion {
+  Pose X0, X1;                    // the input doubles
+  std::array<mpz_class, 4> q0;    // (w, x, y, z) of q0, times 2^a
+  mpz_class s;                    // scalar part of qr = q1 conj(q0) (times 2^b), s > 0
+  std::array<mpz_class, 3> v;     // vector part of qr (times 2^b): g = v / s
+};
+
+// Throws std::domain_error when a quaternion is zero, a coordinate is not
+// finite, or the relative rotation is exactly a half turn (scalar(qr) == 0: no
+// finite Gibbs vector; split the step).
+ExactCayleyMotion make_exact_cayley_motion(const Pose& X0, const Pose& X1);
+
+// Exact world position at rational u of the body point r_B: p(u) + C(u g) R(q0) r_B.
+ExactPoint motion_point_exact(const ExactCayleyMotion& m, const mpq_class& u, const Vec3& r_B);
+// Exact world position under the static pose X (METHOD.md section 1).
+ExactPoint transform_point_exact(const Pose& X, const Vec3& r_B);
+
+// The body moves, the obstacle is static. Body features in the body frame (B),
+// obstacle features in the world frame (W). Only contacts at u <= u_max are
+// looked for (u_max in (0, 1], a double taken exactly; std::invalid_argument
+// otherwise): a miss then means no contact in [0, u_max].
+ExactToi moving_vertex_face_toi(const ExactCayleyMotion& m, const Vec3& v_B, const std::array<Vec3, 3>& f_W,
+                                double u_max = 1.0);
+ExactToi vertex_moving_face_toi(const ExactCayleyMotion& m, const Vec3& v_W, const std::array<Vec3, 3>& f_B,
+                                double u_max = 1.0);
+ExactToi moving_edge_edge_toi(const ExactCayleyMotion& m, const std::array<Vec3, 2>& e_B,
+                              const std::array<Vec3, 2>& e_W, double u_max = 1.0);
+
+// Degree of the coplanarity polynomial after removing the positive factors W,
+// -1 when it is identically zero (for tests and documentation).
+int moving_vertex_face_degree(const ExactCayleyMotion& m, const Vec3& v_B, const std::array<Vec3, 3>& f_W);
+int vertex_moving_face_degree(const ExactCayleyMotion& m, const Vec3& v_W, const std::array<Vec3, 3>& f_B);
+int moving_edge_edge_degree(const ExactCayleyMotion& m, const std::array<Vec3, 2>& e_B,
+                            const std::array<Vec3, 2>& e_W);
+
+// ---------------------------------------------------------------------------
+// Mesh level: a moving god-object mesh (body frame) against a static obstacle
+// mesh (world frame).
+
+struct Aabb {
+  Vec3 lo = Vec3::Constant(1), hi = Vec3::Constant(-1);  // empty by default
+};
+
+// Bounding-box tree over items (triangles, vertices or edges). Node i has box
+// box[i]; an inner node has children child[i] and child[i] + 1; a leaf has
+// child[i] = -1 and items item[first[i] .. first[i] + count[i]).
+struct AabbTree {
+  std::vector<Aabb> box;
+  std::vector<int32_t> child, first, count, item;
+};
+
+// Everything that depends only on the two meshes, built once.
+struct ExactMeshPair {
+  TriangleMesh body;                              // god-object, body frame
+  TriangleMesh obstacle;                          // static, world frame
+  std::vector<std::array<int32_t, 2>> body_edges, obstacle_edges;  // unique, sorted
+  AabbTree obstacle_faces, obstacle_vertices, obstacle_edge_tree;  // exact boxes (doubles)
+  double body_radius = 0;  // max |r_B| over body vertices (rounded up)
+};
+
+// Throws std::invalid_argument on an empty mesh or an index out of range.
+ExactMeshPair make_exact_mesh_pair(const TriangleMesh& body_B, const TriangleMesh& obstacle_W);
+// Unique undirected edges (i < j), sorted.
+std::vector<std::array<int32_t, 2>> mesh_edges(const TriangleMesh& m);
+
+struct FeaturePair {
+  enum Type { kBodyVertexObstacleFace, kObstacleVertexBodyFace, kEdgeEdge };
+  Type type;
+  int32_t body;      // body vertex, face or edge (index into body_edges)
+  int32_t obstacle;  // obstacle face, vertex or edge (index into obstacle_edges)
+};
+
+struct MeshContact {
+  ExactToi toi;                      // first contact over all feature pairs
+  std::vector<FeaturePair> pairs;    // every pair touching exactly at u* (empty on a miss)
+  int64_t num_candidate_pairs = 0;   // pairs whose swept boxes overlap (each solved exactly)
+};
+
+// Exact first contact over u in [0, 1] of the Cayley motion X0 -> X1: minimum
+// over body vertex/obstacle face, obstacle vertex/body face and edge/edge
+// pairs. Culling is conservative: a pair is skipped only when the swept box of
+// the body feature (provably containing its whole path) misses the obstacle
+// feature's box. Throws as make_exact_cayley_motion.
+MeshContact mesh_first_contact(const ExactMeshPair& meshes, const Pose& X0, const Pose& X1);
+
+// Number of (body triangle, obstacle triangle) pairs that intersect (share at
+// least a point) with the body at pose X, exactly (Gmpq coordinates).
+int64_t count_intersecting_pairs(const ExactMeshPair& meshes, const Pose& X);
+
+struct ExactSeparation {
+  bool within = false;         // some triangle pair is at distance <= max_distance
+  mpq_class squared_distance;  // exact minimum squared distance (when within)
+  double lower = 0, upper = 0; // bracket of the distance: lower <= d <= upper
+  int32_t body_face = -1, obstacle_face = -1;  // a pair achieving it
+};
+// Exact minimum triangle/triangle distance between the body at pose X and the
+// obstacle, over pairs whose boxes are within max_distance (>= 0); within ==
+// false when every pair is farther than max_distance.
+ExactSeparation separation_distance(const ExactMeshPair& meshes, const Pose& X, double max_distance);
+
+}  // namespace gauss6::reference

@@ -1,0 +1,312 @@
+// Exact certificate check of a claimed active set for the quasi-static
+// projection (METHOD.md sections 2-3), in GMP rationals, plus the small exact
+// linear algebra it shares with the exact projection. No CGAL here: this file
+// is the fast path that runs on tens of thousands of instances; only the rare
+// fallback for dependent active rows calls the exact LP (quasistatics_exact.cpp).
+#include <mpfr.h>
+
+#include <algorithm>
+#include <array>
+
+#include "exact_linear_algebra.h"
+#include "gauss6/reference/quasistatics.h"
+
+namespace gauss6::reference {
+namespace internal {
+
+bool valid_inputs(const Mat6& M, const Vec6& au,
+                  const Eigen::Ref<const Eigen::MatrixXd>& J,
+                  const Eigen::VectorXd& b) {
+  if (J.cols() != 6) return false;
+  if (b.size() != 0 && b.size() != J.rows()) return false;
+  return M.allFinite() && au.allFinite() && J.allFinite() && b.allFinite();
+}
+
+Sym6 symmetric_part(const Mat6& M) {
+  Sym6 S;
+  for (int i = 0; i < 6; ++i)
+    for (int j = 0; j < 6; ++j) {
+      if (i == j) {
+        S[6 * i + j] = M(i, j);
+      } else {
+        S[6 * i + j] = (Rational(M(i, j)) + Rational(M(j, i))) / 2;
+      }
+    }
+  return S;
+}
+
+void integerize(const Rational* v, int n, mpz_class* out) {
+  mpz_class L = 1;
+  for (int i = 0; i < n; ++i) mpz_lcm(L.get_mpz_t(), L.get_mpz_t(), v[i].get_den_mpz_t());
+  for (int i = 0; i < n; ++i) {
+    mpz_divexact(out[i].get_mpz_t(), L.get_mpz_t(), v[i].get_den_mpz_t());
+    out[i] *= v[i].get_num();
+  }
+}
+
+bool bareiss_solve(std::vector<mpz_class>& A, int n, int spd_block,
+                   std::vector<mpz_class>& x, mpz_class& det) {
+  const int w = n + 1;
+  auto at = [&](int i, int j) -> mpz_class& { return A[static_cast<size_t>(w) * i + j]; };
+  mpz_class prev = 1, t;
+  for (int k = 0; k < n; ++k) {
+    // Entry (i, j) after step k is the minor of rows {0..k, i}, columns {0..k, j}.
+    int p = k;
+    if (k < spd_block) {
+      if (sgn(at(k, k)) <= 0) return false;  // leading minor k + 1 of the block
+    } else {
+      while (p < n && sgn(at(p, k)) == 0) ++p;
+      if (p == n) return false;
+      if (p != k)
+        for (int j = k; j < w; ++j) mpz_swap(at(p, j).get_mpz_t(), at(k, j).get_mpz_t());
+    }
+    const mpz_class& piv = at(k, k);
+    for (int i = k + 1; i < n; ++i) {
+      const bool zero_ik = sgn(at(i, k)) == 0;
+      for (int j = k + 1; j < w; ++j) {
+        mpz_mul(t.get_mpz_t(), piv.get_mpz_t(), at(i, j).get_mpz_t());
+        if (!zero_ik) mpz_submul(t.get_mpz_t(), at(i, k).get_mpz_t(), at(k, j).get_mpz_t());
+        mpz_divexact(at(i, j).get_mpz_t(), t.get_mpz_t(), prev.get_mpz_t());
+      }
+      at(i, k) = 0;
+    }
+    prev = piv;
+  }
+  // Back substitution on the integers x = det y (Cramer numerators).
+  det = at(n - 1, n - 1);
+  x.resize(n);
+  for (int i = n - 1; i >= 0; --i) {
+    mpz_mul(t.get_mpz_t(), det.get_mpz_t(), at(i, n).get_mpz_t());
+    for (int j = i + 1; j < n; ++j)
+      if (sgn(at(i, j)) != 0) mpz_submul(t.get_mpz_t(), at(i, j).get_mpz_t(), x[j].get_mpz_t());
+    mpz_divexact(x[i].get_mpz_t(), t.get_mpz_t(), at(i, i).get_mpz_t());
+  }
+  return true;
+}
+
+bool positive_definite(const Sym6& S) {
+  std::vector<mpz_class> A(6 * 7);
+  for (int i = 0; i < 6; ++i) {
+    integerize(&S[6 * i], 6, &A[7 * i]);  // row scaling keeps the minors' signs
+    A[7 * i + 6] = 0;
+  }
+  std::vector<mpz_class> x;
+  mpz_class det;
+  return bareiss_solve(A, 6, /*spd_block=*/6, x, det);
+}
+
+Row6 exact_row(const Eigen::Ref<const Eigen::MatrixXd>& J, int k) {
+  Row6 r;
+  for (int j = 0; j < 6; ++j) r[j] = J(k, j);
+  return r;
+}
+
+}  // namespace internal
+
+using internal::Row6;
+
+double to_double_nearest(const Rational& q) {
+  // 53-bit MPFR rounding to nearest, then an exact conversion.
+  mpfr_t x;
+  mpfr_init2(x, 53);
+  mpfr_set_q(x, q.get_mpq_t(), MPFR_RNDN);
+  const double d = mpfr_get_d(x, MPFR_RNDN);
+  mpfr_clear(x);
+  return d;
+}
+
+double max_abs_difference(const std::vector<Rational>& exact, const Vec6& approx) {
+  Rational worst = 0;
+  const int n = std::min<int>(static_cast<int>(exact.size()), 6);
+  for (int i = 0; i < n; ++i) {
+    const Rational diff = abs(exact[i] - Rational(approx[i]));
+    if (diff > worst) worst = diff;
+  }
+  return to_double_nearest(worst);
+}
+
+std::vector<std::string> to_strings(const std::vector<Rational>& values) {
+  std::vector<std::string> out;
+  out.reserve(values.size());
+  for (const Rational& v : values) out.push_back(v.get_str());
+  return out;
+}
+
+CertificateReport check_certificate(const Mat6& M, const Vec6& au,
+                                    const Eigen::Ref<const Eigen::MatrixXd>& J,
+                                    const Eigen::VectorXd& b,
+                                    const std::vector<int>& active_set) {
+  CertificateReport rep;  // failure = bad_input until the inputs are checked
+  if (!internal::valid_inputs(M, au, J, b)) return rep;
+  const int m = static_cast<int>(J.rows());
+  auto rhs = [&](int k) { return b.size() == 0 ? 0.0 : b[k]; };
+
+  // W as a list of distinct rows, in the caller's order.
+  std::vector<char> in_w(m, 0);
+  std::vector<int> rows;
+  for (int k : active_set) {
+    if (k < 0 || k >= m) return rep;
+    if (!in_w[k]) {
+      in_w[k] = 1;
+      rows.push_back(k);
+    }
+  }
+
+  const internal::Sym6 Ms = internal::symmetric_part(M);
+
+  // 1. A maximal independent subset B of W, greedily in W's order, by
+  //    fraction-free row reduction of the integer-scaled rows: each echelon row
+  //    is zero at the pivot columns of the earlier ones.
+  std::vector<std::array<mpz_class, 6>> echelon;
+  std::vector<int> pivot_col;
+  std::vector<int> basis;
+  for (int k : rows) {
+    const Row6 jk = internal::exact_row(J, k);
+    std::array<mpz_class, 6> r;
+    internal::integerize(jk.data(), 6, r.data());
+    for (size_t e = 0; e < echelon.size(); ++e) {
+      const int pc = pivot_col[e];
+      if (sgn(r[pc]) == 0) continue;
+      const mpz_class f = r[pc], g = echelon[e][pc];
+      for (int j = 0; j < 6; ++j) r[j] = g * r[j] - f * echelon[e][j];
+    }
+    int p = 0;
+    while (p < 6 && sgn(r[p]) == 0) ++p;
+    if (p == 6) {
+      ++rep.num_dependent_rows;
+      continue;
+    }
+    mpz_class content = 0;  // keep the entries small
+    for (int j = 0; j < 6; ++j) mpz_gcd(content.get_mpz_t(), content.get_mpz_t(), r[j].get_mpz_t());
+    for (int j = 0; j < 6; ++j) mpz_divexact(r[j].get_mpz_t(), r[j].get_mpz_t(), content.get_mpz_t());
+    echelon.push_back(std::move(r));
+    pivot_col.push_back(p);
+    basis.push_back(k);
+  }
+  const int nb = static_cast<int>(basis.size());
+  rep.rank = nb;
+
+  // 2. The KKT point of B, written for d = a - au:
+  //      [ sym(M)  -J_B^T ] [ d        ]   [ 0                ]
+  //      [ J_B      0     ] [ lambda_B ] = [ b_B - J_B au     ],
+  //    each row scaled to integers and solved fraction-free; the first six
+  //    pivots are M's leading minors, which checks that M is positive definite.
+  const int n = 6 + nb, w = n + 1;
+  std::vector<mpz_class> K(static_cast<size_t>(n) * w);
+  std::vector<Rational> row(w);
+  for (int i = 0; i < 6; ++i) {
+    for (int j = 0; j < 6; ++j) row[j] = Ms[6 * i + j];
+    for (int q = 0; q < nb; ++q) row[6 + q] = -J(basis[q], i);
+    row[n] = 0;
+    internal::integerize(row.data(), w, &K[static_cast<size_t>(w) * i]);
+  }
+  std::vector<Rational> c(m);  // c_k = J_k au - b_k, exact
+  for (int k = 0; k < m; ++k) {
+    Rational v = -Rational(rhs(k));
+    for (int t = 0; t < 6; ++t)
+      if (J(k, t) != 0 && au[t] != 0) v += Rational(J(k, t)) * Rational(au[t]);
+    c[k] = std::move(v);
+  }
+  for (int q = 0; q < nb; ++q) {
+    for (int j = 0; j < 6; ++j) row[j] = J(basis[q], j);
+    for (int j = 6; j < n; ++j) row[j] = 0;
+    row[n] = -c[basis[q]];
+    internal::integerize(row.data(), w, &K[static_cast<size_t>(w) * (6 + q)]);
+  }
+  std::vector<mpz_class> x;
+  mpz_class det;
+  if (!internal::bareiss_solve(K, n, /*spd_block=*/6, x, det)) {
+    // J_B has full row rank, so only a non-positive-definite M gets here.
+    return rep;
+  }
+  const int det_sign = sgn(det);
+  const Rational det_q(det);
+
+  Row6 a;
+  for (int t = 0; t < 6; ++t) {
+    a[t] = Rational(x[t]) / det_q;
+    a[t] += au[t];
+  }
+  std::vector<Rational> lambda_b(nb);
+  for (int q = 0; q < nb; ++q) lambda_b[q] = Rational(x[6 + q]) / det_q;
+
+  rep.ac_exact.assign(a.begin(), a.end());
+  rep.lambda_exact.assign(m, Rational(0));
+  for (int q = 0; q < nb; ++q) rep.lambda_exact[basis[q]] = lambda_b[q];
+
+  auto finish = [&](CertificateFailure failure, int bad_row, const Rational& amount) {
+    rep.failure = failure;
+    rep.pass = failure == CertificateFailure::none;
+    rep.row = bad_row;
+    rep.amount = to_double_nearest(amount);
+    for (int t = 0; t < 6; ++t) rep.ac_rounded[t] = to_double_nearest(rep.ac_exact[t]);
+    rep.lambda_rounded.resize(m);
+    for (int k = 0; k < m; ++k) rep.lambda_rounded[k] = to_double_nearest(rep.lambda_exact[k]);
+    return rep;
+  };
+
+  // 3. Primal feasibility of every row: s_k = J_k a - b_k = c_k + J_k d, so
+  //    det s_k = det c_k + J_k x is dyadic: no division per row. Remember which
+  //    rows of W are tight.
+  int worst_row = -1;
+  Rational worst = 0;  // most negative det_sign * det * s_k
+  std::vector<int> tight;
+  Rational ts;
+  for (int k = 0; k < m; ++k) {
+    ts = c[k] * det_q;
+    for (int t = 0; t < 6; ++t)
+      if (J(k, t) != 0 && sgn(x[t]) != 0) ts += Rational(J(k, t)) * Rational(x[t]);
+    if (det_sign < 0) ts = -ts;
+    if (ts < worst) {
+      worst = ts;
+      worst_row = k;
+    }
+    if (in_w[k] && sgn(ts) == 0) tight.push_back(k);
+  }
+  if (worst_row >= 0) {
+    const Rational amount = -worst / abs(det_q);
+    return finish(CertificateFailure::violated_constraint, worst_row, amount);
+  }
+
+  // 4. Dual feasibility: lambda_B >= 0 settles it.
+  int neg_row = -1;
+  Rational neg_value = 0;
+  for (int i = 0; i < nb; ++i)
+    if (lambda_b[i] < neg_value) {
+      neg_value = lambda_b[i];
+      neg_row = basis[i];
+    }
+  if (neg_row < 0) return finish(CertificateFailure::none, -1, Rational(0));
+
+  // Otherwise, with more tight rows of W than B, the multipliers are not unique:
+  // search lambda >= 0 over the tight rows with the same wrench g = J_B^T lambda_B,
+  // then verify it here, exactly, whatever found it.
+  if (static_cast<int>(tight.size()) > nb) {
+    Row6 g;
+    for (int t = 0; t < 6; ++t) {
+      Rational v = 0;
+      for (int i = 0; i < nb; ++i) v += Rational(J(basis[i], t)) * lambda_b[i];
+      g[t] = v;
+    }
+    std::vector<Rational> lambda_t;
+    if (internal::find_nonnegative_combination(J, tight, g, lambda_t) &&
+        lambda_t.size() == tight.size()) {
+      bool ok = std::all_of(lambda_t.begin(), lambda_t.end(),
+                            [](const Rational& l) { return sgn(l) >= 0; });
+      for (int t = 0; t < 6 && ok; ++t) {
+        Rational v = 0;
+        for (size_t i = 0; i < tight.size(); ++i) v += Rational(J(tight[i], t)) * lambda_t[i];
+        ok = v == g[t];
+      }
+      if (ok) {
+        rep.used_lp = true;
+        std::fill(rep.lambda_exact.begin(), rep.lambda_exact.end(), Rational(0));
+        for (size_t i = 0; i < tight.size(); ++i) rep.lambda_exact[tight[i]] = lambda_t[i];
+        return finish(CertificateFailure::none, -1, Rational(0));
+      }
+    }
+  }
+  return finish(CertificateFailure::negative_multiplier, neg_row, -neg_value);
+}
+
+}  // namespace gauss6::reference

@@ -1,0 +1,139 @@
+// The exact quasi-static projection (METHOD.md sections 2-3) with CGAL's exact
+// quadratic program solver, and the exact LP behind the certificate check's
+// fallback for dependent active rows. The only CGAL translation unit of the
+// projection code (it takes tens of seconds and over 1 GB to compile).
+//
+// Number types: every input double is a dyadic rational m 2^e, and so are the
+// sums and products c = -sym(M) au and sym(M) = (M + M^T) / 2, so the program
+// is stated in CGAL::Gmpzf (arbitrary-precision binary floating point, exact
+// for + - *) and solved with exact type Gmpzf: no rounding anywhere.
+#include <CGAL/Gmpzf.h>
+#include <CGAL/QP_functions.h>
+#include <CGAL/QP_models.h>
+
+#include "exact_linear_algebra.h"
+#include "gauss6/reference/quasistatics.h"
+
+namespace gauss6::reference {
+namespace {
+
+using ET = CGAL::Gmpzf;
+using Program = CGAL::Quadratic_program<ET>;
+using Solution = CGAL::Quadratic_program_solution<ET>;
+
+// x = man 2^exp, exactly.
+Rational to_rational(const ET& x) {
+  Rational q;
+  mpq_set_z(q.get_mpq_t(), x.man());
+  const long e = x.exp();
+  if (e > 0) mpq_mul_2exp(q.get_mpq_t(), q.get_mpq_t(), static_cast<mp_bitcnt_t>(e));
+  if (e < 0) mpq_div_2exp(q.get_mpq_t(), q.get_mpq_t(), static_cast<mp_bitcnt_t>(-e));
+  return q;
+}
+
+Rational to_rational(const CGAL::Quotient<ET>& x) {
+  return to_rational(x.numerator()) / to_rational(x.denominator());
+}
+
+}  // namespace
+
+ExactProjection project_exact(const Mat6& M, const Vec6& au,
+                              const Eigen::Ref<const Eigen::MatrixXd>& J,
+                              const Eigen::VectorXd& b) {
+  ExactProjection out;  // status = bad_input until the inputs are checked
+  if (!internal::valid_inputs(M, au, J, b)) return out;
+  if (!internal::positive_definite(internal::symmetric_part(M))) return out;
+  const int m = static_cast<int>(J.rows());
+
+  // min 1/2 a^T sym(M) a + c^T a, c = -sym(M) au, subject to J a >= b and
+  // a free. CGAL minimises x^T D x + c^T x and set_d takes 2D (lower triangle).
+  Program qp(CGAL::LARGER, /*finite_lower=*/false, ET(0), /*finite_upper=*/false, ET(0));
+  const ET half(0.5);
+  ET Ms[6][6];
+  for (int i = 0; i < 6; ++i)
+    for (int j = 0; j <= i; ++j) {
+      Ms[i][j] = i == j ? ET(M(i, i)) : (ET(M(i, j)) + ET(M(j, i))) * half;
+      Ms[j][i] = Ms[i][j];
+      if (!CGAL::is_zero(Ms[i][j])) qp.set_d(i, j, Ms[i][j]);
+    }
+  for (int i = 0; i < 6; ++i) {
+    ET c(0);
+    for (int j = 0; j < 6; ++j) c -= Ms[i][j] * ET(au[j]);
+    qp.set_c(i, c);
+  }
+  for (int k = 0; k < m; ++k) {
+    for (int j = 0; j < 6; ++j)
+      if (J(k, j) != 0) qp.set_a(j, k, ET(J(k, j)));  // set_a(variable, row, value)
+    qp.set_b(k, ET(b.size() == 0 ? 0.0 : b[k]));
+  }
+
+  const Solution sol = CGAL::solve_quadratic_program(qp, ET());
+  switch (sol.status()) {
+    case CGAL::QP_INFEASIBLE:
+      out.status = ProjectionStatus::infeasible;
+      return out;
+    case CGAL::QP_UNBOUNDED:
+      out.status = ProjectionStatus::unbounded;
+      return out;
+    case CGAL::QP_OPTIMAL:
+      break;
+    case CGAL::QP_UPDATE:  // an intermediate state, never a solver's answer
+      return out;
+  }
+
+  out.status = ProjectionStatus::optimal;
+  out.ac.reserve(6);
+  for (auto it = sol.variable_values_begin(); it != sol.variable_values_end(); ++it)
+    out.ac.push_back(to_rational(*it));
+  out.ac.resize(6);  // CGAL reports one value per variable: 6
+  // CGAL's multipliers satisfy c + 2 D x + A^T l = 0 with l <= 0 on >= rows:
+  // M (ac - au) = J^T (-l), so the contact multipliers are -l.
+  out.lambda.reserve(m);
+  for (auto it = sol.optimality_certificate_begin(); it != sol.optimality_certificate_end(); ++it)
+    out.lambda.push_back(-to_rational(*it));
+  out.lambda.resize(m);
+
+  for (int i = 0; i < 6; ++i) out.ac_double[i] = to_double_nearest(out.ac[i]);
+  out.lambda_double.resize(m);
+  for (int k = 0; k < m; ++k) out.lambda_double[k] = to_double_nearest(out.lambda[k]);
+  for (int k = 0; k < m; ++k) {
+    Rational s = -Rational(b.size() == 0 ? 0.0 : b[k]);
+    for (int j = 0; j < 6; ++j)
+      if (J(k, j) != 0) s += Rational(J(k, j)) * out.ac[j];
+    if (sgn(s) == 0) out.active_set.push_back(k);
+  }
+  return out;
+}
+
+namespace internal {
+
+bool find_nonnegative_combination(const Eigen::Ref<const Eigen::MatrixXd>& J,
+                                  const std::vector<int>& rows, const Row6& g,
+                                  std::vector<Rational>& lambda) {
+  // Scale g to integers: g = g_num / d, d > 0 the lcm of its denominators; then
+  // mu = d lambda solves sum_i mu_i J_i = g_num, mu >= 0 (a dyadic LP in Gmpzf).
+  mpz_class d = 1;
+  for (const Rational& v : g) mpz_lcm(d.get_mpz_t(), d.get_mpz_t(), v.get_den_mpz_t());
+  Program lp(CGAL::EQUAL, /*finite_lower=*/true, ET(0), /*finite_upper=*/false, ET(0));
+  for (int t = 0; t < 6; ++t) {
+    const mpz_class num = g[t].get_num() * (d / g[t].get_den());
+    lp.set_b(t, ET(num.get_mpz_t()));
+  }
+  const int n = static_cast<int>(rows.size());
+  for (int i = 0; i < n; ++i) {
+    lp.set_c(i, ET(0));
+    for (int t = 0; t < 6; ++t)
+      if (J(rows[i], t) != 0) lp.set_a(i, t, ET(J(rows[i], t)));
+  }
+  const Solution sol = CGAL::solve_linear_program(lp, ET());
+  if (sol.status() != CGAL::QP_OPTIMAL) return false;
+  lambda.clear();
+  const Rational dq(d);
+  for (auto it = sol.variable_values_begin(); it != sol.variable_values_end(); ++it)
+    lambda.push_back(to_rational(*it) / dq);
+  lambda.resize(n);
+  return true;
+}
+
+}  // namespace internal
+}  // namespace gauss6::reference

@@ -1,0 +1,52 @@
+#!/usr/bin/env bash
+# Brings a clone of gauss6 to a working state, idempotently: Debian packages,
+# the Python venv at .venv (pinned requirements.txt), the CMake build (Release
+# with debug info) with the Python extension, and the `gauss6` command in the venv.
+# A second run only rebuilds incrementally. Called by `make test` and `make reproduce`.
+set -euo pipefail
+root=$(cd "$(dirname "$0")/.." && pwd)
+cd "$root"
+
+# 1. Debian packages (one list: tools/debian-packages.txt).
+mapfile -t pkgs < <(grep -v '^\s*#' tools/debian-packages.txt | grep -v '^\s*$')
+missing=()
+for p in "${pkgs[@]}"; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+if [ ${#missing[@]} -gt 0 ]; then
+  if [ "$(id -u)" -ne 0 ]; then
+    echo "gauss6 setup: missing Debian packages; run:" >&2
+    echo "  sudo apt-get update && sudo apt-get install -y ${missing[*]}" >&2
+    exit 1
+  fi
+  echo "gauss6 setup: installing ${missing[*]}"
+  apt-get update -qq
+  DEBIAN_FRONTEND=noninteractive apt-get install -y -qq "${missing[@]}" >/dev/null
+fi
+
+# 2. Python venv with pinned requirements (re-installed only when requirements.txt changes).
+py=${PYTHON:-python3}
+stamp=.venv/.requirements.sha256
+want=$(sha256sum requirements.txt | cut -d' ' -f1)
+if [ ! -x .venv/bin/python ]; then
+  echo "gauss6 setup: creating .venv from $($py --version)"
+  "$py" -m venv .venv
+fi
+if [ "$(cat "$stamp" 2>/dev/null)" != "$want" ]; then
+  echo "gauss6 setup: installing Python requirements"
+  .venv/bin/python -m pip install -q --disable-pip-version-check -r requirements.txt
+  echo "$want" > "$stamp"
+fi
+
+# 3. CMake build (configured once; later runs build incrementally).
+if [ ! -f build/build.ninja ]; then
+  cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo \
+    -DPython_EXECUTABLE="$root/.venv/bin/python" \
+    -Dpybind11_DIR="$(.venv/bin/python -m pybind11 --cmakedir)"
+fi
+cmake --build build -j "${GAUSS6_JOBS:-$(nproc)}"
+
+# 4. The gauss6 package and command in the venv (editable: the extension lives in python/gauss6).
+if [ ! -x .venv/bin/gauss6 ]; then
+  .venv/bin/python -m pip install -q --disable-pip-version-check --no-deps --no-build-isolation -e python
+fi
