@@ -1,0 +1,178 @@
+// Bounding volume hierarchies (axis-aligned boxes) over triangle meshes, their
+// conservative traversal under the Cayley motion, and the mesh-level CCD step
+// ccd_step(): the first contact between the moving god-object and the static
+// obstacles along the in-between motion of METHOD.md section 4.
+//
+// Frames: an obstacle's mesh and BVH are in the world frame W (apply a fixed
+// pose to the vertices once at load time); the god-object's are in its body
+// frame B (origin at G). Swept boxes of god-object nodes over a parameter range
+// U come from the interval enclosure of the motion (ccd.h): for every u in U
+// and every body point in the node's box, the world point lies in the swept box,
+// rounding included. Boxes of obstacles are exact (min/max of doubles).
+//
+// Build: load time (allocates). Traversal and ccd_step: no allocation, no
+// locks, no exceptions; fixed-capacity stacks in the workspace.
+#pragma once
+
+#include <cstdint>
+#include <utility>
+#include <vector>
+
+#include "gauss6/ccd.h"
+#include "gauss6/mesh.h"
+
+namespace gauss6 {
+
+struct Aabb {
+  Vec3 lo = Vec3::Zero(), hi = Vec3::Zero();
+};
+inline bool overlap(const Aabb& a, const Aabb& b) {
+  return (a.lo.array() <= b.hi.array()).all() && (b.lo.array() <= a.hi.array()).all();
+}
+
+struct BvhNode {
+  Aabb box;            // the mesh's own frame
+  int32_t first = 0;   // leaf: first slot in Bvh::triangles; inner: left child (right = first + 1)
+  int32_t count = 0;   // leaf: number of triangles (> 0); inner: 0
+};
+
+// Feature ownership: each vertex and each undirected edge belongs to exactly one
+// of its triangles (the lowest-numbered), so that the feature pairs of all
+// triangle pairs test every (vertex, face) and (edge, edge) pair exactly once.
+struct Bvh {
+  std::vector<BvhNode> nodes;        // nodes[0] is the root (empty mesh: no nodes)
+  std::vector<int32_t> triangles;    // triangle indices, in leaf order
+  std::vector<uint8_t> owned;        // #F: bit k owns vertex F(f,k); bit 3+k owns edge F(f,k)->F(f,(k+1)%3)
+  std::vector<int32_t> neighbor;     // 3 #F: triangle across edge k of f, -1 on a boundary
+  int depth = 0;                     // levels (1: the root is a leaf)
+  double radius = 0;                 // max |vertex| about the frame's origin (scene units)
+  double build_seconds = 0;
+  size_t memory_bytes() const;
+};
+
+// Top-down build: median split of the triangles' centroids along the longest
+// axis of their bounds, leaves of at most leaf_size triangles. Load time.
+Bvh build_bvh(const TriangleMesh& mesh, int leaf_size = 4);
+
+// Exact box of triangle f of the mesh (its own frame).
+Aabb triangle_box(const TriangleMesh& mesh, int f);
+// Conservative world box of every p(u) + R(u) r_B, u in e.u, r_B in body_box.
+Aabb swept_box(const MotionEnclosure& e, const Aabb& body_box);
+// box grown by margin on every side, rounded outward.
+Aabb inflate(const Aabb& box, double margin);
+
+// Fixed-capacity stack of node pairs for the simultaneous descent.
+struct BvhStack {
+  explicit BvhStack(int capacity = 1024) : items(static_cast<size_t>(capacity)) {}
+  std::vector<std::pair<int32_t, int32_t>> items;
+};
+
+enum class TraversalStatus { kDone = 0, kStopped, kStackFull };
+
+// Calls visit(god_triangle, obstacle_triangle) for every pair whose boxes may
+// overlap: god boxes mapped to the world by god_box(Aabb body) -> Aabb world
+// (conservative), obstacle boxes inflated by margin. visit returns false to
+// stop. *num_node_pairs counts the node pairs tested. On kStackFull some pairs
+// were not visited: the caller must treat the result as unknown.
+template <class GodBox, class Visit>
+TraversalStatus for_each_candidate_pair(const TriangleMesh& god_mesh, const Bvh& god, const TriangleMesh& obs_mesh,
+                                        const Bvh& obs, const GodBox& god_box, double margin, BvhStack* stack,
+                                        Visit&& visit, int* num_node_pairs) {
+  if (god.nodes.empty() || obs.nodes.empty()) return TraversalStatus::kDone;
+  const int capacity = static_cast<int>(stack->items.size());
+  auto* items = stack->items.data();
+  int size = 0;
+  items[size++] = {0, 0};
+  while (size > 0) {
+    const auto [gi, oi] = items[--size];
+    const BvhNode& gn = god.nodes[gi];
+    const BvhNode& on = obs.nodes[oi];
+    ++*num_node_pairs;
+    const Aabb gw = god_box(gn.box);
+    if (!overlap(gw, inflate(on.box, margin))) continue;
+    if (gn.count > 0 && on.count > 0) {
+      // Leaf pair: test triangle boxes, then hand the pair over.
+      for (int i = 0; i < gn.count; ++i) {
+        const int gf = god.triangles[gn.first + i];
+        const Aabb gt = god_box(triangle_box(god_mesh, gf));
+        for (int j = 0; j < on.count; ++j) {
+          const int of = obs.triangles[on.first + j];
+          if (!overlap(gt, inflate(triangle_box(obs_mesh, of), margin))) continue;
+          if (!visit(gf, of)) return TraversalStatus::kStopped;
+        }
+      }
+      continue;
+    }
+    if (size + 2 > capacity) return TraversalStatus::kStackFull;
+    // Descend the inner node with the larger box (or the only inner one).
+    const double gs = (gw.hi - gw.lo).sum(), os = (on.box.hi - on.box.lo).sum();
+    if (on.count > 0 || (gn.count == 0 && gs >= os)) {
+      items[size++] = {gn.first + 1, oi};
+      items[size++] = {gn.first, oi};
+    } else {
+      items[size++] = {gi, on.first + 1};
+      items[size++] = {gi, on.first};
+    }
+  }
+  return TraversalStatus::kDone;
+}
+
+// ---------------------------------------------------------------------------
+// Mesh-level CCD step.
+// ---------------------------------------------------------------------------
+
+// A mesh and its BVH (built from that mesh). Obstacles: world frame; god-object:
+// body frame.
+struct CcdBody {
+  const TriangleMesh* mesh = nullptr;
+  const Bvh* bvh = nullptr;
+};
+
+// Which features touch. A vertex is F(face, corner); an edge runs from
+// F(face, corner) to F(face, (corner + 1) % 3); a face is `face` (corner -1).
+enum class PairKind { kGodVertexObstacleFace = 0, kObstacleVertexGodFace, kEdgeEdge };
+const char* to_string(PairKind k);
+struct FeaturePair {
+  PairKind kind = PairKind::kGodVertexObstacleFace;
+  int obstacle = -1;                       // index into the obstacle list
+  int god_face = -1, god_corner = -1;
+  int obstacle_face = -1, obstacle_corner = -1;
+};
+
+struct CcdStepSettings {
+  CcdSettings narrow;                      // tolerances and min_separation of every pair test
+  int max_sub_intervals = 16;              // u-ranges whose swept boxes are computed separately
+  double sub_interval_angle = 0.1;         // radians of rotation per sub-interval (at most)
+  double sub_interval_travel = 0.25;       // travel of G per sub-interval, in god-object radii (at most)
+};
+
+struct CcdStepResult {
+  CcdStatus status = CcdStatus::kOk;       // kOk, kHalfTurn (split the step: split_step()),
+                                           // kInvalidInput, or a pair test's give-up (hit kept conservative)
+  bool hit = false;
+  double u_hit = 1;                        // first possible contact over all pairs (<= u*); 1 when none
+  FeaturePair pair;                        // the pair that gave u_hit (when hit)
+  double time_tolerance_reached = 0, distance_reached = 0;  // of that pair's test
+  CcdMotion motion;                        // the enclosed motion used (for make_stop_pose)
+  int num_sub_intervals = 0, num_node_pairs = 0, num_triangle_pairs = 0, num_pair_tests = 0;
+  long num_box_iterations = 0;             // narrow-phase boxes, all tests together
+};
+
+// Everything ccd_step needs, allocated once.
+struct CcdStepWorkspace {
+  explicit CcdStepWorkspace(int box_capacity = 1 << 14, int stack_capacity = 1024)
+      : narrow(box_capacity), stack(stack_capacity) {}
+  CcdWorkspace narrow;
+  BvhStack stack;
+};
+
+// The first contact of the god-object moving from X0 to X1 (the Cayley motion)
+// with any obstacle: u_hit <= u* over all feature pairs, searching each pair only
+// up to the best u found so far. Inputs: obstacles[0 .. num_obstacles) (world
+// frame), god (body frame), X0, X1 (poses of G). Stop pose: make_stop_pose(
+// result.motion, result.u_hit, god.bvh->radius) when hit (u = 1 otherwise);
+// with narrow.min_separation = d its exact separation is >= d - deviation.
+void ccd_step(const CcdBody* obstacles, int num_obstacles, const CcdBody& god, const Pose& X0, const Pose& X1,
+              const CcdStepSettings& settings, CcdStepWorkspace* ws, CcdStepResult* result);
+
+}  // namespace gauss6

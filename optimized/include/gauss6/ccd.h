@@ -1,0 +1,240 @@
+// Conservative continuous collision detection (CCD), narrow phase and the
+// mesh-level step of METHOD.md section 4.
+//
+// Guarantee. For every query, u_hit <= u*, the exact first parameter at which
+// the two features touch (or, with min_separation > 0, at which their distance
+// may fall to min_separation): the god-object is never advanced into or through
+// a contact. How far u_hit may lie below u* is what the tolerances trade against
+// speed, and every result reports what it reached (time width, distance bound).
+//
+// Method: inclusion-based bisection over the box (u, a, b) of the motion
+// parameter and the two feature parameters, in the spirit of Tight-Inclusion
+// (Wang et al. 2021), with an interval enclosure of the feature difference
+// F(u, a, b) (vertex minus face point, or point of edge A minus point of edge B)
+// whose every floating-point operation is widened outward (see Interval below).
+// A box whose enclosure misses [-min_separation, min_separation]^3 provably
+// contains no contact and is dropped; boxes are explored in increasing u, so the
+// first u-interval accepted (at most time_tolerance wide, holding a small
+// parameter box that may touch) bounds u* from below. So u_hit <= u*, and at
+// u_hit the features are already within distance_reached; if they truly touch
+// in the accepted interval, u* - u_hit <= time_tolerance_reached (in practice
+// u* - u_hit <= 2 time_tolerance unless the motion grazes: see the tests).
+//
+// Two kinds of vertex trajectories:
+//   linear: x(u) = x0 + u (x1 - x0) per vertex (the shared test data's form);
+//   rigid:  the Cayley motion of motion.h for the god-object's body points r_B,
+//           the obstacle static in the world frame.
+//
+// Real-time rules: queries never allocate (CcdWorkspace is sized once), never
+// lock and never throw; bad input is a status.
+#pragma once
+
+#include <algorithm>
+#include <array>
+#include <bit>
+#include <cstdint>
+#include <limits>
+#include <vector>
+
+#include "gauss6/motion.h"
+#include "gauss6/pose.h"
+
+namespace gauss6 {
+
+// ---------------------------------------------------------------------------
+// Interval arithmetic with outward rounding.
+//
+// Proof of enclosure. Every operation below computes its double result(s) in the
+// default round-to-nearest mode (IEEE 754, SSE2 on x86-64: no excess precision)
+// and then moves the lower bound one float down and the upper bound one float up.
+// If r = fl(x) is a nearest float to the exact real x, then next_down(r) <= x:
+// otherwise next_down(r) would lie strictly between x and r, closer to x than r.
+// Likewise next_up(r) >= x. This holds for subnormal results and for overflow
+// (fl(x) = +inf gives next_down = DBL_MAX <= x, and the upper bound stays +inf).
+// The widening works on the bits of the rounded result (std::bit_cast), so a
+// compiler cannot fuse two operations across it (no FMA contraction can skip a
+// rounding we account for), and no -frounding-math is needed: the rounding mode
+// is never changed. A NaN bound makes every exclusion test false (comparisons
+// with NaN are false), so a NaN can only cause a false positive, never a miss.
+// ---------------------------------------------------------------------------
+inline double next_up(double x) {
+  if (!(x < std::numeric_limits<double>::infinity())) return x;  // +inf, NaN
+  if (x == 0) return std::numeric_limits<double>::denorm_min();
+  uint64_t b = std::bit_cast<uint64_t>(x);
+  b = (x > 0) ? b + 1 : b - 1;  // magnitude up for x > 0, down for x < 0
+  return std::bit_cast<double>(b);
+}
+inline double next_down(double x) { return -next_up(-x); }
+
+// A closed interval [lo, hi] of reals; lo <= hi unless a NaN crept in.
+struct Interval {
+  double lo = 0, hi = 0;
+  static Interval point(double x) { return {x, x}; }
+  double width() const { return hi - lo; }
+  bool contains(double x) const { return lo <= x && x <= hi; }
+};
+
+inline Interval operator+(Interval a, Interval b) { return {next_down(a.lo + b.lo), next_up(a.hi + b.hi)}; }
+inline Interval operator-(Interval a, Interval b) { return {next_down(a.lo - b.hi), next_up(a.hi - b.lo)}; }
+inline Interval operator-(Interval a) { return {-a.hi, -a.lo}; }  // exact
+inline Interval operator*(Interval a, Interval b) {
+  const double p1 = a.lo * b.lo, p2 = a.lo * b.hi, p3 = a.hi * b.lo, p4 = a.hi * b.hi;
+  const double lo = std::min(std::min(p1, p2), std::min(p3, p4));
+  const double hi = std::max(std::max(p1, p2), std::max(p3, p4));
+  return {next_down(lo), next_up(hi)};
+}
+inline Interval operator*(double s, Interval a) {
+  const double p1 = s * a.lo, p2 = s * a.hi;
+  return {next_down(std::min(p1, p2)), next_up(std::max(p1, p2))};
+}
+// Quotient by an interval that lies in (0, inf): the caller guarantees b.lo > 0.
+inline Interval div_positive(Interval a, Interval b) {
+  const double q1 = a.lo / b.lo, q2 = a.lo / b.hi, q3 = a.hi / b.lo, q4 = a.hi / b.hi;
+  return {next_down(std::min(std::min(q1, q2), std::min(q3, q4))),
+          next_up(std::max(std::max(q1, q2), std::max(q3, q4)))};
+}
+// Square of an interval (tight: never negative).
+inline Interval sqr(Interval a) {
+  if (a.lo >= 0) return {next_down(a.lo * a.lo), next_up(a.hi * a.hi)};
+  if (a.hi <= 0) return {next_down(a.hi * a.hi), next_up(a.lo * a.lo)};
+  const double m = std::max(-a.lo, a.hi);
+  return {0.0, next_up(m * m)};
+}
+inline Interval hull(Interval a, Interval b) { return {std::min(a.lo, b.lo), std::max(a.hi, b.hi)}; }
+
+using IVec3 = std::array<Interval, 3>;
+using IMat3 = std::array<Interval, 9>;  // row-major
+
+inline IVec3 to_interval(const Vec3& v) { return {Interval::point(v.x()), Interval::point(v.y()), Interval::point(v.z())}; }
+
+// ---------------------------------------------------------------------------
+// The exact Cayley motion, enclosed.
+// ---------------------------------------------------------------------------
+
+// Interval enclosure of the exact in-between motion of METHOD.md section 4 from
+// two double poses: p0, dp = p1 - p0, R0 = R(q0) (rational form) and the Gibbs
+// vector g = vec(qr) / scalar(qr), qr = q1 conj(q0), each enclosing the exact
+// rational value computed from the input doubles. `nominal` is the double motion
+// of motion.h (the same motion, rounded), used for poses and heuristics.
+struct CcdMotion {
+  IVec3 p0, dp, g;
+  IMat3 R0;
+  Interval g2;           // |g|^2
+  IMat3 K2;              // [g]x^2 = g g^T - |g|^2 I
+  CayleyMotion nominal;
+};
+
+// kOk, or the status of make_cayley_motion (invalid pose, half turn). Also
+// kHalfTurn when the enclosure of scalar(qr) is not safely positive.
+MotionStatus make_ccd_motion(const Pose& x0, const Pose& x1, CcdMotion* motion);
+
+// Enclosure of the motion over a parameter range U = [u0, u1] subset of [0, 1]:
+// for every u in U, R(u) is in R and p(u) in p (world frame).
+struct MotionEnclosure {
+  Interval u;
+  IMat3 R;   // entries intersected with [-1, 1] (R(u) is exactly a rotation)
+  IVec3 p;
+};
+void enclose_motion(const CcdMotion& motion, Interval u, MotionEnclosure* out);
+// Enclosure of the world points p(u) + R(u) r_B for u in e.u and r_B in r_B.
+IVec3 enclose_point(const MotionEnclosure& e, const IVec3& r_B);
+
+// ---------------------------------------------------------------------------
+// Requests and results.
+// ---------------------------------------------------------------------------
+
+enum class CcdStatus {
+  kOk = 0,          // the search finished: hit or no hit is decided within the tolerances
+  kMaxIterations,   // gave up after max_iterations boxes: hit reported conservatively
+  kWorkspaceFull,   // box stack full: hit reported conservatively
+  kInvalidInput,    // a non-finite or huge coordinate, or an empty window
+  kHalfTurn,        // mesh step only: relative rotation near 180 degrees, split_step() it
+};
+const char* to_string(CcdStatus s);
+
+struct CcdSettings {
+  double time_tolerance = 1e-6;       // accept a box at most this wide in u ...
+  double distance_tolerance = 1e-9;   // ... holding a feature-parameter box not excluded whose widths move F by
+                                      // at most max(this, u-width x speed) (scene units; raised to 1e-12 of the
+                                      // largest coordinate, the rounding floor)
+  double min_separation = 0;          // report the first u where the distance may be <= this (scene units, >= 0)
+  int max_iterations = 200000;        // boxes examined before a conservative give-up
+};
+
+struct CcdResult {
+  CcdStatus status = CcdStatus::kOk;
+  bool hit = false;                   // conservative: true on give-up
+  double u_hit = 1;                   // first possible contact (<= u*); the window's end when no hit
+  double time_tolerance_reached = 0;  // u-width of the accepted (or last) box
+  double distance_reached = 0;        // hit: the features are within this distance (Euclidean) at u_hit,
+                                      // for some feature parameters; +inf on give-up
+  int iterations = 0;                 // boxes examined
+};
+
+// Box stack of the bisection (the parameter-box fronts of the pending
+// u-intervals), sized once: capacity boxes of 48 bytes.
+class CcdWorkspace {
+ public:
+  explicit CcdWorkspace(int capacity = 1 << 14);
+  struct Box { double u[2], a[2], b[2]; };
+  int capacity() const { return static_cast<int>(boxes_.size()); }
+  Box* data() { return boxes_.data(); }
+
+ private:
+  std::vector<Box> boxes_;
+};
+
+// Linear per-vertex motion: index [0] is the position at u = 0, [1] at u = 1.
+// Vertex/face: contact when the vertex lies on the triangle (face[.][0..2]).
+struct LinearVertexFaceQuery {
+  std::array<Vec3, 2> vertex;
+  std::array<std::array<Vec3, 3>, 2> face;
+  double u_begin = 0, u_end = 1;      // search window, 0 <= u_begin <= u_end <= 1
+};
+// Edge/edge: edge_a[time][endpoint], edge_b[time][endpoint].
+struct LinearEdgeEdgeQuery {
+  std::array<std::array<Vec3, 2>, 2> edge_a, edge_b;
+  double u_begin = 0, u_end = 1;
+};
+
+// Rigid motion: one feature on the moving body (body frame B, moved by *motion),
+// the other static (world frame W).
+struct RigidVertexFaceQuery {
+  const CcdMotion* motion = nullptr;
+  bool vertex_on_body = true;         // true: vertex r_B moving, face static (W);
+                                      // false: vertex static (W), face moving (B)
+  Vec3 vertex = Vec3::Zero();
+  std::array<Vec3, 3> face = {Vec3::Zero(), Vec3::Zero(), Vec3::Zero()};
+  double u_begin = 0, u_end = 1;
+};
+struct RigidEdgeEdgeQuery {
+  const CcdMotion* motion = nullptr;
+  std::array<Vec3, 2> edge_body;      // r_B, moving
+  std::array<Vec3, 2> edge_world;     // static
+  double u_begin = 0, u_end = 1;
+};
+
+void ccd_linear_vertex_face(const LinearVertexFaceQuery& q, const CcdSettings& s, CcdWorkspace* ws, CcdResult* r);
+void ccd_linear_edge_edge(const LinearEdgeEdgeQuery& q, const CcdSettings& s, CcdWorkspace* ws, CcdResult* r);
+void ccd_rigid_vertex_face(const RigidVertexFaceQuery& q, const CcdSettings& s, CcdWorkspace* ws, CcdResult* r);
+void ccd_rigid_edge_edge(const RigidEdgeEdgeQuery& q, const CcdSettings& s, CcdWorkspace* ws, CcdResult* r);
+
+// The mesh-level step (BVH traversal, first hit over all feature pairs) is
+// ccd_step() in bvh.h.
+
+// ---------------------------------------------------------------------------
+// Stop pose.
+// ---------------------------------------------------------------------------
+
+// The pose of the motion at u, as doubles, and a bound on how far any body point
+// with |r_B| <= body_radius lies from where the exact motion puts it at u:
+// |(p + R(q) r_B) - (p(u) + R(u) r_B)| <= deviation. With a CCD run at
+// min_separation = d and u = u_hit, the stop pose's exact separation is at least
+// d - deviation (and the exact motion on [0, u_hit] keeps a distance >= d).
+struct StopPose {
+  Pose pose;
+  double deviation = 0;   // scene units
+};
+StopPose make_stop_pose(const CcdMotion& motion, double u, double body_radius);
+
+}  // namespace gauss6

@@ -1,0 +1,205 @@
+// Contact set generation at a stop pose: BVH descent with boxes grown by the
+// contact distance, closest points of the owned vertex/face and edge/edge pairs,
+// normals signed out of the obstacle, merging of duplicates, Jacobian rows.
+#include "gauss6/contacts.h"
+
+#include <cmath>
+
+namespace gauss6 {
+
+const char* to_string(ContactStatus s) {
+  switch (s) {
+    case ContactStatus::kOk: return "ok";
+    case ContactStatus::kOverflow: return "overflow: more contacts than the set holds, first ones kept";
+    case ContactStatus::kStackFull: return "stack_full: traversal stack too small, set incomplete";
+    case ContactStatus::kInvalidInput: return "invalid_input: bad pose, distance or bodies";
+  }
+  return "unknown";
+}
+
+// Ericson, Real-Time Collision Detection, 5.1.5: Voronoi regions of the triangle.
+Vec3 closest_point_on_triangle(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c) {
+  const Vec3 ab = b - a, ac = c - a, ap = p - a;
+  const double d1 = ab.dot(ap), d2 = ac.dot(ap);
+  if (d1 <= 0 && d2 <= 0) return a;
+  const Vec3 bp = p - b;
+  const double d3 = ab.dot(bp), d4 = ac.dot(bp);
+  if (d3 >= 0 && d4 <= d3) return b;
+  const double vc = d1 * d4 - d3 * d2;
+  if (vc <= 0 && d1 >= 0 && d3 <= 0) return a + (d1 / (d1 - d3)) * ab;
+  const Vec3 cp = p - c;
+  const double d5 = ab.dot(cp), d6 = ac.dot(cp);
+  if (d6 >= 0 && d5 <= d6) return c;
+  const double vb = d5 * d2 - d1 * d6;
+  if (vb <= 0 && d2 >= 0 && d6 <= 0) return a + (d2 / (d2 - d6)) * ac;
+  const double va = d3 * d6 - d5 * d4;
+  if (va <= 0 && (d4 - d3) >= 0 && (d5 - d6) >= 0) return b + ((d4 - d3) / ((d4 - d3) + (d5 - d6))) * (c - b);
+  const double denom = 1 / (va + vb + vc);
+  return a + ab * (vb * denom) + ac * (vc * denom);
+}
+
+// Ericson 5.1.9, with degenerate segments handled.
+void closest_segment_parameters(const Vec3& p0, const Vec3& p1, const Vec3& q0, const Vec3& q1, double* s_out,
+                                double* t_out) {
+  const Vec3 d1 = p1 - p0, d2 = q1 - q0, r = p0 - q0;
+  const double a = d1.squaredNorm(), e = d2.squaredNorm(), f = d2.dot(r);
+  double s = 0, t = 0;
+  if (a <= 0 && e <= 0) {
+    s = t = 0;
+  } else if (a <= 0) {
+    t = std::clamp(f / e, 0.0, 1.0);
+  } else {
+    const double c = d1.dot(r);
+    if (e <= 0) {
+      s = std::clamp(-c / a, 0.0, 1.0);
+    } else {
+      const double b = d1.dot(d2), denom = a * e - b * b;
+      s = denom > 0 ? std::clamp((b * f - c * e) / denom, 0.0, 1.0) : 0.0;
+      t = (b * s + f) / e;
+      if (t < 0) {
+        t = 0;
+        s = std::clamp(-c / a, 0.0, 1.0);
+      } else if (t > 1) {
+        t = 1;
+        s = std::clamp((b - c) / a, 0.0, 1.0);
+      }
+    }
+  }
+  *s_out = s;
+  *t_out = t;
+}
+
+namespace {
+
+Vec3 unit_normal(const Vec3& a, const Vec3& b, const Vec3& c) {
+  const Vec3 n = (b - a).cross(c - a);
+  const double len = n.norm();
+  return len > 0 && std::isfinite(len) ? Vec3(n / len) : Vec3::Zero();
+}
+
+struct Collector {
+  const ContactSettings& settings;
+  double merge_distance, merge_cos;
+  ContactSet* set;
+  bool overflow = false;
+
+  void add(const Contact& c) {
+    ++set->num_pairs_within;
+    for (int i = 0; i < set->num_contacts; ++i) {
+      Contact& o = set->contacts[i];
+      if ((o.point - c.point).norm() <= merge_distance && o.normal.dot(c.normal) >= merge_cos) {
+        if (c.separation < o.separation) o = c;
+        return;
+      }
+    }
+    if (set->num_contacts == set->capacity()) {
+      overflow = true;
+      return;
+    }
+    set->contacts[set->num_contacts++] = c;
+  }
+};
+
+}  // namespace
+
+ContactStatus generate_contacts(const CcdBody* obstacles, int num_obstacles, const CcdBody& god, const Pose& X_WB,
+                                const ContactSettings& settings, ContactWorkspace* ws, ContactSet* set) {
+  set->num_contacts = 0;
+  set->num_pairs_within = 0;
+  if (!god.mesh || !god.bvh || !ws || !is_valid_pose(X_WB) || !(settings.distance > 0) ||
+      !std::isfinite(settings.distance) || ws->god_world.size() != static_cast<size_t>(god.mesh->V.rows()) ||
+      (num_obstacles > 0 && !obstacles))
+    return ContactStatus::kInvalidInput;
+  const TriangleMesh& gm = *god.mesh;
+  const Mat3 R = rotation_matrix(X_WB.q);
+  const Vec3& G = X_WB.p;
+  for (Eigen::Index v = 0; v < gm.V.rows(); ++v) ws->god_world[v] = G + R * gm.V.row(v).transpose();
+  // World box of a body box: centre and half extents through |R|, grown by a
+  // rounding allowance (the double vertices above carry ~1e-16 relative error).
+  const Mat3 absR = R.cwiseAbs();
+  const auto god_box = [&](const Aabb& b) {
+    const Vec3 c = G + R * (0.5 * (b.lo + b.hi));
+    const Vec3 h = absR * (0.5 * (b.hi - b.lo));
+    const Vec3 slack = 1e-12 * (c.cwiseAbs() + h) + Vec3::Constant(1e-300);
+    return Aabb{c - h - slack, c + h + slack};
+  };
+  const double d = settings.distance;
+  Collector col{settings, settings.merge_distance > 0 ? settings.merge_distance : 1e-3 * d,
+                std::cos(settings.merge_angle), set};
+  const double par2 = settings.parallel_sine * settings.parallel_sine;
+  ContactStatus status = ContactStatus::kOk;
+  for (int o = 0; o < num_obstacles; ++o) {
+    if (!obstacles[o].mesh || !obstacles[o].bvh) return ContactStatus::kInvalidInput;
+    const TriangleMesh& om = *obstacles[o].mesh;
+    const Bvh& ob = *obstacles[o].bvh;
+    const auto ov = [&](int f, int k) -> Vec3 { return om.V.row(om.F(f, k)).transpose(); };
+    const auto gv = [&](int f, int k) -> const Vec3& { return ws->god_world[gm.F(f, k)]; };
+    const auto visit = [&](int gf, int of) {
+      const uint8_t go = god.bvh->owned[gf], oo = ob.owned[of];
+      const Vec3 oa = ov(of, 0), obb = ov(of, 1), oc = ov(of, 2);
+      // God vertices against the obstacle face: the face normal.
+      for (int k = 0; k < 3; ++k) {
+        if (!(go & (1u << k))) continue;
+        const Vec3& x = gv(gf, k);
+        const double sep = (x - closest_point_on_triangle(x, oa, obb, oc)).norm();
+        const Vec3 n = unit_normal(oa, obb, oc);
+        if (sep <= d && n != Vec3::Zero())
+          col.add({x, n, sep, {PairKind::kGodVertexObstacleFace, o, gf, k, of, -1}});
+      }
+      // Obstacle vertices against the god face: minus the god face's normal.
+      for (int k = 0; k < 3; ++k) {
+        if (!(oo & (1u << k))) continue;
+        const Vec3 y = ov(of, k);
+        const Vec3 c = closest_point_on_triangle(y, gv(gf, 0), gv(gf, 1), gv(gf, 2));
+        const double sep = (y - c).norm();
+        const Vec3 n = -unit_normal(gv(gf, 0), gv(gf, 1), gv(gf, 2));
+        if (sep <= d && n != Vec3::Zero())
+          col.add({c, n, sep, {PairKind::kObstacleVertexGodFace, o, gf, -1, of, k}});
+      }
+      // Edge/edge with closest points inside both edges, edges not parallel.
+      for (int k = 0; k < 3; ++k) {
+        if (!(go & (8u << k))) continue;
+        const Vec3 &g0 = gv(gf, k), &g1 = gv(gf, (k + 1) % 3);
+        for (int j = 0; j < 3; ++j) {
+          if (!(oo & (8u << j))) continue;
+          const Vec3 o0 = ov(of, j), o1 = ov(of, (j + 1) % 3);
+          double s, t;
+          closest_segment_parameters(g0, g1, o0, o1, &s, &t);
+          if (!(s > 0 && s < 1 && t > 0 && t < 1)) continue;
+          const Vec3 pg = g0 + s * (g1 - g0), po = o0 + t * (o1 - o0);
+          const double sep = (pg - po).norm();
+          if (!(sep <= d)) continue;
+          Vec3 n = (g1 - g0).cross(o1 - o0);
+          if (n.squaredNorm() <= par2 * (g1 - g0).squaredNorm() * (o1 - o0).squaredNorm()) continue;
+          n.normalize();
+          // Sign: from the obstacle's point to the god-object's; if they coincide,
+          // along the obstacle edge's outward direction (sum of its faces' normals).
+          double side = n.dot(pg - po);
+          if (side == 0) {
+            Vec3 out = unit_normal(oa, obb, oc);
+            const int nb = ob.neighbor[3 * of + j];
+            if (nb >= 0) out += unit_normal(ov(nb, 0), ov(nb, 1), ov(nb, 2));
+            side = n.dot(out);
+          }
+          if (side < 0) n = -n;
+          col.add({pg, n, sep, {PairKind::kEdgeEdge, o, gf, k, of, j}});
+        }
+      }
+      return true;
+    };
+    int node_pairs = 0;
+    if (for_each_candidate_pair(gm, *god.bvh, om, ob, god_box, d, &ws->stack, visit, &node_pairs) ==
+        TraversalStatus::kStackFull)
+      status = ContactStatus::kStackFull;
+  }
+  // Jacobian rows J_k = [n_k^T, ((I_k - G) x n_k)^T].
+  for (int k = 0; k < set->num_contacts; ++k) {
+    const Contact& c = set->contacts[k];
+    set->J.row(k).head<3>() = c.normal.transpose();
+    set->J.row(k).tail<3>() = (c.point - G).cross(c.normal).transpose();
+  }
+  if (status == ContactStatus::kOk && col.overflow) status = ContactStatus::kOverflow;
+  return status;
+}
+
+}  // namespace gauss6

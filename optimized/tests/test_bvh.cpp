@@ -1,0 +1,281 @@
+// Tests of bvh.h: tree structure and feature ownership, conservative swept boxes,
+// no truly colliding triangle pair culled (against a brute-force all-pairs run of
+// the narrow phase), and ccd_step on steps with a known first contact.
+#include <catch2/catch.hpp>
+
+#include <gmpxx.h>
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <random>
+#include <set>
+
+#include "gauss6/bvh.h"
+#include "mesh_shapes.h"
+
+using namespace gauss6;
+using gauss6::test::make_box;
+using gauss6::test::make_icosphere;
+
+namespace {
+
+bool contains(const Aabb& outer, const Aabb& inner) {
+  return (outer.lo.array() <= inner.lo.array()).all() && (inner.hi.array() <= outer.hi.array()).all();
+}
+
+// Brute force: every owned feature pair of every triangle pair over [0, 1]; the
+// earliest hit and the set of triangle pairs with a hit.
+struct BruteForce {
+  bool hit = false;
+  double u_hit = 1;
+  std::set<std::pair<int, int>> hitting_pairs;
+};
+BruteForce brute_force(const TriangleMesh& god, const Bvh& gb, const TriangleMesh& obs, const Bvh& ob,
+                       const CcdMotion& m, const CcdSettings& s) {
+  BruteForce out;
+  CcdWorkspace ws;
+  CcdResult r;
+  const auto V = [](const TriangleMesh& mesh, int f, int k) -> Vec3 { return mesh.V.row(mesh.F(f, k)).transpose(); };
+  for (int gf = 0; gf < god.F.rows(); ++gf)
+    for (int of = 0; of < obs.F.rows(); ++of) {
+      const std::array<Vec3, 3> G = {V(god, gf, 0), V(god, gf, 1), V(god, gf, 2)};
+      const std::array<Vec3, 3> O = {V(obs, of, 0), V(obs, of, 1), V(obs, of, 2)};
+      bool any = false;
+      double first = 2;
+      const auto take = [&] {
+        if (r.hit) { any = true; first = std::min(first, r.u_hit); }
+      };
+      for (int k = 0; k < 3; ++k) {
+        if (gb.owned[gf] & (1u << k)) {
+          ccd_rigid_vertex_face({&m, true, G[k], O, 0, 1}, s, &ws, &r);
+          take();
+        }
+        if (ob.owned[of] & (1u << k)) {
+          ccd_rigid_vertex_face({&m, false, O[k], G, 0, 1}, s, &ws, &r);
+          take();
+        }
+        for (int j = 0; j < 3; ++j)
+          if ((gb.owned[gf] & (8u << k)) && (ob.owned[of] & (8u << j))) {
+            ccd_rigid_edge_edge({&m, {G[k], G[(k + 1) % 3]}, {O[j], O[(j + 1) % 3]}, 0, 1}, s, &ws, &r);
+            take();
+          }
+      }
+      if (any) {
+        out.hitting_pairs.insert({gf, of});
+        if (first < out.u_hit || !out.hit) out.u_hit = first;
+        out.hit = true;
+      }
+    }
+  return out;
+}
+
+}  // namespace
+
+TEST_CASE("BVH: structure, boxes and feature ownership", "[bvh]") {
+  const TriangleMesh mesh = make_icosphere(3, 1.0);  // 1280 triangles
+  const Bvh bvh = build_bvh(mesh, 4);
+  std::printf("BVH of %d triangles: %zu nodes, depth %d, %.1f KiB, built in %.3f ms\n", static_cast<int>(mesh.F.rows()),
+              bvh.nodes.size(), bvh.depth, bvh.memory_bytes() / 1024.0, 1e3 * bvh.build_seconds);
+  // Every triangle in exactly one leaf, inside its leaf's box; children inside parents.
+  std::vector<int> seen(mesh.F.rows(), 0);
+  for (const BvhNode& n : bvh.nodes) {
+    if (n.count > 0) {
+      CHECK(n.count <= 4);
+      for (int i = 0; i < n.count; ++i) {
+        const int f = bvh.triangles[n.first + i];
+        ++seen[f];
+        CHECK(contains(n.box, triangle_box(mesh, f)));
+      }
+    } else {
+      CHECK(contains(n.box, bvh.nodes[n.first].box));
+      CHECK(contains(n.box, bvh.nodes[n.first + 1].box));
+    }
+  }
+  for (int c : seen) REQUIRE(c == 1);
+  CHECK(bvh.depth <= 12);  // balanced: ceil(log2(1280 / 4)) + 1 = 10
+  // Each vertex owned once; each undirected edge owned once.
+  std::vector<int> vown(mesh.V.rows(), 0);
+  std::map<std::pair<int, int>, int> eown;
+  for (int f = 0; f < mesh.F.rows(); ++f)
+    for (int k = 0; k < 3; ++k) {
+      if (bvh.owned[f] & (1u << k)) ++vown[mesh.F(f, k)];
+      const auto e = std::minmax(mesh.F(f, k), mesh.F(f, (k + 1) % 3));
+      eown[e] += (bvh.owned[f] & (8u << k)) ? 1 : 0;
+      CHECK(bvh.neighbor[3 * f + k] >= 0);  // closed mesh: every edge has a neighbour
+    }
+  for (int c : vown) CHECK(c == 1);
+  for (const auto& [e, c] : eown) CHECK(c == 1);
+}
+
+TEST_CASE("BVH: swept boxes contain the moving box over the u-range", "[bvh]") {
+  std::mt19937 rng(2);
+  std::normal_distribution<double> n(0, 1);
+  for (int i = 0; i < 200; ++i) {
+    const Pose x0{{n(rng), n(rng), n(rng)}, normalized(Quat{n(rng), n(rng), n(rng), n(rng)})};
+    const Pose x1{x0.p + Vec3(n(rng), n(rng), n(rng)),
+                  normalized(quat_exp(0.012 * i * Vec3(n(rng), n(rng), n(rng)).normalized()) * x0.q)};
+    CcdMotion m;
+    REQUIRE(make_ccd_motion(x0, x1, &m) == MotionStatus::kOk);
+    const double u0 = 0.5 * std::abs(std::tanh(n(rng))), u1 = std::min(1.0, u0 + 0.3 * std::abs(n(rng)));
+    MotionEnclosure e;
+    enclose_motion(m, {u0, u1}, &e);
+    const Vec3 c(n(rng), n(rng), n(rng)), h = Vec3(n(rng), n(rng), n(rng)).cwiseAbs() * 0.3;
+    const Aabb body{c - h, c + h};
+    const Aabb w = swept_box(e, body);
+    for (int k = 0; k <= 10; ++k)
+      for (int corner = 0; corner < 8; ++corner) {
+        const Vec3 r(corner & 1 ? body.hi.x() : body.lo.x(), corner & 2 ? body.hi.y() : body.lo.y(),
+                     corner & 4 ? body.hi.z() : body.lo.z());
+        // 1e-12: motion_point's own rounding.
+        const Vec3 p = motion_point(m.nominal, u0 + (u1 - u0) * k / 10, r);
+        REQUIRE((p.array() >= w.lo.array() - 1e-12).all());
+        REQUIRE((p.array() <= w.hi.array() + 1e-12).all());
+      }
+  }
+}
+
+TEST_CASE("BVH: every truly colliding triangle pair is a candidate; ccd_step agrees with brute force", "[bvh]") {
+  const TriangleMesh god = make_icosphere(1, 0.5);    // 80 triangles, body frame about G
+  const TriangleMesh obs = make_box(2, 2, 1, Vec3(0, 0, -0.5));  // world frame, top at z = 0
+  const TriangleMesh obs2 = make_icosphere(1, 0.4);
+  const Bvh gb = build_bvh(god, 2), ob = build_bvh(obs, 2), ob2 = build_bvh(obs2, 2);
+  std::mt19937 rng(17);
+  std::uniform_real_distribution<double> U(-1, 1);
+  CcdStepSettings settings;
+  CcdStepWorkspace ws;
+  int hits = 0;
+  for (int i = 0; i < 40; ++i) {
+    const bool sphere = i % 2;
+    const TriangleMesh& om = sphere ? obs2 : obs;
+    const Bvh& obvh = sphere ? ob2 : ob;
+    // Start above (or beside) the obstacle, end near or through it.
+    const Vec3 start = sphere ? Vec3(1.2 * U(rng), 1.2 * U(rng), 1.2) : Vec3(U(rng), U(rng), 0.6 + 0.3 * std::abs(U(rng)));
+    const Vec3 end = sphere ? Vec3(0.3 * U(rng), 0.3 * U(rng), 0.3 * U(rng)) : Vec3(U(rng), U(rng), 0.3 * U(rng));
+    const Pose x0{start, normalized(Quat{1 + U(rng), U(rng), U(rng), U(rng)})};
+    const Pose x1{end, normalized(quat_exp(Vec3(U(rng), U(rng), U(rng))) * x0.q)};
+    CcdMotion m;
+    REQUIRE(make_ccd_motion(x0, x1, &m) == MotionStatus::kOk);
+    const BruteForce bf = brute_force(god, gb, om, obvh, m, settings.narrow);
+    // Candidates over the whole step.
+    MotionEnclosure e;
+    enclose_motion(m, {0, 1}, &e);
+    std::set<std::pair<int, int>> candidates;
+    BvhStack stack;
+    int node_pairs = 0;
+    const auto ts = for_each_candidate_pair(
+        god, gb, om, obvh, [&](const Aabb& b) { return swept_box(e, b); }, 0.0, &stack,
+        [&](int gf, int of) {
+          candidates.insert({gf, of});
+          return true;
+        },
+        &node_pairs);
+    REQUIRE(ts == TraversalStatus::kDone);
+    for (const auto& p : bf.hitting_pairs) CHECK(candidates.count(p) == 1);
+    // The mesh-level step finds the same first contact (both are lower bounds of
+    // u*, each within its tolerance; 1e-5 bounds their difference).
+    CcdBody ob_body{&om, &obvh};
+    CcdStepResult r;
+    ccd_step(&ob_body, 1, {&god, &gb}, x0, x1, settings, &ws, &r);
+    REQUIRE(r.status == CcdStatus::kOk);
+    CHECK(r.hit == bf.hit);
+    if (r.hit && bf.hit) {
+      ++hits;
+      CHECK(std::abs(r.u_hit - bf.u_hit) <= 1e-5);
+    }
+  }
+  CHECK(hits >= 10);
+}
+
+TEST_CASE("ccd_step: a box falling flat onto a slab, and one tipping onto it", "[bvh]") {
+  const TriangleMesh god = make_box(1, 1, 1);
+  const TriangleMesh slab = make_box(4, 4, 1, Vec3(0, 0, -0.5));  // top face z = 0
+  const Bvh gb = build_bvh(god), sb = build_bvh(slab);
+  const CcdBody obstacle{&slab, &sb};
+  const CcdBody body{&god, &gb};
+  CcdStepSettings settings;
+  CcdStepWorkspace ws;
+  CcdStepResult r;
+
+  SECTION("falling: the bottom face (z = G - 1/2) reaches z = 0 at u = 1/3") {
+    ccd_step(&obstacle, 1, body, {Vec3(0.1, 0.2, 1.5), Quat{}}, {Vec3(0.1, 0.2, -1.5), Quat{}}, settings, &ws, &r);
+    REQUIRE(r.status == CcdStatus::kOk);
+    REQUIRE(r.hit);
+    CHECK(mpq_class(r.u_hit) <= mpq_class(1, 3));
+    CHECK(1.0 / 3 - r.u_hit <= 1e-5);  // time tolerance 1e-6, distance tolerance 1e-9 at speed 3
+    // Stop pose with min separation: the exact separation stays >= d - deviation > 0.
+    CcdStepSettings sep = settings;
+    sep.narrow.min_separation = 1e-5;
+    ccd_step(&obstacle, 1, body, {Vec3(0.1, 0.2, 1.5), Quat{}}, {Vec3(0.1, 0.2, -1.5), Quat{}}, sep, &ws, &r);
+    REQUIRE(r.hit);
+    const StopPose sp = make_stop_pose(r.motion, r.u_hit, gb.radius);
+    CHECK(sp.deviation < 1e-12);
+    const double bottom = sp.pose.p.z() - 0.5;
+    CHECK(bottom >= 1e-5 - 1e-12);
+    CHECK(bottom <= 1e-5 + 1e-4);  // no stop far from contact (3 u-tolerance + distance tolerances)
+    std::printf("falling box: u_hit %.12f, gap at stop %.3e, %d triangle pairs, %d pair tests, %ld boxes\n", r.u_hit,
+                bottom, r.num_triangle_pairs, r.num_pair_tests, r.num_box_iterations);
+  }
+  SECTION("tipping: a quarter turn about x lowers the box's edge onto the slab") {
+    // G at height 0.6; turning by theta about x, the lowest edge is at
+    // 0.6 - (cos theta + sin theta) / 2: zero at theta* = asin(1.2 / sqrt 2) - 45 deg.
+    // With a 90 degree step, u* = tan(theta* / 2) / tan(45 deg).
+    const double theta = std::asin(1.2 / std::sqrt(2.0)) - M_PI / 4;
+    const double u_star = std::tan(theta / 2);
+    ccd_step(&obstacle, 1, body, {Vec3(0, 0, 0.6), Quat{}}, {Vec3(0, 0, 0.6), quat_exp(Vec3(M_PI / 2, 0, 0))},
+             settings, &ws, &r);
+    REQUIRE(r.status == CcdStatus::kOk);
+    REQUIRE(r.hit);
+    CHECK(r.u_hit <= u_star + 1e-12);  // 1e-12: u_star's own rounding
+    CHECK(u_star - r.u_hit <= 1e-5);
+    std::printf("tipping box: u_hit %.12f (u* %.12f), %d sub-intervals, %d triangle pairs, %d pair tests\n", r.u_hit,
+                u_star, r.num_sub_intervals, r.num_triangle_pairs, r.num_pair_tests);
+  }
+  SECTION("moving away: no hit; bad poses and half turns are statuses") {
+    ccd_step(&obstacle, 1, body, {Vec3(0, 0, 0.6), Quat{}}, {Vec3(0.3, 0, 2), quat_exp(Vec3(0, 0, 1))}, settings, &ws,
+             &r);
+    CHECK(r.status == CcdStatus::kOk);
+    CHECK_FALSE(r.hit);
+    CHECK(r.u_hit == 1.0);
+    ccd_step(&obstacle, 1, body, {Vec3(0, 0, NAN), Quat{}}, {Vec3(0, 0, 2), Quat{}}, settings, &ws, &r);
+    CHECK(r.status == CcdStatus::kInvalidInput);
+    ccd_step(&obstacle, 1, body, {Vec3(0, 0, 2), Quat{}}, {Vec3(0, 0, 2), quat_exp(Vec3(0, 0, 3.1))}, settings, &ws,
+             &r);
+    CHECK(r.status == CcdStatus::kHalfTurn);
+  }
+}
+
+TEST_CASE("ccd_step timing on spheres", "[bvh][timing]") {
+  // Prints per-step times for the report; fails only on a bad status.
+  const TriangleMesh god = make_icosphere(3, 0.5), obs = make_icosphere(4, 1.0);
+  const Bvh gb = build_bvh(god), ob = build_bvh(obs);
+  CcdStepSettings settings;
+  settings.narrow.min_separation = 1e-5;
+  CcdStepWorkspace ws;
+  CcdStepResult r;
+  const CcdBody obstacle{&obs, &ob};
+  std::mt19937 rng(1);
+  std::uniform_real_distribution<double> U(-1, 1);
+  double total = 0, worst = 0;
+  int hits = 0;
+  long pair_tests = 0, boxes = 0, triangle_pairs = 0;
+  const int n = 50;
+  for (int i = 0; i < n; ++i) {
+    const Vec3 dir = Vec3(U(rng), U(rng), U(rng)).normalized();
+    const Pose x0{1.6 * dir, Quat{}};
+    const Pose x1{(1.45 + 0.1 * U(rng)) * dir + 0.02 * Vec3(U(rng), U(rng), U(rng)), quat_exp(0.05 * Vec3(U(rng), U(rng), U(rng)))};
+    const auto t0 = std::chrono::steady_clock::now();
+    ccd_step(&obstacle, 1, {&god, &gb}, x0, x1, settings, &ws, &r);
+    const double dt = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    total += dt;
+    worst = std::max(worst, dt);
+    hits += r.hit;
+    pair_tests += r.num_pair_tests;
+    boxes += r.num_box_iterations;
+    triangle_pairs += r.num_triangle_pairs;
+    REQUIRE(r.status == CcdStatus::kOk);
+  }
+  std::printf("ccd_step, icosphere 1280 tris vs 5120 tris, approach steps: mean %.1f us, worst %.1f us, %d/%d hits; "
+              "per step %ld triangle pairs, %ld pair tests, %ld boxes\n",
+              1e6 * total / n, 1e6 * worst, hits, n, triangle_pairs / n, pair_tests / n, boxes / n);
+}

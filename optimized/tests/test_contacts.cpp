@@ -1,0 +1,125 @@
+// Tests of contacts.h: a box resting on a box (four corner contacts, normals +z,
+// the Jacobian rows), duplicates merged, the edge/edge normal's sign, and the
+// closest-point primitives against dense sampling.
+#include <catch2/catch.hpp>
+
+#include <cmath>
+#include <random>
+
+#include "gauss6/contacts.h"
+#include "mesh_shapes.h"
+
+using namespace gauss6;
+using gauss6::test::make_box;
+
+namespace {
+constexpr double kDelta = 1e-5;
+}
+
+TEST_CASE("contacts: a unit box resting on a slab inside one top triangle", "[contacts]") {
+  // Slab top z = 0 is split along y = x; the god box's footprint x in [0.5, 1.5],
+  // y in [-1.5, -0.5] lies in the triangle y < x, far from every slab edge.
+  const TriangleMesh god = make_box(1, 1, 1), slab = make_box(4, 4, 1, Vec3(0, 0, -0.5));
+  const Bvh gb = build_bvh(god), sb = build_bvh(slab);
+  const CcdBody obstacle{&slab, &sb};
+  ContactWorkspace ws(god);
+  ContactSet set(16);
+  ContactSettings cs;
+  cs.distance = 1.1 * kDelta;
+  const Pose X{Vec3(1, -1, 0.5 + kDelta), Quat{}};
+  REQUIRE(generate_contacts(&obstacle, 1, {&god, &gb}, X, cs, &ws, &set) == ContactStatus::kOk);
+  REQUIRE(set.num_contacts == 4);
+  int corners = 0;
+  for (int k = 0; k < set.num_contacts; ++k) {
+    const Contact& c = set.contacts[k];
+    // Normal +z exactly (axis-aligned face: the cross product is exact).
+    CHECK(c.normal == Vec3(0, 0, 1));
+    CHECK(c.features.kind == PairKind::kGodVertexObstacleFace);
+    // Separation delta up to rounding of 0.5 + delta - 0.5 (1e-16 of 1).
+    CHECK(std::abs(c.separation - kDelta) < 1e-15);
+    const Vec3 r = c.point - X.p;  // (+-1/2, +-1/2, -1/2)
+    CHECK(std::abs(std::abs(r.x()) - 0.5) < 1e-15);
+    CHECK(std::abs(std::abs(r.y()) - 0.5) < 1e-15);
+    CHECK(std::abs(r.z() + 0.5) < 1e-15);
+    corners |= 1 << ((r.x() > 0 ? 1 : 0) + (r.y() > 0 ? 2 : 0));
+    // J_k = [n, (I - G) x n] = [0 0 1, r_y, -r_x, 0].
+    CHECK((set.J.row(k).transpose() - (Vec6() << 0, 0, 1, r.y(), -r.x(), 0).finished()).norm() < 1e-15);
+  }
+  CHECK(set.num_pairs_within == 4);
+  CHECK(corners == 15);  // one contact at each of the four bottom corners
+  // Lifted by 2 delta: out of range, no contact.
+  REQUIRE(generate_contacts(&obstacle, 1, {&god, &gb}, {Vec3(1, -1, 0.5 + 2 * kDelta), Quat{}}, cs, &ws, &set) ==
+          ContactStatus::kOk);
+  CHECK(set.num_contacts == 0);
+}
+
+TEST_CASE("contacts: corners over the slab's diagonal are merged", "[contacts]") {
+  // Centred box: corners (-1/2, -1/2) and (1/2, 1/2) lie on the diagonal y = x
+  // shared by the two top triangles: each is seen by both (6 pairs), 4 contacts.
+  const TriangleMesh god = make_box(1, 1, 1), slab = make_box(4, 4, 1, Vec3(0, 0, -0.5));
+  const Bvh gb = build_bvh(god), sb = build_bvh(slab);
+  const CcdBody obstacle{&slab, &sb};
+  ContactWorkspace ws(god);
+  ContactSet set(16);
+  ContactSettings cs;
+  cs.distance = 1.1 * kDelta;
+  REQUIRE(generate_contacts(&obstacle, 1, {&god, &gb}, {Vec3(0, 0, 0.5 + kDelta), Quat{}}, cs, &ws, &set) ==
+          ContactStatus::kOk);
+  CHECK(set.num_pairs_within == 6);
+  CHECK(set.num_contacts == 4);
+  for (int k = 0; k < set.num_contacts; ++k) CHECK(set.contacts[k].normal == Vec3(0, 0, 1));
+}
+
+TEST_CASE("contacts: edge/edge normal points from the obstacle to the god-object", "[contacts]") {
+  // God box turned 45 degrees about x (lowest edge along x), obstacle box turned
+  // 45 degrees about y (highest edge along y): the edges cross at the origin.
+  const double h = std::sqrt(0.5);  // half diagonal of a unit square
+  const TriangleMesh god = make_box(1, 1, 1);
+  TriangleMesh obs = make_box(1, 1, 1);
+  const Mat3 Ry = rotation_matrix(quat_exp(Vec3(0, M_PI / 4, 0)));
+  for (int v = 0; v < obs.V.rows(); ++v) obs.V.row(v) = (Ry * obs.V.row(v).transpose()).transpose();
+  const Quat qx = quat_exp(Vec3(M_PI / 4, 0, 0));
+  const Bvh gb = build_bvh(god), ob = build_bvh(obs);
+  ContactWorkspace ws(god);
+  ContactSet set(16);
+  ContactSettings cs;
+  cs.distance = 1.1 * kDelta;
+  for (const double side : {+1.0, -1.0}) {
+    // Obstacle centred at the origin (its extreme edges at z = +-h); god centred
+    // at z = +-(2 h + delta/2), so its nearest edge is delta/2 away.
+    const TriangleMesh& o = obs;
+    const CcdBody obstacle{&o, &ob};
+    const Pose X{Vec3(0, 0, side * (2 * h + 0.5 * kDelta)), qx};
+    REQUIRE(generate_contacts(&obstacle, 1, {&god, &gb}, X, cs, &ws, &set) == ContactStatus::kOk);
+    REQUIRE(set.num_contacts == 1);
+    const Contact& c = set.contacts[0];
+    CHECK(c.features.kind == PairKind::kEdgeEdge);
+    // +z when the god-object is above, -z below (1e-12: rounding of the turned boxes).
+    CHECK((c.normal - Vec3(0, 0, side)).norm() < 1e-12);
+    CHECK(std::abs(c.separation - 0.5 * kDelta) < 1e-12);
+    // J row: I - G = (0, 0, -side h) is parallel to n: no torque part.
+    CHECK(set.J.row(0).tail<3>().norm() < 1e-12);
+  }
+}
+
+TEST_CASE("contacts: closest points agree with dense sampling", "[contacts]") {
+  std::mt19937 rng(8);
+  std::normal_distribution<double> n(0, 1);
+  for (int i = 0; i < 200; ++i) {
+    const Vec3 p(n(rng), n(rng), n(rng)), a(n(rng), n(rng), n(rng)), b(n(rng), n(rng), n(rng)), c(n(rng), n(rng), n(rng));
+    const double d = (p - closest_point_on_triangle(p, a, b, c)).norm();
+    double best = INFINITY;
+    for (int s = 0; s <= 100; ++s)
+      for (int t = 0; s + t <= 100; ++t) best = std::min(best, (p - (a + (s / 100.0) * (b - a) + (t / 100.0) * (c - a))).norm());
+    CHECK(d <= best + 1e-12);
+    CHECK(d >= best - 0.03 * ((b - a).norm() + (c - a).norm()));  // grid spacing bound
+    const Vec3 q0(n(rng), n(rng), n(rng)), q1(n(rng), n(rng), n(rng));
+    double s, t;
+    closest_segment_parameters(a, b, q0, q1, &s, &t);
+    const double ds = ((a + s * (b - a)) - (q0 + t * (q1 - q0))).norm();
+    double bs = INFINITY;
+    for (int k = 0; k <= 200; ++k)
+      for (int j = 0; j <= 200; ++j) bs = std::min(bs, ((a + (k / 200.0) * (b - a)) - (q0 + (j / 200.0) * (q1 - q0))).norm());
+    CHECK(ds <= bs + 1e-12);
+  }
+}
