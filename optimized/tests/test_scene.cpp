@@ -6,6 +6,9 @@
 #include <filesystem>
 #include <fstream>
 #include <string>
+#include <system_error>
+
+#include <unistd.h>
 
 #include "gauss6/scene.h"
 
@@ -50,13 +53,19 @@ script = "none"
 
 struct TempScene {
   fs::path dir;
+  // A directory of its own (process id and a counter): tests run in parallel processes.
   explicit TempScene(const std::string& scene_text) {
-    dir = fs::temp_directory_path() / ("gauss6_scene_test_" + std::to_string(std::hash<std::string>{}(scene_text)));
+    static int counter = 0;
+    dir = fs::temp_directory_path() /
+          ("gauss6_scene_test_" + std::to_string(::getpid()) + "_" + std::to_string(counter++));
     fs::create_directories(dir);
     std::ofstream(dir / "box.obj") << kBoxObj;
     std::ofstream(dir / "scene.toml") << scene_text;
   }
-  ~TempScene() { fs::remove_all(dir); }
+  ~TempScene() {
+    std::error_code ignored;
+    fs::remove_all(dir, ignored);
+  }
   std::string path() const { return (dir / "scene.toml").string(); }
 };
 

@@ -3,6 +3,7 @@
     gauss6 scene info SCENE [--json]
     gauss6 datasets generate | check
     gauss6 crosscheck qp [--family NAME] [--json]
+    gauss6 report qp --out DIR
     gauss6 reproduce peg|bunny|all --out DIR
 
 Every subcommand exits non-zero on a failed check, with a message naming the problem.
@@ -92,6 +93,15 @@ def cmd_crosscheck_qp(args: argparse.Namespace) -> int:
     return 0 if result["ok"] else 1
 
 
+def cmd_report_qp(args: argparse.Namespace) -> int:
+    from .report_qp import format_table, run
+
+    result = run(Path(args.out), [args.family] if args.family else None)
+    print(format_table(result))
+    print(f"written to {args.out}/ (time_vs_error.png, .svg, table.md, results.json)")
+    return 0
+
+
 def build_parser() -> argparse.ArgumentParser:
     p = argparse.ArgumentParser(prog="gauss6", description=__doc__.splitlines()[0])
     sub = p.add_subparsers(dest="command", required=True)
@@ -117,6 +127,12 @@ def build_parser() -> argparse.ArgumentParser:
     ccq.add_argument("--tolerance", type=float, default=1e-9, help="max relative error in the M-norm (default 1e-9)")
     ccq.add_argument("--no-osqp", action="store_true", help="skip the OSQP cross-check")
     ccq.set_defaults(func=cmd_crosscheck_qp)
+
+    report = sub.add_parser("report", help="speed against error reports").add_subparsers(dest="what", required=True)
+    rq = report.add_parser("qp", help="projection solvers: time against error on the same instances")
+    rq.add_argument("--out", required=True, help="output directory")
+    rq.add_argument("--family", help="one instance family (default: all but warm)")
+    rq.set_defaults(func=cmd_report_qp)
 
     rep = sub.add_parser("reproduce", help="run the paper's scenarios and write figures and summaries")
     rep.add_argument("scenario", choices=["peg", "bunny", "all"])

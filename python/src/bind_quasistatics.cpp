@@ -7,6 +7,7 @@
 #include <pybind11/stl.h>
 
 #include <algorithm>
+#include <chrono>
 #include <optional>
 #include <string>
 
@@ -122,6 +123,40 @@ void bind_quasistatics(py::module_& m) {
       .def(py::init<const ProjectionSettings&>(), py::arg("settings") = ProjectionSettings{})
       .def("project", &Projector::project, py::arg("M"), py::arg("au"), py::arg("J"), py::arg("b") = py::none())
       .def("reset", &Projector::reset);
+
+  m.def("time_project",
+        [](const Mat6& M, const Vec6& au, const RowsX6& J, const std::optional<Eigen::VectorXd>& b, int repeats,
+           bool warm) {
+          // Native timing for reports (`gauss6 report qp`), not a benchmark: the
+          // median of `repeats` calls timed one by one with steady_clock. Cold:
+          // a fresh workspace per call; warm: the same workspace, primed once.
+          check_shapes(J, b);
+          ProjectionProblem problem;
+          problem.M = &M;
+          problem.au = au;
+          problem.J = J.rows() ? J.data() : nullptr;
+          problem.b = b ? b->data() : nullptr;
+          problem.num_rows = static_cast<int>(J.rows());
+          ProjectionSettings settings;
+          settings.warm_start = warm;
+          settings.compute_residuals = false;
+          ProjectionResult r;
+          ProjectionWorkspace primed;
+          project(problem, settings, &primed, &r);
+          std::vector<double> t(std::max(repeats, 1));
+          for (double& ti : t) {
+            ProjectionWorkspace fresh;
+            ProjectionWorkspace* ws = warm ? &primed : &fresh;
+            const auto t0 = std::chrono::steady_clock::now();
+            project(problem, settings, ws, &r);
+            const auto t1 = std::chrono::steady_clock::now();
+            ti = std::chrono::duration<double>(t1 - t0).count();
+          }
+          std::nth_element(t.begin(), t.begin() + t.size() / 2, t.end());
+          return t[t.size() / 2];
+        },
+        py::arg("M"), py::arg("au"), py::arg("J"), py::arg("b") = py::none(), py::arg("repeats") = 21,
+        py::arg("warm") = false, "Median seconds of one projection, timed natively (cold or warm).");
 
   m.def("coupling_force",
         [](const Mat6& M, const Vec6& au, const RowsX6& J, double kh, const std::optional<Eigen::VectorXd>& b) {

@@ -18,7 +18,7 @@ const char* to_string(reference::ProjectionStatus s) {
   switch (s) {
     case reference::ProjectionStatus::optimal: return "optimal";
     case reference::ProjectionStatus::infeasible: return "infeasible";
-    case reference::ProjectionStatus::unbounded: return "unbounded";
+    case reference::ProjectionStatus::solver_failure: return "solver_failure";
     case reference::ProjectionStatus::bad_input: return "bad_input";
   }
   return "unknown";

@@ -42,6 +42,23 @@ bool positive_definite(const Sym6& S);
 // Row k of J, exactly.
 Row6 exact_row(const Eigen::Ref<const Eigen::MatrixXd>& J, int k);
 
+// Exact verification of a claimed optimum of the projection, independent of
+// whichever solver produced it: J ac >= b, lambda >= 0, lambda_k (J_k ac - b_k)
+// = 0 for every row, and sym(M) (ac - au) = J^T lambda. These KKT conditions
+// are sufficient for a strictly convex problem, so true means ac is the exact
+// optimum. ac has size 6, lambda size m (else false); b as in project_exact.
+bool verify_optimum(const Mat6& M, const Vec6& au,
+                    const Eigen::Ref<const Eigen::MatrixXd>& J,
+                    const Eigen::VectorXd& b, const std::vector<Rational>& ac,
+                    const std::vector<Rational>& lambda);
+
+// Exact verification of a Farkas certificate of infeasibility of J a >= b:
+// y >= 0 (size m), J^T y = 0 and b^T y > 0 (so 0 = y^T J a >= y^T b > 0 would
+// follow for any feasible a). b as in project_exact (size 0 means 0: never
+// infeasible).
+bool verify_infeasibility(const Eigen::Ref<const Eigen::MatrixXd>& J,
+                          const Eigen::VectorXd& b, const std::vector<Rational>& y);
+
 // Searches lambda >= 0 (one entry per listed row) with
 //   sum_i lambda_i J_{rows[i]} = g
 // exactly (an exact linear program, CGAL). Returns false when none exists.

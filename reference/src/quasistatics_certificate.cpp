@@ -101,6 +101,57 @@ Row6 exact_row(const Eigen::Ref<const Eigen::MatrixXd>& J, int k) {
   return r;
 }
 
+bool verify_optimum(const Mat6& M, const Vec6& au,
+                    const Eigen::Ref<const Eigen::MatrixXd>& J,
+                    const Eigen::VectorXd& b, const std::vector<Rational>& ac,
+                    const std::vector<Rational>& lambda) {
+  const int m = static_cast<int>(J.rows());
+  if (ac.size() != 6 || static_cast<int>(lambda.size()) != m) return false;
+  // Primal and dual feasibility, complementarity, row by row.
+  Rational s;
+  for (int k = 0; k < m; ++k) {
+    if (sgn(lambda[k]) < 0) return false;
+    s = b.size() == 0 ? Rational(0) : Rational(-b[k]);
+    for (int j = 0; j < 6; ++j)
+      if (J(k, j) != 0) s += Rational(J(k, j)) * ac[j];
+    if (sgn(s) < 0) return false;
+    if (sgn(s) != 0 && sgn(lambda[k]) != 0) return false;
+  }
+  // Stationarity: sym(M) (ac - au) == J^T lambda, entry by entry.
+  const Sym6 Ms = symmetric_part(M);
+  Row6 d;
+  for (int j = 0; j < 6; ++j) d[j] = ac[j] - Rational(au[j]);
+  Rational lhs;
+  for (int i = 0; i < 6; ++i) {
+    lhs = 0;
+    for (int j = 0; j < 6; ++j)
+      if (sgn(Ms[6 * i + j]) != 0) lhs += Ms[6 * i + j] * d[j];
+    for (int k = 0; k < m; ++k)
+      if (J(k, i) != 0 && sgn(lambda[k]) != 0) lhs -= Rational(J(k, i)) * lambda[k];
+    if (sgn(lhs) != 0) return false;
+  }
+  return true;
+}
+
+bool verify_infeasibility(const Eigen::Ref<const Eigen::MatrixXd>& J,
+                          const Eigen::VectorXd& b, const std::vector<Rational>& y) {
+  const int m = static_cast<int>(J.rows());
+  if (static_cast<int>(y.size()) != m || b.size() != m) return false;
+  Rational v = 0;
+  for (int k = 0; k < m; ++k) {
+    if (sgn(y[k]) < 0) return false;
+    if (b[k] != 0) v += Rational(b[k]) * y[k];
+  }
+  if (sgn(v) <= 0) return false;  // b^T y > 0
+  for (int j = 0; j < 6; ++j) {   // J^T y == 0
+    v = 0;
+    for (int k = 0; k < m; ++k)
+      if (J(k, j) != 0) v += Rational(J(k, j)) * y[k];
+    if (sgn(v) != 0) return false;
+  }
+  return true;
+}
+
 }  // namespace internal
 
 using internal::Row6;

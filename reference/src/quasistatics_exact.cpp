@@ -6,7 +6,9 @@
 // Number types: every input double is a dyadic rational m 2^e, and so are the
 // sums and products c = -sym(M) au and sym(M) = (M + M^T) / 2, so the program
 // is stated in CGAL::Gmpzf (arbitrary-precision binary floating point, exact
-// for + - *) and solved with exact type Gmpzf: no rounding anywhere.
+// for + - *) and solved with exact type Gmpzf: no rounding anywhere. CGAL's
+// answer is then verified in GMP rationals by code that does not use CGAL
+// (quasistatics_certificate.cpp) before it is returned.
 #include <CGAL/Gmpzf.h>
 #include <CGAL/QP_functions.h>
 #include <CGAL/QP_models.h>
@@ -68,31 +70,40 @@ ExactProjection project_exact(const Mat6& M, const Vec6& au,
   }
 
   const Solution sol = CGAL::solve_quadratic_program(qp, ET());
-  switch (sol.status()) {
-    case CGAL::QP_INFEASIBLE:
-      out.status = ProjectionStatus::infeasible;
-      return out;
-    case CGAL::QP_UNBOUNDED:
-      out.status = ProjectionStatus::unbounded;
-      return out;
-    case CGAL::QP_OPTIMAL:
-      break;
-    case CGAL::QP_UPDATE:  // an intermediate state, never a solver's answer
-      return out;
-  }
 
-  out.status = ProjectionStatus::optimal;
-  out.ac.reserve(6);
+  // Every answer is verified here in exact rational arithmetic, independently
+  // of CGAL's own claim: a Farkas certificate for infeasible, the KKT
+  // conditions for optimal. Anything unverified is a solver failure.
+  out.status = ProjectionStatus::solver_failure;
+  if (sol.status() == CGAL::QP_INFEASIBLE) {
+    // CGAL's certificate l has l <= 0 on >= rows, l^T A = 0, l^T b < 0: y = -l.
+    std::vector<Rational> y;
+    y.reserve(m);
+    for (auto it = sol.infeasibility_certificate_begin();
+         it != sol.infeasibility_certificate_end(); ++it)
+      y.push_back(-to_rational(*it));
+    if (internal::verify_infeasibility(J, b, y)) out.status = ProjectionStatus::infeasible;
+    return out;
+  }
+  // sym(M) is positive definite (checked exactly above), so "unbounded" is
+  // impossible, and QP_UPDATE is an intermediate state, never an answer.
+  if (sol.status() != CGAL::QP_OPTIMAL) return out;
+
+  // Both iterators give CGAL::Quotient<ET> values (numerator / denominator).
+  std::vector<Rational> ac, lambda;
+  ac.reserve(6);
   for (auto it = sol.variable_values_begin(); it != sol.variable_values_end(); ++it)
-    out.ac.push_back(to_rational(*it));
-  out.ac.resize(6);  // CGAL reports one value per variable: 6
+    ac.push_back(to_rational(*it));
   // CGAL's multipliers satisfy c + 2 D x + A^T l = 0 with l <= 0 on >= rows:
   // M (ac - au) = J^T (-l), so the contact multipliers are -l.
-  out.lambda.reserve(m);
+  lambda.reserve(m);
   for (auto it = sol.optimality_certificate_begin(); it != sol.optimality_certificate_end(); ++it)
-    out.lambda.push_back(-to_rational(*it));
-  out.lambda.resize(m);
+    lambda.push_back(-to_rational(*it));
+  if (!internal::verify_optimum(M, au, J, b, ac, lambda)) return out;
 
+  out.status = ProjectionStatus::optimal;
+  out.ac = std::move(ac);
+  out.lambda = std::move(lambda);
   for (int i = 0; i < 6; ++i) out.ac_double[i] = to_double_nearest(out.ac[i]);
   out.lambda_double.resize(m);
   for (int k = 0; k < m; ++k) out.lambda_double[k] = to_double_nearest(out.lambda[k]);

@@ -33,11 +33,19 @@ using Rational = mpq_class;
 // ---------------------------------------------------------------------------
 // Exact projection (CGAL's exact quadratic program solver).
 
+// Every optimal or infeasible answer is verified in exact rational arithmetic
+// after the solve, independently of the solver's own claim: optimal means the
+// returned (ac, lambda) satisfy J ac >= b, lambda >= 0, complementarity and
+// sym(M) (ac - au) = J^T lambda exactly (sufficient for this strictly convex
+// problem); infeasible means a Farkas certificate y >= 0 with J^T y = 0 and
+// b^T y > 0 was checked exactly.
 enum class ProjectionStatus {
-  optimal,     // ac, lambda hold the exact optimum and multipliers
-  infeasible,  // no a satisfies J a >= b (possible only when b != 0)
-  unbounded,   // cannot happen for M positive definite; reported if it does
-  bad_input,   // non-finite entry, wrong sizes, or sym(M) not positive definite
+  optimal,         // ac, lambda hold the exact optimum and multipliers (verified)
+  infeasible,      // no a satisfies J a >= b (possible only when b != 0; verified)
+  solver_failure,  // the solver's answer did not pass the exact verification
+                   // (or it claimed "unbounded", impossible for sym(M) > 0);
+                   // ac, lambda are empty. Never seen on the test families.
+  bad_input,       // non-finite entry, wrong sizes, or sym(M) not positive definite
 };
 
 struct ExactProjection {
@@ -52,12 +60,21 @@ struct ExactProjection {
 };
 
 // Solves the projection exactly.
+//
+// The optimum is that of the problem exactly as given in doubles. Where rows are
+// nearly dependent (a body jammed between opposite faces, coplanar contacts),
+// rounding J to doubles can shrink the exact feasible cone to a lower dimension
+// than the intended geometry has; the exact optimum then has huge multipliers
+// (1e12 and more) and can differ by O(|au|) from a floating-point solver's
+// answer, which violates some row exactly by about 1e-20. Both are right: such
+// an instance is ill-conditioned (test "[refqp-illposed]").
 //   M   6 x 6, symmetric part positive definite.
 //   au  6, unconstrained acceleration.
 //   J   m x 6 (m >= 0), one contact per row.
 //   b   size m, or size 0 for b = 0 (no offsets).
-// Not real-time: allocates; about 0.5 ms CPU for m = 3, 1.5 ms for m = 12,
-// 5 ms for m = 50 (test "[refqp-timing]", random contacts).
+// Not real-time: allocates; about 0.4 ms CPU for m = 3, 1.3 ms for m = 12,
+// 5 ms for m = 50 (test "[refqp-timing]", random contacts), the exact
+// verification included (about a sixth of it).
 ExactProjection project_exact(const Mat6& M, const Vec6& au,
                               const Eigen::Ref<const Eigen::MatrixXd>& J,
                               const Eigen::VectorXd& b = Eigen::VectorXd());
