@@ -6,6 +6,8 @@
 
 #include <cmath>
 
+#include "gauss6/contacts.h"  // closest points: the separating axes of the u-filter
+
 namespace gauss6 {
 
 const char* to_string(CcdStatus s) {
@@ -490,6 +492,211 @@ double rigid_speed(const CcdMotion& m, double rho) {
   return max_abs(m.nominal.dp) + 2 * m.nominal.g.norm() * rho;
 }
 
+// ---------------------------------------------------------------------------
+// Cheap u-filters run before the bisection (rigid trajectories).
+//
+// Two necessary conditions for a contact within distance d at parameter u,
+// each enclosed over a u-interval U with outward-rounded interval arithmetic
+// from the enclosed motion (so they hold for the exact motion of the input
+// doubles):
+//
+// (1) Coplanarity polynomial. With D(u) = 1 + u^2 s, s = |g|^2, and
+//     Dc(u) v = D(u) C(u g) v = v + u (2 g x v) + u^2 (2 (g.v) g - s v), the
+//     conditions below are cubics P(u) = k0 + k1 u + k2 u^2 + k3 u^3:
+//   - body vertex w = R0 r_B, static face (f0, n = (f1 - f0) x (f2 - f0)):
+//       P = D (p(u) - f0).n + (Dc(u) w).n = D times (x(u) - f0).n;
+//       the vertex is within d of the face only if |P| <= d |n| D.
+//   - static vertex y, body face (f0' = R0 f0_B, n' = R0 n_B):
+//       P = (y - p(u)).Dc(u) n' - D f0'.n' = D times (y - x_f0(u)).(C n');
+//       |C n'| = |n_B|, so the condition is |P| <= d |n_B| D.
+//   - body edge (a0' = R0 a0_B, ea' = R0 ea_B), static edge (b0, eb):
+//       det[p(u) + C a0' - b0, C ea', eb] = det[p(u) - b0, C ea', eb]
+//       + det[a0', ea', C^T eb] (det[C x, C y, z] = det[x, y, C^T z]) and
+//       C^T = C(-u g), so P = D det = det[p(u) - b0, Dc(u) ea', eb]
+//       + det[a0', ea', Dc(-u) eb]. The lines' distance is |det| / |C ea' x eb|
+//       (a lower bound of the segments' distance), and
+//       |C ea' x eb| <= |ea' x eb| + |C ea' - ea'| |eb| <= |ea' x eb| + theta |ea| |eb|
+//       with theta = 2 atan(u |g|) <= 2 u |g| (a chord is shorter than its arc):
+//       contact within d only if |P| <= d L D, L that bound (parallel edges:
+//       P = 0, the condition holds and this filter never rejects them).
+//     Over U, P is enclosed twice (Horner, and the mean-value form
+//     P(m) + P'(U) (U - m), valid as P is smooth) and the two intersected;
+//     U is excluded when |P| > d L max_U D on all of it.
+// (2) A separating axis. For any fixed vector n, points x, y within d have
+//     |n.x - n.y| <= d |n|. The moving feature's points at u are convex
+//     combinations of its corners, so their projections lie within the hull of
+//     the corners' projections. A body corner's world point is
+//       x(u) = p0 + w + u (dp + 2 g x w) - gamma(u) (g x w) + beta(u) g x (g x w),
+//     with alpha = 2u / D = 2u - gamma, gamma = 2 u^3 s / D in [0, 2 u^3 s], and
+//     beta = 2 u^2 / D increasing in u: its projection over U is enclosed by
+//     c0 + U c1 - Gamma c2 + B c3 (scalar intervals). U is excluded when the
+//     moving and static projections lie more than d |n| apart. The axis, any
+//     vector, is taken from the features' closest points at the window's start
+//     (the direction conservative advancement would use); n = 0 disables it.
+//
+// Guarantee. A u-interval is dropped only when (1) or (2) proves that no
+// contact within d occurs in it; the bisection then runs on the remaining
+// windows in increasing u, so its first accepted interval still starts at or
+// before u*. Windows are produced by a depth-first left-first 1-D subdivision
+// that keeps intervals down to a width of (window)/2^10 (or the time tolerance),
+// merged when adjacent; past a fixed number of evaluations the rest of the
+// window is kept whole (conservative).
+// ---------------------------------------------------------------------------
+
+IVec3 mul(const IMat3& R, const IVec3& v) {
+  IVec3 out;
+  for (int i = 0; i < 3; ++i) out[i] = R[3 * i] * v[0] + R[3 * i + 1] * v[1] + R[3 * i + 2] * v[2];
+  return out;
+}
+Interval dot(const IVec3& a, const IVec3& b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
+IVec3 cross(const IVec3& a, const IVec3& b) {
+  return {a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]};
+}
+IVec3 scale(Interval s, const IVec3& a) { return {s * a[0], s * a[1], s * a[2]}; }
+// Upper bound of the Euclidean norm of every vector in the box v.
+double norm_upper(const IVec3& v) {
+  double s2 = 0;
+  for (const Interval& c : v) {
+    const double m = std::max(std::abs(c.lo), std::abs(c.hi));
+    s2 = next_up(s2 + next_up(m * m));
+  }
+  return next_up(std::sqrt(s2));
+}
+Interval intersect(Interval a, Interval b) { return {std::max(a.lo, b.lo), std::min(a.hi, b.hi)}; }
+
+// Coefficients of Dc(u) v = v + u c1 + u^2 c2.
+struct CayleyCoefficients { IVec3 c1, c2; };
+CayleyCoefficients cayley_coefficients(const CcdMotion& m, const IVec3& v) {
+  const IVec3 gxv = cross(m.g, v);
+  const Interval gv = dot(m.g, v);
+  const IVec3 c2 = scale(2.0 * gv, m.g) - scale(m.g2, v);
+  return {2.0 * gxv, c2};
+}
+
+struct UFilter {
+  // (1) the cubic and the right-hand side factor d L (>= 0); active when has_cubic.
+  bool has_cubic = false;
+  Interval k[4];
+  double dL = 0;
+  // (2) the axis: corners' projection coefficients and the static projection
+  // grown by d |n|; active when num_corners > 0.
+  int num_corners = 0;
+  Interval c0[3], c1[3], c2[3], c3[3];
+  Interval static_proj;
+  const CcdMotion* motion = nullptr;
+
+  // Adds a body corner w = R0 r_B (world-oriented offset from G) for the axis n.
+  void add_corner(const IVec3& w, const IVec3& n) {
+    const IVec3 gxw = cross(motion->g, w), ggw = cross(motion->g, gxw);
+    const int j = num_corners++;
+    c0[j] = dot(n, motion->p0 + w);
+    c1[j] = dot(n, motion->dp + 2.0 * gxw);
+    c2[j] = dot(n, gxw);
+    c3[j] = dot(n, ggw);
+  }
+  void set_axis_static(Interval proj, const IVec3& n, double d) {
+    const double dn = next_up(d * norm_upper(n));
+    static_proj = {next_down(proj.lo - dn), next_up(proj.hi + dn)};
+  }
+
+  bool excludes(double u0, double u1) const {
+    const Interval U{u0, u1};
+    const Interval s = motion->g2;
+    if (has_cubic) {
+      const Interval k1 = k[1], k2 = k[2], k3 = k[3];
+      const Interval horner = k[0] + U * (k1 + U * (k2 + U * k3));
+      const double mid = 0.5 * (u0 + u1);
+      const Interval M = Interval::point(mid);
+      const Interval at_mid = k[0] + M * (k1 + M * (k2 + M * k3));
+      const Interval slope = k1 + U * (2.0 * k2 + U * (3.0 * k3));
+      const Interval P = intersect(horner, at_mid + slope * (U - M));
+      const double rhs = (Interval::point(dL) * (Interval::point(1) + sqr(Interval::point(u1)) * s)).hi;
+      if (P.lo > rhs || P.hi < -rhs) return true;
+    }
+    if (num_corners > 0) {
+      const auto beta_at = [&](double v) {
+        return div_positive(2.0 * sqr(Interval::point(v)), Interval::point(1) + sqr(Interval::point(v)) * s);
+      };
+      const Interval B = hull(beta_at(u0), beta_at(u1));
+      const Interval Gamma{0, (2.0 * (sqr(Interval::point(u1)) * Interval::point(u1)) * s).hi};
+      Interval proj{};
+      for (int j = 0; j < num_corners; ++j) {
+        const Interval pj = c0[j] + U * c1[j] - Gamma * c2[j] + B * c3[j];
+        proj = j == 0 ? pj : hull(proj, pj);
+      }
+      if (proj.lo > static_proj.hi || proj.hi < static_proj.lo) return true;
+    }
+    return false;
+  }
+};
+
+// Runs the bisection on the windows of [u_begin, u_end] that the filter cannot
+// exclude, in increasing u; the first hit ends the search.
+template <class Enclose>
+void filtered_bisect(const Enclose& enclose, bool triangle, const Scales& sc, const UFilter& filter, double u_begin,
+                     double u_end, const CcdSettings& s, CcdWorkspace* ws, CcdResult* r) {
+  constexpr int kMaxEvaluations = 512, kStack = 64;
+  const double min_width = std::max(s.time_tolerance, std::ldexp(u_end - u_begin, -10));
+  int evaluations = 0, total_iterations = 0;
+  bool pending = false;
+  double w0 = 0, w1 = 0;  // the pending window
+  *r = CcdResult{};
+  // Bisection on one window; true when it ends the search (hit or give-up).
+  const auto run = [&](double a, double b) {
+    CcdSettings sw = s;
+    sw.max_iterations = std::max(1, s.max_iterations - total_iterations);
+    bisect(enclose, triangle, sc, a, b, sw, ws, r);
+    total_iterations += r->iterations;
+    r->iterations = total_iterations;
+    return r->hit;
+  };
+  const auto keep = [&](double a, double b) {
+    if (pending && a == w1) {
+      w1 = b;
+      return false;
+    }
+    const bool done = pending && run(w0, w1);
+    pending = true;
+    w0 = a;
+    w1 = b;
+    return done;
+  };
+  double stack[kStack][2];
+  int top = 0;
+  stack[top][0] = u_begin;
+  stack[top][1] = u_end;
+  ++top;
+  while (top > 0) {
+    --top;
+    const double a = stack[top][0], b = stack[top][1];
+    if (evaluations >= kMaxEvaluations) {
+      // Budget spent: keep the rest whole (everything still on the stack lies
+      // to the right of a and ends at u_end).
+      if (keep(a, u_end)) return;
+      top = 0;
+      break;
+    }
+    ++evaluations;
+    if (filter.excludes(a, b)) continue;
+    const double m = 0.5 * (a + b);
+    if (b - a <= min_width || !(a < m && m < b) || top + 2 > kStack) {
+      if (keep(a, b)) return;
+      continue;
+    }
+    stack[top][0] = m;  // right half below, left half on top
+    stack[top][1] = b;
+    ++top;
+    stack[top][0] = a;
+    stack[top][1] = m;
+    ++top;
+  }
+  if (pending && run(w0, w1)) return;
+  r->status = CcdStatus::kOk;
+  r->hit = false;
+  r->u_hit = u_end;
+  r->iterations = total_iterations;
+}
+
 }  // namespace
 
 void ccd_rigid_vertex_face(const RigidVertexFaceQuery& q, const CcdSettings& s, CcdWorkspace* ws,
@@ -530,7 +737,51 @@ void ccd_rigid_vertex_face(const RigidVertexFaceQuery& q, const CcdSettings& s, 
         }
     }
   };
-  bisect(enclose, /*triangle=*/true, sc, q.u_begin, q.u_end, s, ws, r);
+  if (!s.use_u_filter) return bisect(enclose, /*triangle=*/true, sc, q.u_begin, q.u_end, s, ws, r);
+  // The u-filter (see UFilter): coplanarity cubic and a separating axis.
+  const CcdMotion& m = *q.motion;
+  const double d = s.min_separation;
+  UFilter filter;
+  filter.motion = &m;
+  filter.has_cubic = true;
+  if (q.vertex_on_body) {
+    const Vec3 x_begin = motion_point(m.nominal, q.u_begin, q.vertex);  // heuristic only (the axis)
+    const IVec3 n = cross(e1, e2), w = mul(m.R0, v);
+    const CayleyCoefficients cw = cayley_coefficients(m, w);
+    const Interval A = dot(m.p0 - f0, n), E = dot(m.dp, n);
+    filter.k[0] = A + dot(w, n);
+    filter.k[1] = E + dot(cw.c1, n);
+    filter.k[2] = m.g2 * A + dot(cw.c2, n);
+    filter.k[3] = m.g2 * E;
+    filter.dL = next_up(d * norm_upper(n));
+    const Vec3 axis = x_begin - closest_point_on_triangle(x_begin, q.face[0], q.face[1], q.face[2]);
+    if (axis != Vec3::Zero() && std::isfinite(axis.squaredNorm())) {
+      const IVec3 na = to_interval(axis);
+      filter.add_corner(w, na);
+      filter.set_axis_static(hull(hull(dot(na, f0), dot(na, f0 + e1)), dot(na, f0 + e2)), na, d);
+    }
+  } else {
+    const IVec3 nB = cross(e1, e2), nW = mul(m.R0, nB), f0W = mul(m.R0, f0);
+    const CayleyCoefficients cn = cayley_coefficients(m, nW);
+    const IVec3 Y = v - m.p0;
+    const Interval F = dot(f0W, nW);
+    filter.k[0] = dot(Y, nW) - F;
+    filter.k[1] = dot(Y, cn.c1) - dot(m.dp, nW);
+    filter.k[2] = (dot(Y, cn.c2) - dot(m.dp, cn.c1)) - m.g2 * F;
+    filter.k[3] = -dot(m.dp, cn.c2);
+    filter.dL = next_up(d * norm_upper(nB));
+    Vec3 corner[3];
+    for (int k = 0; k < 3; ++k) corner[k] = motion_point(m.nominal, q.u_begin, q.face[k]);
+    const Vec3 axis = q.vertex - closest_point_on_triangle(q.vertex, corner[0], corner[1], corner[2]);
+    if (axis != Vec3::Zero() && std::isfinite(axis.squaredNorm())) {
+      const IVec3 na = to_interval(axis);
+      filter.add_corner(f0W, na);
+      filter.add_corner(mul(m.R0, f0 + e1), na);
+      filter.add_corner(mul(m.R0, f0 + e2), na);
+      filter.set_axis_static(dot(na, v), na, d);
+    }
+  }
+  filtered_bisect(enclose, /*triangle=*/true, sc, filter, q.u_begin, q.u_end, s, ws, r);
 }
 
 void ccd_rigid_edge_edge(const RigidEdgeEdgeQuery& q, const CcdSettings& s, CcdWorkspace* ws, CcdResult* r) {
@@ -552,7 +803,36 @@ void ccd_rigid_edge_edge(const RigidEdgeEdgeQuery& q, const CcdSettings& s, CcdW
     const IVec3 pb[2] = {b0 + box.b[0] * eb, b0 + box.b[1] * eb};
     *F = hull(hull(pa[0] - pb[0], pa[0] - pb[1]), hull(pa[1] - pb[0], pa[1] - pb[1]));
   };
-  bisect(enclose, /*triangle=*/false, sc, q.u_begin, q.u_end, s, ws, r);
+  if (!s.use_u_filter) return bisect(enclose, /*triangle=*/false, sc, q.u_begin, q.u_end, s, ws, r);
+  // The u-filter (see UFilter): coplanarity cubic and a separating axis.
+  const CcdMotion& m = *q.motion;
+  const double d = s.min_separation;
+  UFilter filter;
+  filter.motion = &m;
+  filter.has_cubic = true;
+  const IVec3 a0W = mul(m.R0, a0), eaW = mul(m.R0, ea), Q = m.p0 - b0;
+  const CayleyCoefficients ca = cayley_coefficients(m, eaW), cb = cayley_coefficients(m, eb);
+  const IVec3 T0 = cross(eaW, eb), T1 = cross(ca.c1, eb), T2 = cross(ca.c2, eb), Z = cross(a0W, eaW);
+  filter.k[0] = dot(Q, T0) + dot(Z, eb);
+  filter.k[1] = (dot(Q, T1) + dot(m.dp, T0)) - dot(Z, cb.c1);
+  filter.k[2] = (dot(Q, T2) + dot(m.dp, T1)) + dot(Z, cb.c2);
+  filter.k[3] = dot(m.dp, T2);
+  // L >= |C ea' x eb| on the window: |ea' x eb| + 2 u_end |g| |ea| |eb|.
+  const double g_norm = next_up(std::sqrt(m.g2.hi));
+  const double turn = next_up(next_up(2 * q.u_end * g_norm) * next_up(norm_upper(ea) * norm_upper(eb)));
+  filter.dL = next_up(d * next_up(norm_upper(T0) + turn));
+  const Vec3 A0 = motion_point(m.nominal, q.u_begin, q.edge_body[0]);
+  const Vec3 A1 = motion_point(m.nominal, q.u_begin, q.edge_body[1]);
+  double sa = 0, tb = 0;
+  closest_segment_parameters(A0, A1, q.edge_world[0], q.edge_world[1], &sa, &tb);
+  const Vec3 axis = (A0 + sa * (A1 - A0)) - (q.edge_world[0] + tb * (q.edge_world[1] - q.edge_world[0]));
+  if (axis != Vec3::Zero() && std::isfinite(axis.squaredNorm())) {
+    const IVec3 na = to_interval(axis);
+    filter.add_corner(a0W, na);
+    filter.add_corner(mul(m.R0, a0 + ea), na);
+    filter.set_axis_static(hull(dot(na, b0), dot(na, b0 + eb)), na, d);
+  }
+  filtered_bisect(enclose, /*triangle=*/false, sc, filter, q.u_begin, q.u_end, s, ws, r);
 }
 
 StopPose make_stop_pose(const CcdMotion& m, double u, double body_radius) {

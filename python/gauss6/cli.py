@@ -5,6 +5,7 @@
     gauss6 crosscheck qp [--family NAME] [--json]
     gauss6 report qp --out DIR
     gauss6 reproduce peg|bunny|all --out DIR
+    gauss6 device list [--json]
 
 Every subcommand exits non-zero on a failed check, with a message naming the problem.
 """
@@ -102,6 +103,14 @@ def cmd_report_qp(args: argparse.Namespace) -> int:
     return 0
 
 
+def cmd_device_list(args: argparse.Namespace) -> int:
+    from .device import format_devices, list_devices
+
+    devices = list_devices()
+    print(json.dumps(devices, indent=2) if args.json else format_devices(devices))
+    return 0
+
+
 def build_parser() -> argparse.ArgumentParser:
     p = argparse.ArgumentParser(prog="gauss6", description=__doc__.splitlines()[0])
     sub = p.add_subparsers(dest="command", required=True)
@@ -133,6 +142,11 @@ def build_parser() -> argparse.ArgumentParser:
     rq.add_argument("--out", required=True, help="output directory")
     rq.add_argument("--family", help="one instance family (default: all but warm)")
     rq.set_defaults(func=cmd_report_qp)
+
+    dev = sub.add_parser("device", help="haptic devices").add_subparsers(dest="action", required=True)
+    dl = dev.add_parser("list", help="the HID devices hidapi sees, with their gauss6 profile")
+    dl.add_argument("--json", action="store_true", help="machine-readable output")
+    dl.set_defaults(func=cmd_device_list)
 
     rep = sub.add_parser("reproduce", help="run the paper's scenarios and write figures and summaries")
     rep.add_argument("scenario", choices=["peg", "bunny", "all"])

@@ -41,8 +41,9 @@ void check_shapes(const RowsX6& J, const std::optional<Eigen::VectorXd>& b) {
                           " rows");
 }
 
-PyProjection run(const Mat6& M, const Vec6& au, const RowsX6& J, const std::optional<Eigen::VectorXd>& b,
-                 const ProjectionSettings& settings, ProjectionWorkspace* ws) {
+// The solver's view of numpy data (no copy; the arrays outlive the call).
+ProjectionProblem make_problem(const Mat6& M, const Vec6& au, const RowsX6& J,
+                               const std::optional<Eigen::VectorXd>& b) {
   check_shapes(J, b);
   ProjectionProblem problem;
   problem.M = &M;
@@ -50,6 +51,12 @@ PyProjection run(const Mat6& M, const Vec6& au, const RowsX6& J, const std::opti
   problem.J = J.rows() ? J.data() : nullptr;
   problem.b = b ? b->data() : nullptr;
   problem.num_rows = static_cast<int>(J.rows());
+  return problem;
+}
+
+PyProjection run(const Mat6& M, const Vec6& au, const RowsX6& J, const std::optional<Eigen::VectorXd>& b,
+                 const ProjectionSettings& settings, ProjectionWorkspace* ws) {
+  const ProjectionProblem problem = make_problem(M, au, J, b);
   ProjectionResult r;
   project(problem, settings, ws, &r);
   PyProjection out;
@@ -130,13 +137,7 @@ void bind_quasistatics(py::module_& m) {
           // Native timing for reports (`gauss6 report qp`), not a benchmark: the
           // median of `repeats` calls timed one by one with steady_clock. Cold:
           // a fresh workspace per call; warm: the same workspace, primed once.
-          check_shapes(J, b);
-          ProjectionProblem problem;
-          problem.M = &M;
-          problem.au = au;
-          problem.J = J.rows() ? J.data() : nullptr;
-          problem.b = b ? b->data() : nullptr;
-          problem.num_rows = static_cast<int>(J.rows());
+          const ProjectionProblem problem = make_problem(M, au, J, b);
           ProjectionSettings settings;
           settings.warm_start = warm;
           settings.compute_residuals = false;

@@ -4,6 +4,7 @@
 PYBIND11_MODULE(_gauss6, m) {
   m.doc() = "gauss6: six-DoF god-object haptic rendering (C++ core)";
   gauss6::python::bind_core(m);
+  gauss6::python::bind_device(m);
   gauss6::python::bind_quasistatics(m);
   gauss6::python::bind_reference(m);
 }

@@ -159,6 +159,8 @@ struct CcdSettings {
                                       // largest coordinate, the rounding floor)
   double min_separation = 0;          // report the first u where the distance may be <= this (scene units, >= 0)
   int max_iterations = 200000;        // boxes examined before a conservative give-up
+  bool use_u_filter = true;           // rigid queries: drop u-ranges by the coplanarity cubic and a separating
+                                      // axis before the bisection (conservative; false: bisection alone)
 };
 
 struct CcdResult {

@@ -1,0 +1,57 @@
+// The one Device interface of gauss6: a haptic handle that reports its pose and
+// buttons and takes a wrench. Virtual dispatch lives here, at the device
+// boundary, and nowhere else. Implementations: simulated (device/src/simulated),
+// replay of a recorded trace (device/src/replay), HID through hidapi (device/src/hid).
+//
+// Real-time contract: read() and write() are called from the haptic loop at the
+// device's rate; they allocate nothing, take no lock that a non-real-time thread
+// may hold for long, and throw nothing: failures come back as a DeviceStatus.
+#pragma once
+
+#include <cstdint>
+#include <string>
+
+#include "gauss6/pose.h"
+
+namespace gauss6 {
+
+enum class DeviceStatus {
+  kOk = 0,
+  kNotConnected,   // never opened, or unplugged: the loop zeroes the force and reports it
+  kTimeout,        // no fresh sample within the device's period
+  kEnded,          // a replay or a script reached its end
+  kError,          // anything else; DeviceState::message says what
+};
+const char* to_string(DeviceStatus s);
+
+// What a device can do, fixed when it opens.
+struct DeviceInfo {
+  std::string name;            // e.g. "simulated: peg_in_hole", "3Dconnexion SpaceMouse Compact"
+  double rate_hz = 1000;       // the haptic loop's rate with this device
+  double max_force = 20;       // N: larger forces are clamped before write()
+  double max_torque = 1;       // N m
+  bool renders_force = true;   // false: input-only (the force is recorded, not sent)
+};
+
+// One sample of the handle, world frame (the scene's units).
+struct DeviceState {
+  double time = 0;             // s, the device's clock (virtual in lockstep runs)
+  Pose X_WH;                   // pose of the handle: the god-object's target xh
+  uint32_t buttons = 0;        // bit i: button i pressed
+  bool gripped = true;         // false once the user lets go of the handle
+  DeviceStatus status = DeviceStatus::kOk;
+  const char* message = "";    // static text for status != kOk
+};
+
+class Device {
+ public:
+  virtual ~Device() = default;
+  virtual const DeviceInfo& info() const = 0;
+  // Samples the handle at time t (s since the run started). Never throws.
+  virtual DeviceStatus read(double t, DeviceState* state) = 0;
+  // Applies the wrench F = (force, torque about the handle's point), world frame,
+  // already clamped to info()'s limits and finite. Input-only devices ignore it.
+  virtual DeviceStatus write(double t, const Vec6& F) = 0;
+};
+
+}  // namespace gauss6

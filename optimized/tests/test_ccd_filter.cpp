@@ -1,0 +1,259 @@
+// Tests of the u-filter of the rigid CCD queries (coplanarity cubic and
+// separating axis, ccd.cpp): on contacts built into random motions and
+// verified in exact rationals (GMP) against the exact Cayley motion of the
+// input doubles, the filtered query must report a hit no later than the
+// contact's parameter; and on haptic-size steps the filtered and the plain
+// bisection agree on hit / no hit up to their tolerances.
+#include <catch2/catch.hpp>
+
+#include <gmpxx.h>
+
+#include <cmath>
+#include <random>
+
+#include "gauss6/ccd.h"
+
+using namespace gauss6;
+
+namespace {
+
+mpq_class Q(double x) { return mpq_class(x); }  // exact
+struct Q3 {
+  mpq_class x, y, z;
+};
+Q3 q3(const Vec3& v) { return {Q(v.x()), Q(v.y()), Q(v.z())}; }
+Q3 operator-(const Q3& a, const Q3& b) { return {a.x - b.x, a.y - b.y, a.z - b.z}; }
+Q3 operator+(const Q3& a, const Q3& b) { return {a.x + b.x, a.y + b.y, a.z + b.z}; }
+Q3 operator*(const mpq_class& s, const Q3& a) { return {s * a.x, s * a.y, s * a.z}; }
+mpq_class dot(const Q3& a, const Q3& b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
+Q3 cross(const Q3& a, const Q3& b) { return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x}; }
+Vec3 to_double(const Q3& a) { return {a.x.get_d(), a.y.get_d(), a.z.get_d()}; }
+
+// The exact Cayley motion of METHOD.md section 4 from two double poses.
+struct ExactMotion {
+  Q3 p0, dp, g;
+  mpq_class R0[9];
+  explicit ExactMotion(const Pose& x0, const Pose& x1) {
+    p0 = q3(x0.p);
+    dp = q3(x1.p) - p0;
+    const mpq_class w = Q(x0.q.w), x = Q(x0.q.x), y = Q(x0.q.y), z = Q(x0.q.z);
+    const mpq_class n = w * w + x * x + y * y + z * z;
+    const mpq_class e[9] = {w * w + x * x - y * y - z * z, 2 * (x * y - w * z), 2 * (x * z + w * y),
+                            2 * (x * y + w * z), w * w - x * x + y * y - z * z, 2 * (y * z - w * x),
+                            2 * (x * z - w * y), 2 * (y * z + w * x), w * w - x * x - y * y + z * z};
+    for (int i = 0; i < 9; ++i) R0[i] = e[i] / n;
+    // qr = q1 conj(q0), sign as make_ccd_motion (from the double product).
+    const mpq_class aw = Q(x1.q.w), ax = Q(x1.q.x), ay = Q(x1.q.y), az = Q(x1.q.z);
+    const mpq_class bw = w, bx = -x, by = -y, bz = -z;
+    const mpq_class rw = aw * bw - ax * bx - ay * by - az * bz;
+    const mpq_class rx = aw * bx + ax * bw + ay * bz - az * by;
+    const mpq_class ry = aw * by - ax * bz + ay * bw + az * bx;
+    const mpq_class rz = aw * bz + ax * by - ay * bx + az * bw;
+    g = {rx / rw, ry / rw, rz / rw};  // the sign of qr cancels in the quotient
+  }
+  // World point at u of the body point r.
+  Q3 point(const mpq_class& u, const Q3& r) const {
+    const Q3 v{R0[0] * r.x + R0[1] * r.y + R0[2] * r.z, R0[3] * r.x + R0[4] * r.y + R0[5] * r.z,
+               R0[6] * r.x + R0[7] * r.y + R0[8] * r.z};
+    const Q3 h = u * g;
+    const mpq_class hh = dot(h, h);
+    const Q3 Cv = (1 / (1 + hh)) * ((((1 - hh) * v) + ((2 * dot(h, v)) * h)) + (mpq_class(2) * cross(h, v)));
+    return (p0 + u * dp) + Cv;
+  }
+};
+
+// Exact: is point x within distance d of the triangle (a, b, c), its projection
+// on the plane falling inside? (A sufficient test of "within d".)
+bool within_of_triangle(const Q3& x, const Q3& a, const Q3& b, const Q3& c, const mpq_class& d) {
+  const Q3 n = cross(b - a, c - a);
+  const mpq_class nn = dot(n, n);
+  if (nn == 0) return false;
+  const mpq_class t = dot(x - a, n);
+  if (t * t > d * d * nn) return false;
+  return dot(cross(b - a, x - a), n) >= 0 && dot(cross(c - b, x - b), n) >= 0 && dot(cross(a - c, x - c), n) >= 0;
+}
+
+// Exact: are the segments [p0, p1], [q0, q1] within distance d, their closest
+// points interior to both (a sufficient test)?
+bool within_of_segment(const Q3& p0, const Q3& p1, const Q3& q0, const Q3& q1, const mpq_class& d) {
+  const Q3 d1 = p1 - p0, d2 = q1 - q0, r = p0 - q0;
+  const mpq_class a = dot(d1, d1), b = dot(d1, d2), e = dot(d2, d2), c = dot(d1, r), f = dot(d2, r);
+  const mpq_class den = a * e - b * b;
+  if (den == 0) return false;
+  const mpq_class s = (b * f - c * e) / den, t = (a * f - b * c) / den;
+  if (s < 0 || s > 1 || t < 0 || t > 1) return false;
+  const Q3 w = (p0 + s * d1) - (q0 + t * d2);
+  return dot(w, w) <= d * d;
+}
+
+Vec3 rnd(std::mt19937& rng, double scale) {
+  std::normal_distribution<double> n(0, scale);
+  return {n(rng), n(rng), n(rng)};
+}
+
+// A random step: haptic-size (0.1-1 mm, 0.1-1 degree at a 5 cm scale) or large.
+void random_step(std::mt19937& rng, int i, Pose* x0, Pose* x1) {
+  std::uniform_real_distribution<double> U(0, 1);
+  x0->p = rnd(rng, 0.05);
+  x0->q = normalized(Quat{U(rng) - 0.5, U(rng) - 0.5, U(rng) - 0.5, U(rng) - 0.5});
+  const bool haptic = i % 2 == 0;
+  const double move = haptic ? 1e-4 + 9e-4 * U(rng) : 0.02 * U(rng);
+  const double angle = haptic ? (0.1 + 0.9 * U(rng)) * 3.14159265358979 / 180 : 1.5 * U(rng);
+  x1->p = x0->p + move * rnd(rng, 1).normalized();
+  x1->q = normalized(quat_exp(angle * rnd(rng, 1).normalized()) * x0->q);
+}
+
+}  // namespace
+
+TEST_CASE("u-filter keeps every exact contact: body vertex against a static face", "[ccd]") {
+  std::mt19937 rng(101);
+  std::uniform_real_distribution<double> U(0.02, 0.98), H(-1, 1);
+  CcdWorkspace ws;
+  CcdResult r;
+  int verified = 0, misses = 0;
+  for (int i = 0; i < 400; ++i) {
+    Pose x0, x1;
+    random_step(rng, i, &x0, &x1);
+    CcdMotion m;
+    REQUIRE(make_ccd_motion(x0, x1, &m) == MotionStatus::kOk);
+    const ExactMotion em(x0, x1);
+    CcdSettings s;
+    s.min_separation = (i % 3 == 0) ? 0.0 : 1e-6;
+    const Vec3 r_B = rnd(rng, 0.03);
+    const double u_c = U(rng);
+    const Q3 x_star = em.point(Q(u_c), q3(r_B));
+    // A static face through a point near x*: off its plane by up to 0.9 d (a
+    // grazing approach when the motion runs along the plane), e1/e2 random or,
+    // every fourth query, containing the step's direction (a sliding contact).
+    Vec3 e1 = rnd(rng, 0.01), e2 = rnd(rng, 0.01);
+    if (i % 4 == 1) e1 = 0.01 * (x1.p - x0.p).normalized();
+    const Vec3 nrm = e1.cross(e2).normalized();
+    const Vec3 P = to_double(x_star) + 0.9 * s.min_separation * H(rng) * nrm;
+    RigidVertexFaceQuery q;
+    q.motion = &m;
+    q.vertex = r_B;
+    q.face = {P - (e1 + e2) / 3, P + 2 * e1 / 3 - e2 / 3, P - e1 / 3 + 2 * e2 / 3};
+    // Tolerance: none. Skip the rare placements whose rounding leaves x* farther
+    // than d (only possible with d = 0): the exact check decides.
+    if (!within_of_triangle(x_star, q3(q.face[0]), q3(q.face[1]), q3(q.face[2]), Q(s.min_separation))) continue;
+    ++verified;
+    ccd_rigid_vertex_face(q, s, &ws, &r);
+    if (!r.hit || Q(r.u_hit) > Q(u_c)) ++misses;
+  }
+  INFO("verified contacts: " << verified);
+  CHECK(verified >= 200);
+  CHECK(misses == 0);
+}
+
+TEST_CASE("u-filter keeps every exact contact: static vertex against a body face", "[ccd]") {
+  std::mt19937 rng(202);
+  std::uniform_real_distribution<double> U(0.02, 0.98), H(-1, 1);
+  CcdWorkspace ws;
+  CcdResult r;
+  int verified = 0, misses = 0;
+  for (int i = 0; i < 400; ++i) {
+    Pose x0, x1;
+    random_step(rng, i, &x0, &x1);
+    CcdMotion m;
+    REQUIRE(make_ccd_motion(x0, x1, &m) == MotionStatus::kOk);
+    const ExactMotion em(x0, x1);
+    CcdSettings s;
+    s.min_separation = (i % 3 == 0) ? 0.0 : 1e-6;
+    const Vec3 c = rnd(rng, 0.03), e1 = rnd(rng, 0.01), e2 = rnd(rng, 0.01);
+    const std::array<Vec3, 3> face = {c - (e1 + e2) / 3, c + 2 * e1 / 3 - e2 / 3, c - e1 / 3 + 2 * e2 / 3};
+    const double u_c = U(rng);
+    Q3 X[3];
+    for (int k = 0; k < 3; ++k) X[k] = em.point(Q(u_c), q3(face[k]));
+    const Q3 centre = mpq_class(1, 3) * ((X[0] + X[1]) + X[2]);
+    const Vec3 nrm = to_double(cross(X[1] - X[0], X[2] - X[0])).normalized();
+    RigidVertexFaceQuery q;
+    q.motion = &m;
+    q.vertex_on_body = false;
+    q.vertex = to_double(centre) + 0.9 * s.min_separation * H(rng) * nrm;
+    q.face = face;
+    if (!within_of_triangle(q3(q.vertex), X[0], X[1], X[2], Q(s.min_separation))) continue;
+    ++verified;
+    ccd_rigid_vertex_face(q, s, &ws, &r);
+    if (!r.hit || Q(r.u_hit) > Q(u_c)) ++misses;
+  }
+  INFO("verified contacts: " << verified);
+  CHECK(verified >= 200);
+  CHECK(misses == 0);
+}
+
+TEST_CASE("u-filter keeps every exact contact: edge/edge", "[ccd]") {
+  std::mt19937 rng(303);
+  std::uniform_real_distribution<double> U(0.02, 0.98), H(-1, 1), S(0.2, 0.8);
+  CcdWorkspace ws;
+  CcdResult r;
+  int verified = 0, misses = 0;
+  for (int i = 0; i < 400; ++i) {
+    Pose x0, x1;
+    random_step(rng, i, &x0, &x1);
+    CcdMotion m;
+    REQUIRE(make_ccd_motion(x0, x1, &m) == MotionStatus::kOk);
+    const ExactMotion em(x0, x1);
+    CcdSettings s;
+    s.min_separation = (i % 3 == 0) ? 0.0 : 1e-6;
+    const Vec3 a0 = rnd(rng, 0.03), a1 = a0 + rnd(rng, 0.01);
+    const double u_c = U(rng), t = S(rng);
+    const Q3 A0 = em.point(Q(u_c), q3(a0)), A1 = em.point(Q(u_c), q3(a1));
+    const Q3 x_star = A0 + Q(t) * (A1 - A0);
+    // The static edge crosses the body edge at x*, offset along their common
+    // normal by up to 0.9 d; every fourth query nearly parallel (1e-3 rad).
+    Vec3 eb = rnd(rng, 0.01);
+    const Vec3 ea = to_double(A1 - A0);
+    if (i % 4 == 1) eb = ea + 1e-3 * ea.norm() * rnd(rng, 1);
+    const Vec3 nrm = ea.cross(eb).normalized();
+    const Vec3 P = to_double(x_star) + 0.9 * s.min_separation * H(rng) * nrm;
+    const double sb = S(rng);
+    RigidEdgeEdgeQuery q;
+    q.motion = &m;
+    q.edge_body = {a0, a1};
+    q.edge_world = {P - sb * eb, P + (1 - sb) * eb};
+    if (!within_of_segment(A0, A1, q3(q.edge_world[0]), q3(q.edge_world[1]), Q(s.min_separation))) continue;
+    ++verified;
+    ccd_rigid_edge_edge(q, s, &ws, &r);
+    if (!r.hit || Q(r.u_hit) > Q(u_c)) ++misses;
+  }
+  INFO("verified contacts: " << verified);
+  CHECK(verified >= 200);
+  CHECK(misses == 0);
+}
+
+TEST_CASE("u-filter never stops later than a contact certified by the plain bisection", "[ccd]") {
+  // Random faces a few tenths of a millimetre from a vertex, haptic-size steps.
+  // The plain bisection at d/2 certifies a contact when its accepted box's
+  // distance_reached (a rigorous upper bound of the features' distance at
+  // u_hit) is <= d: then the filtered query at d must hit no later.
+  std::mt19937 rng(404);
+  CcdWorkspace ws;
+  CcdResult plain, filtered;
+  int certified = 0, later = 0;
+  for (int i = 0; i < 300; ++i) {
+    Pose x0, x1;
+    random_step(rng, 2 * i, &x0, &x1);  // haptic-size only
+    CcdMotion m;
+    REQUIRE(make_ccd_motion(x0, x1, &m) == MotionStatus::kOk);
+    CcdSettings s;
+    s.min_separation = 1e-6;
+    const Vec3 r_B = rnd(rng, 0.03);
+    const Vec3 P = motion_point(m.nominal, 0.5, r_B) + rnd(rng, 3e-4);
+    const Vec3 e1 = rnd(rng, 0.005), e2 = rnd(rng, 0.005);
+    RigidVertexFaceQuery q;
+    q.motion = &m;
+    q.vertex = r_B;
+    q.face = {P - (e1 + e2) / 3, P + 2 * e1 / 3 - e2 / 3, P - e1 / 3 + 2 * e2 / 3};
+    CcdSettings sp = s;
+    sp.use_u_filter = false;
+    sp.min_separation = 0.5 * s.min_separation;
+    ccd_rigid_vertex_face(q, sp, &ws, &plain);
+    if (!(plain.hit && plain.status == CcdStatus::kOk && plain.distance_reached <= s.min_separation)) continue;
+    ++certified;
+    ccd_rigid_vertex_face(q, s, &ws, &filtered);
+    if (!filtered.hit || filtered.u_hit > plain.u_hit) ++later;
+  }
+  INFO("certified contacts: " << certified);
+  CHECK(certified > 10);
+  CHECK(later == 0);
+}

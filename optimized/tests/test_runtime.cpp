@@ -1,0 +1,514 @@
+// Tests of runtime.h and shared_state.h: the three loops on a box god-object
+// (10 cm, 1 kg) pressed onto a box obstacle (top face z = 0) by a scripted test
+// device, in lockstep runs (exact, repeatable) and threaded runs (sanity only:
+// no assertion on durations). Checked against the analytic answers of this
+// geometry: the god-object never goes below the plane z = delta, the force is
+// kh m ks (xs_z - xh_z) straight up, nothing in free space or along the surface.
+#include <catch2/catch.hpp>
+
+#include <algorithm>
+#include <atomic>
+#include <cmath>
+#include <cstring>
+#include <functional>
+#include <memory>
+#include <mutex>
+#include <thread>
+#include <vector>
+
+#include "gauss6/mass_properties.h"
+#include "gauss6/runtime.h"
+#include "mesh_shapes.h"
+
+using namespace gauss6;
+using gauss6::test::make_box;
+
+namespace {
+
+constexpr double kSide = 0.1;        // god-object: cube of side 10 cm, density 1000: m = 1 kg
+constexpr double kHalf = kSide / 2;  // G rests at z = kHalf above the top face
+constexpr double kDelta = 1e-5;
+constexpr double kKs = 0.5, kKh = 1000;  // felt stiffness kh m ks = 500 N/m
+constexpr double kRate = 1000;
+
+Scene make_scene(double offset_eps = -1e-3, double offset_time = 0.05) {
+  Scene sc;
+  sc.path = "test:box_on_box";
+  sc.name = "box_on_box";
+  Body slab;
+  slab.name = "slab";
+  slab.mesh = make_box(1.0, 1.0, 0.1, Vec3(0, 0, -0.05));  // top face z = 0
+  build_adjacency(&slab.mesh);
+  compute_vertex_normals(&slab.mesh);
+  sc.obstacles.push_back(slab);
+  sc.god_object.name = "cube";
+  sc.god_object.role = BodyRole::kGodObject;
+  sc.god_object.mesh = make_box(kSide, kSide, kSide);  // body frame: origin at G (centre)
+  build_adjacency(&sc.god_object.mesh);
+  compute_vertex_normals(&sc.god_object.mesh);
+  sc.god_object.pose = {Vec3(0, 0, 0.2), Quat{}};
+  std::string error;
+  REQUIRE(compute_mass_properties(sc.god_object.mesh, 1000, &sc.god_mass.mass, &error));
+  sc.gains.ks = kKs;
+  sc.gains.kh = kKh;
+  sc.contact.delta = kDelta;
+  sc.contact.offset_eps = offset_eps;
+  sc.contact.offset_time = offset_time;
+  sc.device.rate_hz = kRate;
+  sc.device.max_force = 20;
+  sc.device.max_torque = 1;
+  return sc;
+}
+
+// Lowest point of the god-object at pose x: the top face is at z = 0.
+double lowest_z(const RuntimeModel& model, const Pose& x) {
+  double z = INFINITY;
+  for (int v = 0; v < model.god_mesh_B.V.rows(); ++v)
+    z = std::min(z, transform_point(x, model.god_mesh_B.V.row(v).transpose()).z());
+  return z;
+}
+
+// A device that plays a scripted handle trajectory, with faults on request,
+// and records every wrench it is sent.
+class ScriptedDevice : public Device {
+ public:
+  explicit ScriptedDevice(std::function<Pose(double)> script) : script_(std::move(script)) {
+    info_.name = "scripted test device";
+    info_.rate_hz = kRate;
+    writes.reserve(100000);
+  }
+  const DeviceInfo& info() const override { return info_; }
+  DeviceStatus read(double t, DeviceState* state) override {
+    state->time = t;
+    if (t >= end_time) return state->status = DeviceStatus::kEnded;
+    if (t >= timeout_from) return state->status = DeviceStatus::kTimeout;
+    state->X_WH = script_(t);
+    if (t >= nan_from && t < nan_to) state->X_WH.p.x() = std::nan("");
+    return state->status = DeviceStatus::kOk;
+  }
+  DeviceStatus write(double t, const Vec6& F) override {
+    writes.push_back({t, F});
+    return DeviceStatus::kOk;
+  }
+  struct Write {
+    double t;
+    Vec6 F;
+  };
+  std::vector<Write> writes;
+  double nan_from = INFINITY, nan_to = INFINITY, timeout_from = INFINITY, end_time = INFINITY;
+
+ private:
+  std::function<Pose(double)> script_;
+  DeviceInfo info_;
+};
+
+// Everything the hooks report.
+struct Recorder {
+  std::vector<RuntimeEvent> events;
+  std::mutex events_mutex;
+  std::vector<SimStepInfo> sims;
+  std::vector<CouplingStepInfo> couplings;
+  std::vector<HapticTickRecord> ticks;
+  std::atomic<bool> stop{false};
+  std::function<void(const HapticTickRecord&)> on_tick;  // optional extra check
+  RuntimeObserver observer() {
+    RuntimeObserver o;
+    o.user = this;
+    o.on_event = [](void* u, const RuntimeEvent& e) {
+      auto* rec = static_cast<Recorder*>(u);
+      std::lock_guard<std::mutex> lock(rec->events_mutex);  // threaded runs: several loops report
+      rec->events.push_back(e);
+    };
+    o.on_sim_step = [](void* u, const SimStepInfo& i) { static_cast<Recorder*>(u)->sims.push_back(i); };
+    o.on_coupling_step = [](void* u, const CouplingStepInfo& i) { static_cast<Recorder*>(u)->couplings.push_back(i); };
+    o.on_haptic_tick = [](void* u, const HapticTickRecord& r) {
+      auto* rec = static_cast<Recorder*>(u);
+      rec->ticks.push_back(r);
+      if (rec->on_tick) rec->on_tick(r);
+    };
+    return o;
+  }
+  int count(RuntimeEventKind k) const {
+    return static_cast<int>(std::count_if(events.begin(), events.end(), [&](const RuntimeEvent& e) { return e.kind == k; }));
+  }
+};
+
+// Handle straight down from G at z0 to z1 at speed v, then held.
+std::function<Pose(double)> press_script(double z0, double z1, double v) {
+  return [=](double t) { return Pose{Vec3(0, 0, std::max(z1, z0 - v * t)), Quat{}}; };
+}
+
+struct Run {
+  std::unique_ptr<RuntimeModel> model;
+  std::unique_ptr<RuntimeData> data;
+  Recorder rec;
+};
+
+void run(Run* r, const Scene& scene, const RuntimeSettings& settings, Device* device, long ticks) {
+  r->model = std::make_unique<RuntimeModel>(scene, settings);
+  r->data = std::make_unique<RuntimeData>(*r->model);
+  r->rec.sims.reserve(ticks + 1);
+  r->rec.couplings.reserve(ticks + 1);
+  r->rec.ticks.reserve(ticks + 1);
+  run_lockstep(*r->model, device, ticks, r->rec.observer(), r->data.get());
+}
+
+// Tolerance of Fc . ac = 0 relative to |Fc| |au| (|ac| <= |au| in the M-norm:
+// the natural scale of both factors): the projection meets complementarity to
+// ~1e-13 relative (feasibility_tol); 1e-9 leaves room for the 6x6 products and
+// still fails on any real tangential component.
+constexpr double kOrthogonalityTol = 1e-9;
+
+}  // namespace
+
+TEST_CASE("runtime: model built once; refused settings and surfaces", "[runtime]") {
+  const Scene sc = make_scene();
+  const RuntimeModel model(sc, RuntimeSettings{});
+  REQUIRE(model.obstacles.size() == 1);
+  // The slab's mesh was moved to the world once (identity pose here) and its
+  // top face is at z = 0.
+  CHECK(model.obstacle_meshes_W[0].V.col(2).maxCoeff() == 0.0);
+  CHECK(model.settings.ccd.narrow.min_separation == kDelta);
+  CHECK(model.mass == Approx(1.0).epsilon(1e-12));
+  // M at a quarter turn: the cube's inertia is isotropic (m s^2 / 6), so M is diagonal.
+  const Mat6 M = mass_matrix_at(model, quat_exp(Vec3(0, 0, M_PI / 2)));
+  CHECK((M - Mat6(Vec6(1, 1, 1, kSide * kSide / 6, kSide * kSide / 6, kSide * kSide / 6).asDiagonal())).norm() <
+        1e-12);
+  Scene shaded = sc;
+  shaded.surface.kind = SurfaceKind::kForceShading;
+  CHECK_THROWS_AS(RuntimeModel(shaded, RuntimeSettings{}), RuntimeError);
+  RuntimeSettings bad;
+  bad.gap_factor = 1.0;  // not below contact_factor
+  CHECK_THROWS_AS(RuntimeModel(sc, bad), RuntimeError);
+}
+
+TEST_CASE("runtime: a box pressed onto a box never penetrates; the force is up, kh m ks deep", "[runtime]") {
+  // Handle from G = 0.2 down to 0.03 at 0.2 m/s (2 cm deeper than resting, at
+  // t = 0.85 s), held until 1.2 s. One sim step per haptic tick.
+  ScriptedDevice device(press_script(0.2, 0.03, 0.2));
+  Run r;
+  run(&r, make_scene(), RuntimeSettings{}, &device, 1200);
+  REQUIRE(r.rec.sims.size() == 1200);
+  REQUIRE(r.rec.ticks.size() == 1200);
+  REQUIRE(r.rec.events.empty());
+
+  // Never penetrates: every pose keeps the lowest corner at least delta above
+  // the plane, up to make_stop_pose's deviation and rounding (1e-3 delta = 1e-8,
+  // far above both, far below a real penetration). Never stops far away either:
+  // once resting, the gap stays below delta (1 + contact_factor) + 1e-3 delta.
+  double min_gap = INFINITY;
+  int num_contact_steps = 0;
+  for (const SimStepInfo& s : r.rec.sims) {
+    const double gap = lowest_z(*r.model, s.xs);
+    min_gap = std::min(min_gap, gap);
+    if (s.num_contacts > 0) {
+      ++num_contact_steps;
+      CHECK(gap <= kDelta * 1.501);
+    }
+  }
+  CHECK(min_gap >= kDelta * (1 - 1e-3));
+  CHECK(num_contact_steps > 300);
+
+  // Forces: zero in free space, straight up and equal to kh m ks (xs_z - xh_z)
+  // in contact (the four corner rows [0 0 1, r_y, -r_x, 0] give ac_z = 0, no
+  // rotation), non-decreasing while the handle goes deeper.
+  double last_Fz = 0;
+  int num_free = 0, num_pressed = 0;
+  for (size_t k = 0; k < r.rec.ticks.size(); ++k) {
+    const HapticTickRecord& tick = r.rec.ticks[k];
+    const CouplingStepInfo& c = r.rec.couplings[k];
+    const SimStepInfo& s = r.rec.sims[k];  // the sim step of this tick (before it)
+    const Vec6& F = tick.F_sent;
+    const double depth = kHalf - tick.xh.p.z();  // handle below its resting height
+    if (c.num_rows == 0) {
+      ++num_free;
+      CHECK(F.norm() == 0.0);  // ac = au exactly without rows
+      continue;
+    }
+    if (depth < 1e-3) continue;  // approach: contact set just forming
+    ++num_pressed;
+    // Tolerance 1e-9 N: the force is 5-10 N; the rows are exact axis-aligned
+    // normals, so only rounding (~1e-15 relative) separates F from the formula.
+    const double expected = kKh * r.model->mass * kKs * (s.xs.p.z() - tick.xh.p.z());
+    CHECK(std::abs(F[2] - expected) <= 1e-9);
+    CHECK(std::abs(F[0]) <= 1e-9);
+    CHECK(std::abs(F[1]) <= 1e-9);
+    CHECK(F.tail<3>().norm() <= 1e-9);
+    CHECK(F[2] >= last_Fz - 1e-9);  // grows with the penetration (held: constant)
+    last_Fz = F[2];
+    // Orthogonality Fc . ac = 0.
+    CHECK(std::abs(c.Fc.dot(c.ac)) <= kOrthogonalityTol * c.Fc.norm() * c.au.norm());
+  }
+  CHECK(num_free > 500);
+  CHECK(num_pressed > 300);
+  // Held 2 cm deep: 500 N/m x 2 cm = 10 N, up to the resting gap (1.5 delta x 500 N/m < 1e-2 N).
+  CHECK(std::abs(last_Fz - 10.0) < 1e-2);
+}
+
+TEST_CASE("runtime: sliding along the top, the force stays normal and the god-object follows", "[runtime]") {
+  // Pressed 1 cm deep, then slid 4 cm along +x (over the slab's diagonal edge)
+  // at 0.1 m/s, then held.
+  auto script = [](double t) {
+    const double z = std::max(0.04, 0.2 - 0.4 * t);
+    const double x = t < 0.5 ? 0.0 : std::min(0.04, 0.1 * (t - 0.5));
+    return Pose{Vec3(x, 0.001, z), Quat{}};
+  };
+  ScriptedDevice device(script);
+  Run r;
+  run(&r, make_scene(), RuntimeSettings{}, &device, 1000);
+  REQUIRE(r.rec.events.empty());
+  int num_sliding = 0, num_offsets_started = 0;
+  for (size_t k = 0; k < r.rec.ticks.size(); ++k) {
+    const HapticTickRecord& tick = r.rec.ticks[k];
+    const CouplingStepInfo& c = r.rec.couplings[k];
+    CHECK(lowest_z(*r.model, r.rec.sims[k].xs) >= kDelta * (1 - 1e-3));
+    if (tick.time <= 0.5) continue;
+    num_offsets_started += c.num_new_offsets;
+    ++num_sliding;
+    const Vec6& F = tick.F_sent;
+    // Pressing 1 cm: 5 N up.
+    CHECK(F[2] > 4.9);
+    // No tangential component: Fc . (1, 0, 0, 0, 0, 0) and Fc . (0, 1, 0, ...)
+    // vanish up to rounding (1e-9 of the 5 N force: the contact normals are
+    // exactly +z, nothing else can put force along x or y).
+    CHECK(std::abs(F[0]) <= 1e-9 * F.norm());
+    CHECK(std::abs(F[1]) <= 1e-9 * F.norm());
+    CHECK(std::abs(c.Fc.dot(c.ac)) <= kOrthogonalityTol * c.Fc.norm() * c.au.norm());
+  }
+  CHECK(num_sliding > 400);
+  // The rows carried over from snapshot to snapshot are recognised as the same
+  // constraints: no offset restarts while sliding across triangles.
+  CHECK(num_offsets_started == 0);
+  // The god-object slid with the handle: within one sim step's lag (v dt = 1e-4 m)
+  // plus margin, no sticking.
+  const Pose& xs = r.data->sim.xs;
+  CHECK(std::abs(xs.p.x() - 0.04) < 1e-3);
+  CHECK(std::abs(xs.p.y() - 0.001) < 1e-3);
+}
+
+TEST_CASE("runtime: a new contact with the handle already deep starts small and ramps (offsets)", "[runtime]") {
+  // Handle held 1 cm above the resting height, then 1.5 cm below it in one tick
+  // at t = 0.1 s: the first contact set arrives with d_k = ks (-1.5 cm) = -7.5 mm
+  // < eps = -1e-4: offset rows, ramped back to 0 in T = 0.05 s.
+  const double T = 0.05;
+  auto script = [](double t) { return Pose{Vec3(0, 0, t < 0.1 ? kHalf + 0.01 : kHalf - 0.015), Quat{}}; };
+  ScriptedDevice device(script);
+  Run r;
+  run(&r, make_scene(/*offset_eps=*/-1e-4, /*offset_time=*/T), RuntimeSettings{}, &device, 300);
+  const double full = kKh * 1.0 * kKs * 0.015;  // 7.5 N (up to the resting gap, < 1e-2 N)
+  // The first tick with contacts.
+  size_t first = 0;
+  while (first < r.rec.couplings.size() && r.rec.couplings[first].num_rows == 0) ++first;
+  REQUIRE(first < r.rec.couplings.size());
+  CHECK(r.rec.couplings[first].num_new_offsets == 4);  // the four corners
+  const double t0 = r.rec.ticks[first].time;
+  // Starts small: the offset rows admit au exactly (f_k(0) = d_k), so Fc = 0.
+  CHECK(r.rec.ticks[first].F_sent.norm() < 1e-9 * full);
+  double last = -1;
+  for (size_t k = first; k < r.rec.ticks.size(); ++k) {
+    const double Fz = r.rec.ticks[k].F_sent[2];
+    const double dt = r.rec.ticks[k].time - t0;
+    CHECK(Fz >= last - 1e-9);  // ramps up, never down
+    last = Fz;
+    // The ramp follows the smoothstep f_k(dt) = d_k (1 - s(dt / T)): the force
+    // is full * s(dt / T) (1e-2 N: the resting gap's share).
+    const double u = std::min(1.0, dt / T);
+    CHECK(std::abs(Fz - full * (3 * u * u - 2 * u * u * u)) < 1e-2);
+    if (dt > T) CHECK(r.rec.couplings[k].num_offset_rows == 0);
+  }
+  CHECK(std::abs(last - full) < 1e-2);
+}
+
+TEST_CASE("runtime: safety: NaN from the device, device timeout, sim stall, force limits", "[runtime]") {
+  const Scene sc = make_scene();
+  SECTION("a non-finite handle pose gives zero force and one event; then the force returns") {
+    ScriptedDevice device(press_script(0.2, 0.04, 0.4));
+    device.nan_from = 0.6;
+    device.nan_to = 0.6035;  // four ticks: 0.600 .. 0.603
+    Run r;
+    run(&r, sc, RuntimeSettings{}, &device, 700);
+    CHECK(r.rec.count(RuntimeEventKind::kInvalidHandlePose) == 1);
+    REQUIRE(r.rec.events.size() == 1);
+    CHECK(r.rec.events[0].time == Approx(0.6).margin(1e-12));
+    int zeroed = 0;
+    for (const HapticTickRecord& t : r.rec.ticks) {
+      CHECK(t.F_sent.allFinite());
+      if (t.time > 0.5 && t.time < 0.5995) CHECK(t.F_sent[2] > 4.9);  // pressing 1 cm: 5 N
+      if (t.time >= 0.5995 && t.time < 0.6035) {
+        CHECK(t.F_sent.norm() == 0.0);
+        ++zeroed;
+      }
+      if (t.time > 0.605) CHECK(t.F_sent[2] > 4.9);
+    }
+    CHECK(zeroed == 4);
+    // The device saw exactly these forces.
+    REQUIRE(device.writes.size() == r.rec.ticks.size() + 1);  // + the final zero
+    for (size_t k = 0; k < r.rec.ticks.size(); ++k) CHECK(device.writes[k].F == r.rec.ticks[k].F_sent);
+    CHECK(device.writes.back().F.norm() == 0.0);
+  }
+  SECTION("a device that stops answering: force kept for device_timeout, then zero, watchdog event") {
+    ScriptedDevice device(press_script(0.2, 0.04, 0.4));
+    device.timeout_from = 0.6;
+    RuntimeSettings settings;
+    settings.device_timeout = 0.0055;  // not a multiple of the period: no tie to round
+    Run r;
+    run(&r, sc, settings, &device, 700);
+    CHECK(r.rec.count(RuntimeEventKind::kDeviceError) == 1);
+    CHECK(r.rec.count(RuntimeEventKind::kDeviceTimeout) == 1);
+    // Last good sample at 0.599; the watchdog fires when t - 0.599 > 0.0055.
+    for (const HapticTickRecord& t : r.rec.ticks) {
+      if (t.time > 0.5 && t.time < 0.6045) CHECK(t.F_sent[2] > 4.9);
+      if (t.time > 0.6045) CHECK(t.F_sent.norm() == 0.0);
+    }
+    for (const RuntimeEvent& e : r.rec.events)
+      if (e.kind == RuntimeEventKind::kDeviceTimeout) CHECK(e.time == Approx(0.605).margin(1e-12));
+  }
+  SECTION("a stalled sim loop zeroes the force") {
+    // One sim step every 0.2 s; the force is zeroed when its snapshot is older
+    // than sim_timeout = 0.05 s.
+    ScriptedDevice device(press_script(0.2, 0.04, 0.4));
+    RuntimeSettings settings;
+    settings.lockstep_sim_period = 200;
+    settings.sim_timeout = 0.05;
+    Run r;
+    run(&r, sc, settings, &device, 1000);
+    CHECK(r.rec.count(RuntimeEventKind::kSimStalled) == 5);  // once per 0.2 s gap
+    for (const HapticTickRecord& t : r.rec.ticks) {
+      const double since_sim = std::fmod(t.time + 1e-9, 0.2);
+      if (since_sim > 0.0505) CHECK(t.F_sent.norm() == 0.0);
+    }
+  }
+  SECTION("the safety stage: limits keep the direction, non-finite becomes zero") {
+    uint32_t events = 0;
+    Vec6 F;
+    F << 30, 40, 0, 0, 0, 0.5;  // |force| = 50 N > 20 N
+    const Vec6 safe = make_safe_wrench(F, 20, 1, &events);
+    CHECK((safe.head<3>() - Vec3(12, 16, 0)).norm() < 1e-12);
+    CHECK(safe[5] == 0.5);
+    CHECK(events == 1u << static_cast<int>(RuntimeEventKind::kForceClamped));
+    events = 0;
+    F[3] = INFINITY;
+    CHECK(make_safe_wrench(F, 20, 1, &events).norm() == 0.0);
+    CHECK(events == 1u << static_cast<int>(RuntimeEventKind::kNonFiniteForce));
+  }
+}
+
+TEST_CASE("runtime: lockstep runs are repeatable bit for bit", "[runtime]") {
+  // A pressing, sliding and twisting handle: edge contacts, rotations, offsets.
+  auto script = [](double t) {
+    const double z = std::max(0.035, 0.2 - 0.5 * t);
+    const double s = std::max(0.0, t - 0.35);
+    return Pose{Vec3(0.05 * std::sin(3 * s), 0.03 * s, z), quat_exp(Vec3(0.2 * s, 0.1 * s, 0.8 * s))};
+  };
+  RuntimeSettings settings;
+  settings.lockstep_sim_period = 3;
+  auto run_once = [&](Run* r, ScriptedDevice* device) { run(r, make_scene(-1e-4, 0.05), settings, device, 800); };
+  ScriptedDevice d1(script), d2(script);
+  Run r1, r2;
+  run_once(&r1, &d1);
+  run_once(&r2, &d2);
+  REQUIRE(d1.writes.size() == d2.writes.size());
+  REQUIRE(d1.writes.size() == 801);
+  int differing = 0;
+  double max_force = 0;
+  for (size_t k = 0; k < d1.writes.size(); ++k) {
+    differing += std::memcmp(d1.writes[k].F.data(), d2.writes[k].F.data(), sizeof(double) * 6) != 0;
+    max_force = std::max(max_force, d1.writes[k].F.head<3>().norm());
+  }
+  CHECK(differing == 0);
+  CHECK(max_force > 1);  // the run did press: the comparison is not of zeros
+  REQUIRE(r1.rec.sims.size() == r2.rec.sims.size());
+  for (size_t k = 0; k < r1.rec.sims.size(); ++k) {
+    const Pose &a = r1.rec.sims[k].xs, &b = r2.rec.sims[k].xs;
+    CHECK(std::memcmp(a.p.data(), b.p.data(), sizeof(double) * 3) == 0);
+    CHECK((a.q.w == b.q.w && a.q.x == b.q.x && a.q.y == b.q.y && a.q.z == b.q.z));
+    CHECK(lowest_z(*r1.model, a) >= kDelta * (1 - 1e-3));
+  }
+}
+
+TEST_CASE("shared state: a seqlock read under a concurrent writer is never torn", "[runtime]") {
+  // Every write fills all words with one counter value; a torn read would mix two.
+  struct Payload {
+    uint64_t words[300];
+  };
+  static SeqLock<Payload> lock;
+  std::atomic<bool> done{false};
+  constexpr uint64_t kWrites = 200000;
+  std::thread writer([&] {
+    static Payload p;
+    for (uint64_t i = 1; i <= kWrites; ++i) {
+      std::fill(std::begin(p.words), std::end(p.words), i);
+      lock.write(p);
+    }
+    done.store(true);
+  });
+  long reads = 0, torn = 0, backwards = 0;
+  uint64_t last = 0;
+  Payload got;
+  while (!done.load() || reads == 0) {
+    if (!lock.try_read(&got)) continue;
+    ++reads;
+    for (uint64_t w : got.words) torn += w != got.words[0];
+    backwards += got.words[0] < last;
+    last = got.words[0];
+  }
+  writer.join();
+  REQUIRE(lock.try_read(&got));
+  CHECK(got.words[0] == kWrites);
+  CHECK(lock.num_writes() == kWrites);
+  CHECK(reads > 0);
+  CHECK(torn == 0);
+  CHECK(backwards == 0);
+}
+
+TEST_CASE("runtime: threaded runs give sane forces (both force sources)", "[runtime]") {
+  for (const ForceSource source : {ForceSource::kHapticTick, ForceSource::kCouplingLoop}) {
+    // Pressed 1 cm deep. The run stops once 50 successive ticks sent more than
+    // 4 N, or after 5 s of wall time (a loaded machine only makes it slower).
+    ScriptedDevice device(press_script(0.2, 0.04, 1.0));
+    RuntimeSettings settings;
+    settings.force_source = source;
+    settings.coupling_min_period = 1e-4;  // leave the two cores some room
+    settings.sim_timeout = 1.0;
+    settings.coupling_timeout = 0.05;
+    const RuntimeModel model(make_scene(), settings);
+    auto data = std::make_unique<RuntimeData>(model);
+    Recorder rec;
+    rec.ticks.reserve(10000);
+    rec.sims.reserve(20000);
+    rec.couplings.reserve(200000);
+    int pressed_in_a_row = 0;
+    rec.on_tick = [&](const HapticTickRecord& t) {
+      pressed_in_a_row = t.F_sent[2] > 4 ? pressed_in_a_row + 1 : 0;
+      if (pressed_in_a_row >= 50) rec.stop.store(true);
+    };
+    RuntimeObserver observer = rec.observer();
+    observer.on_coupling_step = nullptr;  // the coupling thread would race with the haptic thread's vector
+    run_threaded(model, &device, 5.0, &rec.stop, observer, data.get());
+    INFO("force source " << static_cast<int>(source));
+    CHECK(rec.stop.load());
+    REQUIRE(!device.writes.empty());
+    for (const auto& w : device.writes) {
+      CHECK(w.F.allFinite());
+      CHECK(w.F.head<3>().norm() <= 20 * (1 + 1e-15));
+      CHECK(w.F.tail<3>().norm() <= 1 * (1 + 1e-15));
+      CHECK(w.F[2] >= -1e-9);  // never pulls down into the obstacle
+    }
+    // The last pressed tick: 5 N up (resting gap: < 1e-2 N), nothing sideways.
+    const HapticTickRecord& last = rec.ticks.back();
+    CHECK(std::abs(last.F_sent[2] - 5.0) < 1e-2);
+    CHECK(last.F_sent.head<2>().norm() < 1e-9);
+    for (const SimStepInfo& s : rec.sims) CHECK(lowest_z(model, s.xs) >= kDelta * (1 - 1e-3));
+    CHECK(device.writes.back().F.norm() == 0.0);  // released at the end
+    CHECK(data->stats.haptic.period.count > 0);
+    CHECK(data->stats.sim.work.count > 0);
+    CHECK(data->stats.coupling.work.count > 0);
+    std::printf("threaded (%s): %ld haptic ticks, period mean %.1f us (max jitter %.1f us, %ld overruns); "
+                "%ld sim steps, update mean %.1f us max %.1f us; %ld coupling steps, force mean %.2f us max %.2f us\n",
+                source == ForceSource::kHapticTick ? "coupling in the haptic tick" : "coupling thread",
+                data->stats.haptic.period.count + 1, 1e6 * data->stats.haptic.period.mean(),
+                1e6 * data->stats.haptic.max_jitter, data->stats.haptic.overruns, data->stats.sim.work.count,
+                1e6 * data->stats.sim.work.mean(), 1e6 * data->stats.sim.work.max, data->stats.coupling.work.count,
+                1e6 * data->stats.coupling.work.mean(), 1e6 * data->stats.coupling.work.max);
+  }
+}

@@ -1,0 +1,198 @@
+"""Read gauss6 run traces (docs/trace-format.md) into numpy arrays, and export them to CSV.
+
+    tr = read_trace("run.g6trace")
+    tr.ticks["t"], tr.ticks["xh_p"] (N, 3), tr.ticks["wrench"] (N, 6), ...
+    tr.steps, tr.contacts, tr.events   (numpy structured arrays)
+    tr.meta                            (the header's JSON metadata, a dict)
+    to_csv(tr, "out/")                 (ticks.csv, steps.csv, contacts.csv, events.csv, meta.json)
+
+Pure Python and numpy: no extension needed. A file cut mid-chunk (a crash) reads up to
+its last complete chunk with a TraceWarning; a malformed file raises TraceFormatError
+naming the file and the problem.
+"""
+from __future__ import annotations
+
+import json
+import struct
+import warnings
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+MAGIC = b"G6TRACE\0"
+VERSION = 1
+HEADER = struct.Struct("<8sIIQ")  # magic, version, flags, metadata length
+CHUNK = struct.Struct("<IIQ")     # type, row width (float64 values), row count
+
+TICKS, STEPS, CONTACTS, EVENTS, END = 1, 2, 3, 4, 5
+STREAMS = {TICKS: "ticks", STEPS: "steps", CONTACTS: "contacts", EVENTS: "events"}
+
+# Version 1 columns (name, width); the metadata repeats them under "columns".
+COLUMNS = {
+    "ticks": [("t", 1), ("xh_p", 3), ("xh_q", 4), ("xs_p", 3), ("xs_q", 4), ("wrench", 6),
+              ("num_contacts", 1), ("force_time", 1), ("status", 1), ("flags", 1), ("buttons", 1)],
+    "steps": [("step", 1), ("t", 1), ("update_time", 1), ("num_contacts", 1), ("status", 1)],
+    "contacts": [("step", 1), ("t", 1), ("point", 3), ("normal", 3), ("separation", 1)],
+    "events": [("t", 1), ("code", 1), ("value", 1)],
+}
+EVENT_CODES = {1: "phase", 2: "let_go", 3: "watchdog", 4: "device_lost", 5: "device_reconnected",
+               6: "device_ended"}
+TICK_FLAGS = {"gripped": 1, "new_contact_set": 2, "force_clamped": 4, "watchdog": 8}
+DEVICE_STATUS = {0: "ok", 1: "not_connected", 2: "timeout", 3: "ended", 4: "error"}
+
+
+class TraceFormatError(ValueError):
+    """A malformed trace: the message names the file and the problem."""
+
+
+class TraceWarning(UserWarning):
+    """A readable but incomplete trace (cut mid-chunk, or never closed)."""
+
+
+def _dtype(columns) -> np.dtype:
+    return np.dtype([(name, "<f8") if width == 1 else (name, "<f8", (width,)) for name, width in columns])
+
+
+DTYPES = {name: _dtype(cols) for name, cols in COLUMNS.items()}
+
+
+@dataclass
+class Trace:
+    path: Path
+    version: int
+    meta: dict
+    ticks: np.ndarray       # structured: t, xh_p (3), xh_q (4: w x y z), xs_p, xs_q, wrench (6), ...
+    steps: np.ndarray
+    contacts: np.ndarray
+    events: np.ndarray
+    complete: bool = False  # the end chunk was found: the writer closed the file
+    dropped: dict = field(default_factory=dict)
+    warnings: list = field(default_factory=list)
+
+    def event_names(self) -> list[str]:
+        codes = {int(k): v for k, v in self.meta.get("event_codes", {}).items()} or EVENT_CODES
+        return [codes.get(int(c), f"code_{int(c)}") for c in self.events["code"]]
+
+
+def read_trace(path) -> Trace:
+    """Reads a trace; see the module docstring for truncated and malformed files."""
+    path = Path(path)
+    try:
+        data = path.read_bytes()
+    except OSError as e:
+        raise TraceFormatError(f"{path}: cannot open the file: {e.strerror}") from None
+
+    def fail(problem: str) -> TraceFormatError:
+        return TraceFormatError(f"{path}: {problem}")
+
+    if len(data) < HEADER.size:
+        raise fail(f"not a gauss6 trace: {len(data)} bytes, shorter than the header")
+    magic, version, _flags, meta_len = HEADER.unpack_from(data, 0)
+    if magic != MAGIC:
+        raise fail('not a gauss6 trace: bad magic (expected "G6TRACE\\0")')
+    if version != VERSION:
+        raise fail(f"unsupported trace version {version} (this reader reads version {VERSION})")
+    if meta_len > len(data) - HEADER.size:
+        raise fail(f"metadata block of {meta_len} bytes runs past the end of the file")
+    try:
+        meta = json.loads(data[HEADER.size:HEADER.size + meta_len].decode("utf-8"))
+    except (UnicodeDecodeError, json.JSONDecodeError):
+        raise fail("the metadata block is not valid JSON") from None
+
+    parts: dict[str, list[np.ndarray]] = {name: [] for name in COLUMNS}
+    widths = {name: sum(w for _, w in cols) for name, cols in COLUMNS.items()}
+    complete, dropped, notes = False, {}, []
+    pos = HEADER.size + meta_len
+    while pos < len(data):
+        if len(data) - pos < CHUNK.size:
+            notes.append(f"{path}: cut mid-chunk at byte {pos} (partial chunk header); "
+                         "read up to the last complete chunk")
+            break
+        ctype, ncols, nrows = CHUNK.unpack_from(data, pos)
+        name = STREAMS.get(ctype)
+        expected = widths[name] if name else (4 if ctype == END else 0)
+        if expected and ncols != expected:
+            raise fail(f"chunk at byte {pos} of type {ctype} has rows of {ncols} values, expected {expected}")
+        if ncols == 0:
+            raise fail(f"chunk at byte {pos} has rows of 0 values")
+        remaining = len(data) - pos - CHUNK.size
+        if nrows > remaining // (8 * ncols):
+            notes.append(f"{path}: cut mid-chunk at byte {pos} ({nrows} rows announced, {remaining} bytes left); "
+                         "read up to the last complete chunk")
+            break
+        start, nbytes = pos + CHUNK.size, nrows * ncols * 8
+        if name:
+            parts[name].append(np.frombuffer(data, dtype=DTYPES[name], count=nrows, offset=start))
+        elif ctype == END:
+            complete = True
+            if nrows >= 1:
+                d = np.frombuffer(data, dtype="<f8", count=4, offset=start)
+                dropped = dict(zip(["ticks", "steps", "contacts", "events"], (int(x) for x in d)))
+        else:
+            notes.append(f"{path}: skipped a chunk of unknown type {ctype} at byte {pos}")
+        pos = start + nbytes
+    if not complete and not notes:
+        notes.append(f"{path}: no end chunk: the writer did not close the file "
+                     "(a crash loses the last flush period)")
+    for note in notes:
+        warnings.warn(note, TraceWarning, stacklevel=2)
+
+    def table(name: str) -> np.ndarray:
+        return np.concatenate(parts[name]) if parts[name] else np.zeros(0, dtype=DTYPES[name])
+
+    return Trace(path=path, version=version, meta=meta, ticks=table("ticks"), steps=table("steps"),
+                 contacts=table("contacts"), events=table("events"), complete=complete,
+                 dropped=dropped, warnings=notes)
+
+
+def _flat(arr: np.ndarray, name: str) -> tuple[list[str], np.ndarray]:
+    """Column headers and a 2-D float array: subarray fields become name_0, name_1, ..."""
+    headers, cols = [], []
+    for field_name, width in COLUMNS[name]:
+        col = arr[field_name]
+        if width == 1:
+            headers.append(field_name)
+            cols.append(col.reshape(-1, 1))
+        else:
+            headers += [f"{field_name}_{i}" for i in range(width)]
+            cols.append(col.reshape(-1, width))
+    return headers, (np.hstack(cols) if cols else np.zeros((0, 0)))
+
+
+def to_csv(trace: Trace, out_dir) -> list[Path]:
+    """Writes ticks.csv, steps.csv, contacts.csv, events.csv and meta.json into out_dir.
+
+    Quaternions are (w, x, y, z): xh_q_0 is w. Values are written with 17 significant
+    digits, so a CSV reads back to the same doubles. Returns the files written.
+    """
+    out = Path(out_dir)
+    out.mkdir(parents=True, exist_ok=True)
+    written = []
+    for name in ("ticks", "steps", "contacts", "events"):
+        headers, values = _flat(getattr(trace, name), name)
+        if name == "events":
+            headers = headers + ["name"]
+            names = trace.event_names()
+            lines = [",".join(headers)] + [",".join([*(f"{v:.17g}" for v in row), n]) for row, n in zip(values, names)]
+        else:
+            lines = [",".join(headers)] + [",".join(f"{v:.17g}" for v in row) for row in values]
+        p = out / f"{name}.csv"
+        p.write_text("\n".join(lines) + "\n")
+        written.append(p)
+    p = out / "meta.json"
+    p.write_text(json.dumps({**trace.meta, "complete": trace.complete, "dropped": trace.dropped}, indent=2) + "\n")
+    written.append(p)
+    return written
+
+
+def export_csv(trace_path, out_dir) -> str:
+    """`gauss6 trace export TRACE --csv DIR`: reads the trace, writes the CSV files, returns a summary line."""
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always", TraceWarning)
+        tr = read_trace(trace_path)
+    files = to_csv(tr, out_dir)
+    summary = (f"{tr.path}: {len(tr.ticks)} ticks, {len(tr.steps)} steps, {len(tr.contacts)} contacts, "
+               f"{len(tr.events)} events -> {', '.join(f.name for f in files)} in {out_dir}")
+    notes = [str(w.message) for w in caught]
+    return "\n".join([summary] + [f"warning: {n}" for n in notes])

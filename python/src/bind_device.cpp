@@ -1,0 +1,140 @@
+// Bindings of device/: HID enumeration and profiles, the simulated device and
+// the trace writer (gauss6._gauss6.device). The trace reader is pure Python
+// (gauss6.trace), so that traces read without the extension too.
+#include <pybind11/eigen.h>
+#include <pybind11/stl.h>
+
+#include "gauss6/hid_device.h"
+#include "gauss6/simulated_device.h"
+#include "gauss6/trace.h"
+#include "module.h"
+
+namespace py = pybind11;
+
+namespace gauss6::python {
+
+namespace {
+Quat quat_from(const Eigen::Vector4d& q) { return {q[0], q[1], q[2], q[3]}; }
+Eigen::Vector4d quat_to(const Quat& q) { return {q.w, q.x, q.y, q.z}; }
+
+py::dict entry_dict(const HidDeviceEntry& e) {
+  py::dict d;
+  d["path"] = e.path;
+  d["vendor_id"] = e.vendor_id;
+  d["product_id"] = e.product_id;
+  d["serial"] = e.serial;
+  d["manufacturer"] = e.manufacturer;
+  d["product"] = e.product;
+  d["interface_number"] = e.interface_number;
+  const HidProfile* p = find_hid_profile(e.vendor_id, e.product_id);
+  d["profile"] = p ? py::cast(std::string(p->name)) : py::none();
+  return d;
+}
+}  // namespace
+
+void bind_device(py::module_& parent) {
+  py::module_ m = parent.def_submodule("device", "Devices (simulated, HID) and the trace writer");
+  py::register_exception<TraceError>(m, "TraceError", PyExc_ValueError);
+
+  m.def("list_hid_devices", [] {
+    py::list out;
+    for (const HidDeviceEntry& e : list_hid_devices(*make_hidapi_backend())) out.append(entry_dict(e));
+    return out;
+  }, "Every HID interface hidapi sees, as dicts (path, vendor_id, product_id, serial, manufacturer, "
+     "product, interface_number, profile: the gauss6 profile name or None).");
+  m.def("hid_profiles", [] {
+    py::list out;
+    for (const HidProfile& p : hid_profiles()) {
+      py::dict d;
+      d["vendor_id"] = p.vendor_id;
+      d["product_id"] = p.product_id;
+      d["name"] = p.name;
+      d["layout"] = p.layout == HidReportLayout::kSplit ? "split" : "combined";
+      d["num_buttons"] = p.num_buttons;
+      d["full_scale"] = p.full_scale;
+      d["renders_force"] = p.renders_force;
+      out.append(d);
+    }
+    return out;
+  }, "The known HID device profiles (the SpaceMouse family).");
+
+  // The simulated device, driven from Python in lockstep: read(t) then write(t, F).
+  py::class_<SimulatedDevice>(m, "SimulatedDevice")
+      .def(py::init([](const std::string& script_json) {
+             return std::make_unique<SimulatedDevice>(hand_script_from_json(script_json, "script"));
+           }),
+           py::arg("script_json"), "A simulated device from a JSON hand script (default handle parameters).")
+      .def("read", [](SimulatedDevice& d, double t) {
+             DeviceState st;
+             d.read(t, &st);
+             return py::make_tuple(Eigen::Vector3d(st.X_WH.p), quat_to(st.X_WH.q), st.gripped, to_string(st.status));
+           }, py::arg("t"), "Advance to t (s): returns (p, q, gripped, status).")
+      .def("write", [](SimulatedDevice& d, double t, const Vec6& F) { return std::string(to_string(d.write(t, F))); },
+           py::arg("t"), py::arg("F"), "Hold the wrench F = (force, torque) until the next write.")
+      .def_property_readonly("rate_hz", [](const SimulatedDevice& d) { return d.info().rate_hz; });
+
+  py::class_<TraceWriter>(m, "TraceWriter")
+      .def(py::init([](const std::string& path, const std::string& scene, const std::string& device, double rate_hz,
+                       const std::vector<std::pair<std::string, double>>& phases, const std::string& extra_json,
+                       bool background_thread, double flush_period) {
+             TraceMeta meta;
+             meta.scene = scene;
+             meta.device = device;
+             meta.device_rate_hz = rate_hz;
+             for (const auto& [name, start] : phases) meta.phases.push_back({name, start});
+             meta.extra_json = extra_json;
+             TraceWriterSettings s;
+             s.background_thread = background_thread;
+             s.flush_period = flush_period;
+             return std::make_unique<TraceWriter>(path, meta, s);
+           }),
+           py::arg("path"), py::arg("scene") = "", py::arg("device") = "", py::arg("rate_hz") = 0.0,
+           py::arg("phases") = std::vector<std::pair<std::string, double>>{}, py::arg("extra_json") = "{}",
+           py::arg("background_thread") = true, py::arg("flush_period") = 0.25)
+      .def("append_tick",
+           [](TraceWriter& w, double t, const Eigen::Vector3d& xh_p, const Eigen::Vector4d& xh_q,
+              const Eigen::Vector3d& xs_p, const Eigen::Vector4d& xs_q, const Vec6& wrench, int num_contacts,
+              double force_time, int status, uint32_t flags, uint32_t buttons) {
+             TraceTick r;
+             r.t = t;
+             r.X_WH = {xh_p, quat_from(xh_q)};
+             r.X_WS = {xs_p, quat_from(xs_q)};
+             r.F = wrench;
+             r.num_contacts = num_contacts;
+             r.force_time = force_time;
+             r.status = static_cast<DeviceStatus>(status);
+             r.flags = flags;
+             r.buttons = buttons;
+             return w.append(r);
+           },
+           py::arg("t"), py::arg("xh_p"), py::arg("xh_q"), py::arg("xs_p"), py::arg("xs_q"), py::arg("wrench"),
+           py::arg("num_contacts") = 0, py::arg("force_time") = 0.0, py::arg("status") = 0, py::arg("flags") = 0,
+           py::arg("buttons") = 0)
+      .def("append_step",
+           [](TraceWriter& w, uint64_t step, double t, double update_time, int num_contacts, int status) {
+             return w.append(TraceStep{step, t, update_time, num_contacts, status});
+           },
+           py::arg("step"), py::arg("t"), py::arg("update_time"), py::arg("num_contacts"), py::arg("status") = 0)
+      .def("append_contact",
+           [](TraceWriter& w, uint64_t step, double t, const Eigen::Vector3d& point, const Eigen::Vector3d& normal,
+              double separation) { return w.append(TraceContact{step, t, point, normal, separation}); },
+           py::arg("step"), py::arg("t"), py::arg("point"), py::arg("normal"), py::arg("separation"))
+      .def("append_event",
+           [](TraceWriter& w, double t, uint32_t code, double value) {
+             return w.append(TraceEvent{t, static_cast<TraceEventCode>(code), value});
+           },
+           py::arg("t"), py::arg("code"), py::arg("value") = 0.0)
+      .def("flush", &TraceWriter::flush, py::call_guard<py::gil_scoped_release>())
+      .def("close", &TraceWriter::close, py::call_guard<py::gil_scoped_release>())
+      .def("stats", [](const TraceWriter& w) {
+        const TraceWriterStats s = w.stats();
+        py::dict d;
+        d["written"] = s.written;
+        d["dropped"] = s.dropped;
+        d["num_flushes"] = s.num_flushes;
+        d["num_chunks"] = s.num_chunks;
+        return d;
+      });
+}
+
+}  // namespace gauss6::python
