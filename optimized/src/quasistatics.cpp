@@ -8,6 +8,30 @@
 //   projection of y_u on the affine set of W and dual feasible. Adding the most
 //   violated row strictly increases the dual objective, so no working set
 //   repeats (no cycling); ties are broken by the smallest row index.
+//
+// Tolerances (ProjectionSettings; eps = 2.2e-16; relative to a row's scale
+// |A_k| |y| + |b_k|):
+// - feasibility_tol = 1e-13 (~450 eps). A computed slack A_k y - b_k carries a
+//   rounding of about a dozen eps (a 6-term product; for a row of W, the
+//   triangular solve; Q's loss of orthogonality, kept near 40 eps by
+//   rebuilding, see kMaxRotationsBeforeRebuild), so rows of W and their exact
+//   copies do not count as violated, while every other row left out is met to
+//   1e-13: the answer is the exact optimum for a b changed by that much (a
+//   backward error), apart from skipped dependent rows (below). It must be
+//   this small: a row nearly parallel to an active one (sine theta) accepted
+//   with violation v moves the answer by about v / theta.
+// - dependence_tol = 1e-10: the guard against a numerically singular R. The
+//   computed sine of a row's angle to span(W) has a rounding of about eps
+//   cond(R) (1e-11 for a body jammed between planes 1e-5 from opposite), so
+//   rows below 1e-10 cannot be told from dependent ones. A violated dependent
+//   row n = A_W^T r + z is handled as in Goldfarb-Idnani: when some r_j > 0,
+//   the multipliers move by -t r, t = min lambda_j / r_j over r_j > 0, and
+//   that row j leaves W (n then usually joins); when r <= 0, its slack on W's
+//   face is r^T b_W - b_p + z^T y: the offsets are inconsistent when
+//   b_p - r^T b_W exceeds the feasibility tolerance, else the row (violated by
+//   at most dependence_tol |A_k| |y| plus rounding) is skipped until a partial
+//   step changes the face. Always so for b = 0, whose feasible set is never
+//   empty.
 #include "gauss6/quasistatics.h"
 
 #include <Eigen/Cholesky>
@@ -30,8 +54,14 @@ constexpr double kSymmetryTol = 1e-9;
 constexpr double kMinPivotRatio = 1e-14;
 // Relative size of rounding noise in a multiplier's correction (a few dozen ulps).
 constexpr double kRoundoff = 64 * std::numeric_limits<double>::epsilon();
-// Rebuild Q and R from the working set's rows after this many rotations.
-constexpr long kMaxRotationsBeforeRebuild = 10000;
+// Rebuild Q and R from the working set's rows after this many rotations:
+// Q's loss of orthogonality grows like sqrt(rotations) eps (measured: below
+// 1e-14 over long warm runs) and adds to the rounding of every slack, so it
+// must stay well below feasibility_tol.
+constexpr long kMaxRotationsBeforeRebuild = 1000;
+// in_active[k] of a row that is dependent on the working set and consistent
+// with it to rounding (see the main loop): not a candidate until the next drop.
+constexpr unsigned char kSkipped = 2;
 
 bool all_finite(const double* p, int n) noexcept {
   double acc = 0;
@@ -205,6 +235,33 @@ void solve_working_set(ProjectionWorkspace& ws, const Vec6& yu, const double* b,
   }
 }
 
+// Solves the working set and drops its most negative multiplier until none is
+// (y is then the projection on W's face and dual feasible); returns the number
+// of drops. A multiplier whose correction lambda_i |A_i| is rounding noise
+// (< kRoundoff of the row's scale) counts as zero and is dropped too, so that a
+// warm start never leaves a spurious active row (J au >= b => ac = au).
+int drop_until_dual_feasible(ProjectionWorkspace& ws, const Vec6& yu, double yu_norm, const double* b,
+                             Vec6* y) noexcept {
+  for (int drops = 0;; ++drops) {
+    solve_working_set(ws, yu, b, y);
+    const double y_scale = std::max(y->norm(), yu_norm);
+    int worst = -1;
+    double worst_value = 0;
+    for (int i = 0; i < ws.num_active; ++i) {
+      const int k = ws.active[i];
+      const double value = ws.lambda_active[i] * ws.row_norm[k];  // length of its correction
+      const double noise = kRoundoff * (y_scale + (b ? std::abs(b[k]) * ws.inv_row_norm[k] : 0.0));
+      if (value <= noise && (worst < 0 || value < worst_value ||
+                             (value == worst_value && k < ws.active[worst]))) {
+        worst = i;
+        worst_value = value;
+      }
+    }
+    if (worst < 0) return drops;
+    factor_drop(ws, worst);
+  }
+}
+
 bool valid_settings(const ProjectionSettings& s) noexcept {
   return std::isfinite(s.dependence_tol) && s.dependence_tol >= 0 && s.dependence_tol < 1 &&
          std::isfinite(s.feasibility_tol) && s.feasibility_tol >= 0 && s.max_iterations >= 0;
@@ -307,30 +364,10 @@ ProjectionStatus project(const ProjectionProblem& pb, const ProjectionSettings& 
   int iterations = 0;
   ProjectionStatus status = ProjectionStatus::kOptimal;
   Vec6 y;
-  // Make the start dual feasible: drop the most negative multiplier until none
-  // is. A multiplier whose correction lambda_i |A_i| is rounding noise
-  // (< kRoundoff of the row's scale) counts as zero and is dropped too, so that
-  // a warm start never leaves a spurious active row (J au >= b => ac = au).
-  for (;;) {
-    solve_working_set(ws, yu, b, &y);
-    const double y_scale = std::max(y.norm(), yu_norm);
-    int worst = -1;
-    double worst_value = 0;
-    for (int i = 0; i < ws.num_active; ++i) {
-      const int k = ws.active[i];
-      const double value = ws.lambda_active[i] * ws.row_norm[k];  // length of its correction
-      const double noise = kRoundoff * (y_scale + (b ? std::abs(b[k]) * ws.inv_row_norm[k] : 0.0));
-      if (value <= noise && (worst < 0 || value < worst_value ||
-                             (value == worst_value && k < ws.active[worst]))) {
-        worst = i;
-        worst_value = value;
-      }
-    }
-    if (worst < 0) break;
-    factor_drop(ws, worst);
-    ++iterations;
-  }
+  // Make the start dual feasible (a warm start's multipliers may be negative).
+  iterations += drop_until_dual_feasible(ws, yu, yu_norm, b, &y);
 
+  bool has_skipped = false;  // some in_active[k] == kSkipped
   for (;;) {
     // Most violated row (largest distance to its hyperplane, smallest index on ties).
     const double y_scale = std::max(y.norm(), yu_norm);
@@ -392,7 +429,28 @@ ProjectionStatus project(const ProjectionProblem& pb, const ProjectionSettings& 
       }
       const double t2 = dependent ? kInf : -s_p / z2;
       if (t1 == kInf && t2 == kInf) {
-        status = ProjectionStatus::kInfeasibleOffsets;
+        // n = A_W^T r + z, |z| <= dependence_tol |n|, with r <= 0: no step
+        // can satisfy row p. On W's face its slack is r^T b_W - b_p + z^T y,
+        // so the offsets are inconsistent when b_p - r^T b_W exceeds the
+        // feasibility tolerance; otherwise (always when b = 0) the violation
+        // is the small z^T y plus rounding of W's slacks, and p is skipped
+        // until a partial step changes the face.
+        double gap = b ? b[p] : 0.0;
+        if (b)
+          for (int i = 0; i < q; ++i) gap -= r[i] * b[ws.active[i]];
+        if (gap > feas_tol * (ws.row_norm[p] * y_scale + std::abs(b ? b[p] : 0.0))) {
+          status = ProjectionStatus::kInfeasibleOffsets;
+          break;
+        }
+        ws.in_active[p] = kSkipped;
+        has_skipped = true;
+        if (lambda_p > 0) {
+          // Exchange steps gave p a multiplier that W cannot carry (W is
+          // ill-conditioned enough that p stayed dependent after a drop): go
+          // back to the projection on W's face, made dual feasible. y did not
+          // move (dependent steps change only multipliers).
+          iterations += drop_until_dual_feasible(ws, yu, yu_norm, b, &y);
+        }
         break;
       }
       const double t = std::min(t1, t2);
@@ -410,6 +468,12 @@ ProjectionStatus project(const ProjectionProblem& pb, const ProjectionSettings& 
       }
       ws.lambda_active[block] = 0;
       factor_drop(ws, block);
+      if (has_skipped) {
+        // The face changed: skipped rows are examined again.
+        for (int k = 0; k < m; ++k)
+          if (ws.in_active[k] == kSkipped) ws.in_active[k] = 0;
+        has_skipped = false;
+      }
     }
     if (status != ProjectionStatus::kOptimal) break;
   }

@@ -23,9 +23,11 @@
 #include <limits>
 #include <optional>
 #include <random>
+#include <set>
 #include <vector>
 
 #include "gauss6/coupling.h"
+#include "gauss6/qp_instances.h"
 #include "gauss6/quasistatics.h"
 
 namespace {
@@ -681,4 +683,192 @@ TEST_CASE("property: KKT, orthogonality, dissipativity, warm = cold", "[qp]") {
     RC_ASSERT(warm.dual_infeasibility <= 1e2 * kEps * std::max(lam_max, 0.0));
   });
   REQUIRE(ok);
+}
+
+namespace {
+
+// The optimum as a KKT point found by enumeration, in long double: for every
+// subset S (at most 6 rows, full rank) of `candidates`, the minimiser on the
+// face {J_S a = b_S}, a = au + M^-1 J_S^T lambda_S, is the projection when it
+// is feasible for all rows and lambda_S >= 0 (KKT conditions of a strictly
+// convex problem: sufficient, so restricting the enumeration to some rows can
+// only miss the optimum, never accept a wrong point). Tolerances: feasibility
+// 1e-15 of the row's scale |A_k| |au|_M + |b_k| (long double rounding, 1e-19,
+// times the faces' condition, below 1e4 here) and multipliers >= -1e-15 of
+// |au|_M / |A_k| (the optimum is unique, so a degenerate zero multiplier
+// rounded slightly negative still names it). nullopt: none found.
+std::optional<Vec6> kkt_point_by_enumeration(const Mat6& M, const Vec6& au, const Rows& rows,
+                                             const std::vector<int>& candidates) {
+  using MatL = Eigen::Matrix<long double, Eigen::Dynamic, Eigen::Dynamic>;
+  using VecL = Eigen::Matrix<long double, Eigen::Dynamic, 1>;
+  using Mat6L = Eigen::Matrix<long double, 6, 6>;
+  using Vec6L = Eigen::Matrix<long double, 6, 1>;
+  const int m = rows.m();
+  const Mat6L Ml = M.cast<long double>();
+  const Mat6L Minv = Ml.ldlt().solve(Mat6L::Identity());
+  const Vec6L aul = au.cast<long double>();
+  const long double au_M = std::sqrt(aul.dot(Ml * aul));
+  MatL J(m, 6);
+  VecL b(m), Ak(m);
+  for (int k = 0; k < m; ++k) {
+    J.row(k) = rows.row(k).transpose().cast<long double>();
+    b[k] = rows.bk(k);
+    Ak[k] = std::sqrt(J.row(k).dot(Minv * J.row(k).transpose()));
+  }
+  std::optional<Vec6> found;
+  std::vector<int> S;
+  auto visit = [&](auto&& self, int next) -> void {
+    if (found) return;
+    const int s = static_cast<int>(S.size());
+    MatL JS(s, 6);
+    VecL rhs(s);
+    for (int i = 0; i < s; ++i) {
+      JS.row(i) = J.row(S[i]);
+      rhs[i] = b[S[i]] - J.row(S[i]).dot(aul);
+    }
+    const MatL MinvJt = Minv * JS.transpose();
+    Eigen::FullPivLU<MatL> lu(JS * MinvJt);
+    lu.setThreshold(1e-14L);
+    if (lu.rank() == s) {
+      const VecL lambda = lu.solve(rhs);
+      const Vec6L a = aul + MinvJt * lambda;
+      bool kkt = true;
+      for (int i = 0; i < s && kkt; ++i) kkt = lambda[i] * Ak[S[i]] >= -1e-15L * au_M;
+      for (int k = 0; k < m && kkt; ++k) kkt = J.row(k).dot(a) - b[k] >= -1e-15L * (Ak[k] * au_M + std::abs(b[k]));
+      if (kkt) {
+        found = a.cast<double>();
+        return;
+      }
+    }
+    if (s == 6) return;
+    for (int i = next; i < static_cast<int>(candidates.size()); ++i) {
+      S.push_back(candidates[i]);
+      self(self, i + 1);
+      S.pop_back();
+    }
+  };
+  visit(visit, 0);
+  return found;
+}
+
+Rows rows_of(const gauss6::QpInstance& q) {
+  Rows rows;
+  for (int k = 0; k < q.J.rows(); ++k) rows.add(q.J.row(k).transpose(), q.b.size() ? q.b[k] : 0.0);
+  return rows;
+}
+
+}  // namespace
+
+TEST_CASE("regression: nearly parallel rows of the redundant family", "[qp]") {
+  // Instances (datasets_generated/qp/redundant.json) where a row nearly
+  // parallel to an active one (angle 1e-6..1e-10) was once accepted with a
+  // violation of 1e-11..5e-9 of its scale, moving ac by 1e-9..2e-7 of |au|_M.
+  // The exact problems are well-conditioned (multipliers ~1e-3), so ac must
+  // match the independent KKT point to 1e-11 of |au|_M: rounding (1e-15) times
+  // the conditioning of the optimal face, with margin; cold, warm from the same
+  // working set, and warm after another instance (factors rebuilt).
+  const std::set<std::string> ids = {
+      "redundant-0003", "redundant-0004", "redundant-0015", "redundant-0028", "redundant-0052", "redundant-0055",
+      "redundant-0108", "redundant-0124", "redundant-0132", "redundant-0148", "redundant-0151", "redundant-0155",
+      "redundant-0172", "redundant-0183", "redundant-0199", "redundant-0220"};
+  const std::vector<gauss6::QpInstance> all =
+      gauss6::read_qp_instances(std::string(GAUSS6_SOURCE_DIR) + "/datasets_generated/qp/redundant.json");
+  const ProjectionSettings settings;
+  ProjectionWorkspace shared;  // warm starts carried from one instance to the next
+  int checked = 0;
+  for (const gauss6::QpInstance& q : all) {
+    if (!ids.count(q.id)) continue;
+    INFO(q.id);
+    ++checked;
+    const Rows rows = rows_of(q);
+    const ProjectionResult cold = solve_cold(q.M, q.au, rows, settings);
+    check_kkt(q.M, q.au, rows, cold, settings);
+    // Enumerate all rows when few; else the rows within 1e-6 of their scale of
+    // being active at the solver's answer (a pruning only: see above).
+    std::vector<int> candidates;
+    const Mat6 Minv = q.M.llt().solve(Mat6::Identity());
+    for (int k = 0; k < rows.m(); ++k) {
+      const double scale = std::sqrt(rows.row(k).dot(Minv * rows.row(k))) * m_norm(q.M, q.au) + std::abs(rows.bk(k));
+      if (rows.m() <= 12 || rows.row(k).dot(cold.ac) - rows.bk(k) <= 1e-6 * scale) candidates.push_back(k);
+    }
+    INFO("m " << rows.m() << ", " << candidates.size() << " candidate rows");
+    const std::optional<Vec6> truth = kkt_point_by_enumeration(q.M, q.au, rows, candidates);
+    REQUIRE(truth.has_value());
+    check_same(q.M, q.au, cold.ac, *truth, 1e-11);
+
+    ProjectionResult warm, again;
+    REQUIRE(gauss6::project(make_problem(q.M, q.au, rows), settings, &shared, &warm) == ProjectionStatus::kOptimal);
+    check_same(q.M, q.au, warm.ac, *truth, 1e-11);
+    REQUIRE(gauss6::project(make_problem(q.M, q.au, rows), settings, &shared, &again) == ProjectionStatus::kOptimal);
+    check_same(q.M, q.au, again.ac, *truth, 1e-11);
+  }
+  CHECK(checked == static_cast<int>(ids.size()));
+}
+
+TEST_CASE("a dependent row met to rounding does not make the cone infeasible", "[qp]") {
+  // Rows A1 = B u + v and A2 = -B u + w (nearly opposite for large B) jam the
+  // body along u; A3 = -(A1 + A2) = -(v + w) is spanned by them with
+  // coefficients -1, -1 (exactly: small integers, B a power of 2, M diagonal
+  // with powers of 4, so that J, A = J L^-T and A3 = -(A1 + A2) are exact).
+  // On their common face A3 a = 0, but its computed slack carries the rounding
+  // of A1 a and A2 a, about eps B |a|, far above feasibility_tol |A3| |a|. With
+  // b = 0 the feasible set is a cone (never empty): the answer must be optimal
+  // and match the brute-force answer. Tolerance 64 eps B (relative, M-norm):
+  // the face of A1, A2 is known to eps times their condition number ~B. (Both
+  // ways of skipping such a row occur here: straight away, and after exchange
+  // steps that left W too ill-conditioned to carry it.)
+  std::mt19937_64 rng(23);
+  std::uniform_int_distribution<int> small(-3, 3), expo(-2, 2);
+  int checked = 0;
+  for (double B : {0x1p7, 0x1p14, 0x1p17}) {
+    for (int t = 0; t < 300; ++t) {
+      Mat6 M = Mat6::Zero();
+      for (int i = 0; i < 6; ++i) M(i, i) = std::ldexp(1.0, 2 * expo(rng));
+      Vec6 u = Vec6::Zero(), v, w, x;
+      u[t % 6] = 1;
+      for (int i = 0; i < 6; ++i) {
+        v[i] = small(rng);
+        w[i] = small(rng);
+        x[i] = small(rng);
+      }
+      if ((v + w).isZero() || x.isZero()) continue;
+      Rows rows;
+      rows.add(B * u + v);
+      rows.add(-B * u + w);
+      rows.add(-(v + w));
+      rows.add(x);
+      // au pushes into the jammed pair, and anywhere else.
+      const Vec6 au = random_vec(rng) - (v + w).normalized();
+      INFO("B " << B << " t " << t);
+      const ProjectionResult res = solve_cold(M, au, rows);
+      REQUIRE(res.status == ProjectionStatus::kOptimal);
+      const auto truth = brute_force(M, au, rows);
+      REQUIRE(truth.has_value());
+      check_same(M, au, res.ac, *truth, 64 * kEps * B);
+      ++checked;
+    }
+  }
+  CHECK(checked >= 800);
+}
+
+TEST_CASE("Q stays orthogonal over long warm-started runs", "[qp]") {
+  // The working set's Q is updated by Givens rotations and rebuilt from the
+  // rows every kMaxRotationsBeforeRebuild rotations, so its loss of
+  // orthogonality (which adds to the rounding of every slack) stays well below
+  // feasibility_tol (1e-13): checked at 2e-14 over 20000 calls.
+  std::mt19937_64 rng(29);
+  const Mat6 M = random_spd(rng, 1e3);
+  Vec6 au = random_vec(rng);
+  const Rows rows = random_rows(rng, 30, au, Push::kSome);
+  ProjectionWorkspace ws;
+  const ProjectionSettings settings;
+  double worst = 0;
+  for (int step = 0; step < 20000; ++step) {
+    au = 0.9 * au + random_vec(rng, 0.5);
+    ProjectionResult res;
+    REQUIRE(gauss6::project(make_problem(M, au, rows), settings, &ws, &res) == ProjectionStatus::kOptimal);
+    worst = std::max(worst, (ws.Q.transpose() * ws.Q - Mat6::Identity()).cwiseAbs().maxCoeff());
+  }
+  INFO("max |Q^T Q - I| " << worst);
+  CHECK(worst <= 2e-14);
 }

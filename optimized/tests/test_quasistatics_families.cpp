@@ -109,7 +109,7 @@ TEST_CASE("the proved properties hold on every instance family", "[qp][families]
       else CHECK(Fu.dot(r.ac) <= Fu.dot(q.au) + lambda.dot(q.b) + tol);  // dissipativity_offset
 
       // KKT primal feasibility, relative to the row's scale |J_k| |au| + |b_k|
-      // at the solver's own feasibility tolerance (1e-9, quasistatics.h).
+      // at the solver's own feasibility tolerance (settings.feasibility_tol, quasistatics.h).
       for (int k = 0; k < m; ++k) {
         const double slack = q.J.row(k).dot(r.ac) - (q.b.size() ? q.b[k] : 0.0);
         CHECK(slack >= -settings.feasibility_tol * (q.J.row(k).norm() * q.au.norm() + std::abs(q.b.size() ? q.b[k] : 0.0)));

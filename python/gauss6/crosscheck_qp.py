@@ -26,7 +26,10 @@ projection is defined:
 """
 from __future__ import annotations
 
+import contextlib
 import math
+import os
+import sys
 from collections import Counter
 from dataclasses import dataclass, field
 
@@ -46,6 +49,23 @@ def m_norm(M: np.ndarray, x: np.ndarray) -> float:
     return math.sqrt(max(float(x @ M @ x), 0.0))
 
 
+@contextlib.contextmanager
+def c_stdout_silenced():
+    """OSQP's C code prints ("Polishing not needed ...") to the process's stdout
+    even with verbose=False: send file descriptor 1 to /dev/null meanwhile, so
+    that the command's own output (JSON) stays clean."""
+    sys.stdout.flush()
+    saved = os.dup(1)
+    devnull = os.open(os.devnull, os.O_WRONLY)
+    try:
+        os.dup2(devnull, 1)
+        yield
+    finally:
+        os.dup2(saved, 1)
+        os.close(saved)
+        os.close(devnull)
+
+
 def solve_osqp(M: np.ndarray, au: np.ndarray, J: np.ndarray, b: np.ndarray) -> np.ndarray | None:
     """OSQP at eps 1e-10, polished: the independent floating-point cross-check."""
     import osqp
@@ -57,7 +77,8 @@ def solve_osqp(M: np.ndarray, au: np.ndarray, J: np.ndarray, b: np.ndarray) -> n
     solver = osqp.OSQP()
     solver.setup(sp.csc_matrix(np.triu(M)), -M @ au, sp.csc_matrix(J), b, np.full(m, np.inf),
                  eps_abs=1e-10, eps_rel=1e-10, polishing=True, verbose=False, max_iter=200000)
-    r = solver.solve()
+    with c_stdout_silenced():
+        r = solver.solve()
     return None if r.info.status not in ("solved", "solved inaccurate") else np.asarray(r.x)
 
 

@@ -20,7 +20,7 @@ from pathlib import Path
 import numpy as np
 
 from . import _gauss6, qp_instances
-from .crosscheck_qp import certified_optimum, m_norm
+from .crosscheck_qp import c_stdout_silenced, certified_optimum, m_norm
 
 FAMILIES = ["box", "peg", "bunny", "inertia", "redundant", "m50", "offsets"]
 EXACT_FLOOR = 1e-17  # errors of exactly zero are drawn here on the log axis
@@ -33,7 +33,8 @@ def _osqp(M, au, J, b, precise: bool):
     s = osqp.OSQP()
     kw = dict(eps_abs=1e-10, eps_rel=1e-10, polishing=True, max_iter=200000) if precise else {}
     s.setup(sp.csc_matrix(np.triu(M)), -M @ au, sp.csc_matrix(J), b, np.full(len(b), np.inf), verbose=False, **kw)
-    r = s.solve()
+    with c_stdout_silenced():
+        r = s.solve()
     ok = r.info.status in ("solved", "solved inaccurate")
     return (np.asarray(r.x) if ok else None), r.info.solve_time
 

@@ -33,20 +33,22 @@ inline constexpr int kMaxContacts = 64;
 // Size of a working set: at most 6 linearly independent rows in R^6.
 inline constexpr int kMaxActive = 6;
 
-// Tolerances and limits; defaults suit double-precision haptics.
+// Tolerances and limits; defaults suit double-precision haptics. Both
+// tolerances are relative (to |A_k| = sqrt(J_k M^-1 J_k^T), |y| = |a|_M,
+// |b_k|): independent of units and row scaling. Why these values: see
+// "Tolerances" at the top of quasistatics.cpp.
 struct ProjectionSettings {
-  // A row whose component orthogonal to the working set's rows (in the
-  // M^-1-norm, y-space) is <= dependence_tol times its norm (sin of its angle to
-  // their span) is treated as dependent on them and never joins the working
-  // set. This bounds the condition number of R by about 1/dependence_tol, so
-  // lambda keeps ~eps/dependence_tol (2e-6) relative accuracy in the worst
-  // case, while a skipped row of the cone (b = 0) is violated by at most
-  // dependence_tol * |A_k| |y|, below feasibility_tol: it never re-enters.
+  // Row k is dependent on the working set W when the sine of its angle to the
+  // span of W's rows (y-space) is <= dependence_tol: it never joins W; a
+  // violated one is exchanged for a row of W that spans it. 1e-10: keeps
+  // cond(R) below 1e10, and stays above the rounding of that sine (eps cond(R)
+  // for ill-conditioned W, e.g. a body jammed between nearly opposite planes).
   double dependence_tol = 1e-10;
-  // Row k counts as violated when J_k a - b_k < -feasibility_tol * scale_k,
-  // scale_k = |A_k| max(|y|, |y_u|) + |b_k| (|A_k|^2 = J_k M^-1 J_k^T,
-  // |y| = |a|_M): a relative tolerance, independent of units and row scaling.
-  double feasibility_tol = 1e-9;
+  // Row k is violated when J_k a - b_k < -feasibility_tol * scale_k, with
+  // scale_k = |A_k| max(|y|, |y_u|) + |b_k|. 1e-13 (~450 eps): above the
+  // rounding of a slack, and small because a nearly parallel row left violated
+  // by v moves the answer by v / (their sine).
+  double feasibility_tol = 1e-13;
   // Cap on the add/drop steps of one call (typ. <= 2 m are needed).
   int max_iterations = 200;
   // Start from the previous call's working set (kept in the workspace).
@@ -60,9 +62,11 @@ enum class ProjectionStatus {
   kIterationCap,       // max_iterations reached: ac (finite) is the projection
                        // on the last working set; the residuals say how far
                        // from optimal it is.
-  kInfeasibleOffsets,  // {a : J a >= b} is empty, or is reached only through
-                       // rows dependent within dependence_tol (only possible
-                       // with b != 0): ac = au (zero force), lambda = 0.
+  kInfeasibleOffsets,  // {a : J a >= b} is empty: a violated row is, within
+                       // dependence_tol, a nonpositive combination of working
+                       // set rows whose offsets contradict it by more than
+                       // feasibility_tol (only possible with b != 0):
+                       // ac = au (zero force), lambda = 0.
   kBadInput,           // non-finite data, M not SPD, num_rows out of [0, cap],
                        // J null with rows, or settings out of range.
 };
