@@ -3,6 +3,8 @@
     gauss6 scene info SCENE [--json]
     gauss6 datasets generate | check
     gauss6 crosscheck qp [--family NAME] [--json]
+    gauss6 ccd queries FILE.csv|DIR [--kind vf|ee] [--impl optimized|reference] [--json]
+    gauss6 crosscheck ccd [--set NAME] [--json] [--peers]
     gauss6 report qp --out DIR
     gauss6 reproduce peg|bunny|all --out DIR
     gauss6 device list [--json]
@@ -103,6 +105,25 @@ def cmd_report_qp(args: argparse.Namespace) -> int:
     return 0
 
 
+def cmd_ccd_queries(args: argparse.Namespace) -> int:
+    from .ccd import format_stats, run_queries
+
+    try:
+        stats = run_queries(Path(args.target), args.kind, args.impl, time_tolerance=args.time_tolerance)
+    except (ValueError, RuntimeError) as e:
+        return _error(str(e))
+    print(json.dumps(stats.as_json()) if args.json else format_stats(stats, args.impl))
+    for m in stats.missed[:50]:
+        print(f"FALSE NEGATIVE {m}", file=sys.stderr)
+    return 1 if stats.false_negatives else 0
+
+
+def cmd_crosscheck_ccd(args: argparse.Namespace) -> int:
+    from .crosscheck_ccd import run_cli
+
+    return run_cli(args)
+
+
 def cmd_device_list(args: argparse.Namespace) -> int:
     from .device import format_devices, list_devices
 
@@ -136,6 +157,20 @@ def build_parser() -> argparse.ArgumentParser:
     ccq.add_argument("--tolerance", type=float, default=1e-9, help="max relative error in the M-norm (default 1e-9)")
     ccq.add_argument("--no-osqp", action="store_true", help="skip the OSQP cross-check")
     ccq.set_defaults(func=cmd_crosscheck_qp)
+    ccc = cc.add_parser("ccd", help="mesh CCD steps: optimized ccd_step against the exact first contact (and FCL)")
+    ccc.add_argument("--set", dest="set_name", help="one step set of datasets_generated/ccd/ (default: all)")
+    ccc.add_argument("--json", action="store_true", help="machine-readable output")
+    ccc.add_argument("--peers", action="store_true", help="print FCL's misses and time (JSON) instead")
+    ccc.set_defaults(func=cmd_crosscheck_ccd)
+
+    ccd = sub.add_parser("ccd", help="continuous collision detection").add_subparsers(dest="action", required=True)
+    cq = ccd.add_parser("queries", help="run a CCD query file (or a folder of them) through one implementation")
+    cq.add_argument("target", help="query CSV file, or a directory (every CSV under vertex-face/ or edge-edge/)")
+    cq.add_argument("--kind", choices=["vf", "ee"], help="vertex/face or edge/edge (default: from the folder name)")
+    cq.add_argument("--impl", choices=["optimized", "reference"], default="optimized", help="default: optimized")
+    cq.add_argument("--time-tolerance", type=float, default=1e-6, help="optimized CCD time tolerance (default 1e-6)")
+    cq.add_argument("--json", action="store_true", help="machine-readable output")
+    cq.set_defaults(func=cmd_ccd_queries)
 
     report = sub.add_parser("report", help="speed against error reports").add_subparsers(dest="what", required=True)
     rq = report.add_parser("qp", help="projection solvers: time against error on the same instances")

@@ -14,8 +14,6 @@ namespace py = pybind11;
 namespace gauss6::python {
 
 namespace {
-Quat quat_from(const Eigen::Vector4d& q) { return {q[0], q[1], q[2], q[3]}; }
-Eigen::Vector4d quat_to(const Quat& q) { return {q.w, q.x, q.y, q.z}; }
 
 py::dict entry_dict(const HidDeviceEntry& e) {
   py::dict d;

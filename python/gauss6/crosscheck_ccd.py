@@ -1,0 +1,314 @@
+"""`gauss6 crosscheck ccd`: the optimized mesh CCD step against the exact first contact.
+
+For every step of the sets in datasets_generated/ccd/ (README.md there), with the
+set's separation delta (METHOD.md section 4):
+
+- optimized: ccd_step(X0 -> X1) with min_separation = delta gives u_hit; the stop
+  pose is make_stop_pose(motion, u_hit) on a hit, X1 otherwise;
+- exact: mesh_first_contact(X0 -> X1) gives u* (poses with the exact meaning of
+  METHOD.md section 1, the exact Cayley motion of section 4).
+
+Violations (any one makes the command exit 1):
+- false negative: an exact contact the optimized step did not report;
+- late hit: u_hit > u*, decided exactly (compare_toi), never by rounding;
+- intersecting stop pose: count_intersecting_pairs(stop pose) > 0, exactly.
+
+Reported: gap = u* - u_hit over steps where both hit (max and 99th percentile),
+the largest exact separation at a hit's stop pose (scene units; separations
+beyond STOP_SEPARATION_WINDOW deltas are reported as that window, a lower bound),
+the optimized time per step (fastest of 3 runs) and the reference's.
+
+Peers (`--peers`, and the human-readable table): FCL's continuous collision on the
+steps where its motion equals ours as a path: pure translation (CCDM_TRANS) and
+pure rotation about G (CCDM_SCREW, rotation about the axis of qr through G; its
+time t maps to our u = tan(t theta / 2) / tan(theta / 2)). Its misses and late
+stops are counted against the same exact u*.
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import sys
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from . import _gauss6, paths
+
+SETS_DIR = paths.DATASETS_DIR / "ccd"
+FORMAT = "gauss6-ccd-steps"
+FORMAT_VERSION = 1
+STOP_SEPARATION_WINDOW = 100.0   # deltas: the exact separation is computed up to this distance
+OPTIMIZED_REPEATS = 3            # timing: fastest of this many runs of each step
+
+
+def set_names() -> list[str]:
+    return sorted(p.stem for p in SETS_DIR.glob("*.json") if p.name != "MANIFEST.json")
+
+
+def load_set(name: str) -> dict:
+    """One step set, checked for format and version (ValueError naming the file)."""
+    path = SETS_DIR / f"{name}.json"
+    if not path.is_file():
+        raise ValueError(f"{path}: no such set (sets: {', '.join(set_names())})")
+    doc = json.loads(path.read_text())
+    if doc.get("format") != FORMAT or doc.get("version") != FORMAT_VERSION:
+        raise ValueError(f"{path}: not a {FORMAT} version {FORMAT_VERSION} file")
+    return doc
+
+
+class Meshes:
+    """MeshPair objects (optimized + exact) per (obstacle, god, offset), built once."""
+
+    def __init__(self):
+        self._pairs: dict[tuple, object] = {}
+        self.god_body: dict[tuple, tuple[np.ndarray, np.ndarray]] = {}
+        self.obstacle: dict[tuple, tuple[np.ndarray, np.ndarray]] = {}
+
+    def get(self, step: dict):
+        key = (step["obstacle"], step["god"], tuple(step["offset"]))
+        if key not in self._pairs:
+            Vo, Fo = _gauss6.read_mesh(str(paths.DATASETS_DIR / step["obstacle"]))
+            Vg, Fg = _gauss6.read_mesh(str(paths.DATASETS_DIR / step["god"]))
+            Vg = Vg - np.asarray(step["offset"])  # body frame: origin at G (README.md)
+            self._pairs[key] = _gauss6.ccd.MeshPair(Vo, Fo, Vg, Fg)
+            self.obstacle[key], self.god_body[key] = (Vo, Fo), (Vg, Fg)
+        return key, self._pairs[key]
+
+
+def poses(step: dict) -> tuple[np.ndarray, ...]:
+    return tuple(np.asarray(step[k], dtype=float) for k in ("p0", "q0", "p1", "q1"))
+
+
+@dataclass
+class SetResult:
+    name: str
+    steps: int = 0
+    false_negatives: int = 0
+    late_hits: int = 0
+    gaps: list[float] = field(default_factory=list)
+    intersecting_stop_poses: int = 0
+    max_stop_separation: float = 0.0
+    optimized_seconds: float = 0.0
+    reference_seconds: float = 0.0
+    exact_hits: int = 0
+    optimized_hits: int = 0
+    statuses: dict[str, int] = field(default_factory=dict)
+    failures: list[str] = field(default_factory=list)
+
+    def as_json(self) -> dict:
+        n = max(self.steps, 1)
+        return {"name": self.name, "steps": self.steps, "false_negatives": self.false_negatives,
+                "late_hits": self.late_hits, "max_gap_u": max(self.gaps, default=0.0),
+                "p99_gap_u": float(np.percentile(self.gaps, 99)) if self.gaps else 0.0,
+                "intersecting_stop_poses": self.intersecting_stop_poses,
+                "max_stop_separation": self.max_stop_separation,
+                "optimized_us_per_step": 1e6 * self.optimized_seconds / n,
+                "reference_s_per_step": self.reference_seconds / n}
+
+
+def check_step(pair, step: dict, delta: float, res: SetResult) -> object:
+    """Runs one step both ways, adds it to res and returns the exact contact."""
+    p0, q0, p1, q1 = poses(step)
+    opt = pair.step(p0, q0, p1, q1, delta, repeats=OPTIMIZED_REPEATS)
+    ex = pair.exact_first_contact(p0, q0, p1, q1)
+    res.steps += 1
+    res.optimized_seconds += opt["seconds"]
+    res.reference_seconds += ex.seconds
+    res.exact_hits += int(ex.hit)
+    res.optimized_hits += int(opt["hit"])
+    res.statuses[opt["status"]] = res.statuses.get(opt["status"], 0) + 1
+    sid = step["id"]
+    if ex.hit and not opt["hit"]:
+        res.false_negatives += 1
+        res.failures.append(f"{sid}: false negative (u* in [{ex.lower!r}, {ex.upper!r}], no optimized hit)")
+    if opt["hit"] and ex.compare(opt["u_hit"]) > 0:
+        res.late_hits += 1
+        res.failures.append(f"{sid}: late hit u_hit = {opt['u_hit']!r} > u* in [{ex.lower!r}, {ex.upper!r}]")
+    if opt["hit"] and ex.hit:
+        res.gaps.append(max(ex.lower - opt["u_hit"], 0.0) if ex.compare(opt["u_hit"]) <= 0 else 0.0)
+    # The pose the god-object takes: the stop pose on a hit, X1 otherwise. Exactly free?
+    sp, sq = np.asarray(opt["stop_p"]), np.asarray(opt["stop_q"])
+    n_int = pair.count_intersecting_pairs(sp, sq)
+    if n_int:
+        res.intersecting_stop_poses += 1
+        res.failures.append(f"{sid}: {n_int} intersecting triangle pairs at the stop pose")
+    elif opt["hit"]:
+        window = STOP_SEPARATION_WINDOW * delta
+        sep = pair.separation(sp, sq, window)
+        res.max_stop_separation = max(res.max_stop_separation, sep["upper"] if sep["within"] else window)
+    return ex
+
+
+# --------------------------------------------------------------------------------------
+# FCL, side by side on the steps whose motion it shares
+# --------------------------------------------------------------------------------------
+
+@dataclass
+class PeerResult:
+    motion: str                 # "translation" or "rotation_about_g"
+    solver: str
+    steps: int = 0
+    exact_hits: int = 0
+    misses: int = 0             # exact contact, FCL none
+    late: int = 0               # FCL's time (in our u) after u*
+    false_positives: int = 0    # FCL contact, exact none
+    seconds: float = 0.0
+
+    def as_json(self) -> dict:
+        n = max(self.steps, 1)
+        return {"motion": self.motion, "solver": self.solver, "steps": self.steps, "exact_hits": self.exact_hits,
+                "misses": self.misses, "late": self.late, "false_positives": self.false_positives,
+                "us_per_step": 1e6 * self.seconds / n}
+
+
+def _fcl():
+    try:
+        import fcl  # python-fcl (FCL 0.7)
+    except ImportError:
+        return None
+    return fcl
+
+
+def motion_kind(step: dict) -> str | None:
+    """'translation' (q0 == q1), 'rotation_about_g' (p0 == p1, q0 != q1), or None."""
+    if step["q0"] == step["q1"]:
+        return "translation"
+    if step["p0"] == step["p1"]:
+        return "rotation_about_g"
+    return None
+
+
+class FclPeer:
+    SOLVERS = ("CCDC_CONSERVATIVE_ADVANCEMENT", "CCDC_NAIVE")
+
+    def __init__(self, fcl):
+        self.fcl = fcl
+        self._models: dict[tuple, tuple] = {}
+
+    def _model(self, V: np.ndarray, F: np.ndarray):
+        m = self.fcl.BVHModel()
+        m.beginModel(len(V), len(F))
+        m.addSubModel(np.ascontiguousarray(V), np.ascontiguousarray(F, dtype=np.int32))
+        m.endModel()
+        return m
+
+    def run(self, meshes: Meshes, key: tuple, step: dict, kind: str, solver: str) -> tuple[bool, float, float]:
+        """(hit, u in our parameter, seconds) of FCL on one step."""
+        fcl = self.fcl
+        if key not in self._models:
+            self._models[key] = (self._model(*meshes.obstacle[key]), self._model(*meshes.god_body[key]))
+        obs_model, god_model = self._models[key]
+        p0, q0, p1, q1 = poses(step)
+        q0n, q1n = q0 / np.linalg.norm(q0), q1 / np.linalg.norm(q1)
+        god = fcl.CollisionObject(god_model, fcl.Transform(q0n, p0))
+        obs = fcl.CollisionObject(obs_model, fcl.Transform())
+        req = fcl.ContinuousCollisionRequest()
+        req.ccd_motion_type = fcl.CCDMotionType.CCDM_TRANS if kind == "translation" else fcl.CCDMotionType.CCDM_SCREW
+        req.ccd_solver_type = getattr(fcl.CCDSolverType, solver)
+        res = fcl.ContinuousCollisionResult()
+        t0 = time.perf_counter()
+        fcl.continuousCollide(god, fcl.Transform(q1n, p1), obs, fcl.Transform(), req, res)
+        seconds = time.perf_counter() - t0
+        t = float(res.time_of_contact)
+        if not res.is_collide:
+            return False, 1.0, seconds
+        if kind == "translation":
+            return True, t, seconds
+        # Screw motion: angle t theta; Cayley: angle 2 atan(u tan(theta / 2)).
+        qr = _qmul(q1n, q0n * np.array([1, -1, -1, -1]))
+        half = math.atan2(float(np.linalg.norm(qr[1:])), abs(float(qr[0])))
+        return True, math.tan(t * half) / math.tan(half), seconds
+
+
+def _qmul(a, b):
+    aw, ax, ay, az = a
+    bw, bx, by, bz = b
+    return np.array([aw * bw - ax * bx - ay * by - az * bz, aw * bx + ax * bw + ay * bz - az * by,
+                     aw * by - ax * bz + ay * bw + az * bx, aw * bz + ax * by - ay * bx + az * bw])
+
+
+# --------------------------------------------------------------------------------------
+# The run
+# --------------------------------------------------------------------------------------
+
+def crosscheck(names: list[str] | None = None, with_peers: bool = True, show_progress: bool = False):
+    """Returns (result JSON, failures, peer results or None when FCL is absent)."""
+    names = names or set_names()
+    meshes = Meshes()
+    fcl = _fcl() if with_peers else None
+    peer = FclPeer(fcl) if fcl else None
+    peers: dict[tuple[str, str], PeerResult] = {}
+    results, failures = [], []
+    for name in names:
+        doc = load_set(name)
+        res = SetResult(name)
+        steps = doc["steps"]
+        if show_progress:
+            from tqdm import tqdm
+            steps = tqdm(steps, desc=name, leave=False, file=sys.stderr)
+        for step in steps:
+            key, pair = meshes.get(step)
+            ex = check_step(pair, step, float(doc["delta"]), res)
+            kind = motion_kind(step) if peer else None
+            if kind:
+                for solver in FclPeer.SOLVERS:
+                    pr = peers.setdefault((kind, solver), PeerResult(kind, solver))
+                    hit, u, s = peer.run(meshes, key, step, kind, solver)
+                    pr.steps += 1
+                    pr.seconds += s
+                    pr.exact_hits += int(ex.hit)
+                    pr.misses += int(ex.hit and not hit)
+                    pr.false_positives += int(hit and not ex.hit)
+                    pr.late += int(hit and ex.hit and ex.compare(u) > 0)
+        results.append(res)
+        failures += [f"{name}/{f}" for f in res.failures]
+    sets = [r.as_json() for r in results]
+    ok = all(s["false_negatives"] == 0 and s["late_hits"] == 0 and s["intersecting_stop_poses"] == 0 for s in sets)
+    ours = {r.name: r for r in results}
+    return {"ok": ok, "sets": sets}, failures, (list(peers.values()) if peer else None), ours
+
+
+def format_table(result: dict, ours: dict[str, SetResult], peers: list[PeerResult] | None) -> str:
+    lines = [f"{'set':<18}{'steps':>6}{'hits*':>6}{'FN':>4}{'late':>5}{'max gap u':>11}{'p99 gap u':>11}"
+             f"{'isect':>6}{'max stop sep':>14}{'opt us/step':>13}{'ref s/step':>11}"]
+    for s in result["sets"]:
+        r = ours[s["name"]]
+        lines.append(f"{s['name']:<18}{s['steps']:>6}{r.exact_hits:>6}{s['false_negatives']:>4}{s['late_hits']:>5}"
+                     f"{s['max_gap_u']:>11.2e}{s['p99_gap_u']:>11.2e}{s['intersecting_stop_poses']:>6}"
+                     f"{s['max_stop_separation']:>14.3e}{s['optimized_us_per_step']:>13.1f}"
+                     f"{s['reference_s_per_step']:>11.3f}")
+    lines.append("hits*: exact contacts; FN: false negatives; late: u_hit > u* (exact); isect: stop poses "
+                 "that intersect (exact); stop sep in scene units")
+    if peers is None:
+        lines.append("FCL: python-fcl not installed (pip install -r requirements.txt): peers skipped")
+    else:
+        lines.append("FCL 0.7 (python-fcl) on the same steps, same exact u*, where its motion equals ours:")
+        for p in peers:
+            lines.append(f"  {p.motion:<17} {p.solver:<31} {p.steps:>4} steps {p.exact_hits:>4} contacts: "
+                         f"{p.misses:>3} missed, {p.late:>3} late, {p.false_positives:>3} false positives, "
+                         f"{1e6 * p.seconds / max(p.steps, 1):9.1f} us/step")
+    lines.append("ok" if result["ok"] else "FAILED")
+    return "\n".join(lines)
+
+
+def run_cli(args: argparse.Namespace) -> int:
+    names = [args.set_name] if args.set_name else None
+    try:
+        result, failures, peers, ours = crosscheck(names, with_peers=not args.json or args.peers,
+                                                   show_progress=not (args.json or args.peers))
+    except ValueError as e:
+        print(f"gauss6: error: {e}", file=sys.stderr)
+        return 2
+    if args.peers:
+        print(json.dumps({"ok": result["ok"], "fcl": None if peers is None else [p.as_json() for p in peers]}))
+    elif args.json:
+        print(json.dumps(result))
+    else:
+        print(format_table(result, ours, peers))
+    for f in failures[:50]:
+        print(f"FAIL {f}", file=sys.stderr)
+    return 0 if result["ok"] else 1
