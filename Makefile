@@ -1,11 +1,11 @@
 # gauss6: the two commands of the README, and a few helpers.
-#   make test       set up, then every test suite: ctest (Catch2), pytest, Coq proofs
+#   make test       set up, then every test suite: ctest (Catch2), pytest, Coq proofs, checks
 #   make reproduce  set up, then the project's main job (datasets, scenes, figures)
 SHELL := /bin/bash
 VENV := .venv/bin
 JOBS ?= $(shell nproc)
 
-.PHONY: setup test reproduce ctest pytest proofs datasets clean
+.PHONY: setup test reproduce ctest pytest proofs checks datasets clean
 
 setup:
 	@tools/setup.sh
@@ -19,12 +19,22 @@ pytest: setup
 proofs: setup
 	@tools/check_proofs.sh
 
+# The full cross-checks against exact ground truth (pytest runs `crosscheck qp` whole and
+# samples the CCD sets): every shared CCD query through both implementations, every
+# rigid CCD step set against the exact first contact.
+SHARED_QUERIES := ../shared/data/ccd-sample-queries
+checks: setup
+	$(VENV)/gauss6 ccd queries $(SHARED_QUERIES) --impl optimized
+	$(VENV)/gauss6 ccd queries $(SHARED_QUERIES) --impl reference
+	$(VENV)/gauss6 crosscheck ccd
+
 # Every suite runs even when an earlier one fails; the target fails if any did.
 test: setup
 	@status=0; \
 	$(MAKE) --no-print-directory ctest || status=1; \
 	$(MAKE) --no-print-directory pytest || status=1; \
 	$(MAKE) --no-print-directory proofs || status=1; \
+	$(MAKE) --no-print-directory checks || status=1; \
 	if [ $$status -ne 0 ]; then echo "make test: FAILED"; else echo "make test: all suites passed"; fi; \
 	exit $$status
 
