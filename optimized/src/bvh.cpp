@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <limits>
 #include <map>
 #include <numeric>
 
@@ -23,7 +24,8 @@ const char* to_string(PairKind k) {
 
 size_t Bvh::memory_bytes() const {
   return nodes.capacity() * sizeof(BvhNode) + triangles.capacity() * sizeof(int32_t) +
-         owned.capacity() * sizeof(uint8_t) + neighbor.capacity() * sizeof(int32_t) + sizeof(Bvh);
+         owned.capacity() * sizeof(uint8_t) + neighbor.capacity() * sizeof(int32_t) + slabs.capacity() * sizeof(Slab) +
+         sizeof(Bvh);
 }
 
 Aabb triangle_box(const TriangleMesh& m, int f) {
@@ -132,6 +134,25 @@ Bvh build_bvh(const TriangleMesh& mesh, int leaf_size) {
         if (bvh.neighbor[3 * g + j] < 0) bvh.neighbor[3 * g + j] = f;
       }
     }
+  // Face slabs: n.x over the corners in outward-rounded interval arithmetic.
+  bvh.slabs.resize(static_cast<size_t>(nf));
+  for (int f = 0; f < nf; ++f) {
+    Bvh::Slab& sl = bvh.slabs[f];
+    const Vec3 a = mesh.V.row(mesh.F(f, 0)).transpose(), b = mesh.V.row(mesh.F(f, 1)).transpose(),
+               c = mesh.V.row(mesh.F(f, 2)).transpose();
+    const Vec3 n = (b - a).cross(c - a);
+    const double len = n.norm();
+    sl.n = len > 0 && std::isfinite(len) ? Vec3(n / len) : Vec3::Zero();
+    sl.lo = std::numeric_limits<double>::infinity();
+    sl.hi = -sl.lo;
+    for (const Vec3* x : {&a, &b, &c}) {
+      const Interval s = Interval::point(sl.n.x()) * Interval::point(x->x()) +
+                         Interval::point(sl.n.y()) * Interval::point(x->y()) +
+                         Interval::point(sl.n.z()) * Interval::point(x->z());
+      sl.lo = std::min(sl.lo, s.lo);
+      sl.hi = std::max(sl.hi, s.hi);
+    }
+  }
   if (nf > 0) {
     Builder b{mesh, std::max(leaf_size, 1), {}, {}, &bvh};
     b.centroid.resize(static_cast<size_t>(nf));
@@ -159,6 +180,59 @@ namespace {
 
 Vec3 vertex(const TriangleMesh& m, int f, int k) { return m.V.row(m.F(f, k)).transpose(); }
 
+// The god-object at a sub-interval's start u0 in doubles (X = p + R r_B), and
+// bounds on how far the exactly moving point p(u) + R(u) r_B, for u in [u0, u1]
+// and |r_B| <= the god radius rho, can lie from the double X:
+//   - static_error: the stop pose's deviation (make_stop_pose: double pose vs
+//     exact motion) plus the double evaluation of R(q) r_B + p and of one
+//     projection n.X (|n| = 1 up to rounding): a few roundings of terms bounded
+//     by |p|_inf + rho, well within 1e-13 (|p|_inf + rho);
+//   - speed: |p(u) - p(u0)| <= (u - u0) |dp|, and R(u) R(u0)^T is the turn about
+//     g by 2 (atan(u |g|) - atan(u0 |g|)) <= 2 (u - u0) |g| (atan is
+//     1-Lipschitz), so a body point moves by at most (u - u0)(|dp| + 2 |g| rho).
+struct StartFrame {
+  Mat3 R = Mat3::Identity();
+  Vec3 p = Vec3::Zero();
+  double u0 = 0, static_error = 0, speed = 0;
+  void set(const CcdMotion& m, double u, double rho) {
+    const StopPose sp = make_stop_pose(m, u, rho);
+    u0 = u;
+    R = rotation_matrix(sp.pose.q);
+    p = sp.pose.p;
+    double dp2 = 0;
+    for (const Interval& c : m.dp) {
+      const double a = std::max(std::abs(c.lo), std::abs(c.hi));
+      dp2 = next_up(dp2 + next_up(a * a));
+    }
+    speed = next_up(next_up(std::sqrt(dp2)) + next_up(2 * next_up(std::sqrt(m.g2.hi)) * rho));
+    static_error = next_up(sp.deviation + next_up(1e-13 * next_up(p.cwiseAbs().maxCoeff() + rho)));
+    if (!std::isfinite(static_error) || !std::isfinite(speed)) static_error = speed = std::numeric_limits<double>::infinity();
+  }
+
+  // A lower bound of the first u >= u0 at which the god triangle gf can come
+  // within min_separation d of the obstacle triangle `of` (u0 when unknown):
+  // the obstacle triangle lies in its slab lo <= n.x <= hi; if every god vertex
+  // is at u0 above hi by at least `gap` (or below lo), the two triangles, and so
+  // all their features, are farther apart than gap / |n| - static_error -
+  // (u - u0) speed at u (|n| <= 1 + 1e-15, covered by the factor 1 - 1e-12).
+  double earliest(const TriangleMesh& gm, int gf, const Bvh& ob, int of, double d) const {
+    if (ob.slabs.size() != ob.owned.size()) return u0;  // a Bvh not made by build_bvh
+    const Bvh::Slab& sl = ob.slabs[of];
+    if (sl.n == Vec3::Zero()) return u0;
+    double above = std::numeric_limits<double>::infinity(), below = above;
+    for (int k = 0; k < 3; ++k) {
+      const double x = sl.n.dot(R * gm.V.row(gm.F(gf, k)).transpose() + p);
+      above = std::min(above, x - sl.hi);
+      below = std::min(below, sl.lo - x);
+    }
+    const double gap = next_down(std::max(above, below));  // NaN: comparisons below fail
+    const double clear = next_down(next_down(next_down(gap * (1 - 1e-12)) - static_error) - d);
+    if (!(clear > 0)) return u0;
+    if (!(speed > 0)) return std::numeric_limits<double>::infinity();
+    return next_down(u0 + next_down(clear / speed));
+  }
+};
+
 // Runs the owned feature pairs of one (god triangle, obstacle triangle) pair on
 // the window [u0, *u_best]; lowers *u_best and records the pair on a hit.
 struct PairTester {
@@ -168,8 +242,14 @@ struct PairTester {
   CcdWorkspace* ws;
   CcdStepResult* result;
   double u0, u1;  // the sub-interval; tests search [u0, min(u1, best u so far)]
+  SweptBoxCache* swept = nullptr;  // god vertex boxes over *sub, shared by the pairs of the sub-interval
 
-  double end() const { return std::min(u1, result->u_hit); }
+  // Once a pair hit at u_b, later pairs search only up to u_b - time_tolerance:
+  // a contact in (u_b - tol, u_b] cannot lower the step's answer by more than
+  // the tolerance, and the step reports u_b - tol (see ccd_step), which is then
+  // <= u* for those pairs too.
+  double end() const { return result->hit ? std::min(u1, result->u_hit - settings->narrow.time_tolerance) : u1; }
+  bool done() const { return result->hit && end() <= u0; }
 
   void consider(const CcdResult& r, const FeaturePair& p) {
     ++result->num_pair_tests;
@@ -194,12 +274,16 @@ struct PairTester {
     const double margin = settings->narrow.min_separation;
     const auto box_of = [](const Vec3& a, const Vec3& b) { return Aabb{a.cwiseMin(b), a.cwiseMax(b)}; };
     const Aabb obs_face_box = inflate(triangle_box(om, of), margin);
-    const Aabb god_face_swept = swept_box(*sub, triangle_box(gm, gf));
+    // Vertex boxes over the sub-interval (cached per mesh vertex). At each u the
+    // motion maps body points affinely, so an edge or the face lies in the hull
+    // of its vertices' world points, hence in the hull of their swept boxes.
     Aabb god_swept[3], god_edge_swept[3];
-    for (int k = 0; k < 3; ++k) {
-      god_swept[k] = swept_box(*sub, box_of(god_face[k], god_face[k]));
-      god_edge_swept[k] = swept_box(*sub, box_of(god_face[k], god_face[(k + 1) % 3]));
-    }
+    for (int k = 0; k < 3; ++k)
+      god_swept[k] = swept->get(swept->vertices, gm.F(gf, k),
+                                [&] { return swept_box(*sub, box_of(god_face[k], god_face[k])); });
+    const auto hull_of = [](const Aabb& a, const Aabb& b) { return Aabb{a.lo.cwiseMin(b.lo), a.hi.cwiseMax(b.hi)}; };
+    for (int k = 0; k < 3; ++k) god_edge_swept[k] = hull_of(god_swept[k], god_swept[(k + 1) % 3]);
+    const Aabb god_face_swept = hull_of(god_edge_swept[0], god_swept[2]);
     for (int k = 0; k < 3; ++k) {
       if (!(go & (1u << k)) || !(u0 <= end()) || !overlap(god_swept[k], obs_face_box)) continue;
       RigidVertexFaceQuery q{motion, /*vertex_on_body=*/true, god_face[k], obs_face, u0, end()};
@@ -254,17 +338,32 @@ void ccd_step(const CcdBody* obstacles, int num_obstacles, const CcdBody& god, c
   const double want = std::max(angle / settings.sub_interval_angle, travel / settings.sub_interval_travel);
   const int n = static_cast<int>(std::clamp(std::ceil(want), 1.0, static_cast<double>(settings.max_sub_intervals)));
   result->num_sub_intervals = n;
-  const double margin = settings.narrow.min_separation;
   MotionEnclosure e;
-  PairTester tester{&motion, &e, &settings, &ws->narrow, result, 0, 0};
+  StartFrame start;
+  PairTester tester{&motion, &e, &settings, &ws->narrow, result, 0, 0, &ws->swept};
+  CcdStepWorkspace::Candidate* const cand = ws->candidates.data();
+  const int cand_capacity = static_cast<int>(ws->candidates.size());
+  const double d = settings.narrow.min_separation;
   for (int i = 0; i < n; ++i) {
     const double u0 = static_cast<double>(i) / n;
     const double u1 = (i + 1 == n) ? 1.0 : static_cast<double>(i + 1) / n;
-    if (result->hit && result->u_hit <= u0) break;  // earlier hit already found
+    if (result->hit && result->u_hit - settings.narrow.time_tolerance <= u0) break;  // nothing left to search
     enclose_motion(motion, {u0, std::min(u1, result->u_hit)}, &e);
+    start.set(motion, u0, god.bvh->radius);
     tester.u0 = u0;
     tester.u1 = u1;
-    const auto god_box = [&](const Aabb& body) { return swept_box(e, body); };
+    // Candidate triangle pairs of every obstacle, each with a lower bound of its
+    // first contact (StartFrame::earliest); those that cannot touch before the
+    // sub-interval's end are dropped here. When the buffer is full the rest are
+    // tested at once, in traversal order (same result, less pruning).
+    int num_cand = 0;
+    ws->swept.next_interval();  // e changed: every cached god box is stale
+    const auto god_node_box = [&](int node) {
+      return ws->swept.get(ws->swept.nodes, node, [&] { return swept_box(e, god.bvh->nodes[node].box); });
+    };
+    const auto god_face_box = [&](int face) {
+      return ws->swept.get(ws->swept.faces, face, [&] { return swept_box(e, triangle_box(*god.mesh, face)); });
+    };
     for (int o = 0; o < num_obstacles; ++o) {
       const CcdBody& ob = obstacles[o];
       if (!ob.mesh || !ob.bvh) {
@@ -273,11 +372,22 @@ void ccd_step(const CcdBody* obstacles, int num_obstacles, const CcdBody& god, c
       }
       const auto visit = [&](int gf, int of) {
         ++result->num_triangle_pairs;
+        const double t = start.earliest(*god.mesh, gf, *ob.bvh, of, d);
+        if (t > tester.end()) {
+          ++result->num_slab_culls;
+          return true;
+        }
+        if (num_cand < cand_capacity) {
+          cand[num_cand++] = {t, gf, of, o};
+          return true;
+        }
         tester.test(*god.mesh, *god.bvh, gf, *ob.mesh, *ob.bvh, of, o);
-        return true;
+        // A hit at the sub-interval's start cannot be bettered: stop.
+        return !tester.done();
       };
-      const TraversalStatus ts = for_each_candidate_pair(*god.mesh, *god.bvh, *ob.mesh, *ob.bvh, god_box, margin,
-                                                         &ws->stack, visit, &result->num_node_pairs);
+      const TraversalStatus ts =
+          for_each_candidate_pair_indexed(*god.mesh, *god.bvh, *ob.mesh, *ob.bvh, god_node_box, god_face_box, d,
+                                          &ws->stack, visit, &result->num_node_pairs);
       if (ts == TraversalStatus::kStackFull) {
         // Unknown beyond here: stop conservatively at the sub-interval's start.
         result->status = CcdStatus::kWorkspaceFull;
@@ -285,9 +395,25 @@ void ccd_step(const CcdBody* obstacles, int num_obstacles, const CcdBody& god, c
         result->u_hit = std::min(result->u_hit, u0);
         return;
       }
+      if (ts == TraversalStatus::kStopped) break;
+    }
+    // Earliest-first: each hit shortens the windows of the pairs after it, and
+    // once a pair's bound passes the best u so far, so do all the rest.
+    std::sort(cand, cand + num_cand, [](const auto& a, const auto& b) { return a.earliest < b.earliest; });
+    for (int c = 0; c < num_cand; ++c) {
+      if (cand[c].earliest > tester.end() || tester.done()) break;
+      const CcdBody& ob = obstacles[cand[c].obstacle];
+      tester.test(*god.mesh, *god.bvh, cand[c].god_face, *ob.mesh, *ob.bvh, cand[c].obstacle_face,
+                  cand[c].obstacle);
     }
   }
-  if (!result->hit) result->u_hit = 1;
+  if (!result->hit) {
+    result->u_hit = 1;
+  } else {
+    // Pairs searched only up to u_b - tol (PairTester::end): stop there.
+    result->u_hit = std::max(0.0, result->u_hit - settings.narrow.time_tolerance);
+    result->time_tolerance_reached += settings.narrow.time_tolerance;
+  }
 }
 
 }  // namespace gauss6

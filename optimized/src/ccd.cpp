@@ -261,6 +261,34 @@ LinearPoints make_linear_points(const std::array<Vec3, 4>& start, const std::arr
   return p;
 }
 
+// Encloses F = w + a ea - b eb over a box, where at each u the points are
+// p_k = x0_k + u dx_k and w = p_w0 - p_w1, ea = p_a0 - p_a1, eb = p_b0 - p_b1
+// (indices into the four points): the corners' min and max widened by
+// pts.error. (Negating ea or swapping a difference's order is exact, so the
+// error bound above holds for both feature kinds.) Inputs are finite and
+// bounded (validated), so no NaN reaches min/max.
+struct LinearDifference {
+  int w0, w1, a0, a1, b0, b1;
+};
+void enclose_linear(const LinearPoints& pts, const LinearDifference& ix, const Box& box, IVec3* F) {
+  constexpr double kInf = std::numeric_limits<double>::infinity();
+  double lo[3] = {kInf, kInf, kInf}, hi[3] = {-kInf, -kInf, -kInf};
+  for (double u : box.u) {
+    for (int i = 0; i < 3; ++i) {
+      double p[4];
+      for (int k = 0; k < 4; ++k) p[k] = pts.x0[k][i] + u * pts.dx[k][i];
+      const double w = p[ix.w0] - p[ix.w1], ea = p[ix.a0] - p[ix.a1], eb = p[ix.b0] - p[ix.b1];
+      for (double a : box.a)
+        for (double b : box.b) {
+          const double c = (w + a * ea) - b * eb;
+          lo[i] = std::min(lo[i], c);
+          hi[i] = std::max(hi[i], c);
+        }
+    }
+  }
+  for (int i = 0; i < 3; ++i) (*F)[i] = {next_down(lo[i] - pts.error), next_up(hi[i] + pts.error)};
+}
+
 }  // namespace
 
 void ccd_linear_vertex_face(const LinearVertexFaceQuery& q, const CcdSettings& s, CcdWorkspace* ws,
@@ -290,26 +318,8 @@ void ccd_linear_vertex_face(const LinearVertexFaceQuery& q, const CcdSettings& s
   // the static error bound of make_linear_points().
   const LinearPoints pts = make_linear_points({q.vertex[0], q.face[0][0], q.face[0][1], q.face[0][2]},
                                               {q.vertex[1], q.face[1][0], q.face[1][1], q.face[1][2]});
-  auto enclose = [&](const Box& box, IVec3* F) {
-    // Inputs are finite and bounded (validated), so no NaN reaches min/max.
-    constexpr double kInf = std::numeric_limits<double>::infinity();
-    double lo[3] = {kInf, kInf, kInf}, hi[3] = {-kInf, -kInf, -kInf};
-    for (double u : box.u) {
-      for (int i = 0; i < 3; ++i) {
-        // F = (v - f0) - a (f1 - f0) - b (f2 - f0) at this u.
-        const double p0 = pts.x0[0][i] + u * pts.dx[0][i], p1 = pts.x0[1][i] + u * pts.dx[1][i];
-        const double p2 = pts.x0[2][i] + u * pts.dx[2][i], p3 = pts.x0[3][i] + u * pts.dx[3][i];
-        const double w = p0 - p1, e1 = p2 - p1, e2 = p3 - p1;
-        for (double a : box.a)
-          for (double b : box.b) {
-            const double c = (w - a * e1) - b * e2;
-            lo[i] = std::min(lo[i], c);
-            hi[i] = std::max(hi[i], c);
-          }
-      }
-    }
-    for (int i = 0; i < 3; ++i) (*F)[i] = {next_down(lo[i] - pts.error), next_up(hi[i] + pts.error)};
-  };
+  // F = (v - f0) - a (f1 - f0) - b (f2 - f0): w = p0 - p1, ea = p1 - p2, eb = p3 - p1.
+  auto enclose = [&](const Box& box, IVec3* F) { enclose_linear(pts, {0, 1, 1, 2, 3, 1}, box, F); };
   bisect(enclose, /*triangle=*/true, sc, q.u_begin, q.u_end, s, ws, r);
 }
 
@@ -334,26 +344,8 @@ void ccd_linear_edge_edge(const LinearEdgeEdgeQuery& q, const CcdSettings& s, Cc
   sc.u = move_a + move_b;
   const LinearPoints pts = make_linear_points({q.edge_a[0][0], q.edge_a[0][1], q.edge_b[0][0], q.edge_b[0][1]},
                                               {q.edge_a[1][0], q.edge_a[1][1], q.edge_b[1][0], q.edge_b[1][1]});
-  auto enclose = [&](const Box& box, IVec3* F) {
-    // Inputs are finite and bounded (validated), so no NaN reaches min/max.
-    constexpr double kInf = std::numeric_limits<double>::infinity();
-    double lo[3] = {kInf, kInf, kInf}, hi[3] = {-kInf, -kInf, -kInf};
-    for (double u : box.u) {
-      for (int i = 0; i < 3; ++i) {
-        // F = (a0 - b0) + a (a1 - a0) - b (b1 - b0) at this u.
-        const double p0 = pts.x0[0][i] + u * pts.dx[0][i], p1 = pts.x0[1][i] + u * pts.dx[1][i];
-        const double p2 = pts.x0[2][i] + u * pts.dx[2][i], p3 = pts.x0[3][i] + u * pts.dx[3][i];
-        const double w = p0 - p2, ea = p1 - p0, eb = p3 - p2;
-        for (double a : box.a)
-          for (double b : box.b) {
-            const double c = (w + a * ea) - b * eb;
-            lo[i] = std::min(lo[i], c);
-            hi[i] = std::max(hi[i], c);
-          }
-      }
-    }
-    for (int i = 0; i < 3; ++i) (*F)[i] = {next_down(lo[i] - pts.error), next_up(hi[i] + pts.error)};
-  };
+  // F = (a0 - b0) + a (a1 - a0) - b (b1 - b0): w = p0 - p2, ea = p1 - p0, eb = p3 - p2.
+  auto enclose = [&](const Box& box, IVec3* F) { enclose_linear(pts, {0, 2, 1, 0, 3, 2}, box, F); };
   bisect(enclose, /*triangle=*/false, sc, q.u_begin, q.u_end, s, ws, r);
 }
 
@@ -495,7 +487,7 @@ double rigid_speed(const CcdMotion& m, double rho) {
 // ---------------------------------------------------------------------------
 // Cheap u-filters run before the bisection (rigid trajectories).
 //
-// Two necessary conditions for a contact within distance d at parameter u,
+// Necessary conditions for a contact within distance d at parameter u,
 // each enclosed over a u-interval U with outward-rounded interval arithmetic
 // from the enclosed motion (so they hold for the exact motion of the input
 // doubles):
@@ -519,9 +511,7 @@ double rigid_speed(const CcdMotion& m, double rho) {
 //       with theta = 2 atan(u |g|) <= 2 u |g| (a chord is shorter than its arc):
 //       contact within d only if |P| <= d L D, L that bound (parallel edges:
 //       P = 0, the condition holds and this filter never rejects them).
-//     Over U, P is enclosed twice (Horner, and the mean-value form
-//     P(m) + P'(U) (U - m), valid as P is smooth) and the two intersected;
-//     U is excluded when |P| > d L max_U D on all of it.
+//     U is excluded when P - d L D > 0 or -P - d L D > 0 on all of U.
 // (2) A separating axis. For any fixed vector n, points x, y within d have
 //     |n.x - n.y| <= d |n|. The moving feature's points at u are convex
 //     combinations of its corners, so their projections lie within the hull of
@@ -534,12 +524,23 @@ double rigid_speed(const CcdMotion& m, double rho) {
 //     vector, is taken from the features' closest points at the window's start
 //     (the direction conservative advancement would use); n = 0 disables it.
 //
-// Guarantee. A u-interval is dropped only when (1) or (2) proves that no
+// (3) Slabs. A triangle lies in each slab (x - f_k).m_k >= 0, m_k = n x
+//     (f_k+1 - f_k) its inward edge normal, so a point within d of it has
+//     (x - f_k).m_k >= -d |m_k|; times D this is a cubic in u, as in (1) (body
+//     vertex: static m_k; static vertex: body m_k turned by C). A segment lies
+//     between the planes through its ends normal to it: two segments within d
+//     need an end of each within d of the other's slab (for the moving edge,
+//     along C ea': again cubics), so both ends beyond the same plane by more
+//     than d exclude. (Stage 2: added only when (1) and (2) keep the window.)
+//     Every condition reads "g(u) > 0 on all of U excludes U", g a cubic whose
+//     interval coefficients enclose the exact ones; positive_on() bounds g from
+//     below over U by its Bernstein coefficients (outward rounded).
+//
+// Guarantee. A u-interval is dropped only when (1), (2) or (3) proves that no
 // contact within d occurs in it; the bisection then runs on the remaining
-// windows in increasing u, so its first accepted interval still starts at or
-// before u*. Windows are produced by a depth-first left-first 1-D subdivision
-// that keeps intervals down to a width of (window)/2^10 (or the time tolerance),
-// merged when adjacent; past a fixed number of evaluations the rest of the
+// intervals in increasing u, so its first accepted interval still starts at or
+// before u*. Intervals come from a depth-first left-first 1-D subdivision down
+// to the time tolerance; past a fixed number of evaluations the rest of the
 // window is kept whole (conservative).
 // ---------------------------------------------------------------------------
 
@@ -562,7 +563,6 @@ double norm_upper(const IVec3& v) {
   }
   return next_up(std::sqrt(s2));
 }
-Interval intersect(Interval a, Interval b) { return {std::max(a.lo, b.lo), std::min(a.hi, b.hi)}; }
 
 // Coefficients of Dc(u) v = v + u c1 + u^2 c2.
 struct CayleyCoefficients { IVec3 c1, c2; };
@@ -573,18 +573,81 @@ CayleyCoefficients cayley_coefficients(const CcdMotion& m, const IVec3& v) {
   return {2.0 * gxv, c2};
 }
 
-struct UFilter {
-  // (1) the cubic and the right-hand side factor d L (>= 0); active when has_cubic.
-  bool has_cubic = false;
+// A cubic k0 + k1 u + k2 u^2 + k3 u^3 whose coefficients are intervals that
+// enclose the exact ones.
+struct Cubic {
   Interval k[4];
-  double dL = 0;
-  // (2) the axis: corners' projection coefficients and the static projection
-  // grown by d |n|; active when num_corners > 0.
+};
+
+// True when every cubic with coefficients in c is > 0 on all of [u0, u1]
+// (0 <= u0 <= u1). On t = (u - u0) / h, h = u1 - u0, the cubic's Bernstein
+// coefficients b0..b3 bound it from below (convex hull property); they are
+// computed from the Taylor coefficients at u0 in outward-rounded intervals, with
+// h enclosed, so the test holds for the exact cubic. The ends (b0, b3: the values
+// at u0 and u1) are checked first: they decide most calls.
+bool positive_on(const Cubic& c, double u0, double u1) {
+  const Interval U = Interval::point(u0);
+  const Interval a0 = c.k[0] + U * (c.k[1] + U * (c.k[2] + U * c.k[3]));
+  if (!(a0.lo > 0)) return false;
+  const Interval h = Interval::point(u1) - U;
+  const Interval u3k3 = 3.0 * (U * c.k[3]);
+  const Interval A1 = (c.k[1] + U * (2.0 * c.k[2] + u3k3)) * h;  // p'(u0) h
+  const Interval h2 = sqr(h);
+  const Interval A2 = (c.k[2] + u3k3) * h2;                      // p''(u0) / 2 h^2
+  const Interval A3 = c.k[3] * (h2 * h);
+  if (!((a0 + A1 + A2 + A3).lo > 0)) return false;
+  const Interval third{next_down(1.0 / 3), next_up(1.0 / 3)};
+  return (a0 + third * A1).lo > 0 && (a0 + third * (2.0 * A1 + A2)).lo > 0;
+}
+
+// D(u) (x(u) - f).m for the body point with world-oriented offset w = R0 r_B
+// (cw: its Cayley coefficients), a static point f and a static direction m:
+// D (p(u) - f).m + (Dc(u) w).m, with D = 1 + s u^2 and Dc(u) w = w + u c1 + u^2 c2.
+Cubic body_point_along(const CcdMotion& m, const IVec3& w, const CayleyCoefficients& cw, const IVec3& f,
+                       const IVec3& dir) {
+  const Interval A = dot(m.p0 - f, dir), E = dot(m.dp, dir);
+  return {{A + dot(w, dir), E + dot(cw.c1, dir), m.g2 * A + dot(cw.c2, dir), m.g2 * E}};
+}
+// D(u) (y - x_f(u)).(C(u) n') for a static point y and the body point f' = R0 f_B
+// with body direction n' = R0 n_B (cn: the Cayley coefficients of n'):
+// (y - p(u)).Dc(u) n' - D f'.n' (C is a rotation: (C f').(C n') = f'.n').
+Cubic static_point_along(const CcdMotion& m, const IVec3& y, const IVec3& fW, const IVec3& nW,
+                         const CayleyCoefficients& cn) {
+  const IVec3 Y = y - m.p0;
+  const Interval F = dot(fW, nW);
+  return {{dot(Y, nW) - F, dot(Y, cn.c1) - dot(m.dp, nW), (dot(Y, cn.c2) - dot(m.dp, cn.c1)) - m.g2 * F,
+           -dot(m.dp, cn.c2)}};
+}
+
+struct UFilter {
+  // Exclusion conditions g(u) > 0, in groups: a group excludes U when each of
+  // its members is positive on all of U (a single condition is a group of one).
+  static constexpr int kMaxConditions = 10;
+  Cubic cond[kMaxConditions];
+  bool joins_previous[kMaxConditions] = {};
+  int num_conditions = 0;
+  // The axis: corners' projection coefficients and the static projection grown
+  // by d |n|; active when num_corners > 0.
   int num_corners = 0;
   Interval c0[3], c1[3], c2[3], c3[3];
   Interval static_proj;
   const CcdMotion* motion = nullptr;
 
+  // Q(u) <= r D(u) is necessary for a contact: exclude where Q - r D > 0.
+  void at_most(const Cubic& Q, double r, bool join = false) {
+    const Interval R = Interval::point(r);
+    add({{Q.k[0] - R, Q.k[1], Q.k[2] - R * motion->g2, Q.k[3]}}, join);
+  }
+  // Q(u) >= -r D(u) is necessary for a contact: exclude where -(Q + r D) > 0.
+  void at_least(const Cubic& Q, double r, bool join = false) {
+    const Interval R = Interval::point(r);
+    add({{-(Q.k[0] + R), -Q.k[1], -(Q.k[2] + R * motion->g2), -Q.k[3]}}, join);
+  }
+  void add(const Cubic& c, bool join) {
+    if (num_conditions == kMaxConditions) return;  // fewer conditions: still conservative
+    joins_previous[num_conditions] = join && num_conditions > 0;
+    cond[num_conditions++] = c;
+  }
   // Adds a body corner w = R0 r_B (world-oriented offset from G) for the axis n.
   void add_corner(const IVec3& w, const IVec3& n) {
     const IVec3 gxw = cross(motion->g, w), ggw = cross(motion->g, gxw);
@@ -600,20 +663,19 @@ struct UFilter {
   }
 
   bool excludes(double u0, double u1) const {
-    const Interval U{u0, u1};
-    const Interval s = motion->g2;
-    if (has_cubic) {
-      const Interval k1 = k[1], k2 = k[2], k3 = k[3];
-      const Interval horner = k[0] + U * (k1 + U * (k2 + U * k3));
-      const double mid = 0.5 * (u0 + u1);
-      const Interval M = Interval::point(mid);
-      const Interval at_mid = k[0] + M * (k1 + M * (k2 + M * k3));
-      const Interval slope = k1 + U * (2.0 * k2 + U * (3.0 * k3));
-      const Interval P = intersect(horner, at_mid + slope * (U - M));
-      const double rhs = (Interval::point(dL) * (Interval::point(1) + sqr(Interval::point(u1)) * s)).hi;
-      if (P.lo > rhs || P.hi < -rhs) return true;
+    for (int i = 0; i < num_conditions;) {
+      bool all = true;
+      int j = i;
+      do {
+        all = all && positive_on(cond[j], u0, u1);
+        ++j;
+      } while (j < num_conditions && joins_previous[j]);
+      if (all) return true;
+      i = j;
     }
     if (num_corners > 0) {
+      const Interval U{u0, u1};
+      const Interval s = motion->g2;
       const auto beta_at = [&](double v) {
         return div_positive(2.0 * sqr(Interval::point(v)), Interval::point(1) + sqr(Interval::point(v)) * s);
       };
@@ -630,18 +692,85 @@ struct UFilter {
   }
 };
 
-// Runs the bisection on the windows of [u_begin, u_end] that the filter cannot
-// exclude, in increasing u; the first hit ends the search.
+// Early-hit test of filtered_bisect() on [u0, u1]: encloses F at u0 and the
+// feature parameters (a, b) (a valid feature point), and accepts u_hit = u0 when
+// the pair is proven within d + tol there (tol: the bisection's distance
+// tolerance). iterations: the work already spent, reported on.
 template <class Enclose>
-void filtered_bisect(const Enclose& enclose, bool triangle, const Scales& sc, const UFilter& filter, double u_begin,
-                     double u_end, const CcdSettings& s, CcdWorkspace* ws, CcdResult* r) {
-  constexpr int kMaxEvaluations = 512, kStack = 64;
-  const double min_width = std::max(s.time_tolerance, std::ldexp(u_end - u_begin, -10));
-  int evaluations = 0, total_iterations = 0;
-  bool pending = false;
-  double w0 = 0, w1 = 0;  // the pending window
+bool accept_point(const Enclose& enclose, double u0, double u1, double a, double b, double d, double tol,
+                  int iterations, CcdResult* r) {
+  IVec3 F;
+  enclose(Box{{u0, u0}, {a, a}, {b, b}}, &F);
+  double m2 = 0;
+  for (const Interval& c : F) {
+    const double m = std::max(std::abs(c.lo), std::abs(c.hi));
+    m2 = next_up(m2 + next_up(m * m));
+  }
+  const double dist = next_up(std::sqrt(m2));  // >= |F| at (u0, a, b)
+  if (!(dist <= d + tol)) return false;
   *r = CcdResult{};
-  // Bisection on one window; true when it ends the search (hit or give-up).
+  r->status = CcdStatus::kOk;
+  r->hit = true;
+  r->u_hit = u0;
+  r->time_tolerance_reached = u1 - u0;
+  r->distance_reached = dist;
+  r->iterations = iterations + 1;
+  return true;
+}
+
+// Parameters (a, b) of the point of triangle (t0, t1, t2) nearest to c, a point
+// on it: t0 + a (t1 - t0) + b (t2 - t0), clamped into the triangle (a, b >= 0,
+// a + b <= 1 up to one rounding). Heuristic (any triangle point is valid).
+void triangle_parameters(const Vec3& c, const Vec3& t0, const Vec3& t1, const Vec3& t2, double* a, double* b) {
+  const Vec3 e1 = t1 - t0, e2 = t2 - t0, w = c - t0;
+  const double d11 = e1.dot(e1), d12 = e1.dot(e2), d22 = e2.dot(e2), w1 = w.dot(e1), w2 = w.dot(e2);
+  const double det = d11 * d22 - d12 * d12;
+  double x = 0, y = 0;
+  if (det > 0 && std::isfinite(det)) {
+    x = (w1 * d22 - w2 * d12) / det;
+    y = (w2 * d11 - w1 * d12) / det;
+  }
+  x = std::isfinite(x) ? std::clamp(x, 0.0, 1.0) : 0.0;
+  y = std::isfinite(y) ? std::clamp(y, 0.0, 1.0 - x) : 0.0;
+  *a = x;
+  *b = y;
+}
+
+// Runs the bisection on the u-intervals of [u_begin, u_end] that the filter
+// cannot exclude, in increasing u; the first hit ends the search. The filter
+// first sees the whole window with its cheap conditions (stage 1); if they do
+// not exclude it, add_more() adds the rest (stage 2) and a depth-first,
+// left-first subdivision narrows the window to intervals at most
+// time_tolerance wide, handed to the bisection in order (adjacent ones merged).
+// Past a fixed number of evaluations the rest of the window goes to the
+// bisection whole (conservative).
+//
+// Early hit. When an interval [a, b] at most time_tolerance wide survives the
+// filter and everything before a is settled (excluded by the filter or by the
+// bisection), probe(a, b) may accept it directly: it encloses F at u = a at the
+// features' closest parameters (taken from the nominal pose) and accepts when
+// that proves a feature pair within min_separation + distance_tolerance at u = a.
+// This is the bisection's own acceptance rule (a pair within the distance
+// tolerance, in the earliest interval not excluded), reached without the
+// (u, a, b) search: u_hit = a <= u* still holds because every earlier interval
+// was proven free of contact, and distance_reached is a proven upper bound of
+// the distance at u_hit.
+template <class Enclose, class AddMore, class Probe>
+void filtered_bisect(const Enclose& enclose, bool triangle, const Scales& sc, UFilter& filter,
+                     const AddMore& add_more, const Probe& probe, double u_begin, double u_end,
+                     const CcdSettings& s, CcdWorkspace* ws, CcdResult* r) {
+  constexpr int kMaxEvaluations = 256, kStack = 64;
+  int evaluations = 1, total_iterations = 0;
+  *r = CcdResult{};
+  const auto no_hit = [&] {
+    r->status = CcdStatus::kOk;
+    r->hit = false;
+    r->u_hit = u_end;
+    r->iterations = total_iterations;
+  };
+  if (filter.excludes(u_begin, u_end)) return no_hit();
+  add_more(&filter);
+  // Bisection on one interval; true when it ends the search (hit or give-up).
   const auto run = [&](double a, double b) {
     CcdSettings sw = s;
     sw.max_iterations = std::max(1, s.max_iterations - total_iterations);
@@ -650,16 +779,22 @@ void filtered_bisect(const Enclose& enclose, bool triangle, const Scales& sc, co
     r->iterations = total_iterations;
     return r->hit;
   };
+  // Adjacent kept intervals are merged into one pending window before the
+  // bisection runs on it, so its search fronts carry across them.
+  bool pending = false;
+  double w0 = 0, w1 = 0;
   const auto keep = [&](double a, double b) {
     if (pending && a == w1) {
       w1 = b;
       return false;
     }
-    const bool done = pending && run(w0, w1);
+    if (pending && run(w0, w1)) return true;
+    // Everything before a is settled: a may be accepted at once.
+    if (s.early_hit && b - a <= s.time_tolerance && probe(a, b, total_iterations, r)) return true;
     pending = true;
     w0 = a;
     w1 = b;
-    return done;
+    return false;
   };
   double stack[kStack][2];
   int top = 0;
@@ -670,16 +805,14 @@ void filtered_bisect(const Enclose& enclose, bool triangle, const Scales& sc, co
     --top;
     const double a = stack[top][0], b = stack[top][1];
     if (evaluations >= kMaxEvaluations) {
-      // Budget spent: keep the rest whole (everything still on the stack lies
-      // to the right of a and ends at u_end).
+      // Budget spent: everything still on the stack lies right of a and ends at u_end.
       if (keep(a, u_end)) return;
-      top = 0;
       break;
     }
     ++evaluations;
     if (filter.excludes(a, b)) continue;
     const double m = 0.5 * (a + b);
-    if (b - a <= min_width || !(a < m && m < b) || top + 2 > kStack) {
+    if (b - a <= s.time_tolerance || !(a < m && m < b) || top + 2 > kStack) {
       if (keep(a, b)) return;
       continue;
     }
@@ -691,10 +824,7 @@ void filtered_bisect(const Enclose& enclose, bool triangle, const Scales& sc, co
     ++top;
   }
   if (pending && run(w0, w1)) return;
-  r->status = CcdStatus::kOk;
-  r->hit = false;
-  r->u_hit = u_end;
-  r->iterations = total_iterations;
+  no_hit();
 }
 
 }  // namespace
@@ -738,50 +868,77 @@ void ccd_rigid_vertex_face(const RigidVertexFaceQuery& q, const CcdSettings& s, 
     }
   };
   if (!s.use_u_filter) return bisect(enclose, /*triangle=*/true, sc, q.u_begin, q.u_end, s, ws, r);
-  // The u-filter (see UFilter): coplanarity cubic and a separating axis.
+  // The u-filter (see UFilter). Stage 1: the coplanarity cubic and a separating
+  // axis; stage 2: the three edge slabs of the triangle.
   const CcdMotion& m = *q.motion;
   const double d = s.min_separation;
+  const double tol_d = std::max(s.distance_tolerance, 1e-12 * sc.coordinate);  // as in bisect()
   UFilter filter;
   filter.motion = &m;
-  filter.has_cubic = true;
+  const IVec3 corner[3] = {f0, to_interval(q.face[1]), to_interval(q.face[2])};
+  const IVec3 n = cross(e1, e2);
   if (q.vertex_on_body) {
     const Vec3 x_begin = motion_point(m.nominal, q.u_begin, q.vertex);  // heuristic only (the axis)
-    const IVec3 n = cross(e1, e2), w = mul(m.R0, v);
+    const IVec3 w = mul(m.R0, v);
     const CayleyCoefficients cw = cayley_coefficients(m, w);
-    const Interval A = dot(m.p0 - f0, n), E = dot(m.dp, n);
-    filter.k[0] = A + dot(w, n);
-    filter.k[1] = E + dot(cw.c1, n);
-    filter.k[2] = m.g2 * A + dot(cw.c2, n);
-    filter.k[3] = m.g2 * E;
-    filter.dL = next_up(d * norm_upper(n));
+    const Cubic P = body_point_along(m, w, cw, f0, n);
+    const double dL = next_up(d * norm_upper(n));
+    filter.at_most(P, dL);
+    filter.at_least(P, dL);
     const Vec3 axis = x_begin - closest_point_on_triangle(x_begin, q.face[0], q.face[1], q.face[2]);
     if (axis != Vec3::Zero() && std::isfinite(axis.squaredNorm())) {
       const IVec3 na = to_interval(axis);
       filter.add_corner(w, na);
-      filter.set_axis_static(hull(hull(dot(na, f0), dot(na, f0 + e1)), dot(na, f0 + e2)), na, d);
+      filter.set_axis_static(hull(hull(dot(na, corner[0]), dot(na, corner[1])), dot(na, corner[2])), na, d);
     }
-  } else {
-    const IVec3 nB = cross(e1, e2), nW = mul(m.R0, nB), f0W = mul(m.R0, f0);
-    const CayleyCoefficients cn = cayley_coefficients(m, nW);
-    const IVec3 Y = v - m.p0;
-    const Interval F = dot(f0W, nW);
-    filter.k[0] = dot(Y, nW) - F;
-    filter.k[1] = dot(Y, cn.c1) - dot(m.dp, nW);
-    filter.k[2] = (dot(Y, cn.c2) - dot(m.dp, cn.c1)) - m.g2 * F;
-    filter.k[3] = -dot(m.dp, cn.c2);
-    filter.dL = next_up(d * norm_upper(nB));
-    Vec3 corner[3];
-    for (int k = 0; k < 3; ++k) corner[k] = motion_point(m.nominal, q.u_begin, q.face[k]);
-    const Vec3 axis = q.vertex - closest_point_on_triangle(q.vertex, corner[0], corner[1], corner[2]);
-    if (axis != Vec3::Zero() && std::isfinite(axis.squaredNorm())) {
-      const IVec3 na = to_interval(axis);
-      filter.add_corner(f0W, na);
-      filter.add_corner(mul(m.R0, f0 + e1), na);
-      filter.add_corner(mul(m.R0, f0 + e2), na);
-      filter.set_axis_static(dot(na, v), na, d);
-    }
+    // Early hit at the face point nearest the vertex's nominal position.
+    const auto probe = [&](double u0, double u1, int iterations, CcdResult* res) {
+      const Vec3 x = motion_point(m.nominal, u0, q.vertex);
+      double a = 0, b = 0;
+      triangle_parameters(closest_point_on_triangle(x, q.face[0], q.face[1], q.face[2]), q.face[0], q.face[1],
+                          q.face[2], &a, &b);
+      return accept_point(enclose, u0, u1, a, b, d, tol_d, iterations, res);
+    };
+    // Edge slabs: m_k = n x (f_k+1 - f_k) points into the triangle; a point
+    // within d of it has (x - f_k).m_k >= -d |m_k|.
+    filtered_bisect(enclose, /*triangle=*/true, sc, filter, [&](UFilter* f) {
+      for (int k = 0; k < 3; ++k) {
+        const IVec3 mk = cross(n, corner[(k + 1) % 3] - corner[k]);
+        f->at_least(body_point_along(m, w, cw, corner[k], mk), next_up(d * norm_upper(mk)));
+      }
+    }, probe, q.u_begin, q.u_end, s, ws, r);
+    return;
   }
-  filtered_bisect(enclose, /*triangle=*/true, sc, filter, q.u_begin, q.u_end, s, ws, r);
+  const IVec3 nW = mul(m.R0, n), f0W = mul(m.R0, f0);
+  const CayleyCoefficients cn = cayley_coefficients(m, nW);
+  const Cubic P = static_point_along(m, v, f0W, nW, cn);
+  const double dL = next_up(d * norm_upper(n));  // |C R0 n| = |n|
+  filter.at_most(P, dL);
+  filter.at_least(P, dL);
+  Vec3 moved[3];
+  for (int k = 0; k < 3; ++k) moved[k] = motion_point(m.nominal, q.u_begin, q.face[k]);
+  const Vec3 axis = q.vertex - closest_point_on_triangle(q.vertex, moved[0], moved[1], moved[2]);
+  if (axis != Vec3::Zero() && std::isfinite(axis.squaredNorm())) {
+    const IVec3 na = to_interval(axis);
+    for (int k = 0; k < 3; ++k) filter.add_corner(mul(m.R0, corner[k]), na);
+    filter.set_axis_static(dot(na, v), na, d);
+  }
+  // Early hit at the point of the nominally moved face nearest the vertex.
+  const auto probe = [&](double u0, double u1, int iterations, CcdResult* res) {
+    Vec3 t[3];
+    for (int k = 0; k < 3; ++k) t[k] = motion_point(m.nominal, u0, q.face[k]);
+    double a = 0, b = 0;
+    triangle_parameters(closest_point_on_triangle(q.vertex, t[0], t[1], t[2]), t[0], t[1], t[2], &a, &b);
+    return accept_point(enclose, u0, u1, a, b, d, tol_d, iterations, res);
+  };
+  // Edge slabs in the body frame: (y - x_fk(u)).(C m_k') >= -d |m_k|.
+  filtered_bisect(enclose, /*triangle=*/true, sc, filter, [&](UFilter* f) {
+    for (int k = 0; k < 3; ++k) {
+      const IVec3 mk = cross(n, corner[(k + 1) % 3] - corner[k]), mkW = mul(m.R0, mk);
+      f->at_least(static_point_along(m, v, mul(m.R0, corner[k]), mkW, cayley_coefficients(m, mkW)),
+                  next_up(d * norm_upper(mk)));
+    }
+  }, probe, q.u_begin, q.u_end, s, ws, r);
 }
 
 void ccd_rigid_edge_edge(const RigidEdgeEdgeQuery& q, const CcdSettings& s, CcdWorkspace* ws, CcdResult* r) {
@@ -804,23 +961,25 @@ void ccd_rigid_edge_edge(const RigidEdgeEdgeQuery& q, const CcdSettings& s, CcdW
     *F = hull(hull(pa[0] - pb[0], pa[0] - pb[1]), hull(pa[1] - pb[0], pa[1] - pb[1]));
   };
   if (!s.use_u_filter) return bisect(enclose, /*triangle=*/false, sc, q.u_begin, q.u_end, s, ws, r);
-  // The u-filter (see UFilter): coplanarity cubic and a separating axis.
+  // The u-filter (see UFilter). Stage 1: the coplanarity cubic and a separating
+  // axis; stage 2: the four end slabs.
   const CcdMotion& m = *q.motion;
   const double d = s.min_separation;
+  const double tol_d = std::max(s.distance_tolerance, 1e-12 * sc.coordinate);  // as in bisect()
   UFilter filter;
   filter.motion = &m;
-  filter.has_cubic = true;
   const IVec3 a0W = mul(m.R0, a0), eaW = mul(m.R0, ea), Q = m.p0 - b0;
   const CayleyCoefficients ca = cayley_coefficients(m, eaW), cb = cayley_coefficients(m, eb);
   const IVec3 T0 = cross(eaW, eb), T1 = cross(ca.c1, eb), T2 = cross(ca.c2, eb), Z = cross(a0W, eaW);
-  filter.k[0] = dot(Q, T0) + dot(Z, eb);
-  filter.k[1] = (dot(Q, T1) + dot(m.dp, T0)) - dot(Z, cb.c1);
-  filter.k[2] = (dot(Q, T2) + dot(m.dp, T1)) + dot(Z, cb.c2);
-  filter.k[3] = dot(m.dp, T2);
+  const Cubic P{{dot(Q, T0) + dot(Z, eb), (dot(Q, T1) + dot(m.dp, T0)) - dot(Z, cb.c1),
+                 (dot(Q, T2) + dot(m.dp, T1)) + dot(Z, cb.c2), dot(m.dp, T2)}};
   // L >= |C ea' x eb| on the window: |ea' x eb| + 2 u_end |g| |ea| |eb|.
   const double g_norm = next_up(std::sqrt(m.g2.hi));
   const double turn = next_up(next_up(2 * q.u_end * g_norm) * next_up(norm_upper(ea) * norm_upper(eb)));
-  filter.dL = next_up(d * next_up(norm_upper(T0) + turn));
+  const double dL = next_up(d * next_up(norm_upper(T0) + turn));
+  filter.at_most(P, dL);
+  filter.at_least(P, dL);
+  const IVec3 a1W = mul(m.R0, a0 + ea);
   const Vec3 A0 = motion_point(m.nominal, q.u_begin, q.edge_body[0]);
   const Vec3 A1 = motion_point(m.nominal, q.u_begin, q.edge_body[1]);
   double sa = 0, tb = 0;
@@ -829,10 +988,35 @@ void ccd_rigid_edge_edge(const RigidEdgeEdgeQuery& q, const CcdSettings& s, CcdW
   if (axis != Vec3::Zero() && std::isfinite(axis.squaredNorm())) {
     const IVec3 na = to_interval(axis);
     filter.add_corner(a0W, na);
-    filter.add_corner(mul(m.R0, a0 + ea), na);
+    filter.add_corner(a1W, na);
     filter.set_axis_static(hull(dot(na, b0), dot(na, b0 + eb)), na, d);
   }
-  filtered_bisect(enclose, /*triangle=*/false, sc, filter, q.u_begin, q.u_end, s, ws, r);
+  // End slabs. Every point of a segment lies between the planes through its
+  // ends normal to it, so segments within d need the other segment to reach
+  // within d of that slab: both ends of A beyond b0 (or b1) along eb by more
+  // than d |eb| excludes, and both ends of B beyond a0(u) (or a1(u)) along
+  // C ea'. Each pair of ends is one group.
+  // Early hit at the closest points of the nominally moved edge and the static one.
+  const auto probe = [&](double u0, double u1, int iterations, CcdResult* res) {
+    const Vec3 P0 = motion_point(m.nominal, u0, q.edge_body[0]), P1 = motion_point(m.nominal, u0, q.edge_body[1]);
+    double pa = 0, pb = 0;
+    closest_segment_parameters(P0, P1, q.edge_world[0], q.edge_world[1], &pa, &pb);
+    if (!(pa >= 0 && pa <= 1 && pb >= 0 && pb <= 1)) return false;  // NaN or out of range: no early hit
+    return accept_point(enclose, u0, u1, pa, pb, d, tol_d, iterations, res);
+  };
+  filtered_bisect(enclose, /*triangle=*/false, sc, filter, [&](UFilter* f) {
+    const IVec3 b1 = b0 + eb;
+    const CayleyCoefficients c0 = cayley_coefficients(m, a0W), c1 = cayley_coefficients(m, a1W);
+    const double rb = next_up(d * norm_upper(eb)), ra = next_up(d * norm_upper(ea));
+    f->at_least(body_point_along(m, a0W, c0, b0, eb), rb);
+    f->at_least(body_point_along(m, a1W, c1, b0, eb), rb, /*join=*/true);
+    f->at_most(body_point_along(m, a0W, c0, b1, eb), rb);
+    f->at_most(body_point_along(m, a1W, c1, b1, eb), rb, /*join=*/true);
+    f->at_least(static_point_along(m, b0, a0W, eaW, ca), ra);
+    f->at_least(static_point_along(m, b1, a0W, eaW, ca), ra, /*join=*/true);
+    f->at_most(static_point_along(m, b0, a1W, eaW, ca), ra);
+    f->at_most(static_point_along(m, b1, a1W, eaW, ca), ra, /*join=*/true);
+  }, probe, q.u_begin, q.u_end, s, ws, r);
 }
 
 StopPose make_stop_pose(const CcdMotion& m, double u, double body_radius) {

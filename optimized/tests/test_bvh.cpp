@@ -143,7 +143,7 @@ TEST_CASE("BVH: every truly colliding triangle pair is a candidate; ccd_step agr
   std::mt19937 rng(17);
   std::uniform_real_distribution<double> U(-1, 1);
   CcdStepSettings settings;
-  CcdStepWorkspace ws;
+  CcdStepWorkspace ws, ws_unordered(1 << 14, 1024, /*candidate_capacity=*/0);
   int hits = 0;
   for (int i = 0; i < 40; ++i) {
     const bool sphere = i % 2;
@@ -183,6 +183,12 @@ TEST_CASE("BVH: every truly colliding triangle pair is a candidate; ccd_step agr
       ++hits;
       CHECK(std::abs(r.u_hit - bf.u_hit) <= 1e-5);
     }
+    // Without a candidate buffer the pairs are tested in traversal order, not
+    // earliest-first: the same first contact (same 1e-5 bound).
+    CcdStepResult r_unordered;
+    ccd_step(&ob_body, 1, {&god, &gb}, x0, x1, settings, &ws_unordered, &r_unordered);
+    CHECK(r_unordered.hit == r.hit);
+    if (r.hit && r_unordered.hit) CHECK(std::abs(r.u_hit - r_unordered.u_hit) <= 1e-5);
   }
   CHECK(hits >= 10);
 }
@@ -278,4 +284,37 @@ TEST_CASE("ccd_step timing on spheres", "[bvh][timing]") {
   std::printf("ccd_step, icosphere 1280 tris vs 5120 tris, approach steps: mean %.1f us, worst %.1f us, %d/%d hits; "
               "per step %ld triangle pairs, %ld pair tests, %ld boxes\n",
               1e6 * total / n, 1e6 * worst, hits, n, triangle_pairs / n, pair_tests / n, boxes / n);
+}
+
+TEST_CASE("swept box cache: returns the box of the asked index in the current sub-interval", "[bvh]") {
+  // A 2-entry cache (indices 0 and 2 share a slot): every get() must return the
+  // box that make() gives for that index and stamp, recomputing on a slot
+  // collision and after next_interval(), and reusing a valid entry.
+  SweptBoxCache cache(1);
+  int calls = 0, interval = 0;
+  const auto box_of = [&](int index) {
+    ++calls;
+    Aabb b;
+    b.lo = Vec3::Constant(index + 100.0 * interval);
+    b.hi = b.lo + Vec3::Ones();
+    return b;
+  };
+  const auto check = [&](int index) {
+    const Aabb& b = cache.get(cache.nodes, index, [&] { return box_of(index); });
+    return b.lo.x() == index + 100.0 * interval;
+  };
+  cache.next_interval();
+  CHECK(check(0));
+  CHECK(check(0));
+  CHECK(calls == 1);  // reused
+  CHECK(check(2));    // same slot as 0: recomputed
+  CHECK(check(0));
+  CHECK(calls == 3);
+  CHECK(check(1));
+  CHECK(calls == 4);
+  ++interval;
+  cache.next_interval();  // every entry stale
+  CHECK(check(1));
+  CHECK(check(0));
+  CHECK(calls == 6);
 }

@@ -14,24 +14,12 @@
 
 #include "gauss6/ccd.h"
 #include "gauss6/ccd_queries.h"
+#include "ccd_test_util.h"
 
 using namespace gauss6;
+using namespace gauss6::test;
 
 namespace {
-
-mpq_class Q(double x) { return mpq_class(x); }  // exact
-
-struct Q3 {
-  mpq_class x, y, z;
-};
-Q3 q3(const Vec3& v) { return {Q(v.x()), Q(v.y()), Q(v.z())}; }
-Q3 operator-(const Q3& a, const Q3& b) { return {a.x - b.x, a.y - b.y, a.z - b.z}; }
-Q3 operator+(const Q3& a, const Q3& b) { return {a.x + b.x, a.y + b.y, a.z + b.z}; }
-Q3 operator*(const mpq_class& s, const Q3& a) { return {s * a.x, s * a.y, s * a.z}; }
-mpq_class dot(const Q3& a, const Q3& b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
-Q3 cross(const Q3& a, const Q3& b) {
-  return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x};
-}
 
 LinearVertexFaceQuery vf(const Vec3& v0, const Vec3& v1, const std::array<Vec3, 3>& f0,
                          const std::array<Vec3, 3>& f1) {
@@ -406,10 +394,21 @@ TEST_CASE("rigid CCD with a pure translation agrees with the linear CCD", "[ccd]
     // The same trajectory as a linear query (p + r_B rounded: compare loosely).
     ccd_linear_vertex_face(vf(x0.p + r_B, x1.p + r_B, f, f), s, &ws, &rl);
     REQUIRE(rr.status == CcdStatus::kOk);
-    // Hits agree except within a hair of grazing; when both hit, within tolerance.
+    // Hits agree except within a hair of grazing. When both hit, the rigid query
+    // (exact trajectory p0 + r_B + u dp) stops no later than its exact contact,
+    // the crossing of the face's plane (a straight path meets the triangle only
+    // there unless it lies in the plane), and no earlier than the linear query
+    // (whose inputs p + r_B are rounded, and whose accepted box may precede an
+    // oblique crossing by more than the time tolerance) less the tolerance.
     if (rr.hit && rl.hit) {
       ++hits;
-      CHECK(std::abs(rr.u_hit - rl.u_hit) <= 2 * s.time_tolerance + 1e-7);
+      const Q3 n = cross(q3(f[1]) - q3(f[0]), q3(f[2]) - q3(f[0]));
+      const mpq_class den = dot(q3(x1.p) - q3(x0.p), n);
+      if (den != 0) {
+        const mpq_class u_star = -dot((q3(x0.p) + q3(r_B)) - q3(f[0]), n) / den;
+        CHECK(not_after(rr.u_hit, u_star));
+      }
+      CHECK(rr.u_hit >= rl.u_hit - (2 * s.time_tolerance + 1e-7));
     } else {
       CHECK(rr.hit == rl.hit);
     }

@@ -8,59 +8,18 @@
 
 #include <gmpxx.h>
 
+#include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <random>
 
 #include "gauss6/ccd.h"
+#include "ccd_test_util.h"
 
 using namespace gauss6;
+using namespace gauss6::test;
 
 namespace {
-
-mpq_class Q(double x) { return mpq_class(x); }  // exact
-struct Q3 {
-  mpq_class x, y, z;
-};
-Q3 q3(const Vec3& v) { return {Q(v.x()), Q(v.y()), Q(v.z())}; }
-Q3 operator-(const Q3& a, const Q3& b) { return {a.x - b.x, a.y - b.y, a.z - b.z}; }
-Q3 operator+(const Q3& a, const Q3& b) { return {a.x + b.x, a.y + b.y, a.z + b.z}; }
-Q3 operator*(const mpq_class& s, const Q3& a) { return {s * a.x, s * a.y, s * a.z}; }
-mpq_class dot(const Q3& a, const Q3& b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
-Q3 cross(const Q3& a, const Q3& b) { return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x}; }
-Vec3 to_double(const Q3& a) { return {a.x.get_d(), a.y.get_d(), a.z.get_d()}; }
-
-// The exact Cayley motion of METHOD.md section 4 from two double poses.
-struct ExactMotion {
-  Q3 p0, dp, g;
-  mpq_class R0[9];
-  explicit ExactMotion(const Pose& x0, const Pose& x1) {
-    p0 = q3(x0.p);
-    dp = q3(x1.p) - p0;
-    const mpq_class w = Q(x0.q.w), x = Q(x0.q.x), y = Q(x0.q.y), z = Q(x0.q.z);
-    const mpq_class n = w * w + x * x + y * y + z * z;
-    const mpq_class e[9] = {w * w + x * x - y * y - z * z, 2 * (x * y - w * z), 2 * (x * z + w * y),
-                            2 * (x * y + w * z), w * w - x * x + y * y - z * z, 2 * (y * z - w * x),
-                            2 * (x * z - w * y), 2 * (y * z + w * x), w * w - x * x - y * y + z * z};
-    for (int i = 0; i < 9; ++i) R0[i] = e[i] / n;
-    // qr = q1 conj(q0), sign as make_ccd_motion (from the double product).
-    const mpq_class aw = Q(x1.q.w), ax = Q(x1.q.x), ay = Q(x1.q.y), az = Q(x1.q.z);
-    const mpq_class bw = w, bx = -x, by = -y, bz = -z;
-    const mpq_class rw = aw * bw - ax * bx - ay * by - az * bz;
-    const mpq_class rx = aw * bx + ax * bw + ay * bz - az * by;
-    const mpq_class ry = aw * by - ax * bz + ay * bw + az * bx;
-    const mpq_class rz = aw * bz + ax * by - ay * bx + az * bw;
-    g = {rx / rw, ry / rw, rz / rw};  // the sign of qr cancels in the quotient
-  }
-  // World point at u of the body point r.
-  Q3 point(const mpq_class& u, const Q3& r) const {
-    const Q3 v{R0[0] * r.x + R0[1] * r.y + R0[2] * r.z, R0[3] * r.x + R0[4] * r.y + R0[5] * r.z,
-               R0[6] * r.x + R0[7] * r.y + R0[8] * r.z};
-    const Q3 h = u * g;
-    const mpq_class hh = dot(h, h);
-    const Q3 Cv = (1 / (1 + hh)) * ((((1 - hh) * v) + ((2 * dot(h, v)) * h)) + (mpq_class(2) * cross(h, v)));
-    return (p0 + u * dp) + Cv;
-  }
-};
 
 // Exact: is point x within distance d of the triangle (a, b, c), its projection
 // on the plane falling inside? (A sufficient test of "within d".)
@@ -256,4 +215,68 @@ TEST_CASE("u-filter never stops later than a contact certified by the plain bise
   INFO("certified contacts: " << certified);
   CHECK(certified > 10);
   CHECK(later == 0);
+}
+
+TEST_CASE("early hit: never after an exact contact, never after the bisection, gap measured", "[ccd]") {
+  // Edge/edge contacts built into random motions as above, queried with a
+  // distance tolerance of 0.1 d (the setting of the mesh-level benchmarks), with
+  // and without the early hit. The early hit must never stop after the exact
+  // contact u_c (verified in rationals) nor after the query without it, and an
+  // early hit reports a pair proven within d + distance_tolerance.
+  std::mt19937 rng(505);
+  std::uniform_real_distribution<double> U(0.02, 0.98), H(-1, 1), S(0.2, 0.8);
+  CcdWorkspace ws;
+  CcdResult on, off;
+  int verified = 0, misses = 0, later_than_bisection = 0, earlier = 0, too_far = 0;
+  double worst_gap_on = 0, worst_gap_off = 0, sum_gap_on = 0, sum_gap_off = 0;
+  for (int i = 0; i < 400; ++i) {
+    Pose x0, x1;
+    random_step(rng, i, &x0, &x1);
+    CcdMotion m;
+    REQUIRE(make_ccd_motion(x0, x1, &m) == MotionStatus::kOk);
+    const ExactMotion em(x0, x1);
+    CcdSettings s;
+    s.min_separation = 1e-5;
+    s.distance_tolerance = 1e-6;
+    const Vec3 a0 = rnd(rng, 0.03), a1 = a0 + rnd(rng, 0.01);
+    const double u_c = U(rng), t = S(rng);
+    const Q3 A0 = em.point(Q(u_c), q3(a0)), A1 = em.point(Q(u_c), q3(a1));
+    const Q3 x_star = A0 + Q(t) * (A1 - A0);
+    Vec3 eb = rnd(rng, 0.01);
+    const Vec3 ea = to_double(A1 - A0);
+    if (i % 4 == 1) eb = ea + 1e-3 * ea.norm() * rnd(rng, 1);  // nearly parallel: line contacts
+    const Vec3 nrm = ea.cross(eb).normalized();
+    const Vec3 P = to_double(x_star) + 0.9 * s.min_separation * H(rng) * nrm;
+    const double sb = S(rng);
+    RigidEdgeEdgeQuery q;
+    q.motion = &m;
+    q.edge_body = {a0, a1};
+    q.edge_world = {P - sb * eb, P + (1 - sb) * eb};
+    if (!within_of_segment(A0, A1, q3(q.edge_world[0]), q3(q.edge_world[1]), Q(s.min_separation))) continue;
+    ++verified;
+    ccd_rigid_edge_edge(q, s, &ws, &on);
+    CcdSettings s_off = s;
+    s_off.early_hit = false;
+    ccd_rigid_edge_edge(q, s_off, &ws, &off);
+    if (!on.hit || Q(on.u_hit) > Q(u_c)) ++misses;
+    if (off.hit && on.u_hit > off.u_hit) ++later_than_bisection;
+    if (on.u_hit < off.u_hit) {
+      ++earlier;
+      if (!(on.distance_reached <= s.min_separation + s.distance_tolerance)) ++too_far;
+    }
+    // u_c is a contact, not necessarily the first one: u_c - u_hit bounds u* - u_hit from above.
+    const double gap_on = u_c - on.u_hit, gap_off = u_c - off.u_hit;
+    worst_gap_on = std::max(worst_gap_on, gap_on);
+    worst_gap_off = std::max(worst_gap_off, gap_off);
+    sum_gap_on += gap_on;
+    sum_gap_off += gap_off;
+  }
+  std::printf("early hit (edge/edge, d 1e-5, tolerance 1e-6): %d exact contacts, %d missed, %d later than the "
+              "bisection, %d earlier; u_c - u_hit mean %.3g worst %.3g (bisection: mean %.3g worst %.3g)\n",
+              verified, misses, later_than_bisection, earlier, sum_gap_on / std::max(verified, 1), worst_gap_on,
+              sum_gap_off / std::max(verified, 1), worst_gap_off);
+  CHECK(verified >= 200);
+  CHECK(misses == 0);
+  CHECK(later_than_bisection == 0);
+  CHECK(too_far == 0);  // an early hit's pair is proven within d + distance_tolerance
 }

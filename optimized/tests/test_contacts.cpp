@@ -14,20 +14,31 @@ using gauss6::test::make_box;
 
 namespace {
 constexpr double kDelta = 1e-5;
-}
+
+// A unit box (the god-object, body frame centred on G) over a 4 x 4 x 1 slab
+// whose top face z = 0 is split along y = x, contacts within 1.1 delta.
+struct BoxOverSlab {
+  TriangleMesh god = make_box(1, 1, 1), slab = make_box(4, 4, 1, Vec3(0, 0, -0.5));
+  Bvh gb = build_bvh(god), sb = build_bvh(slab);
+  CcdBody obstacle{&slab, &sb};
+  ContactWorkspace ws{god};
+  ContactSet set{16};
+  ContactSettings cs = [] {
+    ContactSettings c;
+    c.distance = 1.1 * kDelta;
+    return c;
+  }();
+  ContactStatus contacts_at(const Pose& X) { return generate_contacts(&obstacle, 1, {&god, &gb}, X, cs, &ws, &set); }
+};
+}  // namespace
 
 TEST_CASE("contacts: a unit box resting on a slab inside one top triangle", "[contacts]") {
   // Slab top z = 0 is split along y = x; the god box's footprint x in [0.5, 1.5],
   // y in [-1.5, -0.5] lies in the triangle y < x, far from every slab edge.
-  const TriangleMesh god = make_box(1, 1, 1), slab = make_box(4, 4, 1, Vec3(0, 0, -0.5));
-  const Bvh gb = build_bvh(god), sb = build_bvh(slab);
-  const CcdBody obstacle{&slab, &sb};
-  ContactWorkspace ws(god);
-  ContactSet set(16);
-  ContactSettings cs;
-  cs.distance = 1.1 * kDelta;
+  BoxOverSlab f;
+  const ContactSet& set = f.set;
   const Pose X{Vec3(1, -1, 0.5 + kDelta), Quat{}};
-  REQUIRE(generate_contacts(&obstacle, 1, {&god, &gb}, X, cs, &ws, &set) == ContactStatus::kOk);
+  REQUIRE(f.contacts_at(X) == ContactStatus::kOk);
   REQUIRE(set.num_contacts == 4);
   int corners = 0;
   for (int k = 0; k < set.num_contacts; ++k) {
@@ -48,23 +59,16 @@ TEST_CASE("contacts: a unit box resting on a slab inside one top triangle", "[co
   CHECK(set.num_pairs_within == 4);
   CHECK(corners == 15);  // one contact at each of the four bottom corners
   // Lifted by 2 delta: out of range, no contact.
-  REQUIRE(generate_contacts(&obstacle, 1, {&god, &gb}, {Vec3(1, -1, 0.5 + 2 * kDelta), Quat{}}, cs, &ws, &set) ==
-          ContactStatus::kOk);
+  REQUIRE(f.contacts_at({Vec3(1, -1, 0.5 + 2 * kDelta), Quat{}}) == ContactStatus::kOk);
   CHECK(set.num_contacts == 0);
 }
 
 TEST_CASE("contacts: corners over the slab's diagonal are merged", "[contacts]") {
   // Centred box: corners (-1/2, -1/2) and (1/2, 1/2) lie on the diagonal y = x
   // shared by the two top triangles: each is seen by both (6 pairs), 4 contacts.
-  const TriangleMesh god = make_box(1, 1, 1), slab = make_box(4, 4, 1, Vec3(0, 0, -0.5));
-  const Bvh gb = build_bvh(god), sb = build_bvh(slab);
-  const CcdBody obstacle{&slab, &sb};
-  ContactWorkspace ws(god);
-  ContactSet set(16);
-  ContactSettings cs;
-  cs.distance = 1.1 * kDelta;
-  REQUIRE(generate_contacts(&obstacle, 1, {&god, &gb}, {Vec3(0, 0, 0.5 + kDelta), Quat{}}, cs, &ws, &set) ==
-          ContactStatus::kOk);
+  BoxOverSlab f;
+  const ContactSet& set = f.set;
+  REQUIRE(f.contacts_at({Vec3(0, 0, 0.5 + kDelta), Quat{}}) == ContactStatus::kOk);
   CHECK(set.num_pairs_within == 6);
   CHECK(set.num_contacts == 4);
   for (int k = 0; k < set.num_contacts; ++k) CHECK(set.contacts[k].normal == Vec3(0, 0, 1));

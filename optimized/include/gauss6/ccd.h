@@ -19,6 +19,10 @@
 // u_hit the features are already within distance_reached; if they truly touch
 // in the accepted interval, u* - u_hit <= time_tolerance_reached (in practice
 // u* - u_hit <= 2 time_tolerance unless the motion grazes: see the tests).
+// Rigid queries first drop u-ranges with cheap cubic filters; with early_hit the
+// earliest kept u-interval is accepted without the bisection when a feature
+// pair there is proven within min_separation + distance_tolerance (the same
+// acceptance rule; everything before it was proven free, so u_hit <= u*).
 //
 // Two kinds of vertex trajectories:
 //   linear: x(u) = x0 + u (x1 - x0) per vertex (the shared test data's form);
@@ -31,6 +35,7 @@
 
 #include <algorithm>
 #include <array>
+#include <cmath>
 #include <bit>
 #include <cstdint>
 #include <limits>
@@ -46,23 +51,29 @@ namespace gauss6 {
 //
 // Proof of enclosure. Every operation below computes its double result(s) in the
 // default round-to-nearest mode (IEEE 754, SSE2 on x86-64: no excess precision)
-// and then moves the lower bound one float down and the upper bound one float up.
-// If r = fl(x) is a nearest float to the exact real x, then next_down(r) <= x:
-// otherwise next_down(r) would lie strictly between x and r, closer to x than r.
-// Likewise next_up(r) >= x. This holds for subnormal results and for overflow
-// (fl(x) = +inf gives next_down = DBL_MAX <= x, and the upper bound stays +inf).
-// The widening works on the bits of the rounded result (std::bit_cast), so a
-// compiler cannot fuse two operations across it (no FMA contraction can skip a
-// rounding we account for), and no -frounding-math is needed: the rounding mode
-// is never changed. A NaN bound makes every exclusion test false (comparisons
-// with NaN are false), so a NaN can only cause a false positive, never a miss.
+// and then widens the lower bound down and the upper bound up, branch-free:
+//   next_up(r) = fl(r' + t),  r' = max(r, -DBL_MAX),  t = fl(|r'| 2^-52 + 2^-1074).
+// Let s be the gap from a finite r to the next float above it (r+). For normal r,
+// s <= |r| 2^-52 (also at r = -2^e, where s is half the usual gap); for
+// subnormal r or 0, s = 2^-1074. If |r| 2^-52 underflows, its rounding loses at
+// most 2^-1075 and adding 2^-1074 (exact there) restores it. So t >= s, and,
+// rounding being monotone, fl(r + t) >= fl(r + s) = r+ (or +inf past DBL_MAX).
+// If r = fl(x) is a nearest float to the exact real x, then x <= r+, hence
+// next_up(r) >= x; the result is r+ or the float after it. The argument only uses
+// r + t >= (smallest float >= x), so it still holds if a compiler contracts the
+// product that produced r into a fused multiply-add with the "+ t" (x + t >= that
+// float too). Overflow: fl(x) = -inf means x < -DBL_MAX, and r' = -DBL_MAX
+// gives a result >= -DBL_MAX >= x; +inf stays +inf. next_down(r) = -next_up(-r) mirrors all this.
+// No -frounding-math is needed: the rounding mode is never changed. A NaN bound
+// makes every exclusion test false (comparisons with NaN are false, and the max
+// keeps a NaN first argument), so a NaN can only cause a false positive, never a
+// miss.
 // ---------------------------------------------------------------------------
 inline double next_up(double x) {
-  if (!(x < std::numeric_limits<double>::infinity())) return x;  // +inf, NaN
-  if (x == 0) return std::numeric_limits<double>::denorm_min();
-  uint64_t b = std::bit_cast<uint64_t>(x);
-  b = (x > 0) ? b + 1 : b - 1;  // magnitude up for x > 0, down for x < 0
-  return std::bit_cast<double>(b);
+  constexpr double kMax = std::numeric_limits<double>::max();
+  constexpr double kUlp = 0x1p-52, kTiny = std::numeric_limits<double>::denorm_min();
+  const double r = x < -kMax ? -kMax : x;  // maxsd; keeps a NaN (the comparison is false)
+  return r + (std::abs(r) * kUlp + kTiny);
 }
 inline double next_down(double x) { return -next_up(-x); }
 
@@ -161,6 +172,11 @@ struct CcdSettings {
   int max_iterations = 200000;        // boxes examined before a conservative give-up
   bool use_u_filter = true;           // rigid queries: drop u-ranges by the coplanarity cubic and a separating
                                       // axis before the bisection (conservative; false: bisection alone)
+  bool early_hit = true;              // rigid queries with the u-filter: accept the earliest u-interval the filter
+                                      // keeps (at most time_tolerance wide, all before it excluded) without the
+                                      // bisection when the features' nominal closest points there are proven within
+                                      // min_separation + distance_tolerance at its start (same acceptance rule as
+                                      // the bisection; u_hit <= u* holds either way)
 };
 
 struct CcdResult {
