@@ -5,7 +5,7 @@ SHELL := /bin/bash
 VENV := .venv/bin
 JOBS ?= $(shell nproc)
 
-.PHONY: setup test reproduce ctest pytest proofs checks datasets clean
+.PHONY: setup test reproduce bench ctest pytest proofs checks datasets clean
 
 setup:
 	@tools/setup.sh
@@ -38,10 +38,19 @@ test: setup
 	if [ $$status -ne 0 ]; then echo "make test: FAILED"; else echo "make test: all suites passed"; fi; \
 	exit $$status
 
+# Every benchmark suite (JSON, table, plots in out/bench/) and the speed-against-error
+# sweeps (Pareto plots in out/bench/sweeps/): docs/benchmarks.md.
+bench: setup
+	$(VENV)/gauss6 bench --build build --out out/bench
+	$(VENV)/gauss6 sweep --build build --out out/bench/sweeps
+
 datasets: setup
 	$(VENV)/gauss6 datasets generate
 
+# Regenerates the datasets in place (byte-identical: `gauss6 datasets check`), then runs
+# the paper's scenarios: out/summary.json, out/report.md, the figures and the traces.
 reproduce: setup
+	$(VENV)/gauss6 datasets generate
 	$(VENV)/gauss6 reproduce all --out out
 
 clean:

@@ -157,6 +157,10 @@ RuntimeModel::RuntimeModel(const Scene& scene, const RuntimeSettings& s) : setti
   // The CCD stops the god-object delta before contact; contacts are the pairs
   // within delta (1 + contact_factor).
   settings.ccd.narrow.min_separation = contact.delta;
+  // A hit is accepted once the features are proven within 1.1 delta: the stop pose keeps
+  // at least delta (the guarantee) and the search ends well before rounding-level widths
+  // (the default 1e-9 is meant for unit-size queries; docs/benchmarks.md, the delta sweep).
+  settings.ccd.narrow.distance_tolerance = 0.1 * contact.delta;
   contact_generation.distance = contact.delta * (1 + settings.contact_factor);
   match_distance = settings.match_distance > 0 ? settings.match_distance : 1e-3 * god_radius;
 }
@@ -303,6 +307,7 @@ const SimStepInfo& sim_step(const RuntimeModel& model, double t, RuntimeChannels
   // 5. Publish xs, M, J, the contacts (a new sequence number is the flag).
   publish_god_object(t, s, channels);
   info.xs = s->xs;
+  info.contacts = &s->contacts;
   info.update_seconds = seconds_since(start);
   return info;
 }
@@ -328,24 +333,40 @@ bool receive_god_object(const RuntimeChannels& ch, CouplingState* s) {
 
 // Constraint offsetting of a new set (coupling.h). A row that is the same
 // constraint as a cached one (same body-frame point within match_distance, same
-// normal) keeps its offset. A new row k is measured against what the user feels
-// just before it arrives: d_k = J_k ac_old, with ac_old the projection of au on
-// the kept rows (ac_old = au when none are kept: METHOD.md's d_k = J_k au). A new
-// row with d_k < eps starts an offset at f_k(0) = d_k: ac_old stays feasible and
-// optimal, so the force does not jump. (Measured against au instead, a row that
-// the kept rows already enforce, e.g. an edge crossing a face the god-object
-// slides on, would be offset for nothing.) Returns the number of offsets started.
+// normal) keeps its offset. A new row k is measured against what the user felt
+// just before it arrived: d_k = J_k ac_old, with ac_old the projection of au on
+// the previous set's rows with their right-hand sides at t (ac_old = au when
+// there were none: METHOD.md's d_k = J_k au). A new row with d_k < eps starts an
+// offset at f_k(0) = d_k: ac_old stays feasible and optimal, so the force does
+// not jump. Measured against au instead, a contact that slides across triangles
+// (its rows change identity at every set) would be offset again and again and
+// the force would keep dropping to zero; so would a row that the old rows
+// already enforce (an edge crossing a face the god-object slides on). Returns
+// the number of offsets started.
 int start_offsets(const RuntimeModel& model, double t, const Vec6& au, CouplingState* s) {
   const int m = s->god.num_contacts;
   const Mat3 Rt = rotation_matrix(s->xs.q).transpose();
-  int num_kept = 0, num_new = 0;
+  // The previous set's rows and their right-hand sides now: the "before" problem.
+  // After an empty set, the last non-empty one (arrived or emptied less than
+  // offset_time ago) stands in for it, without offsets.
+  const int num_old = s->num_cached_rows;
+  const bool use_last = num_old == 0 && s->num_last_rows > 0 && t - s->last_rows_time < model.offsets.T;
+  const int num_before = use_last ? s->num_last_rows : num_old;
+  for (int j = 0; j < num_before; ++j) {
+    std::memcpy(&s->kept_J[6 * j], &s->cached_J[6 * j], 6 * sizeof(double));
+    const double dt = t - s->offset_t0[j];
+    s->kept_b[j] = !use_last && s->offset_start[j] < 0 && dt < model.offsets.T
+                       ? offset_rhs(s->offset_start[j], dt, model.offsets)
+                       : 0.0;
+  }
+  int num_new = 0;
   for (int k = 0; k < m; ++k) {
     const Vec3 point_W(s->god.point[k][0], s->god.point[k][1], s->god.point[k][2]);
     const Vec3 normal_W(s->god.normal[k][0], s->god.normal[k][1], s->god.normal[k][2]);
     s->new_point_B[k] = Rt * (point_W - s->xs.p);
     s->new_normal_W[k] = normal_W;
     int match = -1;
-    for (int j = 0; j < s->num_cached_rows && match < 0; ++j)
+    for (int j = 0; j < num_old && match < 0; ++j)
       if ((s->point_B[j] - s->new_point_B[k]).norm() <= model.match_distance &&
           s->normal_W[j].dot(normal_W) >= model.settings.match_cosine)
         match = j;
@@ -354,25 +375,20 @@ int start_offsets(const RuntimeModel& model, double t, const Vec6& au, CouplingS
       ++num_new;
       continue;
     }
-    // Kept: its offset (if any) runs on; its row joins the "before" problem.
+    // Kept: its offset (if any) runs on.
     s->new_start[k] = s->offset_start[match];
     s->new_t0[k] = s->offset_t0[match];
-    const double dt = t - s->new_t0[k];
-    std::memcpy(&s->kept_J[6 * num_kept], s->god.J + 6 * k, 6 * sizeof(double));
-    s->kept_b[num_kept] =
-        s->new_start[k] < 0 && dt < model.offsets.T ? offset_rhs(s->new_start[k], dt, model.offsets) : 0.0;
-    ++num_kept;
   }
   int started = 0;
   if (num_new > 0) {
     Vec6 ac_old = au;
-    if (num_kept > 0) {
+    if (num_before > 0) {
       ProjectionProblem before;
       before.M = &s->M;
       before.au = au;
       before.J = s->kept_J.data();
       before.b = s->kept_b.data();
-      before.num_rows = num_kept;
+      before.num_rows = num_before;
       const ProjectionStatus status = project(before, model.settings.projection, &s->arrival_ws, &s->arrival);
       if (status == ProjectionStatus::kOptimal) ac_old = s->arrival.ac;
     }
@@ -390,6 +406,13 @@ int start_offsets(const RuntimeModel& model, double t, const Vec6& au, CouplingS
     s->offset_t0[k] = s->new_t0[k];
     s->point_B[k] = s->new_point_B[k];
     s->normal_W[k] = s->new_normal_W[k];
+  }
+  if (m > 0) {
+    std::memcpy(s->cached_J.data(), s->god.J, sizeof(double) * 6 * static_cast<size_t>(m));
+    s->num_last_rows = m;
+    s->last_rows_time = t;
+  } else if (num_old > 0) {
+    s->last_rows_time = t;  // the set just emptied: the stand-in's clock starts now
   }
   s->num_cached_rows = m;
   return started;
@@ -430,6 +453,7 @@ const CouplingStepInfo& coupling_step(const RuntimeModel& model, double t, Runti
   if (s->has_handle && s->has_god) {
     info.god_sequence = s->god.sequence;
     info.god_time = s->god.time;
+    info.xs = s->xs;
     const int m = s->god.num_contacts;
     info.num_rows = m;
     // 2. au = ks (xh (-) xs); offsets for the new rows of a new set.
@@ -554,6 +578,8 @@ bool haptic_tick(const RuntimeModel& model, double t, Device* device, RuntimeCha
   rec.time = t;
   rec.device_status = status;
   rec.xh = h->xh;
+  rec.buttons = h->device.buttons;
+  rec.gripped = h->device.gripped;
   rec.F_computed = F_computed;
   rec.F_sent = F;
   rec.active_events = events;

@@ -6,8 +6,12 @@
     gauss6 ccd queries FILE.csv|DIR [--kind vf|ee] [--impl optimized|reference] [--json]
     gauss6 crosscheck ccd [--set NAME] [--json] [--peers]
     gauss6 report qp --out DIR
-    gauss6 reproduce peg|bunny|all --out DIR
+    gauss6 reproduce peg|bunny|all --out DIR [--threaded]
+    gauss6 trace export TRACE --csv DIR
     gauss6 device list [--json]
+    gauss6 bench [--build DIR] [--out DIR] [--filter REGEX]
+    gauss6 sweep [--build DIR] [--out DIR]
+    gauss6 gate --base REV [--json]
 
 Every subcommand exits non-zero on a failed check, with a message naming the problem.
 """
@@ -56,30 +60,6 @@ def cmd_datasets(args: argparse.Namespace) -> int:
         print(f"MISMATCH {p}")
     print("datasets: all checksums match" if not problems else f"datasets: {len(problems)} mismatches")
     return 1 if problems else 0
-
-
-def cmd_reproduce(args: argparse.Namespace) -> int:
-    from . import SceneError
-    from .scene import format_scene_info, scene_info
-
-    from . import datasets, qp_instances
-
-    out = Path(args.out)
-    out.mkdir(parents=True, exist_ok=True)
-    # The datasets are deterministic: regenerating them in place leaves them byte-identical
-    # (`gauss6 datasets check`, run by `make test`, proves it).
-    datasets.generate_all()
-    qp_instances.generate()
-    names = ["peg", "bunny"] if args.scenario == "all" else [args.scenario]
-    for name in names:
-        try:
-            info = scene_info(SCENES[name])
-        except SceneError as e:
-            return _error(str(e))
-        (out / f"scene_{name}.json").write_text(json.dumps(info, indent=2) + "\n")
-        print(format_scene_info(info))
-    print(f"scene summaries written to {out}/")
-    return 0
 
 
 def cmd_crosscheck_qp(args: argparse.Namespace) -> int:
@@ -183,10 +163,15 @@ def build_parser() -> argparse.ArgumentParser:
     dl.add_argument("--json", action="store_true", help="machine-readable output")
     dl.set_defaults(func=cmd_device_list)
 
-    rep = sub.add_parser("reproduce", help="run the paper's scenarios and write figures and summaries")
-    rep.add_argument("scenario", choices=["peg", "bunny", "all"])
-    rep.add_argument("--out", required=True, help="output directory")
-    rep.set_defaults(func=cmd_reproduce)
+    from .reproduce import register as register_reproduce
+
+    register_reproduce(sub)  # reproduce {peg,bunny,all} --out DIR [--threaded]; trace export TRACE --csv DIR
+
+    from . import bench, gate, sweeps  # benchmarks, speed against error, the regression gate
+
+    bench.register(sub)
+    sweeps.register(sub)
+    gate.register(sub)
     return p
 
 

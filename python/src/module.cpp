@@ -8,4 +8,5 @@ PYBIND11_MODULE(_gauss6, m) {
   gauss6::python::bind_quasistatics(m);
   gauss6::python::bind_reference(m);
   gauss6::python::bind_ccd(m);
+  gauss6::python::bind_runtime(m);
 }

@@ -25,7 +25,11 @@
 //     coupling loop, hence the force, uses exactly J a >= 0 (or the offsets);
 //   - a row of a new set is "the same constraint" as a cached one when its
 //     body-frame point and its normal match: its offset runs on; a new row's
-//     d_k is J_k ac_old, ac_old the projection on the kept rows (J_k au without).
+//     d_k is J_k ac_old, ac_old the projection on the previous set's rows (what
+//     the user felt: J_k au without), so that a contact sliding across
+//     triangles, whose rows change identity, is not offset again; after a set
+//     with no rows, the last non-empty set stands in for it for offset_time
+//     (a contact lost for a step, e.g. sliding over a crease, is not ramped again).
 //   - force shading and textures are refused (RuntimeError) when the model is built.
 //
 // Real-time rules: sim_step, coupling_step and haptic_tick allocate nothing, lock
@@ -194,6 +198,7 @@ struct SimStepInfo {
   int num_contacts = 0;
   int num_halves = 1;                  // 2 when the step was split (half turn)
   double update_seconds = 0;           // wall time of the whole step (steady_clock)
+  const ContactSet* contacts = nullptr;  // the contact set at xs (valid during the hook call only)
 };
 
 struct CouplingStepInfo {
@@ -202,6 +207,7 @@ struct CouplingStepInfo {
   bool new_set = false;                // a snapshot arrived this step
   uint64_t god_sequence = 0;
   double god_time = -1;
+  Pose xs;                             // the god-object pose the step used (the cached snapshot's)
   Vec6 au = Vec6::Zero(), ac = Vec6::Zero(), Fc = Vec6::Zero();
   int num_rows = 0, num_offset_rows = 0;  // rows, and rows whose offset still runs
   int num_new_offsets = 0;             // rows offset when this snapshot arrived
@@ -214,6 +220,8 @@ struct HapticTickRecord {
   double time = 0;
   DeviceStatus device_status = DeviceStatus::kOk;
   Pose xh;                             // the last good handle pose
+  uint32_t buttons = 0;                // the last sample's buttons
+  bool gripped = true;                 // the last sample's DeviceState::gripped
   Vec6 F_computed = Vec6::Zero();      // before the safety stage
   Vec6 F_sent = Vec6::Zero();          // what write() received
   uint32_t active_events = 0;          // bit k: RuntimeEventKind k holds this tick
@@ -298,12 +306,15 @@ struct CouplingState {
   std::array<double, kMaxContacts> rhs{};
   std::array<Vec3, kMaxContacts> point_B{};   // I_k in the god-object's frame
   std::array<Vec3, kMaxContacts> normal_W{};
+  std::array<double, kMaxContacts * 6> cached_J{};  // the last non-empty set's rows (m x 6 row-major)
+  int num_last_rows = 0;               // rows in cached_J (kept through empty sets)
+  double last_rows_time = -1;          // s, when that set arrived or was last replaced by an empty one
   // Scratch for the matching of a new snapshot's rows.
   std::array<double, kMaxContacts> new_start{}, new_t0{};
   std::array<Vec3, kMaxContacts> new_point_B{}, new_normal_W{};
   std::array<unsigned char, kMaxContacts> matched{};
-  // The rows kept from the previous set and their right-hand sides, projected
-  // once per new set to measure the new rows (see start_offsets in runtime.cpp).
+  // The previous set's rows and their right-hand sides at the new set's arrival,
+  // projected once per new set to measure the new rows (see start_offsets in runtime.cpp).
   std::array<double, kMaxContacts * 6> kept_J{};
   std::array<double, kMaxContacts> kept_b{};
   ProjectionWorkspace arrival_ws;

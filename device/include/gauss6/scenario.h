@@ -1,0 +1,98 @@
+// Scripted scenarios: a scene, the simulated device driven by a hand script
+// (the paper's peg-in-hole phases a-e, the bunnies), the runtime's three loops
+// (runtime.h), and a trace of the whole run (trace.h, docs/trace-format.md).
+//
+// run_scenario() wires the runtime's observer hooks to a TraceWriter:
+//   per haptic tick: t, xh, xs (as the coupling step used it), the wrench sent,
+//     the number of rows of J behind it, the force-computation time, status, flags;
+//   per sim step:    t, the god-object update time, the number of contacts,
+//     status, and one contact row per contact (point, normal, separation);
+//   events:          each phase's start (value: its index in the metadata's
+//     phases), the let-go, watchdog trips, the script's end.
+// The writer's background thread flushes the file every flush_period (<= 1 s),
+// so a crash loses at most that much of the run.
+//
+// It also checks, per coupling step, the two properties of METHOD.md section 5
+// that the trace cannot show exactly (it records the clamped wrench, not ac):
+// orthogonality Fc . ac = 0 and the constraint stage's energy balance
+// au . Fc <= 0 (the constraints only remove energy); and it runs a
+// Hannaford-Ryu passivity observer on the device port.
+//
+// Units: the scene's (metres, kilograms, seconds in the shipped scenes); wrenches
+// in N and N m, world frame.
+#pragma once
+
+#include <array>
+#include <functional>
+#include <string>
+
+#include "gauss6/runtime.h"
+#include "gauss6/scene.h"
+#include "gauss6/simulated_device.h"
+#include "gauss6/trace.h"
+
+namespace gauss6 {
+
+class ScenarioError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+struct ScenarioOptions {
+  std::string trace_path;              // the trace file to write (required)
+  bool threaded = false;               // false: run_lockstep (virtual clock, repeatable); true: run_threaded (wall clock)
+  double duration = -1;                // s of run time; < 0: until the script ends
+  RuntimeSettings runtime;             // the runtime's settings (lockstep_sim_period, force source, ...)
+  SimulatedHandleParams handle;        // the simulated handle; rate_hz, max_force, max_torque come from the scene
+  TraceWriterSettings trace;           // ring sizes and flush period (the background thread is always used)
+  std::string extra_json = "{}";       // a JSON object stored under the trace metadata's "extra"
+  // Called on the calling thread about every progress_period s of wall time with
+  // the run's time so far (s), and once at the end. May be empty.
+  std::function<void(double run_time)> progress;
+  double progress_period = 0.2;        // s (wall)
+};
+
+struct ScenarioResult {
+  RuntimeStats stats;                  // per-loop rates, work times, events
+  TraceWriterStats trace;              // rows written and dropped
+  std::string trace_path;
+  long num_ticks = 0;                  // haptic ticks run
+  long num_sim_steps = 0;
+  double run_time = 0;                 // s: virtual (lockstep) or wall (threaded)
+  double wall_seconds = 0;             // s of wall time for the whole call
+
+  // Orthogonality (METHOD.md 5.1), over coupling steps with |Fc| > 0, |ac| > 1e-6 |au|
+  // (below, ac is rounding noise: pressing straight into a face gives ac = 0) and
+  // no running offset (an offset row's right-hand side is not 0, so the identity
+  // does not hold there): max |Fc . ac| / (|Fc| |ac|).
+  double max_rel_force_dot_ac = 0;
+  long num_orthogonality_checks = 0;
+  long num_offset_steps = 0;           // coupling steps skipped because an offset ran
+
+  // The constraint stage's work on the user's command (METHOD.md 5.4 with Fu = kh M au):
+  // per coupling step au . Fc = -kh |ac - au|_M^2 <= 0 (J). Sums of its positive and
+  // negative parts; the positive sum must be 0 up to rounding.
+  double constraint_energy_injected = 0;
+  double constraint_energy_removed = 0;
+
+  // Passivity observer on the device port (Hannaford and Ryu 2002): W(n) =
+  // sum_k F_k . (xh_{k+1} (-) xh_k), the work of the sent wrench on the handle,
+  // plus the energy stored in the coupling at tick n, V = F^T M^-1 F / (2 kh ks).
+  // A passive environment keeps W(n) + V(n) <= 0 for every n; this is max(0, max_n).
+  // Zero-order hold of a stiff coupling makes it slightly positive (about
+  // k/2 sum |dx|^2), which is why the constraint-stage balance above is kept apart.
+  double port_energy_max = 0;          // J
+  double port_energy_final = 0;        // J, W + V at the last tick (negative: energy dissipated)
+};
+
+// The hand script named by scene.device.script: the file
+// <scene dir>/../scripts/<name>.json (a path ending in .json is taken as is,
+// relative to the scene's directory). Throws ScenarioError naming the file.
+HandScript load_scene_script(const Scene& scene);
+
+// Runs the scene with a SimulatedDevice following `script` and writes the trace.
+// Throws ScenarioError (bad options, trace file) or RuntimeError (scene) before
+// the run starts; the run itself does not throw.
+ScenarioResult run_scenario(const Scene& scene, const HandScript& script, const ScenarioOptions& options);
+
+}  // namespace gauss6

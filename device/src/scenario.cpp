@@ -1,0 +1,299 @@
+// Scripted scenarios: the simulated device, the runtime's loops and a trace of
+// the run, with the per-step property checks and the passivity observer
+// (scenario.h).
+#include "gauss6/scenario.h"
+
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <memory>
+#include <sstream>
+#include <thread>
+
+namespace gauss6 {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+// Orthogonality is measured only where |ac| > this |au| (see on_coupling_step).
+constexpr double kMinRelativeAc = 1e-6;
+
+constexpr uint32_t bit(RuntimeEventKind k) { return 1u << static_cast<int>(k); }
+constexpr uint32_t kWatchdogEvents = bit(RuntimeEventKind::kDeviceTimeout) | bit(RuntimeEventKind::kSimStalled) |
+                                     bit(RuntimeEventKind::kCouplingStalled);
+
+// What a tick row needs from the last coupling step (another thread's, with
+// ForceSource::kCouplingLoop): passed through a seqlock.
+struct CouplingRecord {
+  double xs_p[3] = {0, 0, 0};
+  double xs_q[4] = {1, 0, 0, 0};
+  int32_t num_rows = 0;
+  uint64_t god_sequence = 0;
+  double force_seconds = 0;
+};
+
+// The observer's state. The hooks run on the loops' threads: each member is
+// written by one thread only (noted), except `time`, an atomic for the progress.
+struct Recorder {
+  const RuntimeModel* model = nullptr;
+  const HandScript* script = nullptr;
+  TraceWriter* writer = nullptr;
+  SeqLock<CouplingRecord> coupling;      // coupling thread -> haptic thread
+  std::atomic<double> time{0};           // haptic thread -> caller (progress)
+  std::atomic<long> num_sim_steps{0};    // sim thread
+
+  // Haptic thread.
+  size_t next_phase = 0;
+  bool let_go_reported = false;
+  uint64_t last_sequence = 0;
+  long num_ticks = 0;
+  bool has_previous = false;
+  Pose previous_xh;
+  Vec6 previous_F = Vec6::Zero();
+  double port_work = 0, port_energy_max = 0, port_energy = 0;
+
+  // Coupling thread.
+  double max_rel_dot = 0;
+  long num_orthogonality_checks = 0, num_offset_steps = 0;
+  double energy_injected = 0, energy_removed = 0;
+};
+
+// V = F^T M^-1 F / (2 kh ks): the energy stored in the coupling spring
+// (stiffness kh ks M) that produces F. M at the orientation q.
+double coupling_energy(const RuntimeModel& model, const Quat& q, const Vec6& F) {
+  const double k = model.gains.kh * model.gains.ks;
+  if (!(k > 0)) return 0;
+  const Mat3 R = rotation_matrix(normalized(q));
+  const Vec3 tau_B = R.transpose() * F.tail<3>();
+  const double e = F.head<3>().squaredNorm() / model.mass + tau_B.dot(model.inertia_G_B.llt().solve(tau_B));
+  return e / (2 * k);
+}
+
+void on_coupling_step(void* user, const CouplingStepInfo& info) {
+  auto* r = static_cast<Recorder*>(user);
+  CouplingRecord c;
+  c.xs_p[0] = info.xs.p[0], c.xs_p[1] = info.xs.p[1], c.xs_p[2] = info.xs.p[2];
+  c.xs_q[0] = info.xs.q.w, c.xs_q[1] = info.xs.q.x, c.xs_q[2] = info.xs.q.y, c.xs_q[3] = info.xs.q.z;
+  c.num_rows = info.num_rows;
+  c.god_sequence = info.god_sequence;
+  c.force_seconds = info.force_seconds;
+  r->coupling.write(c);
+  if (!info.has_god_object) return;
+  // Constraint stage's work on the command: au . Fc = -kh |ac - au|_M^2 (<= 0).
+  const double w = info.au.dot(info.Fc);
+  if (w > 0) r->energy_injected += w;
+  else r->energy_removed -= w;
+  // Orthogonality Fc . ac = 0 (not with running offsets: their b != 0).
+  if (info.num_offset_rows > 0) {
+    ++r->num_offset_steps;
+    return;
+  }
+  // With ac at rounding level (pressing straight into a face: ac = 0 exactly),
+  // the ratio measures rounding noise, not the solver: skip |ac| <= 1e-6 |au|.
+  const double nf = info.Fc.norm(), na = info.ac.norm();
+  if (nf > 0 && na > kMinRelativeAc * info.au.norm()) {
+    r->max_rel_dot = std::max(r->max_rel_dot, std::abs(info.Fc.dot(info.ac)) / (nf * na));
+    ++r->num_orthogonality_checks;
+  }
+}
+
+void on_sim_step(void* user, const SimStepInfo& info) {
+  auto* r = static_cast<Recorder*>(user);
+  r->num_sim_steps.fetch_add(1, std::memory_order_relaxed);
+  TraceStep row;
+  row.step = info.step - 1;  // 0, 1, 2, ...
+  row.t = info.time;
+  row.update_time = info.update_seconds;
+  row.num_contacts = info.num_contacts;
+  row.status = static_cast<int>(info.status);
+  r->writer->append(row);
+  if (!info.contacts) return;
+  const int m = std::min(info.contacts->num_contacts, kMaxContacts);
+  for (int k = 0; k < m; ++k) {
+    const Contact& c = info.contacts->contacts[static_cast<size_t>(k)];
+    r->writer->append(TraceContact{row.step, row.t, c.point, c.normal, c.separation});
+  }
+}
+
+void on_haptic_tick(void* user, const HapticTickRecord& rec) {
+  auto* r = static_cast<Recorder*>(user);
+  // Phase boundaries and the let-go, at the first tick at or after them.
+  const auto& phases = r->script->phases;
+  while (r->next_phase < phases.size() && rec.time >= phases[r->next_phase].start) {
+    r->writer->append(TraceEvent{phases[r->next_phase].start, TraceEventCode::kPhase,
+                                 static_cast<double>(r->next_phase)});
+    ++r->next_phase;
+  }
+  if (!rec.gripped && !r->let_go_reported) {
+    r->writer->append(TraceEvent{rec.time, TraceEventCode::kLetGo, 0});
+    r->let_go_reported = true;
+  }
+
+  CouplingRecord c;
+  const bool has_coupling = r->coupling.try_read(&c);
+  TraceTick row;
+  row.t = rec.time;
+  row.X_WH = rec.xh;
+  row.X_WS = has_coupling ? to_pose(c.xs_p, c.xs_q) : r->model->initial_pose;
+  row.F = rec.F_sent;
+  row.num_contacts = has_coupling ? c.num_rows : 0;
+  row.force_time = has_coupling ? c.force_seconds : 0;
+  row.status = rec.device_status;
+  row.buttons = rec.buttons;
+  row.flags = (rec.gripped ? kTickGripped : 0u) |
+              (has_coupling && c.god_sequence != r->last_sequence ? kTickNewContactSet : 0u) |
+              (rec.active_events & bit(RuntimeEventKind::kForceClamped) ? kTickForceClamped : 0u) |
+              (rec.active_events & kWatchdogEvents ? kTickWatchdog : 0u);
+  if (has_coupling) r->last_sequence = c.god_sequence;
+  r->writer->append(row);
+
+  // Passivity observer: the work of the wrench held since the last tick on the
+  // handle's motion, plus the energy stored in the coupling now.
+  if (r->has_previous) r->port_work += r->previous_F.dot(pose_difference(rec.xh, r->previous_xh));
+  r->port_energy = r->port_work + coupling_energy(*r->model, row.X_WS.q, rec.F_sent);
+  r->port_energy_max = std::max(r->port_energy_max, r->port_energy);
+  r->previous_xh = rec.xh;
+  r->previous_F = rec.F_sent;
+  r->has_previous = true;
+
+  ++r->num_ticks;
+  r->time.store(rec.time, std::memory_order_relaxed);
+}
+
+void on_event(void* user, const RuntimeEvent& e) {
+  auto* r = static_cast<Recorder*>(user);
+  const RuntimeSettings& s = r->model->settings;
+  switch (e.kind) {
+    case RuntimeEventKind::kDeviceEnded: r->writer->append(TraceEvent{e.time, TraceEventCode::kDeviceEnded, 0}); break;
+    case RuntimeEventKind::kDeviceTimeout:
+      r->writer->append(TraceEvent{e.time, TraceEventCode::kWatchdog, s.device_timeout});
+      break;
+    case RuntimeEventKind::kSimStalled: r->writer->append(TraceEvent{e.time, TraceEventCode::kWatchdog, s.sim_timeout}); break;
+    case RuntimeEventKind::kCouplingStalled:
+      r->writer->append(TraceEvent{e.time, TraceEventCode::kWatchdog, s.coupling_timeout});
+      break;
+    default: break;  // counted in RuntimeStats
+  }
+}
+
+std::string read_text(const std::filesystem::path& path) {
+  std::ifstream in(path);
+  if (!in) throw ScenarioError(path.string() + ": cannot open the hand script");
+  std::ostringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+}  // namespace
+
+HandScript load_scene_script(const Scene& scene) {
+  const std::string& name = scene.device.script;
+  if (scene.device.kind != DeviceKind::kSimulated || name.empty())
+    throw ScenarioError("scene '" + scene.path + "': device.kind must be simulated, with a script");
+  const std::filesystem::path dir = std::filesystem::path(scene.path).parent_path();
+  const bool is_file = name.size() > 5 && name.compare(name.size() - 5, 5, ".json") == 0;
+  const std::filesystem::path path = is_file ? dir / name : dir / ".." / "scripts" / (name + ".json");
+  try {
+    return hand_script_from_json(read_text(path), path.lexically_normal().string());
+  } catch (const std::invalid_argument& e) {
+    throw ScenarioError(e.what());
+  }
+}
+
+ScenarioResult run_scenario(const Scene& scene, const HandScript& script, const ScenarioOptions& options) {
+  const Clock::time_point wall_start = Clock::now();
+  if (options.trace_path.empty()) throw ScenarioError("run_scenario: options.trace_path is empty");
+  if (!(options.progress_period > 0)) throw ScenarioError("run_scenario: progress_period must be > 0");
+  try {
+    validate_hand_script(script);
+  } catch (const std::invalid_argument& e) {
+    throw ScenarioError(e.what());
+  }
+
+  // The model, the device (its rate and limits are the scene's), the run's data.
+  const RuntimeModel model(scene, options.runtime);
+  SimulatedHandleParams handle = options.handle;
+  handle.rate_hz = scene.device.rate_hz;
+  handle.max_force = scene.device.max_force;
+  handle.max_torque = scene.device.max_torque;
+  SimulatedDevice device(script, handle, "simulated: " + (scene.device.script.empty() ? scene.name : scene.device.script));
+  device.reset(0);
+  auto data = std::make_unique<RuntimeData>(model);
+
+  const double end = script.end_time >= 0 ? script.end_time : script.keys.back().t;
+  const double duration = options.duration >= 0 ? options.duration : end;
+
+  // The trace: its metadata names the scene, the device and the phases.
+  TraceMeta meta;
+  meta.scene = scene.name.empty() ? scene.path : scene.name;
+  meta.device = device.info().name;
+  meta.device_rate_hz = device.info().rate_hz;
+  meta.renders_force = device.info().renders_force;
+  for (const HandPhase& p : script.phases) meta.phases.push_back({p.name, p.start});
+  meta.extra_json = options.extra_json;
+  TraceWriterSettings ts = options.trace;
+  ts.background_thread = true;
+  std::unique_ptr<TraceWriter> writer;
+  try {
+    writer = std::make_unique<TraceWriter>(options.trace_path, meta, ts);
+  } catch (const TraceError& e) {
+    throw ScenarioError(e.what());
+  }
+
+  Recorder rec;
+  rec.model = &model;
+  rec.script = &script;
+  rec.writer = writer.get();
+  RuntimeObserver observer;
+  observer.user = &rec;
+  observer.on_event = on_event;
+  observer.on_sim_step = on_sim_step;
+  observer.on_coupling_step = on_coupling_step;
+  observer.on_haptic_tick = on_haptic_tick;
+
+  // The run on a worker thread; this thread reports progress meanwhile.
+  std::atomic<bool> done{false};
+  std::thread worker([&] {
+    if (options.threaded) {
+      run_threaded(model, &device, duration, nullptr, observer, data.get());
+    } else {
+      const long num_ticks = static_cast<long>(std::floor(duration * scene.device.rate_hz + 1e-9)) + 1;
+      run_lockstep(model, &device, num_ticks, observer, data.get());
+    }
+    done.store(true, std::memory_order_release);
+  });
+  const auto period = std::chrono::duration<double>(options.progress_period);
+  Clock::time_point last = Clock::now();
+  while (!done.load(std::memory_order_acquire)) {
+    std::this_thread::sleep_for(std::min(period, std::chrono::duration<double>(0.01)));
+    if (options.progress && Clock::now() - last >= period) {
+      last = Clock::now();
+      options.progress(rec.time.load(std::memory_order_relaxed));
+    }
+  }
+  worker.join();
+  writer->close();
+  if (options.progress) options.progress(rec.time.load(std::memory_order_relaxed));
+
+  ScenarioResult out;
+  out.stats = data->stats;
+  out.trace = writer->stats();
+  out.trace_path = options.trace_path;
+  out.num_ticks = rec.num_ticks;
+  out.num_sim_steps = rec.num_sim_steps.load();
+  out.run_time = data->stats.run_seconds;
+  out.max_rel_force_dot_ac = rec.max_rel_dot;
+  out.num_orthogonality_checks = rec.num_orthogonality_checks;
+  out.num_offset_steps = rec.num_offset_steps;
+  out.constraint_energy_injected = rec.energy_injected;
+  out.constraint_energy_removed = rec.energy_removed;
+  out.port_energy_max = rec.port_energy_max;
+  out.port_energy_final = rec.port_energy;
+  out.wall_seconds = std::chrono::duration<double>(Clock::now() - wall_start).count();
+  return out;
+}
+
+}  // namespace gauss6
