@@ -28,30 +28,11 @@ size_t Bvh::memory_bytes() const {
          sizeof(Bvh);
 }
 
-Aabb triangle_box(const TriangleMesh& m, int f) {
-  Aabb b;
-  const Vec3 a = m.V.row(m.F(f, 0)).transpose(), c = m.V.row(m.F(f, 1)).transpose(),
-             d = m.V.row(m.F(f, 2)).transpose();
-  b.lo = a.cwiseMin(c).cwiseMin(d);
-  b.hi = a.cwiseMax(c).cwiseMax(d);
-  return b;
-}
-
 Aabb swept_box(const MotionEnclosure& e, const Aabb& body) {
   const IVec3 r = {Interval{body.lo.x(), body.hi.x()}, Interval{body.lo.y(), body.hi.y()},
                    Interval{body.lo.z(), body.hi.z()}};
   const IVec3 w = enclose_point(e, r);
   return {Vec3(w[0].lo, w[1].lo, w[2].lo), Vec3(w[0].hi, w[1].hi, w[2].hi)};
-}
-
-Aabb inflate(const Aabb& b, double margin) {
-  if (margin == 0) return b;
-  Aabb out;
-  for (int i = 0; i < 3; ++i) {
-    out.lo[i] = next_down(b.lo[i] - margin);
-    out.hi[i] = next_up(b.hi[i] + margin);
-  }
-  return out;
 }
 
 namespace {

@@ -41,10 +41,10 @@ bool valid_settings(const CcdSettings& s) {
          std::isfinite(s.min_separation) && std::isfinite(s.distance_tolerance) && s.max_iterations > 0;
 }
 
-IVec3 operator+(const IVec3& a, const IVec3& b) { return {a[0] + b[0], a[1] + b[1], a[2] + b[2]}; }
-IVec3 operator-(const IVec3& a, const IVec3& b) { return {a[0] - b[0], a[1] - b[1], a[2] - b[2]}; }
-IVec3 operator*(double s, const IVec3& a) { return {s * a[0], s * a[1], s * a[2]}; }
-IVec3 hull(const IVec3& a, const IVec3& b) { return {hull(a[0], b[0]), hull(a[1], b[1]), hull(a[2], b[2])}; }
+GAUSS6_ALWAYS_INLINE IVec3 operator+(const IVec3& a, const IVec3& b) { return {a[0] + b[0], a[1] + b[1], a[2] + b[2]}; }
+GAUSS6_ALWAYS_INLINE IVec3 operator-(const IVec3& a, const IVec3& b) { return {a[0] - b[0], a[1] - b[1], a[2] - b[2]}; }
+GAUSS6_ALWAYS_INLINE IVec3 operator*(double s, const IVec3& a) { return {s * a[0], s * a[1], s * a[2]}; }
+GAUSS6_ALWAYS_INLINE IVec3 hull(const IVec3& a, const IVec3& b) { return {hull(a[0], b[0]), hull(a[1], b[1]), hull(a[2], b[2])}; }
 
 // Heuristic weights of the three box dimensions: how much F can change across
 // the full range of each (scene units). They steer the splitting only.
@@ -544,18 +544,18 @@ double rigid_speed(const CcdMotion& m, double rho) {
 // window is kept whole (conservative).
 // ---------------------------------------------------------------------------
 
-IVec3 mul(const IMat3& R, const IVec3& v) {
+GAUSS6_ALWAYS_INLINE IVec3 mul(const IMat3& R, const IVec3& v) {
   IVec3 out;
   for (int i = 0; i < 3; ++i) out[i] = R[3 * i] * v[0] + R[3 * i + 1] * v[1] + R[3 * i + 2] * v[2];
   return out;
 }
-Interval dot(const IVec3& a, const IVec3& b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
-IVec3 cross(const IVec3& a, const IVec3& b) {
+GAUSS6_ALWAYS_INLINE Interval dot(const IVec3& a, const IVec3& b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
+GAUSS6_ALWAYS_INLINE IVec3 cross(const IVec3& a, const IVec3& b) {
   return {a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]};
 }
-IVec3 scale(Interval s, const IVec3& a) { return {s * a[0], s * a[1], s * a[2]}; }
+GAUSS6_ALWAYS_INLINE IVec3 scale(Interval s, const IVec3& a) { return {s * a[0], s * a[1], s * a[2]}; }
 // Upper bound of the Euclidean norm of every vector in the box v.
-double norm_upper(const IVec3& v) {
+GAUSS6_ALWAYS_INLINE double norm_upper(const IVec3& v) {
   double s2 = 0;
   for (const Interval& c : v) {
     const double m = std::max(std::abs(c.lo), std::abs(c.hi));
@@ -566,7 +566,7 @@ double norm_upper(const IVec3& v) {
 
 // Coefficients of Dc(u) v = v + u c1 + u^2 c2.
 struct CayleyCoefficients { IVec3 c1, c2; };
-CayleyCoefficients cayley_coefficients(const CcdMotion& m, const IVec3& v) {
+GAUSS6_ALWAYS_INLINE CayleyCoefficients cayley_coefficients(const CcdMotion& m, const IVec3& v) {
   const IVec3 gxv = cross(m.g, v);
   const Interval gv = dot(m.g, v);
   const IVec3 c2 = scale(2.0 * gv, m.g) - scale(m.g2, v);
@@ -603,7 +603,7 @@ bool positive_on(const Cubic& c, double u0, double u1) {
 // D(u) (x(u) - f).m for the body point with world-oriented offset w = R0 r_B
 // (cw: its Cayley coefficients), a static point f and a static direction m:
 // D (p(u) - f).m + (Dc(u) w).m, with D = 1 + s u^2 and Dc(u) w = w + u c1 + u^2 c2.
-Cubic body_point_along(const CcdMotion& m, const IVec3& w, const CayleyCoefficients& cw, const IVec3& f,
+GAUSS6_ALWAYS_INLINE Cubic body_point_along(const CcdMotion& m, const IVec3& w, const CayleyCoefficients& cw, const IVec3& f,
                        const IVec3& dir) {
   const Interval A = dot(m.p0 - f, dir), E = dot(m.dp, dir);
   return {{A + dot(w, dir), E + dot(cw.c1, dir), m.g2 * A + dot(cw.c2, dir), m.g2 * E}};
@@ -611,7 +611,7 @@ Cubic body_point_along(const CcdMotion& m, const IVec3& w, const CayleyCoefficie
 // D(u) (y - x_f(u)).(C(u) n') for a static point y and the body point f' = R0 f_B
 // with body direction n' = R0 n_B (cn: the Cayley coefficients of n'):
 // (y - p(u)).Dc(u) n' - D f'.n' (C is a rotation: (C f').(C n') = f'.n').
-Cubic static_point_along(const CcdMotion& m, const IVec3& y, const IVec3& fW, const IVec3& nW,
+GAUSS6_ALWAYS_INLINE Cubic static_point_along(const CcdMotion& m, const IVec3& y, const IVec3& fW, const IVec3& nW,
                          const CayleyCoefficients& cn) {
   const IVec3 Y = y - m.p0;
   const Interval F = dot(fW, nW);
@@ -648,14 +648,16 @@ struct UFilter {
     joins_previous[num_conditions] = join && num_conditions > 0;
     cond[num_conditions++] = c;
   }
-  // Adds a body corner w = R0 r_B (world-oriented offset from G) for the axis n.
-  void add_corner(const IVec3& w, const IVec3& n) {
+  // Adds a body corner w = R0 r_B (world-oriented offset from G) for the axis n
+  // (exact doubles: each product is a double times an interval).
+  void add_corner(const IVec3& w, const Vec3& n) {
     const IVec3 gxw = cross(motion->g, w), ggw = cross(motion->g, gxw);
+    const auto along = [&n](const IVec3& x) { return n[0] * x[0] + n[1] * x[1] + n[2] * x[2]; };
     const int j = num_corners++;
-    c0[j] = dot(n, motion->p0 + w);
-    c1[j] = dot(n, motion->dp + 2.0 * gxw);
-    c2[j] = dot(n, gxw);
-    c3[j] = dot(n, ggw);
+    c0[j] = along(motion->p0 + w);
+    c1[j] = along(motion->dp + 2.0 * gxw);
+    c2[j] = along(gxw);
+    c3[j] = along(ggw);
   }
   void set_axis_static(Interval proj, const IVec3& n, double d) {
     const double dn = next_up(d * norm_upper(n));
@@ -734,6 +736,19 @@ void triangle_parameters(const Vec3& c, const Vec3& t0, const Vec3& t1, const Ve
   y = std::isfinite(y) ? std::clamp(y, 0.0, 1.0 - x) : 0.0;
   *a = x;
   *b = y;
+}
+
+// Axis first. The separating axis needs none of the cubics' set-up and often
+// clears the whole window alone: when the filter, holding only the axis so far,
+// excludes [u_begin, u_end], *r is the no-hit answer filtered_bisect() would give
+// and the caller returns at once (the same exclusion, found earlier).
+bool axis_clears(const UFilter& filter, double u_begin, double u_end, CcdResult* r) {
+  if (filter.num_corners == 0 || !filter.excludes(u_begin, u_end)) return false;
+  *r = CcdResult{};
+  r->status = CcdStatus::kOk;
+  r->hit = false;
+  r->u_hit = u_end;
+  return true;
 }
 
 // Runs the bisection on the u-intervals of [u_begin, u_end] that the filter
@@ -880,17 +895,18 @@ void ccd_rigid_vertex_face(const RigidVertexFaceQuery& q, const CcdSettings& s, 
   if (q.vertex_on_body) {
     const Vec3 x_begin = motion_point(m.nominal, q.u_begin, q.vertex);  // heuristic only (the axis)
     const IVec3 w = mul(m.R0, v);
+    const Vec3 axis = x_begin - closest_point_on_triangle(x_begin, q.face[0], q.face[1], q.face[2]);
+    if (axis != Vec3::Zero() && std::isfinite(axis.squaredNorm())) {
+      const IVec3 na = to_interval(axis);
+      filter.add_corner(w, axis);
+      filter.set_axis_static(hull(hull(dot(na, corner[0]), dot(na, corner[1])), dot(na, corner[2])), na, d);
+    }
+    if (axis_clears(filter, q.u_begin, q.u_end, r)) return;  // before the coplanarity cubic's set-up
     const CayleyCoefficients cw = cayley_coefficients(m, w);
     const Cubic P = body_point_along(m, w, cw, f0, n);
     const double dL = next_up(d * norm_upper(n));
     filter.at_most(P, dL);
     filter.at_least(P, dL);
-    const Vec3 axis = x_begin - closest_point_on_triangle(x_begin, q.face[0], q.face[1], q.face[2]);
-    if (axis != Vec3::Zero() && std::isfinite(axis.squaredNorm())) {
-      const IVec3 na = to_interval(axis);
-      filter.add_corner(w, na);
-      filter.set_axis_static(hull(hull(dot(na, corner[0]), dot(na, corner[1])), dot(na, corner[2])), na, d);
-    }
     // Early hit at the face point nearest the vertex's nominal position.
     const auto probe = [&](double u0, double u1, int iterations, CcdResult* res) {
       const Vec3 x = motion_point(m.nominal, u0, q.vertex);
@@ -909,20 +925,21 @@ void ccd_rigid_vertex_face(const RigidVertexFaceQuery& q, const CcdSettings& s, 
     }, probe, q.u_begin, q.u_end, s, ws, r);
     return;
   }
+  Vec3 moved[3];
+  for (int k = 0; k < 3; ++k) moved[k] = motion_point(m.nominal, q.u_begin, q.face[k]);
+  const Vec3 axis = q.vertex - closest_point_on_triangle(q.vertex, moved[0], moved[1], moved[2]);
+  if (axis != Vec3::Zero() && std::isfinite(axis.squaredNorm())) {
+    const IVec3 na = to_interval(axis);
+    for (int k = 0; k < 3; ++k) filter.add_corner(mul(m.R0, corner[k]), axis);
+    filter.set_axis_static(dot(na, v), na, d);
+  }
+  if (axis_clears(filter, q.u_begin, q.u_end, r)) return;  // before the coplanarity cubic's set-up
   const IVec3 nW = mul(m.R0, n), f0W = mul(m.R0, f0);
   const CayleyCoefficients cn = cayley_coefficients(m, nW);
   const Cubic P = static_point_along(m, v, f0W, nW, cn);
   const double dL = next_up(d * norm_upper(n));  // |C R0 n| = |n|
   filter.at_most(P, dL);
   filter.at_least(P, dL);
-  Vec3 moved[3];
-  for (int k = 0; k < 3; ++k) moved[k] = motion_point(m.nominal, q.u_begin, q.face[k]);
-  const Vec3 axis = q.vertex - closest_point_on_triangle(q.vertex, moved[0], moved[1], moved[2]);
-  if (axis != Vec3::Zero() && std::isfinite(axis.squaredNorm())) {
-    const IVec3 na = to_interval(axis);
-    for (int k = 0; k < 3; ++k) filter.add_corner(mul(m.R0, corner[k]), na);
-    filter.set_axis_static(dot(na, v), na, d);
-  }
   // Early hit at the point of the nominally moved face nearest the vertex.
   const auto probe = [&](double u0, double u1, int iterations, CcdResult* res) {
     Vec3 t[3];
@@ -969,6 +986,19 @@ void ccd_rigid_edge_edge(const RigidEdgeEdgeQuery& q, const CcdSettings& s, CcdW
   UFilter filter;
   filter.motion = &m;
   const IVec3 a0W = mul(m.R0, a0), eaW = mul(m.R0, ea), Q = m.p0 - b0;
+  const IVec3 a1W = mul(m.R0, a0 + ea);
+  const Vec3 A0 = motion_point(m.nominal, q.u_begin, q.edge_body[0]);
+  const Vec3 A1 = motion_point(m.nominal, q.u_begin, q.edge_body[1]);
+  double sa = 0, tb = 0;
+  closest_segment_parameters(A0, A1, q.edge_world[0], q.edge_world[1], &sa, &tb);
+  const Vec3 axis = (A0 + sa * (A1 - A0)) - (q.edge_world[0] + tb * (q.edge_world[1] - q.edge_world[0]));
+  if (axis != Vec3::Zero() && std::isfinite(axis.squaredNorm())) {
+    const IVec3 na = to_interval(axis);
+    filter.add_corner(a0W, axis);
+    filter.add_corner(a1W, axis);
+    filter.set_axis_static(hull(dot(na, b0), dot(na, b0 + eb)), na, d);
+  }
+  if (axis_clears(filter, q.u_begin, q.u_end, r)) return;  // before the coplanarity cubic's set-up
   const CayleyCoefficients ca = cayley_coefficients(m, eaW), cb = cayley_coefficients(m, eb);
   const IVec3 T0 = cross(eaW, eb), T1 = cross(ca.c1, eb), T2 = cross(ca.c2, eb), Z = cross(a0W, eaW);
   const Cubic P{{dot(Q, T0) + dot(Z, eb), (dot(Q, T1) + dot(m.dp, T0)) - dot(Z, cb.c1),
@@ -979,18 +1009,6 @@ void ccd_rigid_edge_edge(const RigidEdgeEdgeQuery& q, const CcdSettings& s, CcdW
   const double dL = next_up(d * next_up(norm_upper(T0) + turn));
   filter.at_most(P, dL);
   filter.at_least(P, dL);
-  const IVec3 a1W = mul(m.R0, a0 + ea);
-  const Vec3 A0 = motion_point(m.nominal, q.u_begin, q.edge_body[0]);
-  const Vec3 A1 = motion_point(m.nominal, q.u_begin, q.edge_body[1]);
-  double sa = 0, tb = 0;
-  closest_segment_parameters(A0, A1, q.edge_world[0], q.edge_world[1], &sa, &tb);
-  const Vec3 axis = (A0 + sa * (A1 - A0)) - (q.edge_world[0] + tb * (q.edge_world[1] - q.edge_world[0]));
-  if (axis != Vec3::Zero() && std::isfinite(axis.squaredNorm())) {
-    const IVec3 na = to_interval(axis);
-    filter.add_corner(a0W, na);
-    filter.add_corner(a1W, na);
-    filter.set_axis_static(hull(dot(na, b0), dot(na, b0 + eb)), na, d);
-  }
   // End slabs. Every point of a segment lies between the planes through its
   // ends normal to it, so segments within d need the other segment to reach
   // within d of that slab: both ends of A beyond b0 (or b1) along eb by more

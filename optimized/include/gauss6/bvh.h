@@ -60,12 +60,26 @@ struct Bvh {
 // axis of their bounds, leaves of at most leaf_size triangles. Load time.
 Bvh build_bvh(const TriangleMesh& mesh, int leaf_size = 4);
 
-// Exact box of triangle f of the mesh (its own frame).
-Aabb triangle_box(const TriangleMesh& mesh, int f);
+// Exact box of triangle f of the mesh (its own frame). Inline: the traversal
+// calls it for every leaf triangle pair.
+inline Aabb triangle_box(const TriangleMesh& mesh, int f) {
+  const Vec3 a = mesh.V.row(mesh.F(f, 0)).transpose(), c = mesh.V.row(mesh.F(f, 1)).transpose(),
+             d = mesh.V.row(mesh.F(f, 2)).transpose();
+  return {a.cwiseMin(c).cwiseMin(d), a.cwiseMax(c).cwiseMax(d)};
+}
 // Conservative world box of every p(u) + R(u) r_B, u in e.u, r_B in body_box.
 Aabb swept_box(const MotionEnclosure& e, const Aabb& body_box);
-// box grown by margin on every side, rounded outward.
-Aabb inflate(const Aabb& box, double margin);
+// box grown by margin on every side, rounded outward. Inline: the traversal
+// calls it for every node pair.
+inline Aabb inflate(const Aabb& box, double margin) {
+  if (margin == 0) return box;
+  Aabb out;
+  for (int i = 0; i < 3; ++i) {
+    out.lo[i] = next_down(box.lo[i] - margin);
+    out.hi[i] = next_up(box.hi[i] + margin);
+  }
+  return out;
+}
 
 // Fixed-capacity stack of node pairs for the simultaneous descent.
 struct BvhStack {
@@ -86,7 +100,7 @@ enum class TraversalStatus { kDone = 0, kStopped, kStackFull };
 // god_face_box(int face) -> Aabb world for face `face` of god_mesh (so a caller
 // can cache them: see SweptBoxCache).
 template <class GodNodeBox, class GodFaceBox, class Visit>
-TraversalStatus for_each_candidate_pair_indexed(const TriangleMesh& god_mesh, const Bvh& god,
+TraversalStatus for_each_candidate_pair_indexed([[maybe_unused]] const TriangleMesh& god_mesh, const Bvh& god,
                                                 const TriangleMesh& obs_mesh, const Bvh& obs,
                                                 const GodNodeBox& god_node_box, const GodFaceBox& god_face_box,
                                                 double margin, BvhStack* stack, Visit&& visit, int* num_node_pairs) {
