@@ -99,21 +99,32 @@ def test_lockstep_runs_repeat(tmp_path):
 
 
 def test_exact_pose_check_finds_intersections_and_agrees_with_the_reference():
-    """The filtered check gives the reference's answer on free, touching-close and intersecting poses."""
+    """The scene-level check sums the reference's exact count over the obstacles: it finds the
+    intersecting poses and gives, pose by pose, the count of the reference's MeshPair binding."""
     up = [0.7071067811865476, 0.7071067811865476, 0.0, 0.0]
     poses = np.array([
         [0, 0, 0.075, *up],          # upright peg 5 mm into the top: intersects
         [0, 0, 0.0801, *up],         # 0.1 mm above the top: free
-        [0, 0, 0.08 + 2e-6, *up],    # 2 um above the top: free (the filter's margin is 1 nm)
+        [0, 0, 0.08 + 2e-6, *up],    # 2 um above the top: free
         [0, -0.05, 0, 1, 0, 0, 0],   # on the hole's axis, half inside: free (0.17 mm clearance)
         [0, -0.05, 5e-4, 1, 0, 0, 0],  # 0.5 mm off the axis: cuts the hole's wall
     ])
     scene = str(reproduce.SCENES["peg"])
-    fast = runtime.count_intersecting_pairs(scene, poses)
-    exact = runtime.count_intersecting_pairs(scene, poses, filter=False)
-    assert list(fast["counts"]) == list(exact["counts"])
-    assert [c > 0 for c in exact["counts"]] == [True, False, False, False, True]
-    assert fast["num_exact"] == 2  # only the intersecting poses needed the reference
+    result = runtime.count_intersecting_pairs(scene, poses)
+    assert sorted(result) == ["counts", "seconds"]
+    assert result["seconds"] >= 0
+    assert [c > 0 for c in result["counts"]] == [True, False, False, False, True]
+    ccd = pytest.importorskip("gauss6._gauss6").ccd
+    geometry = runtime.scene_geometry(scene)
+    pairs = [ccd.MeshPair(V, F, geometry["god_V"], geometry["god_F"]) for _, V, F in geometry["obstacles"]]
+    for pose, count in zip(poses, result["counts"]):
+        assert count == sum(pair.count_intersecting_pairs(pose[:3], pose[3:]) for pair in pairs)
+
+
+def test_exact_pose_check_refuses_a_zero_quaternion():
+    poses = np.array([[0, 0, 0.1, 0, 0, 0, 0]], dtype=float)
+    with pytest.raises(ValueError, match="zero quaternion"):
+        runtime.count_intersecting_pairs(str(reproduce.SCENES["peg"]), poses)
 
 
 def _fake_trace(xs_p, F, flags, t):

@@ -1,26 +1,34 @@
 // Exact mesh-level queries of the reference: first contact of a moving mesh
 // against a static one under the Cayley motion (conservative box culling, then
 // the exact primitives of ccd_exact.cpp), exact triangle/triangle intersection
-// count and exact separation distance at a pose (CGAL, Gmpq coordinates).
-// See gauss6/reference/ccd.h.
+// count and exact separation distance at a pose. The posed-mesh queries cull
+// pairs with CGAL's box_intersection_d on conservative boxes and decide each
+// pair with CGAL's filtered predicates: interval arithmetic first, Gmpq only
+// when the intervals cannot decide. See gauss6/reference/ccd.h.
 #include "gauss6/reference/ccd.h"
 
 #include <algorithm>
 #include <cmath>
 #include <numeric>
+#include <optional>
 #include <stdexcept>
 
+#include <CGAL/Bbox_3.h>
+#include <CGAL/Filtered_predicate.h>
 #include <CGAL/Gmpq.h>
+#include <CGAL/Interval_nt.h>
 #include <CGAL/Simple_cartesian.h>
-#include <CGAL/squared_distance_3.h>
+#include <CGAL/box_intersection_d.h>
 #include <CGAL/intersections.h>
+#include <CGAL/squared_distance_3.h>
 
 namespace gauss6::reference {
 namespace {
 
-using Kernel = CGAL::Simple_cartesian<CGAL::Gmpq>;
-using Point3 = Kernel::Point_3;
-using Triangle3 = Kernel::Triangle_3;
+// Exact kernel (the answers) and interval kernel (the filters' first stage;
+// Interval_nt_advanced needs upward rounding: CGAL::Protect_FPU_rounding).
+using ExactKernel = CGAL::Simple_cartesian<CGAL::Gmpq>;
+using IntervalKernel = CGAL::Simple_cartesian<CGAL::Interval_nt_advanced>;
 
 // Relative inflation of boxes computed in doubles from exact data. Their
 // rounding errors are below 1e-14 relative to the magnitudes involved (a few
@@ -41,10 +49,6 @@ void grow(Aabb* b, const Aabb& o) {
 
 bool overlap(const Aabb& a, const Aabb& b) {
   return (a.lo.array() <= b.hi.array()).all() && (b.lo.array() <= a.hi.array()).all();
-}
-
-Aabb inflated(const Aabb& b, double margin) {
-  return {b.lo - Vec3::Constant(margin), b.hi + Vec3::Constant(margin)};
 }
 
 // Top-down tree, median split on the longest axis of the centres.
@@ -126,38 +130,284 @@ void check_mesh(const TriangleMesh& m, const char* name) {
   if (!m.V.allFinite()) throw std::invalid_argument(std::string(name) + " mesh: non-finite vertex");
 }
 
-// Exact positions of the body's vertices at pose X, and conservative double
-// boxes around them (mpq_get_d truncates: one step outward covers the value).
-struct PosedBody {
-  std::vector<Point3> exact;
-  std::vector<Aabb> box;
+// The body's vertices at pose X, in three forms: doubles with a proven error
+// bound (for the culling boxes), interval enclosures of the exact positions
+// (the filtered predicates' first stage) and the exact Gmpq positions (their
+// second stage). All are p + R(q) r with R(q) the rational rotation of
+// METHOD.md section 1; the exact one is transform_point_exact's value. The
+// enclosures and exact values are computed on demand, for the vertices of
+// candidate pairs only.
+class PosedBody {
+ public:
+  PosedBody(const TriangleMesh& body, const Pose& X)
+      : body_(body), X_(X), approx_(body.V.rows()), state_(body.V.rows(), kUnknown), exact_(body.V.rows()) {
+    // The exact form throws on a zero quaternion or a non-finite coordinate:
+    // check those up front so that every pose is refused the same way.
+    if (X.q.w == 0 && X.q.x == 0 && X.q.y == 0 && X.q.z == 0)
+      throw std::domain_error("exact pose: zero quaternion");
+    if (!(std::isfinite(X.q.w) && std::isfinite(X.q.x) && std::isfinite(X.q.y) && std::isfinite(X.q.z) &&
+          X.p.allFinite()))
+      throw std::domain_error("non-finite coordinate in an exact query");
+    // Magnitude bounds under which neither the doubles nor the intervals
+    // overflow or divide by (an interval holding) zero: the largest |q_i| in
+    // [2^-250, 2^250], |p_i| and |r_i| <= 2^250 (r checked per vertex).
+    // Outside them (never for a metre-scale scene) vertices are handled exactly.
+    const double qmax = std::max({std::abs(X.q.w), std::abs(X.q.x), std::abs(X.q.y), std::abs(X.q.z)});
+    in_range_ = qmax >= kSmall && qmax <= kBig && X.p.cwiseAbs().maxCoeff() <= kBig;
+    if (in_range_) {
+      const double w = X.q.w, x = X.q.x, y = X.q.y, z = X.q.z, n = X.q.norm2();
+      R_ << w * w + x * x - y * y - z * z, 2 * (x * y - w * z), 2 * (x * z + w * y), 2 * (x * y + w * z),
+          w * w - x * x + y * y - z * z, 2 * (y * z - w * x), 2 * (x * z - w * y), 2 * (y * z + w * x),
+          w * w - x * x - y * y + z * z;
+      R_ /= n;
+      CGAL::Protect_FPU_rounding<true> upward;  // Interval_nt_advanced needs it
+      using I = IntervalKernel::FT;
+      const I wi(w), xi(x), yi(y), zi(z);
+      const I n2 = CGAL::square(wi) + CGAL::square(xi) + CGAL::square(yi) + CGAL::square(zi);
+      RI_[0][0] = (wi * wi + xi * xi - yi * yi - zi * zi) / n2;
+      RI_[0][1] = 2 * (xi * yi - wi * zi) / n2;
+      RI_[0][2] = 2 * (xi * zi + wi * yi) / n2;
+      RI_[1][0] = 2 * (xi * yi + wi * zi) / n2;
+      RI_[1][1] = (wi * wi - xi * xi + yi * yi - zi * zi) / n2;
+      RI_[1][2] = 2 * (yi * zi - wi * xi) / n2;
+      RI_[2][0] = 2 * (xi * zi - wi * yi) / n2;
+      RI_[2][1] = 2 * (yi * zi + wi * xi) / n2;
+      RI_[2][2] = (wi * wi - xi * xi - yi * yi + zi * zi) / n2;
+    }
+  }
+
+  // Conservative double box of vertex v: it contains the exact position. In
+  // range: p + R r in doubles (R rounded from q), grown by kBoxInflation times
+  // the magnitudes involved, far above the few dozen roundings of 2^-53 each
+  // (and by 1e-300 against underflow). Otherwise: from the exact value
+  // (mpq_get_d truncates: one step outward covers it).
+  CGAL::Bbox_3 box(int v) const {
+    const Vec3 r = vertex(body_, v);
+    if (in_range_ && r.cwiseAbs().maxCoeff() <= kBig) {
+      const Vec3 x = X_.p + R_ * r;
+      const double e = kBoxInflation * (X_.p.cwiseAbs().maxCoeff() + r.cwiseAbs().sum()) + 1e-300;
+      return {x.x() - e, x.y() - e, x.z() - e, x.x() + e, x.y() + e, x.z() + e};
+    }
+    const ExactKernel::Point_3& p = exact(v);
+    double lo[3], hi[3];
+    for (int c = 0; c < 3; ++c) {
+      const double d = mpq_get_d(p[c].mpq());
+      lo[c] = std::nextafter(d, -HUGE_VAL);
+      hi[c] = std::nextafter(d, HUGE_VAL);
+    }
+    return {lo[0], lo[1], lo[2], hi[0], hi[1], hi[2]};
+  }
+
+  // Conservative world box of the body-frame box b at the pose (every point
+  // of b lands in it), or nullopt out of range. Centre c, half-sides h: the
+  // points land within |R| h of p + R c, grown as in box(v).
+  std::optional<CGAL::Bbox_3> box(const Aabb& b) const {
+    if (!in_range_ || !(b.lo.cwiseAbs().maxCoeff() <= kBig && b.hi.cwiseAbs().maxCoeff() <= kBig)) return std::nullopt;
+    const Vec3 c = 0.5 * (b.lo + b.hi), h = 0.5 * (b.hi - b.lo);
+    const Vec3 x = X_.p + R_ * c;
+    const Vec3 r = R_.cwiseAbs() * h + Vec3::Constant(kBoxInflation * (X_.p.cwiseAbs().maxCoeff() + c.cwiseAbs().sum() +
+                                                                       h.cwiseAbs().sum()) + 1e-300);
+    return CGAL::Bbox_3(x.x() - r.x(), x.y() - r.y(), x.z() - r.z(), x.x() + r.x(), x.y() + r.y(), x.z() + r.z());
+  }
+
+  // Interval enclosure of vertex v (interval arithmetic on the doubles of the
+  // pose and of the mesh encloses the exact rational value); nullptr when the
+  // magnitudes are out of range (v is then decided exactly).
+  const IntervalKernel::Point_3* approx(int v) const {
+    if (state_[v] == kUnknown) {
+      state_[v] = kNone;
+      const Vec3 r = vertex(body_, v);
+      if (in_range_ && r.cwiseAbs().maxCoeff() <= kBig) {
+        CGAL::Protect_FPU_rounding<true> upward;
+        using I = IntervalKernel::FT;
+        I c[3];
+        bool finite = true;
+        for (int a = 0; a < 3; ++a) {
+          c[a] = I(X_.p[a]) + (RI_[a][0] * I(r[0]) + RI_[a][1] * I(r[1]) + RI_[a][2] * I(r[2]));
+          finite = finite && std::isfinite(c[a].inf()) && std::isfinite(c[a].sup());
+        }
+        if (finite) {
+          approx_[v] = IntervalKernel::Point_3(c[0], c[1], c[2]);
+          state_[v] = kEnclosed;
+        }
+      }
+    }
+    return state_[v] == kEnclosed ? &approx_[v] : nullptr;
+  }
+
+  const ExactKernel::Point_3& exact(int v) const {
+    if (!exact_[v]) {
+      const ExactPoint x = transform_point_exact(X_, vertex(body_, v));
+      exact_[v].emplace(CGAL::Gmpq(x[0].get_mpq_t()), CGAL::Gmpq(x[1].get_mpq_t()), CGAL::Gmpq(x[2].get_mpq_t()));
+    }
+    return *exact_[v];
+  }
+
+ private:
+  static constexpr double kBig = 0x1p250, kSmall = 0x1p-250;
+  enum : uint8_t { kUnknown, kEnclosed, kNone };
+
+  const TriangleMesh& body_;
+  const Pose& X_;
+  bool in_range_ = false;
+  Mat3 R_;                      // R(q) rounded (doubles)
+  IntervalKernel::FT RI_[3][3];  // R(q) enclosed (intervals)
+  mutable std::vector<IntervalKernel::Point_3> approx_;
+  mutable std::vector<uint8_t> state_;
+  mutable std::vector<std::optional<ExactKernel::Point_3>> exact_;
 };
 
-PosedBody pose_body(const TriangleMesh& body, const Pose& X) {
-  PosedBody posed;
-  posed.exact.reserve(body.V.rows());
-  posed.box.reserve(body.V.rows());
-  for (int v = 0; v < body.V.rows(); ++v) {
-    const ExactPoint x = transform_point_exact(X, vertex(body, v));
-    Aabb b;
-    for (int c = 0; c < 3; ++c) {
-      const double d = mpq_get_d(x[c].get_mpq_t());
-      b.lo[c] = std::nextafter(d, -HUGE_VAL);
-      b.hi[c] = std::nextafter(d, HUGE_VAL);
+// A triangle of the posed body or of the obstacle, converted on demand to the
+// interval kernel (first stage) or the exact kernel (second stage) by the
+// converters of CGAL::Filtered_predicate.
+struct BodyFace {
+  const PosedBody* body;
+  const TriangleMesh* mesh;
+  int f;
+};
+struct ObstacleFace {
+  const TriangleMesh* mesh;
+  int f;
+};
+
+struct ToInterval {
+  IntervalKernel::Triangle_3 operator()(const BodyFace& t) const {
+    const IntervalKernel::Point_3* p[3];
+    for (int k = 0; k < 3; ++k) {
+      p[k] = t.body->approx(t.mesh->F(t.f, k));
+      if (!p[k]) throw CGAL::Uncertain_conversion_exception("no interval enclosure");  // decided exactly
     }
-    posed.exact.emplace_back(CGAL::Gmpq(x[0].get_mpq_t()), CGAL::Gmpq(x[1].get_mpq_t()),
-                             CGAL::Gmpq(x[2].get_mpq_t()));
-    posed.box.push_back(b);
+    return {*p[0], *p[1], *p[2]};
   }
-  return posed;
+  IntervalKernel::Triangle_3 operator()(const ObstacleFace& t) const {
+    auto p = [&](int k) {
+      const Vec3 x = vertex(*t.mesh, t.mesh->F(t.f, k));
+      return IntervalKernel::Point_3(x.x(), x.y(), x.z());  // doubles: point intervals
+    };
+    return {p(0), p(1), p(2)};
+  }
+};
+
+struct ToExact {
+  ExactKernel::Triangle_3 operator()(const BodyFace& t) const {
+    return {t.body->exact(t.mesh->F(t.f, 0)), t.body->exact(t.mesh->F(t.f, 1)), t.body->exact(t.mesh->F(t.f, 2))};
+  }
+  ExactKernel::Triangle_3 operator()(const ObstacleFace& t) const {
+    auto p = [&](int k) {
+      const Vec3 x = vertex(*t.mesh, t.mesh->F(t.f, k));
+      return ExactKernel::Point_3(x.x(), x.y(), x.z());  // doubles are exact in Gmpq
+    };
+    return {p(0), p(1), p(2)};
+  }
+};
+
+// Closed triangle/triangle intersection: interval arithmetic first, exact
+// Gmpq when the interval signs are uncertain (CGAL's filtered predicate).
+using DoIntersect = CGAL::Filtered_predicate<ExactKernel::Do_intersect_3, IntervalKernel::Do_intersect_3, ToExact,
+                                             ToInterval>;
+
+using FaceBox = CGAL::Box_intersection_d::Box_with_info_d<double, 3, int32_t>;
+
+CGAL::Bbox_3 obstacle_face_bbox(const TriangleMesh& m, int f) {
+  CGAL::Bbox_3 b;
+  for (int k = 0; k < 3; ++k) {
+    const Vec3 x = vertex(m, m.F(f, k));
+    b += CGAL::Bbox_3(x.x(), x.y(), x.z(), x.x(), x.y(), x.z());  // exact
+  }
+  return b;
 }
 
-Triangle3 obstacle_triangle(const TriangleMesh& m, int f) {
-  auto p = [&](int k) {
-    const Vec3 x = vertex(m, m.F(f, k));
-    return Point3(x.x(), x.y(), x.z());  // doubles are exact in Gmpq
+// CGAL's box_intersection_d on two box sets, through pointers (the algorithm
+// reorders its input; pointers are cheaper to move than boxes). Calls
+// visit(info of a, info of b) once per overlapping (closed) pair.
+template <class Visit>
+void intersect_boxes(const std::vector<FaceBox>& a, const std::vector<FaceBox>& b, Visit&& visit) {
+  std::vector<const FaceBox*> pa(a.size()), pb(b.size());
+  for (size_t i = 0; i < a.size(); ++i) pa[i] = &a[i];
+  for (size_t i = 0; i < b.size(); ++i) pb[i] = &b[i];
+  CGAL::box_intersection_d(pa.begin(), pa.end(), pb.begin(), pb.end(),
+                           [&](const FaceBox* x, const FaceBox* y) { visit(x->info(), y->info()); });
+}
+
+CGAL::Bbox_3 to_bbox(const Aabb& b) { return {b.lo.x(), b.lo.y(), b.lo.z(), b.hi.x(), b.hi.y(), b.hi.z()}; }
+
+// b grown by margin >= 0, rounded outward: it holds the exact grown box.
+CGAL::Bbox_3 grown(const CGAL::Bbox_3& b, double margin) {
+  if (margin == 0) return b;
+  return {std::nextafter(b.xmin() - margin, -HUGE_VAL), std::nextafter(b.ymin() - margin, -HUGE_VAL),
+          std::nextafter(b.zmin() - margin, -HUGE_VAL), std::nextafter(b.xmax() + margin, HUGE_VAL),
+          std::nextafter(b.ymax() + margin, HUGE_VAL),  std::nextafter(b.zmax() + margin, HUGE_VAL)};
+}
+
+// Calls visit(body face, obstacle face) for every pair whose boxes, the body's
+// grown by `margin` (>= 0), overlap (closed boxes). Every body box contains its
+// posed triangle's exact position, so no pair within `margin` (in each
+// coordinate) is missed. Narrowing, each step keeping every overlapping pair:
+// (1) the region where the posed body's box and the obstacle's overlap;
+// (2) CGAL's box_intersection_d on the face groups (ExactMeshPair::kFaceGroup
+// nearby faces each) that reach the region; (3) box_intersection_d on the
+// faces of the groups that met.
+template <class Visit>
+void candidate_pairs(const ExactMeshPair& mp, const PosedBody& posed, double margin, Visit&& visit) {
+  constexpr int kGroup = ExactMeshPair::kFaceGroup;
+  const TriangleMesh& body = mp.body;
+  const TriangleMesh& obs = mp.obstacle;
+  if (mp.obstacle_faces.box.empty() || mp.body_faces.box.empty()) return;
+  auto face_bbox = [&](int f) {
+    return grown(posed.box(body.F(f, 0)) + posed.box(body.F(f, 1)) + posed.box(body.F(f, 2)), margin);
   };
-  return Triangle3(p(0), p(1), p(2));
+  // Posed group boxes (from the body-frame group boxes, or from the faces when
+  // the pose is out of the doubles' range).
+  const std::vector<int32_t>& body_order = mp.body_faces.item;
+  std::vector<CGAL::Bbox_3> body_group_boxes(mp.body_face_groups.size());
+  CGAL::Bbox_3 all;
+  for (size_t g = 0; g < body_group_boxes.size(); ++g) {
+    if (const auto b = posed.box(mp.body_face_groups[g])) {
+      body_group_boxes[g] = grown(*b, margin);
+    } else {
+      for (size_t i = g * kGroup; i < std::min(body_order.size(), (g + 1) * kGroup); ++i)
+        body_group_boxes[g] += face_bbox(body_order[i]);
+    }
+    all += body_group_boxes[g];
+  }
+  // (1) The region where pairs can meet: the intersection of the two boxes.
+  const CGAL::Bbox_3 obstacle_all = to_bbox(mp.obstacle_faces.box[0]);
+  if (!CGAL::do_overlap(all, obstacle_all)) return;
+  const CGAL::Bbox_3 region(std::max(all.xmin(), obstacle_all.xmin()), std::max(all.ymin(), obstacle_all.ymin()),
+                            std::max(all.zmin(), obstacle_all.zmin()), std::min(all.xmax(), obstacle_all.xmax()),
+                            std::min(all.ymax(), obstacle_all.ymax()), std::min(all.zmax(), obstacle_all.zmax()));
+  // (2) Groups that reach the region, then the pairs of groups that meet.
+  std::vector<FaceBox> body_groups, obstacle_groups;
+  for (size_t g = 0; g < body_group_boxes.size(); ++g)
+    if (CGAL::do_overlap(body_group_boxes[g], region)) body_groups.emplace_back(body_group_boxes[g], int32_t(g));
+  for (size_t g = 0; g < mp.obstacle_face_groups.size(); ++g) {
+    const CGAL::Bbox_3 b = to_bbox(mp.obstacle_face_groups[g]);
+    if (CGAL::do_overlap(b, region)) obstacle_groups.emplace_back(b, int32_t(g));
+  }
+  if (body_groups.empty() || obstacle_groups.empty()) return;
+  std::vector<int32_t> body_met, obstacle_met;
+  intersect_boxes(body_groups, obstacle_groups, [&](int32_t g, int32_t og) {
+    body_met.push_back(g);
+    obstacle_met.push_back(og);
+  });
+  for (auto* met : {&body_met, &obstacle_met}) {
+    std::sort(met->begin(), met->end());
+    met->erase(std::unique(met->begin(), met->end()), met->end());
+  }
+  // (3) The faces of the groups that met, within the region.
+  std::vector<FaceBox> body_faces, obstacle_faces;
+  for (const int32_t g : body_met)
+    for (size_t i = size_t(g) * kGroup; i < std::min(body_order.size(), size_t(g + 1) * kGroup); ++i) {
+      const CGAL::Bbox_3 b = face_bbox(body_order[i]);
+      if (CGAL::do_overlap(b, region)) body_faces.emplace_back(b, body_order[i]);
+    }
+  const std::vector<int32_t>& obstacle_order = mp.obstacle_faces.item;
+  for (const int32_t g : obstacle_met)
+    for (size_t i = size_t(g) * kGroup; i < std::min(obstacle_order.size(), size_t(g + 1) * kGroup); ++i) {
+      const CGAL::Bbox_3 b = obstacle_face_bbox(obs, obstacle_order[i]);
+      if (CGAL::do_overlap(b, region)) obstacle_faces.emplace_back(b, obstacle_order[i]);
+    }
+  intersect_boxes(body_faces, obstacle_faces, visit);
 }
 
 Aabb face_box(const std::vector<Aabb>& vertex_boxes, const TriangleMesh& m, int f) {
@@ -211,6 +461,17 @@ ExactMeshPair make_exact_mesh_pair(const TriangleMesh& body_B, const TriangleMes
   mp.obstacle_vertices = build_tree(vb);
   mp.obstacle_faces = build_tree(fb);
   mp.obstacle_edge_tree = build_tree(eb);
+  std::vector<Aabb> body_vb(body_B.V.rows()), body_fb(body_B.F.rows());
+  for (int v = 0; v < body_B.V.rows(); ++v) body_vb[v] = point_box(vertex(body_B, v));
+  for (int f = 0; f < body_B.F.rows(); ++f) body_fb[f] = face_box(body_vb, body_B, f);
+  mp.body_faces = build_tree(body_fb);
+  auto groups = [](const AabbTree& t, const std::vector<Aabb>& face_boxes) {
+    std::vector<Aabb> g((t.item.size() + ExactMeshPair::kFaceGroup - 1) / ExactMeshPair::kFaceGroup);
+    for (size_t i = 0; i < t.item.size(); ++i) grow(&g[i / ExactMeshPair::kFaceGroup], face_boxes[t.item[i]]);
+    return g;
+  };
+  mp.body_face_groups = groups(mp.body_faces, body_fb);
+  mp.obstacle_face_groups = groups(mp.obstacle_faces, fb);
   for (int v = 0; v < body_B.V.rows(); ++v) mp.body_radius = std::max(mp.body_radius, vertex(body_B, v).norm());
   mp.body_radius = std::nextafter(mp.body_radius, HUGE_VAL);
   return mp;
@@ -288,73 +549,79 @@ MeshContact mesh_first_contact(const ExactMeshPair& mp, const Pose& X0, const Po
 }
 
 int64_t count_intersecting_pairs(const ExactMeshPair& mp, const Pose& X) {
-  const PosedBody posed = pose_body(mp.body, X);
+  const PosedBody posed(mp.body, X);
+  const DoIntersect do_intersect;
   int64_t count = 0;
-  for (int f = 0; f < mp.body.F.rows(); ++f) {
-    const Triangle3 t(posed.exact[mp.body.F(f, 0)], posed.exact[mp.body.F(f, 1)], posed.exact[mp.body.F(f, 2)]);
-    query_tree(mp.obstacle_faces, face_box(posed.box, mp.body, f), [&](int of) {
-      if (CGAL::do_intersect(t, obstacle_triangle(mp.obstacle, of))) ++count;
-    });
-  }
+  candidate_pairs(mp, posed, 0.0, [&](int32_t f, int32_t of) {
+    if (do_intersect(BodyFace{&posed, &mp.body, f}, ObstacleFace{&mp.obstacle, of})) ++count;
+  });
   return count;
 }
 
 ExactSeparation separation_distance(const ExactMeshPair& mp, const Pose& X, double max_distance) {
   if (!(max_distance >= 0)) throw std::invalid_argument("separation_distance: max_distance must be >= 0");
-  const PosedBody posed = pose_body(mp.body, X);
+  const PosedBody posed(mp.body, X);
   const TriangleMesh& body = mp.body;
-  const TriangleMesh& obs = mp.obstacle;
-  // Pass 1 (doubles, conservative): every pair whose boxes are within
-  // max_distance, with a lower bound of its distance (box to box, rounded
-  // down) and an upper bound (closest corner pair, rounded up).
+  // Pass 1 (boxes): every pair whose boxes are within max_distance, with a
+  // lower bound of its squared distance: the squared gap between the boxes
+  // (the body's contain the exact triangle), rounded down by a relative 1e-12,
+  // far above the few roundings of 2^-53 in it.
   struct Candidate {
     int32_t f, of;
-    double lower;
+    double lower;  // <= the pair's exact squared distance
   };
   std::vector<Candidate> candidates;
-  double best_upper = HUGE_VAL;
-  const double margin = max_distance * (1 + 1e-12);
-  for (int f = 0; f < body.F.rows(); ++f) {
-    const Aabb fb = face_box(posed.box, body, f);
-    query_tree(mp.obstacle_faces, inflated(fb, margin), [&](int of) {
-      Aabb obox;
-      for (int k = 0; k < 3; ++k) grow(&obox, point_box(vertex(obs, obs.F(of, k))));
-      double gap2 = 0;
-      for (int c = 0; c < 3; ++c) {
-        const double g = std::max({0.0, fb.lo[c] - obox.hi[c], obox.lo[c] - fb.hi[c]});
-        gap2 += g * g;
-      }
-      const double lower = std::sqrt(gap2) * (1 - 1e-12);
-      double corner = HUGE_VAL;
-      for (int i = 0; i < 3; ++i)
-        for (int k = 0; k < 3; ++k) {
-          const Aabb& vb = posed.box[body.F(f, i)];
-          const Vec3 x = 0.5 * (vb.lo + vb.hi);
-          corner = std::min(corner, (x - vertex(obs, obs.F(of, k))).norm());
-        }
-      best_upper = std::min(best_upper, corner * (1 + 1e-9) + 1e-300);
-      candidates.push_back({int32_t(f), int32_t(of), lower});
-    });
-  }
-  // Pass 2 (exact): pairs by increasing lower bound, while they can still win.
+  candidate_pairs(mp, posed, max_distance, [&](int32_t f, int32_t of) {
+    const CGAL::Bbox_3 a = posed.box(body.F(f, 0)) + posed.box(body.F(f, 1)) + posed.box(body.F(f, 2));
+    const CGAL::Bbox_3 b = obstacle_face_bbox(mp.obstacle, of);
+    double gap2 = 0;
+    for (int c = 0; c < 3; ++c) {
+      const double g = std::max({0.0, a.min(c) - b.max(c), b.min(c) - a.max(c)});
+      gap2 += g * g;
+    }
+    candidates.push_back({f, of, gap2 * (1 - 1e-12)});
+  });
   std::sort(candidates.begin(), candidates.end(),
             [](const Candidate& a, const Candidate& b) { return a.lower < b.lower; });
-  const mpq_class max2 = mpq_class(max_distance) * mpq_class(max_distance);
+  // Pass 2 (intervals): by increasing box bound, while a pair can still be the
+  // minimum, the enclosure [lower, upper] of its squared distance (CGAL's
+  // triangle/triangle squared_distance in interval arithmetic; the box bound
+  // when the interval signs are uncertain or a vertex has no enclosure).
+  double best_upper = HUGE_VAL;  // >= the minimum squared distance
+  std::vector<Candidate> close;
+  const ToInterval to_interval;
+  for (const Candidate& c : candidates) {
+    if (c.lower > best_upper) break;
+    Candidate refined = c;
+    CGAL::Protect_FPU_rounding<true> upward;
+    try {
+      const IntervalKernel::FT d2 = CGAL::squared_distance(to_interval(BodyFace{&posed, &mp.body, c.f}),
+                                                           to_interval(ObstacleFace{&mp.obstacle, c.of}));
+      if (std::isfinite(d2.inf()) && std::isfinite(d2.sup())) {
+        refined.lower = std::max(c.lower, d2.inf());
+        best_upper = std::min(best_upper, d2.sup());
+      }
+    } catch (CGAL::Uncertain_conversion_exception&) {
+    }
+    close.push_back(refined);
+  }
+  // Pass 3 (exact): by increasing lower bound, while a pair can still win.
+  std::sort(close.begin(), close.end(), [](const Candidate& a, const Candidate& b) { return a.lower < b.lower; });
+  const ToExact to_exact;
   ExactSeparation out;
   CGAL::Gmpq best;
-  double bound = best_upper;
-  for (const Candidate& c : candidates) {
-    if (c.lower > bound) break;
-    const Triangle3 t(posed.exact[body.F(c.f, 0)], posed.exact[body.F(c.f, 1)], posed.exact[body.F(c.f, 2)]);
-    const CGAL::Gmpq d2 = CGAL::squared_distance(t, obstacle_triangle(obs, c.of));
+  for (const Candidate& c : close) {
+    if (c.lower > best_upper || (out.within && CGAL::Gmpq(c.lower) > best)) break;
+    const CGAL::Gmpq d2 =
+        CGAL::squared_distance(to_exact(BodyFace{&posed, &mp.body, c.f}), to_exact(ObstacleFace{&mp.obstacle, c.of}));
     if (!out.within || d2 < best) {
       out.within = true;
       best = d2;
       out.body_face = c.f;
       out.obstacle_face = c.of;
-      bound = std::min(bound, std::nextafter(std::sqrt(std::nextafter(CGAL::to_double(d2), HUGE_VAL)), HUGE_VAL));
     }
   }
+  const mpq_class max2 = mpq_class(max_distance) * mpq_class(max_distance);
   if (out.within && mpq_class(best.mpq()) > max2) out = ExactSeparation{};
   if (out.within) {
     out.squared_distance = mpq_class(best.mpq());

@@ -392,35 +392,11 @@ TEST_CASE("Cayley motion refuses half turns and zero quaternions", "[refccd]") {
 // Mesh level.
 
 #include "../../optimized/tests/mesh_shapes.h"
+#include "off_reader.h"
 
 namespace {
 
-// Minimal OFF reader for the generated datasets (the optimized mesh reader is
-// not linked into the reference).
-gauss6::TriangleMesh read_off(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) throw std::runtime_error(path + ": cannot open");
-  auto next_line = [&] {
-    std::string line;
-    while (std::getline(in, line))
-      if (!line.empty() && line[0] != '#') return line;
-    throw std::runtime_error(path + ": truncated");
-  };
-  if (next_line().rfind("OFF", 0) != 0) throw std::runtime_error(path + ": not OFF");
-  int nv = 0, nf = 0, ne = 0;
-  std::istringstream(next_line()) >> nv >> nf >> ne;
-  gauss6::TriangleMesh m;
-  m.V.resize(nv, 3);
-  m.F.resize(nf, 3);
-  for (int v = 0; v < nv; ++v) std::istringstream(next_line()) >> m.V(v, 0) >> m.V(v, 1) >> m.V(v, 2);
-  for (int f = 0; f < nf; ++f) {
-    int k = 0;
-    std::istringstream(next_line()) >> k >> m.F(f, 0) >> m.F(f, 1) >> m.F(f, 2);
-    if (k != 3) throw std::runtime_error(path + ": non-triangle face");
-  }
-  m.source = path;
-  return m;
-}
+using gauss6::test::read_off;
 
 double seconds_since(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
