@@ -60,15 +60,41 @@ struct Scales { double u, a, b, coordinate; };
 // Proof of the guarantee. Let (u*, a*, b*) be a first contact (|F|_2 <= d with
 // d = min_separation). A parameter box P is dropped by an inner search only if
 // (i) the enclosure of F over U x P proves |F|_2 > d on all of U x P (and so on
-// every sub-interval of U): see excludes(), or
+// every sub-interval of U): see excludes() (vertex/face, rigid: over U x (P cut
+// by the triangle), the only part of P that can hold a contact), or
 // (ii) (vertex/face) a_lo + b_lo > 1 in floating point, which implies the exact
 // sum exceeds 1 (1 is a double and rounding is monotone): P lies outside the
-// triangle. Splits share the double midpoint, so children cover their parent
+// triangle, or
+// (iii) the projections of F on an axis n (any nonzero vector of doubles) lie
+// beyond d |n| on one side: |F|_2 >= |n.F| / |n| > d. For fixed u, F is affine
+// in the feature parameters, so n.F over P lies between its values at P's
+// corners (vertex/face, rigid: at the points whose hull holds P cut by the
+// triangle, see ccd_rigid_vertex_face()), and each corner's value over U lies
+// in n . (the corner's enclosure): the hull of those scalar intervals encloses
+// n.F on U x P. (The
+// axis-aligned hull of F loses up to a factor sqrt(3) on a diagonal n: a pair
+// 1.1 d apart along (1, 1, 1) is never excluded by (i), whatever the split.)
+// Splits share the double midpoint, so children cover their parent
 // exactly, and a front passed to the halves of U is every box of U's search not
 // dropped. Hence a u-interval is dropped only when it holds no contact. The
 // outer search visits u-intervals in increasing order and stops at the first
 // one it accepts (or gives up at), so the interval holding u* is never passed:
 // u_hit = U.lo <= u*.
+//
+// Guide (rigid queries). The axis of (iii) is re-chosen for each u-interval U:
+// the difference of the features' nominal closest points at U.lo (the
+// direction conservative advancement would use; it separates the two convex
+// features at U.lo, and stays separating over a U short enough). Before its
+// inner search, U is dropped whole when the u-filter's separating-axis test
+// (UFilter, (2)) with this axis proves the features' projections more than
+// d |n| apart over U: the same test as (iii) for all parameters at once, with
+// the motion projected on n before it is enclosed over U, so a motion sliding
+// across n does not widen it (a corner's box over U would). With
+// early_hit, the outer search also accepts U.lo at once when F at U.lo and
+// those closest parameters is proven within d + distance_tolerance (the
+// acceptance rule of filtered_bisect()'s early hit): everything before U.lo is
+// settled, so u_hit = U.lo <= u* still holds (reported with
+// time_tolerance_reached = 0: the distance bound holds at u_hit itself).
 //
 // Accuracy. A u-interval is accepted when it is at most time_tolerance wide and
 // the inner search found a parameter box on which F is not excluded and cannot
@@ -94,9 +120,69 @@ inline bool excludes(const IVec3& F, double d) {
   return sum > next_up(d * d);
 }
 
-template <class Enclose>
+// Upper bound of the Euclidean norm of every vector in the box v (of |F|_2
+// over an enclosure F), rounded up.
+GAUSS6_ALWAYS_INLINE double norm_upper(const IVec3& v) {
+  double s2 = 0;
+  for (const Interval& c : v) {
+    const double m = std::max(std::abs(c.lo), std::abs(c.hi));
+    s2 = next_up(s2 + next_up(m * m));
+  }
+  return next_up(std::sqrt(s2));
+}
+
+// n . x for a double vector n and an interval vector x, outward rounded.
+GAUSS6_ALWAYS_INLINE Interval along(const Vec3& n, const IVec3& x) {
+  return n[0] * x[0] + n[1] * x[1] + n[2] * x[2];
+}
+
+// Enclosures of F at the corners of a parameter box (up to 5: see
+// ccd_rigid_vertex_face()), each over the box's whole u-range; F over the box
+// lies in their hull (see bisect()).
+struct Corners {
+  IVec3 c[5];
+  int n = 0;
+  IVec3 hull() const {
+    IVec3 h = c[0];
+    for (int k = 1; k < n; ++k)
+      for (int i = 0; i < 3; ++i) h[i] = {std::min(h[i].lo, c[k][i].lo), std::max(h[i].hi, c[k][i].hi)};
+    return h;
+  }
+};
+
+// The features' nominal closest points at some u (heuristic, from the double
+// motion): the axis F points along there (zero when unknown) and the feature
+// parameters (a, b) of the pair (valid feature points).
+struct Guide {
+  bool valid = false;
+  Vec3 axis = Vec3::Zero();
+  double a = 0, b = 0;
+};
+// A query's guides: at(u), the nominal closest pair at u, and separated(n, u0,
+// u1), true when the projections of the two features on the axis n are proven
+// more than d |n| apart for every u in [u0, u1] (the u-filter's separating-axis
+// test, with this axis).
+template <class At, class Separated>
+struct Guides {
+  At at;
+  Separated separated;
+};
+struct NoGuide {
+  Guide at(double) const { return {}; }
+  bool separated(const Vec3&, double, double) const { return false; }
+};
+
+// Exclusion (iii) of bisect(): true when every corner's projection on the axis
+// lies beyond `reach` = d |axis| (rounded up) on the same side.
+GAUSS6_ALWAYS_INLINE bool axis_excludes(const Corners& K, const Vec3& axis, double reach) {
+  Interval p = along(axis, K.c[0]);
+  for (int k = 1; k < K.n; ++k) p = hull(p, along(axis, K.c[k]));
+  return p.lo > reach || p.hi < -reach;
+}
+
+template <class Enclose, class GuideT = NoGuide>
 void bisect(const Enclose& enclose, bool triangle, const Scales& sc, double u_begin, double u_end,
-            const CcdSettings& s, CcdWorkspace* ws, CcdResult* r) {
+            const CcdSettings& s, CcdWorkspace* ws, CcdResult* r, const GuideT& guides = NoGuide{}) {
   const double d = s.min_separation;
   // Rounding noise makes F's enclosure at least ~1e-15 of the coordinates wide:
   // a distance tolerance below that could never be met.
@@ -117,16 +203,56 @@ void bisect(const Enclose& enclose, bool triangle, const Scales& sc, double u_be
   arena[top++] = Box{{u_begin, u_end}, {0, 0}, {0, 0}};
   arena[top++] = Box{{u_begin, u_end}, {0, 1}, {0, 1}};
   int header = 0;
+  // The guide of the current u-interval's start (recomputed when U.lo changes:
+  // a left half keeps its parent's start, hence its guide and probe outcome).
+  Guide guide;
+  double guide_u = std::numeric_limits<double>::quiet_NaN();
+  double reach = 0;  // d |axis|, rounded up
+  Corners K;
   while (top > 0) {
     // Pop the interval on top: its header and front are arena[header .. top).
     const double u0 = arena[header].u[0], u1 = arena[header].u[1];
     const int front_begin = header + 1;
     const int saved_header_link = static_cast<int>(arena[header].b[0]);  // previous block's header
     const double wu = u1 - u0;
+    if (!(u0 == guide_u)) {
+      guide_u = u0;
+      guide = guides.at(u0);
+      const double n = guide.axis.norm();
+      if (guide.valid && n > 0 && std::isfinite(n)) {
+        guide.axis /= n;  // any nonzero vector is valid; unit length keeps d |axis| ~ d
+        reach = next_up(d * norm_upper(to_interval(guide.axis)));
+        if (s.early_hit) {
+          // Everything before u0 is settled: accept u0 when a pair there is proven within d + tol_d.
+          enclose(Box{{u0, u0}, {guide.a, guide.a}, {guide.b, guide.b}}, &K);
+          const double dist = norm_upper(K.c[0]);
+          if (dist <= d + tol_d) {
+            ++r->iterations;
+            r->status = CcdStatus::kOk;
+            r->hit = true;
+            r->u_hit = u0;
+            r->time_tolerance_reached = 0;
+            r->distance_reached = dist;
+            return;
+          }
+        }
+      } else {
+        guide.axis = Vec3::Zero();
+      }
+    }
+    const bool use_axis = guide.axis != Vec3::Zero();
+    if (use_axis && guides.separated(guide.axis, u0, u1)) {
+      // (iii) for the whole features at once, the u-dependence projected first
+      // (no wrapping of a sliding motion into the axis): no contact in U.
+      ++r->iterations;
+      top = header;
+      header = saved_header_link;
+      continue;
+    }
     // Parameter refinement pays only while it shrinks F more than the u-width
     // blurs it: measure that blur on one parameter point.
-    IVec3 F_point;
-    enclose(Box{{u0, u1}, {0, 0}, {0, 0}}, &F_point);
+    enclose(Box{{u0, u1}, {0, 0}, {0, 0}}, &K);
+    const IVec3 F_point = K.c[0];
     double blur = 0;
     for (const Interval& c : F_point) blur = std::max(blur, c.hi - c.lo);
     if (!(blur < std::numeric_limits<double>::infinity())) blur = wu * sc.u;  // NaN or inf: fall back
@@ -142,9 +268,10 @@ void bisect(const Enclose& enclose, bool triangle, const Scales& sc, double u_be
       P.u[1] = u1;
       ++r->iterations;
       if (triangle && P.a[0] + P.b[0] > 1) continue;  // (ii)
-      IVec3 F;
-      enclose(P, &F);
-      if (excludes(F, d)) continue;  // (i)
+      enclose(P, &K);
+      const IVec3 F = K.hull();
+      if (excludes(F, d)) continue;                               // (i)
+      if (use_axis && axis_excludes(K, guide.axis, reach)) continue;  // (iii)
       const double wa = P.a[1] - P.a[0], wb = P.b[1] - P.b[0];
       const double ma = 0.5 * (P.a[0] + P.a[1]), mb = 0.5 * (P.b[0] + P.b[1]);
       // A dimension whose midpoint equals an end cannot be split (one float wide).
@@ -173,12 +300,7 @@ void bisect(const Enclose& enclose, bool triangle, const Scales& sc, double u_be
       r->hit = true;
       r->u_hit = u0;
       r->time_tolerance_reached = wu;
-      double m2 = 0;
-      for (const Interval& c : F_maybe) {
-        const double m = std::max(std::abs(c.lo), std::abs(c.hi));
-        m2 = next_up(m2 + next_up(m * m));
-      }
-      r->distance_reached = next_up(std::sqrt(m2));
+      r->distance_reached = norm_upper(F_maybe);
       return;
     }
     if (!maybe) {
@@ -270,7 +392,9 @@ LinearPoints make_linear_points(const std::array<Vec3, 4>& start, const std::arr
 struct LinearDifference {
   int w0, w1, a0, a1, b0, b1;
 };
-void enclose_linear(const LinearPoints& pts, const LinearDifference& ix, const Box& box, IVec3* F) {
+void enclose_linear(const LinearPoints& pts, const LinearDifference& ix, const Box& box, Corners* K) {
+  IVec3* F = &K->c[0];
+  K->n = 1;  // the hull alone (the corners' values are not kept)
   constexpr double kInf = std::numeric_limits<double>::infinity();
   double lo[3] = {kInf, kInf, kInf}, hi[3] = {-kInf, -kInf, -kInf};
   for (double u : box.u) {
@@ -278,12 +402,15 @@ void enclose_linear(const LinearPoints& pts, const LinearDifference& ix, const B
       double p[4];
       for (int k = 0; k < 4; ++k) p[k] = pts.x0[k][i] + u * pts.dx[k][i];
       const double w = p[ix.w0] - p[ix.w1], ea = p[ix.a0] - p[ix.a1], eb = p[ix.b0] - p[ix.b1];
-      for (double a : box.a)
-        for (double b : box.b) {
-          const double c = (w + a * ea) - b * eb;
-          lo[i] = std::min(lo[i], c);
-          hi[i] = std::max(hi[i], c);
-        }
+      // The corner values c = (w + a ea) - b eb over the four (a, b) corners,
+      // without evaluating all four: rounding is monotone (fl(x + y) never
+      // decreases with x or y, fl(x - y) never decreases with x nor increases
+      // with y), so the smallest computed c is the one at the a with the
+      // smallest computed a ea and the b with the largest computed b eb (and
+      // vice versa for the largest): the same values as the corner loop.
+      const double pa0 = box.a[0] * ea, pa1 = box.a[1] * ea, pb0 = box.b[0] * eb, pb1 = box.b[1] * eb;
+      lo[i] = std::min(lo[i], (w + std::min(pa0, pa1)) - std::max(pb0, pb1));
+      hi[i] = std::max(hi[i], (w + std::max(pa0, pa1)) - std::min(pb0, pb1));
     }
   }
   for (int i = 0; i < 3; ++i) (*F)[i] = {next_down(lo[i] - pts.error), next_up(hi[i] + pts.error)};
@@ -319,7 +446,7 @@ void ccd_linear_vertex_face(const LinearVertexFaceQuery& q, const CcdSettings& s
   const LinearPoints pts = make_linear_points({q.vertex[0], q.face[0][0], q.face[0][1], q.face[0][2]},
                                               {q.vertex[1], q.face[1][0], q.face[1][1], q.face[1][2]});
   // F = (v - f0) - a (f1 - f0) - b (f2 - f0): w = p0 - p1, ea = p1 - p2, eb = p3 - p1.
-  auto enclose = [&](const Box& box, IVec3* F) { enclose_linear(pts, {0, 1, 1, 2, 3, 1}, box, F); };
+  auto enclose = [&](const Box& box, Corners* K) { enclose_linear(pts, {0, 1, 1, 2, 3, 1}, box, K); };
   bisect(enclose, /*triangle=*/true, sc, q.u_begin, q.u_end, s, ws, r);
 }
 
@@ -345,7 +472,7 @@ void ccd_linear_edge_edge(const LinearEdgeEdgeQuery& q, const CcdSettings& s, Cc
   const LinearPoints pts = make_linear_points({q.edge_a[0][0], q.edge_a[0][1], q.edge_b[0][0], q.edge_b[0][1]},
                                               {q.edge_a[1][0], q.edge_a[1][1], q.edge_b[1][0], q.edge_b[1][1]});
   // F = (a0 - b0) + a (a1 - a0) - b (b1 - b0): w = p0 - p2, ea = p1 - p0, eb = p3 - p2.
-  auto enclose = [&](const Box& box, IVec3* F) { enclose_linear(pts, {0, 2, 1, 0, 3, 2}, box, F); };
+  auto enclose = [&](const Box& box, Corners* K) { enclose_linear(pts, {0, 2, 1, 0, 3, 2}, box, K); };
   bisect(enclose, /*triangle=*/false, sc, q.u_begin, q.u_end, s, ws, r);
 }
 
@@ -554,15 +681,6 @@ GAUSS6_ALWAYS_INLINE IVec3 cross(const IVec3& a, const IVec3& b) {
   return {a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]};
 }
 GAUSS6_ALWAYS_INLINE IVec3 scale(Interval s, const IVec3& a) { return {s * a[0], s * a[1], s * a[2]}; }
-// Upper bound of the Euclidean norm of every vector in the box v.
-GAUSS6_ALWAYS_INLINE double norm_upper(const IVec3& v) {
-  double s2 = 0;
-  for (const Interval& c : v) {
-    const double m = std::max(std::abs(c.lo), std::abs(c.hi));
-    s2 = next_up(s2 + next_up(m * m));
-  }
-  return next_up(std::sqrt(s2));
-}
 
 // Coefficients of Dc(u) v = v + u c1 + u^2 c2.
 struct CayleyCoefficients { IVec3 c1, c2; };
@@ -619,6 +737,50 @@ GAUSS6_ALWAYS_INLINE Cubic static_point_along(const CcdMotion& m, const IVec3& y
            -dot(m.dp, cn.c2)}};
 }
 
+// The separating-axis test (2) for one axis n: the moving feature's corners'
+// projection coefficients and the static projection grown by d |n|.
+struct SeparatingAxis {
+  int num_corners = 0;  // active when > 0
+  Interval c0[3], c1[3], c2[3], c3[3];
+  Interval static_proj;
+
+  // Adds a body corner w = R0 r_B (world-oriented offset from G) for the axis n
+  // (exact doubles: each product is a double times an interval).
+  void add_corner(const CcdMotion& m, const IVec3& w, const Vec3& n) {
+    const IVec3 gxw = cross(m.g, w), ggw = cross(m.g, gxw);
+    add_corner(m, w, gxw, ggw, n);
+  }
+  // The same with g x w and g x (g x w) given (they do not depend on n).
+  void add_corner(const CcdMotion& m, const IVec3& w, const IVec3& gxw, const IVec3& ggw, const Vec3& n) {
+    const int j = num_corners++;
+    c0[j] = along(n, m.p0 + w);
+    c1[j] = along(n, m.dp + 2.0 * gxw);
+    c2[j] = along(n, gxw);
+    c3[j] = along(n, ggw);
+  }
+  void set_static(Interval proj, const IVec3& n, double d) {
+    const double dn = next_up(d * norm_upper(n));
+    static_proj = {next_down(proj.lo - dn), next_up(proj.hi + dn)};
+  }
+  // True when the projections are proven apart for every u in [u0, u1].
+  bool excludes(const CcdMotion& m, double u0, double u1) const {
+    if (num_corners == 0) return false;
+    const Interval U{u0, u1};
+    const Interval s = m.g2;
+    const auto beta_at = [&](double v) {
+      return div_positive(2.0 * sqr(Interval::point(v)), Interval::point(1) + sqr(Interval::point(v)) * s);
+    };
+    const Interval B = hull(beta_at(u0), beta_at(u1));
+    const Interval Gamma{0, (2.0 * (sqr(Interval::point(u1)) * Interval::point(u1)) * s).hi};
+    Interval proj{};
+    for (int j = 0; j < num_corners; ++j) {
+      const Interval pj = c0[j] + U * c1[j] - Gamma * c2[j] + B * c3[j];
+      proj = j == 0 ? pj : hull(proj, pj);
+    }
+    return proj.lo > static_proj.hi || proj.hi < static_proj.lo;
+  }
+};
+
 struct UFilter {
   // Exclusion conditions g(u) > 0, in groups: a group excludes U when each of
   // its members is positive on all of U (a single condition is a group of one).
@@ -626,11 +788,7 @@ struct UFilter {
   Cubic cond[kMaxConditions];
   bool joins_previous[kMaxConditions] = {};
   int num_conditions = 0;
-  // The axis: corners' projection coefficients and the static projection grown
-  // by d |n|; active when num_corners > 0.
-  int num_corners = 0;
-  Interval c0[3], c1[3], c2[3], c3[3];
-  Interval static_proj;
+  SeparatingAxis axis;  // (2), with the axis of the window's start
   const CcdMotion* motion = nullptr;
 
   // Q(u) <= r D(u) is necessary for a contact: exclude where Q - r D > 0.
@@ -648,21 +806,8 @@ struct UFilter {
     joins_previous[num_conditions] = join && num_conditions > 0;
     cond[num_conditions++] = c;
   }
-  // Adds a body corner w = R0 r_B (world-oriented offset from G) for the axis n
-  // (exact doubles: each product is a double times an interval).
-  void add_corner(const IVec3& w, const Vec3& n) {
-    const IVec3 gxw = cross(motion->g, w), ggw = cross(motion->g, gxw);
-    const auto along = [&n](const IVec3& x) { return n[0] * x[0] + n[1] * x[1] + n[2] * x[2]; };
-    const int j = num_corners++;
-    c0[j] = along(motion->p0 + w);
-    c1[j] = along(motion->dp + 2.0 * gxw);
-    c2[j] = along(gxw);
-    c3[j] = along(ggw);
-  }
-  void set_axis_static(Interval proj, const IVec3& n, double d) {
-    const double dn = next_up(d * norm_upper(n));
-    static_proj = {next_down(proj.lo - dn), next_up(proj.hi + dn)};
-  }
+  void add_corner(const IVec3& w, const Vec3& n) { axis.add_corner(*motion, w, n); }
+  void set_axis_static(Interval proj, const IVec3& n, double d) { axis.set_static(proj, n, d); }
 
   bool excludes(double u0, double u1) const {
     for (int i = 0; i < num_conditions;) {
@@ -675,22 +820,7 @@ struct UFilter {
       if (all) return true;
       i = j;
     }
-    if (num_corners > 0) {
-      const Interval U{u0, u1};
-      const Interval s = motion->g2;
-      const auto beta_at = [&](double v) {
-        return div_positive(2.0 * sqr(Interval::point(v)), Interval::point(1) + sqr(Interval::point(v)) * s);
-      };
-      const Interval B = hull(beta_at(u0), beta_at(u1));
-      const Interval Gamma{0, (2.0 * (sqr(Interval::point(u1)) * Interval::point(u1)) * s).hi};
-      Interval proj{};
-      for (int j = 0; j < num_corners; ++j) {
-        const Interval pj = c0[j] + U * c1[j] - Gamma * c2[j] + B * c3[j];
-        proj = j == 0 ? pj : hull(proj, pj);
-      }
-      if (proj.lo > static_proj.hi || proj.hi < static_proj.lo) return true;
-    }
-    return false;
+    return axis.excludes(*motion, u0, u1);
   }
 };
 
@@ -701,14 +831,9 @@ struct UFilter {
 template <class Enclose>
 bool accept_point(const Enclose& enclose, double u0, double u1, double a, double b, double d, double tol,
                   int iterations, CcdResult* r) {
-  IVec3 F;
-  enclose(Box{{u0, u0}, {a, a}, {b, b}}, &F);
-  double m2 = 0;
-  for (const Interval& c : F) {
-    const double m = std::max(std::abs(c.lo), std::abs(c.hi));
-    m2 = next_up(m2 + next_up(m * m));
-  }
-  const double dist = next_up(std::sqrt(m2));  // >= |F| at (u0, a, b)
+  Corners K;
+  enclose(Box{{u0, u0}, {a, a}, {b, b}}, &K);
+  const double dist = norm_upper(K.c[0]);  // >= |F| at (u0, a, b)
   if (!(dist <= d + tol)) return false;
   *r = CcdResult{};
   r->status = CcdStatus::kOk;
@@ -743,7 +868,7 @@ void triangle_parameters(const Vec3& c, const Vec3& t0, const Vec3& t1, const Ve
 // excludes [u_begin, u_end], *r is the no-hit answer filtered_bisect() would give
 // and the caller returns at once (the same exclusion, found earlier).
 bool axis_clears(const UFilter& filter, double u_begin, double u_end, CcdResult* r) {
-  if (filter.num_corners == 0 || !filter.excludes(u_begin, u_end)) return false;
+  if (filter.axis.num_corners == 0 || !filter.excludes(u_begin, u_end)) return false;
   *r = CcdResult{};
   r->status = CcdStatus::kOk;
   r->hit = false;
@@ -770,12 +895,17 @@ bool axis_clears(const UFilter& filter, double u_begin, double u_end, CcdResult*
 // (u, a, b) search: u_hit = a <= u* still holds because every earlier interval
 // was proven free of contact, and distance_reached is a proven upper bound of
 // the distance at u_hit.
-template <class Enclose, class AddMore, class Probe>
+template <class Enclose, class AddMore, class GuideT>
 void filtered_bisect(const Enclose& enclose, bool triangle, const Scales& sc, UFilter& filter,
-                     const AddMore& add_more, const Probe& probe, double u_begin, double u_end,
+                     const AddMore& add_more, const GuideT& guides, double u_begin, double u_end,
                      const CcdSettings& s, CcdWorkspace* ws, CcdResult* r) {
   constexpr int kMaxEvaluations = 256, kStack = 64;
   int evaluations = 1, total_iterations = 0;
+  const double tol_d = std::max(s.distance_tolerance, 1e-12 * sc.coordinate);  // as in bisect()
+  const auto probe = [&](double u0, double u1, int iterations, CcdResult* res) {
+    const Guide g = guides.at(u0);
+    return g.valid && accept_point(enclose, u0, u1, g.a, g.b, s.min_separation, tol_d, iterations, res);
+  };
   *r = CcdResult{};
   const auto no_hit = [&] {
     r->status = CcdStatus::kOk;
@@ -789,7 +919,7 @@ void filtered_bisect(const Enclose& enclose, bool triangle, const Scales& sc, UF
   const auto run = [&](double a, double b) {
     CcdSettings sw = s;
     sw.max_iterations = std::max(1, s.max_iterations - total_iterations);
-    bisect(enclose, triangle, sc, a, b, sw, ws, r);
+    bisect(enclose, triangle, sc, a, b, sw, ws, r, guides);
     total_iterations += r->iterations;
     r->iterations = total_iterations;
     return r->hit;
@@ -860,26 +990,33 @@ void ccd_rigid_vertex_face(const RigidVertexFaceQuery& q, const CcdSettings& s, 
   sc.u = rigid_speed(*q.motion, rho);
   sc.coordinate = std::max({max_abs(q.vertex), max_abs(q.face[0]), max_abs(q.face[1]), max_abs(q.face[2]),
                             max_abs(q.motion->nominal.p0), max_abs(q.motion->nominal.p0 + q.motion->nominal.dp)});
-  auto enclose = [&](const Box& box, IVec3* F) {
+  auto enclose = [&](const Box& box, Corners* K) {
     const MotionEnclosure& e = cache.at(box);
-    bool first = true;
+    // Parameter points whose convex hull holds the part of the box in the
+    // triangle (a + b <= 1): the box's corners, its far corner (a1, b1) replaced,
+    // when outside, by the points where the line a + b = 1 crosses the edges
+    // a = a1 and b = b1, each moved outward along its edge (next_up(1 - x) >= 1 - x).
+    // Proof: the box cut by the half-plane is the convex hull of its corners
+    // inside it and the line's crossings with its edges; the crossings with
+    // a = a0 and b = b0 lie on edges between kept corners, those with a = a1 and
+    // b = b1 between a kept corner and a moved point. A box along the
+    // hypotenuse thus stops reaching across it, which a feature point near the
+    // triangle's edge needs for (iii).
+    const double a0 = box.a[0], a1 = box.a[1], b0 = box.b[0], b1 = box.b[1];
+    double pa[5] = {a0, a1, a0, a1, a1}, pb[5] = {b0, b0, b1, b1, b1};
+    K->n = 4;
+    if (a1 + b1 > 1) {
+      pb[3] = std::clamp(next_up(1 - a1), b0, b1);
+      pa[4] = std::clamp(next_up(1 - b1), a0, a1);
+      K->n = 5;
+    }
     if (q.vertex_on_body) {
       // F = M(u, v) - (f0 + a e1 + b e2)
       const IVec3 mv = enclose_point(e, v) - f0;
-      for (double a : box.a)
-        for (double b : box.b) {
-          const IVec3 c = mv - a * e1 - b * e2;
-          *F = first ? c : hull(*F, c);
-          first = false;
-        }
+      for (int k = 0; k < K->n; ++k) K->c[k] = mv - pa[k] * e1 - pb[k] * e2;
     } else {
       // F = v - M(u, f0 + a e1 + b e2)
-      for (double a : box.a)
-        for (double b : box.b) {
-          const IVec3 c = v - enclose_point(e, f0 + a * e1 + b * e2);
-          *F = first ? c : hull(*F, c);
-          first = false;
-        }
+      for (int k = 0; k < K->n; ++k) K->c[k] = v - enclose_point(e, f0 + pa[k] * e1 + pb[k] * e2);
     }
   };
   if (!s.use_u_filter) return bisect(enclose, /*triangle=*/true, sc, q.u_begin, q.u_end, s, ws, r);
@@ -887,7 +1024,6 @@ void ccd_rigid_vertex_face(const RigidVertexFaceQuery& q, const CcdSettings& s, 
   // axis; stage 2: the three edge slabs of the triangle.
   const CcdMotion& m = *q.motion;
   const double d = s.min_separation;
-  const double tol_d = std::max(s.distance_tolerance, 1e-12 * sc.coordinate);  // as in bisect()
   UFilter filter;
   filter.motion = &m;
   const IVec3 corner[3] = {f0, to_interval(q.face[1]), to_interval(q.face[2])};
@@ -907,13 +1043,23 @@ void ccd_rigid_vertex_face(const RigidVertexFaceQuery& q, const CcdSettings& s, 
     const double dL = next_up(d * norm_upper(n));
     filter.at_most(P, dL);
     filter.at_least(P, dL);
-    // Early hit at the face point nearest the vertex's nominal position.
-    const auto probe = [&](double u0, double u1, int iterations, CcdResult* res) {
-      const Vec3 x = motion_point(m.nominal, u0, q.vertex);
-      double a = 0, b = 0;
-      triangle_parameters(closest_point_on_triangle(x, q.face[0], q.face[1], q.face[2]), q.face[0], q.face[1],
-                          q.face[2], &a, &b);
-      return accept_point(enclose, u0, u1, a, b, d, tol_d, iterations, res);
+    // Guide: the face point nearest the vertex's nominal position.
+    const auto guide_at = [&](double u) {
+      Guide g;
+      const Vec3 x = motion_point(m.nominal, u, q.vertex);
+      const Vec3 c = closest_point_on_triangle(x, q.face[0], q.face[1], q.face[2]);
+      triangle_parameters(c, q.face[0], q.face[1], q.face[2], &g.a, &g.b);
+      g.axis = x - c;
+      g.valid = true;
+      return g;
+    };
+    const IVec3 gxw = cross(m.g, w), ggw = cross(m.g, gxw);
+    const auto separated = [&](const Vec3& axis_u, double u0, double u1) {
+      SeparatingAxis sa;
+      const IVec3 na = to_interval(axis_u);
+      sa.add_corner(m, w, gxw, ggw, axis_u);
+      sa.set_static(hull(hull(dot(na, corner[0]), dot(na, corner[1])), dot(na, corner[2])), na, d);
+      return sa.excludes(m, u0, u1);
     };
     // Edge slabs: m_k = n x (f_k+1 - f_k) points into the triangle; a point
     // within d of it has (x - f_k).m_k >= -d |m_k|.
@@ -922,7 +1068,7 @@ void ccd_rigid_vertex_face(const RigidVertexFaceQuery& q, const CcdSettings& s, 
         const IVec3 mk = cross(n, corner[(k + 1) % 3] - corner[k]);
         f->at_least(body_point_along(m, w, cw, corner[k], mk), next_up(d * norm_upper(mk)));
       }
-    }, probe, q.u_begin, q.u_end, s, ws, r);
+    }, Guides<decltype(guide_at), decltype(separated)>{guide_at, separated}, q.u_begin, q.u_end, s, ws, r);
     return;
   }
   Vec3 moved[3];
@@ -940,13 +1086,28 @@ void ccd_rigid_vertex_face(const RigidVertexFaceQuery& q, const CcdSettings& s, 
   const double dL = next_up(d * norm_upper(n));  // |C R0 n| = |n|
   filter.at_most(P, dL);
   filter.at_least(P, dL);
-  // Early hit at the point of the nominally moved face nearest the vertex.
-  const auto probe = [&](double u0, double u1, int iterations, CcdResult* res) {
+  // Guide: the point of the nominally moved face nearest the vertex.
+  const auto guide_at = [&](double u) {
+    Guide g;
     Vec3 t[3];
-    for (int k = 0; k < 3; ++k) t[k] = motion_point(m.nominal, u0, q.face[k]);
-    double a = 0, b = 0;
-    triangle_parameters(closest_point_on_triangle(q.vertex, t[0], t[1], t[2]), t[0], t[1], t[2], &a, &b);
-    return accept_point(enclose, u0, u1, a, b, d, tol_d, iterations, res);
+    for (int k = 0; k < 3; ++k) t[k] = motion_point(m.nominal, u, q.face[k]);
+    const Vec3 c = closest_point_on_triangle(q.vertex, t[0], t[1], t[2]);
+    triangle_parameters(c, t[0], t[1], t[2], &g.a, &g.b);
+    g.axis = q.vertex - c;
+    g.valid = true;
+    return g;
+  };
+  IVec3 cw[3], cgxw[3], cggw[3];
+  for (int k = 0; k < 3; ++k) {
+    cw[k] = mul(m.R0, corner[k]);
+    cgxw[k] = cross(m.g, cw[k]);
+    cggw[k] = cross(m.g, cgxw[k]);
+  }
+  const auto separated = [&](const Vec3& axis_u, double u0, double u1) {
+    SeparatingAxis sa;
+    for (int k = 0; k < 3; ++k) sa.add_corner(m, cw[k], cgxw[k], cggw[k], axis_u);
+    sa.set_static(along(axis_u, v), to_interval(axis_u), d);
+    return sa.excludes(m, u0, u1);
   };
   // Edge slabs in the body frame: (y - x_fk(u)).(C m_k') >= -d |m_k|.
   filtered_bisect(enclose, /*triangle=*/true, sc, filter, [&](UFilter* f) {
@@ -955,7 +1116,7 @@ void ccd_rigid_vertex_face(const RigidVertexFaceQuery& q, const CcdSettings& s, 
       f->at_least(static_point_along(m, v, mul(m.R0, corner[k]), mkW, cayley_coefficients(m, mkW)),
                   next_up(d * norm_upper(mk)));
     }
-  }, probe, q.u_begin, q.u_end, s, ws, r);
+  }, Guides<decltype(guide_at), decltype(separated)>{guide_at, separated}, q.u_begin, q.u_end, s, ws, r);
 }
 
 void ccd_rigid_edge_edge(const RigidEdgeEdgeQuery& q, const CcdSettings& s, CcdWorkspace* ws, CcdResult* r) {
@@ -970,19 +1131,22 @@ void ccd_rigid_edge_edge(const RigidEdgeEdgeQuery& q, const CcdSettings& s, CcdW
   sc.coordinate = std::max({max_abs(q.edge_body[0]), max_abs(q.edge_body[1]), max_abs(q.edge_world[0]),
                             max_abs(q.edge_world[1]), max_abs(q.motion->nominal.p0),
                             max_abs(q.motion->nominal.p0 + q.motion->nominal.dp)});
-  auto enclose = [&](const Box& box, IVec3* F) {
+  auto enclose = [&](const Box& box, Corners* K) {
     const MotionEnclosure& e = cache.at(box);
     // F = M(u, a0 + a ea) - (b0 + b eb)
     const IVec3 pa[2] = {enclose_point(e, a0 + box.a[0] * ea), enclose_point(e, a0 + box.a[1] * ea)};
     const IVec3 pb[2] = {b0 + box.b[0] * eb, b0 + box.b[1] * eb};
-    *F = hull(hull(pa[0] - pb[0], pa[0] - pb[1]), hull(pa[1] - pb[0], pa[1] - pb[1]));
+    K->n = 4;
+    K->c[0] = pa[0] - pb[0];
+    K->c[1] = pa[0] - pb[1];
+    K->c[2] = pa[1] - pb[0];
+    K->c[3] = pa[1] - pb[1];
   };
   if (!s.use_u_filter) return bisect(enclose, /*triangle=*/false, sc, q.u_begin, q.u_end, s, ws, r);
   // The u-filter (see UFilter). Stage 1: the coplanarity cubic and a separating
   // axis; stage 2: the four end slabs.
   const CcdMotion& m = *q.motion;
   const double d = s.min_separation;
-  const double tol_d = std::max(s.distance_tolerance, 1e-12 * sc.coordinate);  // as in bisect()
   UFilter filter;
   filter.motion = &m;
   const IVec3 a0W = mul(m.R0, a0), eaW = mul(m.R0, ea), Q = m.p0 - b0;
@@ -1014,16 +1178,26 @@ void ccd_rigid_edge_edge(const RigidEdgeEdgeQuery& q, const CcdSettings& s, CcdW
   // within d of that slab: both ends of A beyond b0 (or b1) along eb by more
   // than d |eb| excludes, and both ends of B beyond a0(u) (or a1(u)) along
   // C ea'. Each pair of ends is one group.
-  // Early hit at the closest points of the nominally moved edge and the static one.
-  const auto probe = [&](double u0, double u1, int iterations, CcdResult* res) {
-    const Vec3 P0 = motion_point(m.nominal, u0, q.edge_body[0]), P1 = motion_point(m.nominal, u0, q.edge_body[1]);
-    double pa = 0, pb = 0;
-    closest_segment_parameters(P0, P1, q.edge_world[0], q.edge_world[1], &pa, &pb);
-    if (!(pa >= 0 && pa <= 1 && pb >= 0 && pb <= 1)) return false;  // NaN or out of range: no early hit
-    return accept_point(enclose, u0, u1, pa, pb, d, tol_d, iterations, res);
+  // Guide: the closest points of the nominally moved edge and the static one.
+  const auto guide_at = [&](double u) {
+    Guide g;
+    const Vec3 P0 = motion_point(m.nominal, u, q.edge_body[0]), P1 = motion_point(m.nominal, u, q.edge_body[1]);
+    closest_segment_parameters(P0, P1, q.edge_world[0], q.edge_world[1], &g.a, &g.b);
+    g.valid = g.a >= 0 && g.a <= 1 && g.b >= 0 && g.b <= 1;  // false for NaN or out of range
+    g.axis = (P0 + g.a * (P1 - P0)) - (q.edge_world[0] + g.b * (q.edge_world[1] - q.edge_world[0]));
+    return g;
+  };
+  const IVec3 ea_gxw[2] = {cross(m.g, a0W), cross(m.g, a1W)};
+  const IVec3 ea_ggw[2] = {cross(m.g, ea_gxw[0]), cross(m.g, ea_gxw[1])};
+  const IVec3 b1 = b0 + eb;
+  const auto separated = [&](const Vec3& axis_u, double u0, double u1) {
+    SeparatingAxis sa;
+    sa.add_corner(m, a0W, ea_gxw[0], ea_ggw[0], axis_u);
+    sa.add_corner(m, a1W, ea_gxw[1], ea_ggw[1], axis_u);
+    sa.set_static(hull(along(axis_u, b0), along(axis_u, b1)), to_interval(axis_u), d);
+    return sa.excludes(m, u0, u1);
   };
   filtered_bisect(enclose, /*triangle=*/false, sc, filter, [&](UFilter* f) {
-    const IVec3 b1 = b0 + eb;
     const CayleyCoefficients c0 = cayley_coefficients(m, a0W), c1 = cayley_coefficients(m, a1W);
     const double rb = next_up(d * norm_upper(eb)), ra = next_up(d * norm_upper(ea));
     f->at_least(body_point_along(m, a0W, c0, b0, eb), rb);
@@ -1034,7 +1208,7 @@ void ccd_rigid_edge_edge(const RigidEdgeEdgeQuery& q, const CcdSettings& s, CcdW
     f->at_least(static_point_along(m, b1, a0W, eaW, ca), ra, /*join=*/true);
     f->at_most(static_point_along(m, b0, a1W, eaW, ca), ra);
     f->at_most(static_point_along(m, b1, a1W, eaW, ca), ra, /*join=*/true);
-  }, probe, q.u_begin, q.u_end, s, ws, r);
+  }, Guides<decltype(guide_at), decltype(separated)>{guide_at, separated}, q.u_begin, q.u_end, s, ws, r);
 }
 
 StopPose make_stop_pose(const CcdMotion& m, double u, double body_radius) {

@@ -64,9 +64,18 @@ void random_step(std::mt19937& rng, int i, Pose* x0, Pose* x1) {
 
 }  // namespace
 
-TEST_CASE("u-filter keeps every exact contact: body vertex against a static face", "[ccd]") {
-  std::mt19937 rng(101);
-  std::uniform_real_distribution<double> U(0.02, 0.98), H(-1, 1);
+namespace {
+
+// The scaffolding of the exact-contact tests: 400 random steps (haptic-size and
+// large, alternately), each with its enclosed and its exact motion and the
+// settings settings_for(i). place(i, rng, m, em, s, ws, r) builds a query with a
+// contact at a parameter u_c verified in exact rationals, runs it into *r and
+// returns u_c, or returns a negative value when the placement is not verified
+// (skipped). A miss is no hit, or a hit after u_c (exact comparison: no
+// tolerance). Requires at least 200 verified contacts and no miss.
+template <class SettingsFor, class Place>
+void check_exact_contacts(unsigned seed, const SettingsFor& settings_for, const Place& place) {
+  std::mt19937 rng(seed);
   CcdWorkspace ws;
   CcdResult r;
   int verified = 0, misses = 0;
@@ -76,8 +85,31 @@ TEST_CASE("u-filter keeps every exact contact: body vertex against a static face
     CcdMotion m;
     REQUIRE(make_ccd_motion(x0, x1, &m) == MotionStatus::kOk);
     const ExactMotion em(x0, x1);
-    CcdSettings s;
-    s.min_separation = (i % 3 == 0) ? 0.0 : 1e-6;
+    const CcdSettings s = settings_for(i);
+    const double u_c = place(i, rng, m, em, s, &ws, &r);
+    if (u_c < 0) continue;
+    ++verified;
+    if (!r.hit || Q(r.u_hit) > Q(u_c)) ++misses;
+  }
+  INFO("verified contacts: " << verified);
+  CHECK(verified >= 200);
+  CHECK(misses == 0);
+}
+
+// min_separation 0 every third query, 1e-6 otherwise.
+CcdSettings alternating_separation(int i) {
+  CcdSettings s;
+  s.min_separation = (i % 3 == 0) ? 0.0 : 1e-6;
+  return s;
+}
+
+}  // namespace
+
+TEST_CASE("u-filter keeps every exact contact: body vertex against a static face", "[ccd]") {
+  std::uniform_real_distribution<double> U(0.02, 0.98), H(-1, 1);
+  check_exact_contacts(101, alternating_separation, [&](int i, std::mt19937& rng, const CcdMotion& m,
+                                                        const ExactMotion& em, const CcdSettings& s,
+                                                        CcdWorkspace* ws, CcdResult* r) {
     const Vec3 r_B = rnd(rng, 0.03);
     const double u_c = U(rng);
     const Q3 x_star = em.point(Q(u_c), q3(r_B));
@@ -85,7 +117,7 @@ TEST_CASE("u-filter keeps every exact contact: body vertex against a static face
     // grazing approach when the motion runs along the plane), e1/e2 random or,
     // every fourth query, containing the step's direction (a sliding contact).
     Vec3 e1 = rnd(rng, 0.01), e2 = rnd(rng, 0.01);
-    if (i % 4 == 1) e1 = 0.01 * (x1.p - x0.p).normalized();
+    if (i % 4 == 1) e1 = 0.01 * m.nominal.dp.normalized();
     const Vec3 nrm = e1.cross(e2).normalized();
     const Vec3 P = to_double(x_star) + 0.9 * s.min_separation * H(rng) * nrm;
     RigidVertexFaceQuery q;
@@ -94,30 +126,17 @@ TEST_CASE("u-filter keeps every exact contact: body vertex against a static face
     q.face = {P - (e1 + e2) / 3, P + 2 * e1 / 3 - e2 / 3, P - e1 / 3 + 2 * e2 / 3};
     // Tolerance: none. Skip the rare placements whose rounding leaves x* farther
     // than d (only possible with d = 0): the exact check decides.
-    if (!within_of_triangle(x_star, q3(q.face[0]), q3(q.face[1]), q3(q.face[2]), Q(s.min_separation))) continue;
-    ++verified;
-    ccd_rigid_vertex_face(q, s, &ws, &r);
-    if (!r.hit || Q(r.u_hit) > Q(u_c)) ++misses;
-  }
-  INFO("verified contacts: " << verified);
-  CHECK(verified >= 200);
-  CHECK(misses == 0);
+    if (!within_of_triangle(x_star, q3(q.face[0]), q3(q.face[1]), q3(q.face[2]), Q(s.min_separation))) return -1.0;
+    ccd_rigid_vertex_face(q, s, ws, r);
+    return u_c;
+  });
 }
 
 TEST_CASE("u-filter keeps every exact contact: static vertex against a body face", "[ccd]") {
-  std::mt19937 rng(202);
   std::uniform_real_distribution<double> U(0.02, 0.98), H(-1, 1);
-  CcdWorkspace ws;
-  CcdResult r;
-  int verified = 0, misses = 0;
-  for (int i = 0; i < 400; ++i) {
-    Pose x0, x1;
-    random_step(rng, i, &x0, &x1);
-    CcdMotion m;
-    REQUIRE(make_ccd_motion(x0, x1, &m) == MotionStatus::kOk);
-    const ExactMotion em(x0, x1);
-    CcdSettings s;
-    s.min_separation = (i % 3 == 0) ? 0.0 : 1e-6;
+  check_exact_contacts(202, alternating_separation, [&](int, std::mt19937& rng, const CcdMotion& m,
+                                                        const ExactMotion& em, const CcdSettings& s,
+                                                        CcdWorkspace* ws, CcdResult* r) {
     const Vec3 c = rnd(rng, 0.03), e1 = rnd(rng, 0.01), e2 = rnd(rng, 0.01);
     const std::array<Vec3, 3> face = {c - (e1 + e2) / 3, c + 2 * e1 / 3 - e2 / 3, c - e1 / 3 + 2 * e2 / 3};
     const double u_c = U(rng);
@@ -130,30 +149,17 @@ TEST_CASE("u-filter keeps every exact contact: static vertex against a body face
     q.vertex_on_body = false;
     q.vertex = to_double(centre) + 0.9 * s.min_separation * H(rng) * nrm;
     q.face = face;
-    if (!within_of_triangle(q3(q.vertex), X[0], X[1], X[2], Q(s.min_separation))) continue;
-    ++verified;
-    ccd_rigid_vertex_face(q, s, &ws, &r);
-    if (!r.hit || Q(r.u_hit) > Q(u_c)) ++misses;
-  }
-  INFO("verified contacts: " << verified);
-  CHECK(verified >= 200);
-  CHECK(misses == 0);
+    if (!within_of_triangle(q3(q.vertex), X[0], X[1], X[2], Q(s.min_separation))) return -1.0;
+    ccd_rigid_vertex_face(q, s, ws, r);
+    return u_c;
+  });
 }
 
 TEST_CASE("u-filter keeps every exact contact: edge/edge", "[ccd]") {
-  std::mt19937 rng(303);
   std::uniform_real_distribution<double> U(0.02, 0.98), H(-1, 1), S(0.2, 0.8);
-  CcdWorkspace ws;
-  CcdResult r;
-  int verified = 0, misses = 0;
-  for (int i = 0; i < 400; ++i) {
-    Pose x0, x1;
-    random_step(rng, i, &x0, &x1);
-    CcdMotion m;
-    REQUIRE(make_ccd_motion(x0, x1, &m) == MotionStatus::kOk);
-    const ExactMotion em(x0, x1);
-    CcdSettings s;
-    s.min_separation = (i % 3 == 0) ? 0.0 : 1e-6;
+  check_exact_contacts(303, alternating_separation, [&](int i, std::mt19937& rng, const CcdMotion& m,
+                                                        const ExactMotion& em, const CcdSettings& s,
+                                                        CcdWorkspace* ws, CcdResult* r) {
     const Vec3 a0 = rnd(rng, 0.03), a1 = a0 + rnd(rng, 0.01);
     const double u_c = U(rng), t = S(rng);
     const Q3 A0 = em.point(Q(u_c), q3(a0)), A1 = em.point(Q(u_c), q3(a1));
@@ -170,14 +176,10 @@ TEST_CASE("u-filter keeps every exact contact: edge/edge", "[ccd]") {
     q.motion = &m;
     q.edge_body = {a0, a1};
     q.edge_world = {P - sb * eb, P + (1 - sb) * eb};
-    if (!within_of_segment(A0, A1, q3(q.edge_world[0]), q3(q.edge_world[1]), Q(s.min_separation))) continue;
-    ++verified;
-    ccd_rigid_edge_edge(q, s, &ws, &r);
-    if (!r.hit || Q(r.u_hit) > Q(u_c)) ++misses;
-  }
-  INFO("verified contacts: " << verified);
-  CHECK(verified >= 200);
-  CHECK(misses == 0);
+    if (!within_of_segment(A0, A1, q3(q.edge_world[0]), q3(q.edge_world[1]), Q(s.min_separation))) return -1.0;
+    ccd_rigid_edge_edge(q, s, ws, r);
+    return u_c;
+  });
 }
 
 TEST_CASE("u-filter never stops later than a contact certified by the plain bisection", "[ccd]") {

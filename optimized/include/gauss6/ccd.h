@@ -12,8 +12,10 @@
 // (Wang et al. 2021), with an interval enclosure of the feature difference
 // F(u, a, b) (vertex minus face point, or point of edge A minus point of edge B)
 // whose every floating-point operation is widened outward (see Interval below).
-// A box whose enclosure misses [-min_separation, min_separation]^3 provably
-// contains no contact and is dropped; boxes are explored in increasing u, so the
+// A box whose enclosure proves |F| > min_separation (the enclosure misses the
+// ball of that radius, or, rigid queries, F's projections on a separating axis
+// chosen per u-interval from the features' nominal closest points lie beyond
+// it) provably contains no contact and is dropped; boxes are explored in increasing u, so the
 // first u-interval accepted (at most time_tolerance wide, holding a small
 // parameter box that may touch) bounds u* from below. So u_hit <= u*, and at
 // u_hit the features are already within distance_reached; if they truly touch
@@ -182,7 +184,8 @@ struct CcdSettings {
                                       // keeps (at most time_tolerance wide, all before it excluded) without the
                                       // bisection when the features' nominal closest points there are proven within
                                       // min_separation + distance_tolerance at its start (same acceptance rule as
-                                      // the bisection; u_hit <= u* holds either way)
+                                      // the bisection; u_hit <= u* holds either way); the bisection applies the
+                                      // same test at the start of each u-interval it takes up (all before settled)
 };
 
 struct CcdResult {
