@@ -24,7 +24,7 @@ const char* to_string(PairKind k) {
 
 size_t Bvh::memory_bytes() const {
   return nodes.capacity() * sizeof(BvhNode) + triangles.capacity() * sizeof(int32_t) +
-         owned.capacity() * sizeof(uint8_t) + neighbor.capacity() * sizeof(int32_t) + slabs.capacity() * sizeof(Slab) +
+         owned.capacity() * sizeof(uint8_t) + neighbor.capacity() * sizeof(int32_t) +
          sizeof(Bvh);
 }
 
@@ -115,25 +115,6 @@ Bvh build_bvh(const TriangleMesh& mesh, int leaf_size) {
         if (bvh.neighbor[3 * g + j] < 0) bvh.neighbor[3 * g + j] = f;
       }
     }
-  // Face slabs: n.x over the corners in outward-rounded interval arithmetic.
-  bvh.slabs.resize(static_cast<size_t>(nf));
-  for (int f = 0; f < nf; ++f) {
-    Bvh::Slab& sl = bvh.slabs[f];
-    const Vec3 a = mesh.V.row(mesh.F(f, 0)).transpose(), b = mesh.V.row(mesh.F(f, 1)).transpose(),
-               c = mesh.V.row(mesh.F(f, 2)).transpose();
-    const Vec3 n = (b - a).cross(c - a);
-    const double len = n.norm();
-    sl.n = len > 0 && std::isfinite(len) ? Vec3(n / len) : Vec3::Zero();
-    sl.lo = std::numeric_limits<double>::infinity();
-    sl.hi = -sl.lo;
-    for (const Vec3* x : {&a, &b, &c}) {
-      const Interval s = Interval::point(sl.n.x()) * Interval::point(x->x()) +
-                         Interval::point(sl.n.y()) * Interval::point(x->y()) +
-                         Interval::point(sl.n.z()) * Interval::point(x->z());
-      sl.lo = std::min(sl.lo, s.lo);
-      sl.hi = std::max(sl.hi, s.hi);
-    }
-  }
   if (nf > 0) {
     Builder b{mesh, std::max(leaf_size, 1), {}, {}, &bvh};
     b.centroid.resize(static_cast<size_t>(nf));
@@ -191,23 +172,23 @@ struct StartFrame {
   }
 
   // A lower bound of the first u >= u0 at which the god triangle gf can come
-  // within min_separation d of the obstacle triangle `of` (u0 when unknown):
-  // the obstacle triangle lies in its slab lo <= n.x <= hi; if every god vertex
-  // is at u0 above hi by at least `gap` (or below lo), the two triangles, and so
-  // all their features, are farther apart than gap / |n| - static_error -
-  // (u - u0) speed at u (|n| <= 1 + 1e-15, covered by the factor 1 - 1e-12).
-  double earliest(const TriangleMesh& gm, int gf, const Bvh& ob, int of, double d) const {
-    if (ob.slabs.size() != ob.owned.size()) return u0;  // a Bvh not made by build_bvh
-    const Bvh::Slab& sl = ob.slabs[of];
-    if (sl.n == Vec3::Zero()) return u0;
-    double above = std::numeric_limits<double>::infinity(), below = above;
+  // within min_separation d of the obstacle triangle `of` (u0 when unknown). At
+  // u the god-object has moved at most (u - u0) speed from its double pose at
+  // u0, whose corners X = p + R r_B are within static_error of the exact
+  // motion's; so a gap g between the double triangles (triangle_gap_lower_bound:
+  // face normals, and edge cross products, which separate a long side strip of
+  // the peg from the wide fan triangles around the hole's rim where no face
+  // normal does) keeps every feature pair farther than g - static_error -
+  // (u - u0) speed. The search for a larger gap stops once g passes u_limit.
+  double earliest(const TriangleMesh& gm, int gf, const TriangleMesh& om, int of, double d, double u_limit) const {
+    Vec3 X[3], Y[3];
     for (int k = 0; k < 3; ++k) {
-      const double x = sl.n.dot(R * gm.V.row(gm.F(gf, k)).transpose() + p);
-      above = std::min(above, x - sl.hi);
-      below = std::min(below, sl.lo - x);
+      X[k] = R * gm.V.row(gm.F(gf, k)).transpose() + p;
+      Y[k] = om.V.row(om.F(of, k)).transpose();
     }
-    const double gap = next_down(std::max(above, below));  // NaN: comparisons below fail
-    const double clear = next_down(next_down(next_down(gap * (1 - 1e-12)) - static_error) - d);
+    const double reach = next_up(next_up(static_error + d) + next_up(next_up(u_limit - u0) * speed));
+    const double gap = triangle_gap_lower_bound(X, Y, reach);
+    const double clear = next_down(next_down(gap - static_error) - d);
     if (!(clear > 0)) return u0;
     if (!(speed > 0)) return std::numeric_limits<double>::infinity();
     return next_down(u0 + next_down(clear / speed));
@@ -339,11 +320,20 @@ void ccd_step(const CcdBody* obstacles, int num_obstacles, const CcdBody& god, c
     // tested at once, in traversal order (same result, less pruning).
     int num_cand = 0;
     ws->swept.next_interval();  // e changed: every cached god box is stale
+    // Node pairs whose world boxes meet are then tested as oriented boxes, grown
+    // by what the god-object's points may move over the sub-interval, plus d.
+    const double grow = next_up(next_up(start.static_error + d) + next_up(next_up(u1 - u0) * start.speed));
+    const OrientedBoxFilter oriented(start.R, start.p,
+                                     std::isfinite(grow) ? grow : std::numeric_limits<double>::infinity());
+    // God boxes grown by d once here (outward rounded), so the traversal compares
+    // them with the obstacles' exact boxes as they are (margin 0 below): the same
+    // test as growing each obstacle box by d, without its roundings per node pair.
+    const auto box_over = [&](const Aabb& body) { return inflate(swept_box(e, body), d); };
     const auto god_node_box = [&](int node) {
-      return ws->swept.get(ws->swept.nodes, node, [&] { return swept_box(e, god.bvh->nodes[node].box); });
+      return ws->swept.get(ws->swept.nodes, node, [&] { return box_over(god.bvh->nodes[node].box); });
     };
     const auto god_face_box = [&](int face) {
-      return ws->swept.get(ws->swept.faces, face, [&] { return swept_box(e, triangle_box(*god.mesh, face)); });
+      return ws->swept.get(ws->swept.faces, face, [&] { return box_over(triangle_box(*god.mesh, face)); });
     };
     for (int o = 0; o < num_obstacles; ++o) {
       const CcdBody& ob = obstacles[o];
@@ -353,7 +343,7 @@ void ccd_step(const CcdBody* obstacles, int num_obstacles, const CcdBody& god, c
       }
       const auto visit = [&](int gf, int of) {
         ++result->num_triangle_pairs;
-        const double t = start.earliest(*god.mesh, gf, *ob.bvh, of, d);
+        const double t = start.earliest(*god.mesh, gf, *ob.mesh, of, d, tester.end());
         if (t > tester.end()) {
           ++result->num_slab_culls;
           return true;
@@ -367,8 +357,11 @@ void ccd_step(const CcdBody* obstacles, int num_obstacles, const CcdBody& god, c
         return !tester.done();
       };
       const TraversalStatus ts =
-          for_each_candidate_pair_indexed(*god.mesh, *god.bvh, *ob.mesh, *ob.bvh, god_node_box, god_face_box, d,
-                                          &ws->stack, visit, &result->num_node_pairs);
+          for_each_candidate_pair_indexed(*god.mesh, *god.bvh, *ob.mesh, *ob.bvh, god_node_box, god_face_box,
+                                          /*margin=*/0, &ws->stack, visit, &result->num_node_pairs,
+                                          [&](const Aabb& body, const Aabb& world) {
+                                            return oriented.separated(body, world);
+                                          });
       if (ts == TraversalStatus::kStackFull) {
         // Unknown beyond here: stop conservatively at the sub-interval's start.
         result->status = CcdStatus::kWorkspaceFull;

@@ -113,7 +113,19 @@ ContactStatus generate_contacts(const CcdBody* obstacles, int num_obstacles, con
   const TriangleMesh& gm = *god.mesh;
   const Mat3 R = rotation_matrix(X_WB.q);
   const Vec3& G = X_WB.p;
-  for (Eigen::Index v = 0; v < gm.V.rows(); ++v) ws->god_world[v] = G + R * gm.V.row(v).transpose();
+  // God vertices are posed when a candidate pair first needs them: most of a
+  // large mesh is never near an obstacle.
+  if (++ws->stamp == 0) {  // wrapped around (every 2^32 calls)
+    std::fill(ws->posed.begin(), ws->posed.end(), 0);
+    ws->stamp = 1;
+  }
+  const auto world = [&](int v) -> const Vec3& {
+    if (ws->posed[v] != ws->stamp) {
+      ws->god_world[v] = G + R * gm.V.row(v).transpose();
+      ws->posed[v] = ws->stamp;
+    }
+    return ws->god_world[v];
+  };
   // World box of a body box: centre and half extents through |R|, grown by a
   // rounding allowance (the double vertices above carry ~1e-16 relative error).
   const Mat3 absR = R.cwiseAbs();
@@ -124,6 +136,9 @@ ContactStatus generate_contacts(const CcdBody* obstacles, int num_obstacles, con
     return Aabb{c - h - slack, c + h + slack};
   };
   const double d = settings.distance;
+  // Boxes that meet are then tested as oriented boxes (bvh.h), grown by d and by a
+  // rounding allowance for the posed vertices (relative 1e-16 or so).
+  const OrientedBoxFilter oriented(R, G, d + 1e-12 * (G.cwiseAbs().maxCoeff() + god.bvh->radius));
   Collector col{settings, settings.merge_distance > 0 ? settings.merge_distance : 1e-3 * d,
                 std::cos(settings.merge_angle), set};
   const double par2 = settings.parallel_sine * settings.parallel_sine;
@@ -133,10 +148,13 @@ ContactStatus generate_contacts(const CcdBody* obstacles, int num_obstacles, con
     const TriangleMesh& om = *obstacles[o].mesh;
     const Bvh& ob = *obstacles[o].bvh;
     const auto ov = [&](int f, int k) -> Vec3 { return om.V.row(om.F(f, k)).transpose(); };
-    const auto gv = [&](int f, int k) -> const Vec3& { return ws->god_world[gm.F(f, k)]; };
+    const auto gv = [&](int f, int k) -> const Vec3& { return world(gm.F(f, k)); };
     const auto visit = [&](int gf, int of) {
       const uint8_t go = god.bvh->owned[gf], oo = ob.owned[of];
       const Vec3 oa = ov(of, 0), obb = ov(of, 1), oc = ov(of, 2);
+      // Pairs proven farther apart than d by a separating axis have no pair within d.
+      const Vec3 X[3] = {gv(gf, 0), gv(gf, 1), gv(gf, 2)}, Y[3] = {oa, obb, oc};
+      if (triangle_gap_lower_bound(X, Y, d) > d) return true;
       // God vertices against the obstacle face: the face normal.
       for (int k = 0; k < 3; ++k) {
         if (!(go & (1u << k))) continue;
@@ -188,7 +206,10 @@ ContactStatus generate_contacts(const CcdBody* obstacles, int num_obstacles, con
       return true;
     };
     int node_pairs = 0;
-    if (for_each_candidate_pair(gm, *god.bvh, om, ob, god_box, d, &ws->stack, visit, &node_pairs) ==
+    const auto node_box = [&](int node) { return god_box(god.bvh->nodes[node].box); };
+    const auto face_box = [&](int face) { return god_box(triangle_box(gm, face)); };
+    if (for_each_candidate_pair_indexed(gm, *god.bvh, om, ob, node_box, face_box, d, &ws->stack, visit, &node_pairs,
+                                        [&](const Aabb& body, const Aabb& w) { return oriented.separated(body, w); }) ==
         TraversalStatus::kStackFull)
       status = ContactStatus::kStackFull;
   }

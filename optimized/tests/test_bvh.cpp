@@ -318,3 +318,137 @@ TEST_CASE("swept box cache: returns the box of the asked index in the current su
   CHECK(check(0));
   CHECK(calls == 6);
 }
+
+namespace {
+
+// Reference distance of two triangles in long double: the minimum over the six
+// vertex/triangle and nine edge/edge distances (enough for disjoint triangles;
+// intersecting pairs are not generated below). Independent of contacts.h.
+using Vec3L = Eigen::Matrix<long double, 3, 1>;
+long double point_segment(const Vec3L& x, const Vec3L& a, const Vec3L& b) {
+  const Vec3L ab = b - a;
+  const long double t = std::clamp((x - a).dot(ab) / std::max(ab.squaredNorm(), 1e-300L), 0.0L, 1.0L);
+  return (a + t * ab - x).norm();
+}
+long double point_triangle(const Vec3L& x, const Vec3L T[3]) {
+  const Vec3L n = (T[1] - T[0]).cross(T[2] - T[0]);
+  const Vec3L y = x - n * ((x - T[0]).dot(n) / n.squaredNorm());  // projection on the plane
+  bool inside = true;
+  for (int k = 0; k < 3; ++k) inside &= (T[(k + 1) % 3] - T[k]).cross(y - T[k]).dot(n) >= 0;
+  if (inside) return (x - y).norm();
+  long double best = point_segment(x, T[0], T[1]);
+  for (int k = 1; k < 3; ++k) best = std::min(best, point_segment(x, T[k], T[(k + 1) % 3]));
+  return best;
+}
+long double segment_segment(const Vec3L& p0, const Vec3L& p1, const Vec3L& q0, const Vec3L& q1) {
+  // Minimum over a fine parameter grid refined around its best cell, plus the end cases.
+  long double best = std::min({point_segment(p0, q0, q1), point_segment(p1, q0, q1), point_segment(q0, p0, p1),
+                               point_segment(q1, p0, p1)});
+  const Vec3L d1 = p1 - p0, d2 = q1 - q0, r = p0 - q0;
+  const long double a = d1.dot(d1), e = d2.dot(d2), b = d1.dot(d2), c = d1.dot(r), f = d2.dot(r);
+  const long double den = a * e - b * b;
+  if (den > 1e-24L * a * e) {
+    const long double s = (b * f - c * e) / den, t = (a * f - b * c) / den;
+    if (s >= 0 && s <= 1 && t >= 0 && t <= 1) best = std::min(best, (p0 + s * d1 - q0 - t * d2).norm());
+  }
+  return best;
+}
+long double triangle_distance(const Vec3 A[3], const Vec3 B[3]) {
+  Vec3L a[3], b[3];
+  for (int k = 0; k < 3; ++k) {
+    a[k] = A[k].cast<long double>();
+    b[k] = B[k].cast<long double>();
+  }
+  long double best = std::numeric_limits<long double>::infinity();
+  for (int k = 0; k < 3; ++k) best = std::min({best, point_triangle(a[k], b), point_triangle(b[k], a)});
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j)
+      best = std::min(best, segment_segment(a[i], a[(i + 1) % 3], b[j], b[(j + 1) % 3]));
+  return best;
+}
+
+}  // namespace
+
+TEST_CASE("triangle_gap_lower_bound: never above the distance, and useful", "[bvh]") {
+  std::mt19937 rng(31);
+  std::normal_distribution<double> n(0, 1);
+  std::uniform_real_distribution<double> U(0, 1);
+  int checked = 0, useful = 0, separated_by_plane = 0;
+  for (int i = 0; i < 20000; ++i) {
+    // Triangle A about a random centre; B placed a random gap beyond a random
+    // plane through A's extreme point (so they are disjoint), at scales from
+    // 1e-3 to 1e3, some long and thin (a peg's side strip), some coplanar-ish.
+    const double scale = std::pow(10.0, 6 * U(rng) - 3);
+    const Vec3 c = scale * 10 * Vec3(n(rng), n(rng), n(rng));
+    Vec3 A[3], B[3];
+    for (int k = 0; k < 3; ++k) A[k] = c + scale * Vec3(n(rng), n(rng), n(rng));
+    if (i % 4 == 0) A[2] = A[0] + 1e-2 * (A[2] - A[0]) + 30 * (A[1] - A[0]);  // long and thin
+    const Vec3 m = Vec3(n(rng), n(rng), n(rng)).normalized();
+    double top = -1e300;
+    for (const Vec3& a : A) top = std::max(top, m.dot(a));
+    const double gap = scale * std::pow(10.0, -9 * U(rng));
+    for (int k = 0; k < 3; ++k) {
+      Vec3 v = c + scale * Vec3(n(rng), n(rng), n(rng));
+      if (i % 7 == 0) v -= m * m.dot(v - c) * 0.999;  // nearly parallel to the plane
+      B[k] = v + m * (top + gap - m.dot(v) + scale * std::abs(n(rng)) * (i % 3 == 0 ? 0 : 1));
+    }
+    const long double exact = triangle_distance(A, B);
+    if (!(exact > 0)) continue;
+    const double bound = triangle_gap_lower_bound(A, B, std::numeric_limits<double>::infinity());
+    ++checked;
+    // The reference's own rounding: long double, relative 1e-17 of the coordinates.
+    REQUIRE(static_cast<long double>(bound) <= exact + 1e-16L * (c.norm() + 30 * scale));
+    useful += bound >= 0.5 * static_cast<double>(exact);
+    // The early exit returns more than `enough` or the full bound.
+    const double enough = 0.25 * static_cast<double>(exact);
+    const double early = triangle_gap_lower_bound(A, B, enough);
+    CHECK((early > enough || early == bound));
+    separated_by_plane += gap > 1e-6 * scale;
+  }
+  std::printf("triangle_gap_lower_bound: %d pairs, bound >= half the distance on %d\n", checked, useful);
+  CHECK(checked > 19000);
+  CHECK(useful > checked / 4);  // many pairs' closest features are not along the 11 axes
+  CHECK(separated_by_plane > 1000);
+  // Touching and intersecting triangles: no gap.
+  const Vec3 T[3] = {Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(0, 1, 0)};
+  const Vec3 S[3] = {Vec3(0.2, 0.2, 0), Vec3(0.2, 0.2, 1), Vec3(1, 1, 1)};  // touches T at a point
+  CHECK(triangle_gap_lower_bound(T, S, 0) == 0);
+  const Vec3 P[3] = {Vec3(0.2, 0.2, -1), Vec3(0.2, 0.2, 1), Vec3(1, 1, 1)};  // pierces T
+  CHECK(triangle_gap_lower_bound(T, P, 0) == 0);
+  const Vec3 N[3] = {Vec3(0, 0, std::nan("")), Vec3(1, 0, 2), Vec3(0, 1, 2)};
+  CHECK(triangle_gap_lower_bound(T, N, 0) == 0);
+}
+
+TEST_CASE("OrientedBoxFilter: never separates boxes that share a point, separates far ones", "[bvh]") {
+  std::mt19937 rng(37);
+  std::normal_distribution<double> n(0, 1);
+  std::uniform_real_distribution<double> U(0, 1);
+  int separated_far = 0, far = 0;
+  for (int i = 0; i < 20000; ++i) {
+    const double scale = std::pow(10.0, 4 * U(rng) - 2);
+    Mat3 R = rotation_matrix(normalized(Quat{n(rng), n(rng), n(rng), n(rng)}));
+    if (i % 5 == 0) R = rotation_matrix(normalized(quat_exp(1e-3 * Vec3(n(rng), n(rng), n(rng)))));  // tilted a bit
+    const Vec3 p = scale * 10 * Vec3(n(rng), n(rng), n(rng));
+    const OrientedBoxFilter f(R, p, scale * std::pow(10.0, -8 * U(rng)) * (i % 3 == 0 ? 0 : 1));
+    Vec3 h = scale * Vec3(n(rng), n(rng), n(rng)).cwiseAbs();
+    if (i % 4 == 0) h[i % 3] *= 100;  // long and thin
+    const Vec3 cb = scale * Vec3(n(rng), n(rng), n(rng));
+    const Aabb body{cb - h, cb + h};
+    // A point of the posed box grown by `grow` (a corner, pushed out by up to grow).
+    Vec3 x;
+    for (int k = 0; k < 3; ++k) x[k] = U(rng) < 0.5 ? body.lo[k] : body.hi[k];
+    if (i % 2) x = body.lo + (body.hi - body.lo).cwiseProduct(Vec3(U(rng), U(rng), U(rng)));
+    const Vec3 y = f.R * x + f.p + f.grow * 0.999 * Vec3(n(rng), n(rng), n(rng)).normalized();
+    // A world box with y on its boundary or inside.
+    const Vec3 lo = y - scale * Vec3(U(rng), U(rng), U(rng)) * (i % 3 == 1 ? 0 : 1);
+    const Vec3 hi = y + scale * Vec3(U(rng), U(rng), U(rng)) * (i % 3 == 2 ? 0 : 1);
+    REQUIRE_FALSE(f.separated(body, {lo, hi}));
+    // A world box beyond the grown posed box's bounding sphere: separated.
+    const double radius = (h + Vec3::Constant(f.grow)).norm();
+    const Vec3 dir = Vec3(n(rng), n(rng), n(rng)).normalized();
+    const Vec3 centre = f.R * cb + f.p + dir * (radius * 1.01 + 2 * scale);
+    ++far;
+    separated_far += f.separated(body, {centre - Vec3::Constant(scale), centre + Vec3::Constant(scale)});
+  }
+  CHECK(separated_far == far);
+}

@@ -22,6 +22,9 @@
 #include "gauss6/ccd.h"
 #include "gauss6/mesh.h"
 
+// Forces a hot lambda inline (GCC and Clang), as GAUSS6_ALWAYS_INLINE in ccd.h.
+#define GAUSS6_ALWAYS_INLINE_LAMBDA __attribute__((always_inline))
+
 namespace gauss6 {
 
 struct Aabb {
@@ -45,11 +48,6 @@ struct Bvh {
   std::vector<int32_t> triangles;    // triangle indices, in leaf order
   std::vector<uint8_t> owned;        // #F: bit k owns vertex F(f,k); bit 3+k owns edge F(f,k)->F(f,(k+1)%3)
   std::vector<int32_t> neighbor;     // 3 #F: triangle across edge k of f, -1 on a boundary
-  // Per triangle, a slab that holds it: unit normal n (doubles; zero for a
-  // degenerate triangle) and lo <= n.x <= hi for every point x of the triangle,
-  // the bounds rounded outward. Any n would do: the slab is what is rigorous.
-  struct Slab { Vec3 n = Vec3::Zero(); double lo = 0, hi = 0; };
-  std::vector<Slab> slabs;           // #F
   int depth = 0;                     // levels (1: the root is a leaf)
   double radius = 0;                 // max |vertex| about the frame's origin (scene units)
   double build_seconds = 0;
@@ -81,6 +79,107 @@ inline Aabb inflate(const Aabb& box, double margin) {
   return out;
 }
 
+// Separating-axis bound of the distance of two triangles A and B given by their
+// corners (one frame, doubles): the largest gap proven along the two face
+// normals and the nine edge cross products, rounding included (0 when none
+// proves a positive gap), returned as soon as one axis proves more than
+// `enough`.
+//
+// Proof. For convex sets and any vector a != 0, dist(A, B) >= (min_B a.y -
+// max_A a.x) / |a| (or the mirror). Whatever the rounded axis a is, each
+// rounded projection fl(a.x) is within 3.4e-16 |a|_1 |x|_inf of a.x (three
+// products and two sums), and the difference of two within twice that plus its
+// own rounding; so raw - 1e-13 |a|_1 s, s the largest coordinate of the six
+// corners, is below the exact gap along a. Dividing by |a| (1 + 1e-12), with
+// the quotient rounded down, covers the roundings of the norm and the quotient.
+// Inline: the mesh step and the contact generation call it for every candidate
+// triangle pair.
+inline double triangle_gap_lower_bound(const Vec3 A[3], const Vec3 B[3], double enough) {
+  double s = 0;
+  for (int k = 0; k < 3; ++k) s = std::max(s, std::max(A[k].cwiseAbs().maxCoeff(), B[k].cwiseAbs().maxCoeff()));
+  double best = 0;
+  const auto along = [&](const Vec3& a) GAUSS6_ALWAYS_INLINE_LAMBDA {
+    double a_lo = a.dot(A[0]), a_hi = a_lo, b_lo = a.dot(B[0]), b_hi = b_lo;
+    for (int k = 1; k < 3; ++k) {
+      const double pa = a.dot(A[k]), pb = a.dot(B[k]);
+      a_lo = std::min(a_lo, pa);
+      a_hi = std::max(a_hi, pa);
+      b_lo = std::min(b_lo, pb);
+      b_hi = std::max(b_hi, pb);
+    }
+    const double proven = std::max(b_lo - a_hi, a_lo - b_hi) - 1e-13 * a.cwiseAbs().sum() * s;
+    if (!(proven > 0)) return false;  // also on NaN
+    const double g = next_down(proven / next_up(a.norm() * (1 + 1e-12)));
+    if (g > best) best = g;           // a zero axis gives +inf or NaN: dropped below
+    if (!(best < std::numeric_limits<double>::infinity())) best = 0;
+    return best > enough;
+  };
+  const Vec3 ea[3] = {A[1] - A[0], A[2] - A[1], A[0] - A[2]}, eb[3] = {B[1] - B[0], B[2] - B[1], B[0] - B[2]};
+  if (along(ea[0].cross(ea[1])) || along(eb[0].cross(eb[1]))) return best;
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j)
+      if (along(ea[i].cross(eb[j]))) return best;
+  return best;
+}
+
+// Oriented-box test of the simultaneous descent. A god node's box is tight in the
+// body frame, but its world box (swept_box) grows with the rotation: a 10 cm
+// side strip of the peg tilted by half a degree gets a world box about 1 mm
+// wide, five times the hole's clearance, and meets every box near the hole.
+// Posed as an oriented box, it stays as thin as it is. `pose` is the
+// god-object's double pose (X = R r_B + p) and `grow` must cover how far the
+// node's mesh points may lie from their double posed positions over the range
+// tested, plus the distance sought (the mesh step: static_error + (u1 - u0)
+// speed + d, see StartFrame in bvh.cpp); the box grown by `grow` along its own
+// axes holds the ball of that radius around each of its points.
+struct OrientedBoxFilter {
+  OrientedBoxFilter() = default;
+  OrientedBoxFilter(const Mat3& R_in, const Vec3& p_in, double grow_in) : R(R_in), p(p_in), grow(grow_in) {
+    A = R.cwiseAbs();
+    A.array() += 1e-15;
+  }
+  Mat3 R = Mat3::Identity();
+  Vec3 p = Vec3::Zero();
+  double grow = 0;
+  Mat3 A = Mat3::Constant(1e-15) + Mat3::Identity();  // |R| + 1e-15
+  // True when the posed god box (body frame), grown, provably misses the world
+  // box: a separating axis among the 15 of the two boxes (Gottschalk, Lin and
+  // Manocha 1996). Rounding: every side of every comparison is a sum of at most
+  // a dozen products of an |R| entry (<= 1 + 1e-15) and a number <= s (the
+  // largest coordinate or half extent involved), each rounded to within 2^-53
+  // of itself, and the centres' differences are rounded likewise; 1e-11 s
+  // covers them many times over, and |R| + 1e-15 keeps the
+  // edge axes of near-parallel edges from proving a gap out of rounding noise.
+  GAUSS6_ALWAYS_INLINE bool separated(const Aabb& body_box, const Aabb& world_box) const {
+    const Vec3 ha = 0.5 * (body_box.hi - body_box.lo) + Vec3::Constant(grow);
+    const Vec3 hb = 0.5 * (world_box.hi - world_box.lo);
+    const Vec3 cb = 0.5 * (body_box.lo + body_box.hi), cw = 0.5 * (world_box.lo + world_box.hi);
+    const Vec3 ca = R * cb + p;
+    const Vec3 t_w = cw - ca;             // world frame
+    const Vec3 t = R.transpose() * t_w;   // the god box's frame
+    const double s = std::max({ha.maxCoeff(), hb.maxCoeff(), t_w.cwiseAbs().maxCoeff(), ca.cwiseAbs().maxCoeff(),
+                               cb.cwiseAbs().maxCoeff(), cw.cwiseAbs().maxCoeff(), p.cwiseAbs().maxCoeff()});
+    const double eps = 1e-11 * s;
+    // Axes of the god box (rows of R^T), then the world axes.
+    for (int i = 0; i < 3; ++i)
+      if (std::abs(t[i]) > ha[i] + A.col(i).dot(hb) + eps) return true;
+    for (int j = 0; j < 3; ++j)
+      if (std::abs(t_w[j]) > hb[j] + A.row(j).dot(ha) + eps) return true;
+    // Cross products of a god box axis i (world direction R.col(i)) and world axis j.
+    for (int i = 0; i < 3; ++i) {
+      const int i1 = (i + 1) % 3, i2 = (i + 2) % 3;
+      for (int j = 0; j < 3; ++j) {
+        const int j1 = (j + 1) % 3, j2 = (j + 2) % 3;
+        const double dist = std::abs(t[i2] * R(j, i1) - t[i1] * R(j, i2));
+        const double ra = ha[i1] * A(j, i2) + ha[i2] * A(j, i1);
+        const double rb = hb[j1] * A(j2, i) + hb[j2] * A(j1, i);
+        if (dist > ra + rb + eps) return true;
+      }
+    }
+    return false;  // also on NaN
+  }
+};
+
 // Fixed-capacity stack of node pairs for the simultaneous descent.
 struct BvhStack {
   explicit BvhStack(int capacity = 1024) : items(static_cast<size_t>(capacity)) {}
@@ -98,12 +197,15 @@ enum class TraversalStatus { kDone = 0, kStopped, kStackFull };
 // for_each_candidate_pair_indexed() is the same traversal with the god boxes
 // given by index: god_node_box(int node) -> Aabb world for god.nodes[node], and
 // god_face_box(int face) -> Aabb world for face `face` of god_mesh (so a caller
-// can cache them: see SweptBoxCache).
-template <class GodNodeBox, class GodFaceBox, class Visit>
+// can cache them: see SweptBoxCache); and node pairs whose world boxes overlap
+// are then dropped when separated(god_node_box_body, obstacle_node_box) proves
+// them apart (an OrientedBoxFilter, or nothing: see the overload).
+template <class GodNodeBox, class GodFaceBox, class Visit, class Separated>
 TraversalStatus for_each_candidate_pair_indexed([[maybe_unused]] const TriangleMesh& god_mesh, const Bvh& god,
                                                 const TriangleMesh& obs_mesh, const Bvh& obs,
                                                 const GodNodeBox& god_node_box, const GodFaceBox& god_face_box,
-                                                double margin, BvhStack* stack, Visit&& visit, int* num_node_pairs) {
+                                                double margin, BvhStack* stack, Visit&& visit, int* num_node_pairs,
+                                                const Separated& separated) {
   if (god.nodes.empty() || obs.nodes.empty()) return TraversalStatus::kDone;
   const int capacity = static_cast<int>(stack->items.size());
   auto* items = stack->items.data();
@@ -115,7 +217,7 @@ TraversalStatus for_each_candidate_pair_indexed([[maybe_unused]] const TriangleM
     const BvhNode& on = obs.nodes[oi];
     ++*num_node_pairs;
     const Aabb gw = god_node_box(gi);
-    if (!overlap(gw, inflate(on.box, margin))) continue;
+    if (!overlap(gw, inflate(on.box, margin)) || separated(gn.box, on.box)) continue;
     if (gn.count > 0 && on.count > 0) {
       // Leaf pair: test triangle boxes, then hand the pair over.
       for (int i = 0; i < gn.count; ++i) {
@@ -141,6 +243,15 @@ TraversalStatus for_each_candidate_pair_indexed([[maybe_unused]] const TriangleM
     }
   }
   return TraversalStatus::kDone;
+}
+template <class GodNodeBox, class GodFaceBox, class Visit>
+TraversalStatus for_each_candidate_pair_indexed(const TriangleMesh& god_mesh, const Bvh& god,
+                                                const TriangleMesh& obs_mesh, const Bvh& obs,
+                                                const GodNodeBox& god_node_box, const GodFaceBox& god_face_box,
+                                                double margin, BvhStack* stack, Visit&& visit, int* num_node_pairs) {
+  return for_each_candidate_pair_indexed(god_mesh, god, obs_mesh, obs, god_node_box, god_face_box, margin, stack,
+                                         std::forward<Visit>(visit), num_node_pairs,
+                                         [](const Aabb&, const Aabb&) { return false; });
 }
 template <class GodBox, class Visit>
 TraversalStatus for_each_candidate_pair(const TriangleMesh& god_mesh, const Bvh& god, const TriangleMesh& obs_mesh,
@@ -190,13 +301,14 @@ struct CcdStepResult {
   double time_tolerance_reached = 0, distance_reached = 0;  // of that pair's test
   CcdMotion motion;                        // the enclosed motion used (for make_stop_pose)
   int num_sub_intervals = 0, num_node_pairs = 0, num_triangle_pairs = 0, num_pair_tests = 0;
-  int num_slab_culls = 0;                  // triangle pairs dropped whole by a face slab (no pair test)
+  int num_slab_culls = 0;                  // triangle pairs dropped whole by a separating-axis bound (no pair test)
   long num_box_iterations = 0;             // narrow-phase boxes, all tests together
 };
 
 // Everything ccd_step needs, allocated once.
-// World boxes of god nodes, faces and vertices over the current sub-interval, so each is
-// enclosed once per sub-interval however many obstacle nodes it meets: a
+// World boxes of god nodes, faces and vertices over the current sub-interval (ccd_step
+// keeps node and face boxes grown by min_separation, vertex boxes as they are), so
+// each is enclosed once per sub-interval however many obstacle nodes it meets: a
 // direct-mapped cache (index & mask -> entry; a collision just recomputes), of
 // fixed size, so any mesh fits without allocation. Entries are valid while
 // their stamp equals `stamp` (next_interval() invalidates them all in O(1)).
@@ -242,12 +354,14 @@ struct CcdStepWorkspace {
   BvhStack stack;
   std::vector<Candidate> candidates;  // tested earliest-first; overflow is tested in traversal order
   SweptBoxCache swept;                // god boxes of the current sub-interval
+
 };
 
 // The first contact of the god-object moving from X0 to X1 (the Cayley motion)
 // with any obstacle: u_hit <= u* over all feature pairs. Per sub-interval, the
 // candidate triangle pairs get a rigorous lower bound of their first contact
-// from the obstacle face's slab and a bound on the god-object's speed; pairs
+// from a separating-axis bound of their distance at the sub-interval's start
+// (triangle_gap_lower_bound) and a bound on the god-object's speed; pairs
 // that cannot touch in time are dropped, the rest are tested earliest-first,
 // each only up to (best u so far) - time_tolerance, and the step reports the
 // best u less time_tolerance (so u* - u_hit grows by at most that tolerance).

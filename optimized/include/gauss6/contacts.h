@@ -21,6 +21,7 @@
 // set keeps the first ones found and says so (overflow).
 #pragma once
 
+#include <cstdint>
 #include <vector>
 
 #include <Eigen/Core>
@@ -57,11 +58,14 @@ struct ContactSet {
   Eigen::Matrix<double, Eigen::Dynamic, 6, Eigen::RowMajor> J;
 };
 
-// World positions of the god-object's vertices and the traversal stack.
+// World positions of the god-object's vertices, posed on first use in each call
+// (a vertex is current when its stamp equals `stamp`), and the traversal stack.
 struct ContactWorkspace {
   explicit ContactWorkspace(const TriangleMesh& god_mesh, int stack_capacity = 1024)
-      : god_world(static_cast<size_t>(god_mesh.V.rows())), stack(stack_capacity) {}
+      : god_world(static_cast<size_t>(god_mesh.V.rows())), posed(god_world.size(), 0), stack(stack_capacity) {}
   std::vector<Vec3> god_world;
+  std::vector<uint32_t> posed;
+  uint32_t stamp = 0;
   BvhStack stack;
 };
 
