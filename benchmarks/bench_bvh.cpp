@@ -46,17 +46,8 @@ void BM_BvhBuild(benchmark::State& state, const std::string& relpath, int leaf_s
 
 // u_hit of every step of a set at its delta (1 where no hit).
 std::vector<double> step_answers(const CcdSet& set) {
-  CcdStepSettings settings;
-  settings.narrow.min_separation = set.delta;
-  CcdStepWorkspace ws;
-  CcdStepResult r;
   std::vector<double> u;
-  for (const CcdSetStep& st : set.steps) {
-    const CcdMeshPair& p = *set.pairs[st.pair];
-    const CcdBody obstacle = p.obstacle_body();
-    ccd_step(&obstacle, 1, p.god_body(), st.x0, st.x1, settings, &ws, &r);
-    u.push_back(r.hit ? r.u_hit : 1.0);
-  }
+  for_each_set_step(set, [&](const CcdSetStep&, const CcdStepResult& r) { u.push_back(r.hit ? r.u_hit : 1.0); });
   return u;
 }
 
@@ -71,41 +62,29 @@ void BM_CcdStepLeafSize(benchmark::State& state, const std::string& set_name, in
   settings.narrow.min_separation = set.delta;
   CcdStepWorkspace ws;
   CcdStepResult r;
-  LatencyRecorder rec;
-  size_t i = 0;
-  double node_pairs = 0, pair_tests = 0, calls = 0;
-  for (auto _ : state) {
-    const CcdSetStep& st = set.steps[i++ % set.steps.size()];
-    const CcdMeshPair& p = *set.pairs[st.pair];
-    const CcdBody obstacle = p.obstacle_body();
-    rec.time(state, [&] { ccd_step(&obstacle, 1, p.god_body(), st.x0, st.x1, settings, &ws, &r); });
-    benchmark::DoNotOptimize(r.u_hit);
-    node_pairs += r.num_node_pairs;
-    pair_tests += r.num_pair_tests;
-    calls += 1;
-  }
-  rec.report(state);
+  PerCallCounters counters;
+  time_each(
+      state, set.steps, &counters, [&](const CcdSetStep& st) { run_set_step(set, st, settings, &ws, &r); },
+      [&](const CcdSetStep&) {
+        benchmark::DoNotOptimize(r.u_hit);
+        counters.add("node_pairs", r.num_node_pairs);
+        counters.add("pair_tests", r.num_pair_tests);
+      });
   state.counters["u_hit_max_diff"] = max_diff;
-  state.counters["node_pairs_per_step"] = node_pairs / calls;
-  state.counters["pair_tests_per_step"] = pair_tests / calls;
 }
 
 void register_all() {
   for (const char* m : {"peg_in_hole/peg.off", "peg_in_hole/box_with_hole.off", "bunny/bunny.off"})
     for (int leaf : {1, 2, 4, 8, 16})
-      benchmark::RegisterBenchmark(("BvhBuild/" + std::string(m) + "/leaf:" + std::to_string(leaf)).c_str(),
-                                   BM_BvhBuild, std::string(m), leaf)
-          ->UseManualTime()
-          ->Unit(benchmark::kMicrosecond);
+      register_latency("BvhBuild/" + std::string(m) + "/leaf:" + std::to_string(leaf), BM_BvhBuild, std::string(m),
+                       leaf);
   // Sets with contacts on both meshes; iterations: a few passes over each set.
   struct Case { const char* set; int iterations; };
   for (Case c : {Case{"peg_script", 190}, Case{"random", 180}, Case{"bunny_script", 60}})
     for (int leaf : {1, 2, 4, 8, 16})
-      benchmark::RegisterBenchmark(("CcdStepLeafSize/" + std::string(c.set) + "/leaf:" + std::to_string(leaf)).c_str(),
-                                   BM_CcdStepLeafSize, std::string(c.set), leaf)
-          ->UseManualTime()
-          ->Iterations(c.iterations)
-          ->Unit(benchmark::kMicrosecond);
+      register_latency("CcdStepLeafSize/" + std::string(c.set) + "/leaf:" + std::to_string(leaf), BM_CcdStepLeafSize,
+                       std::string(c.set), leaf)
+          ->Iterations(c.iterations);
 }
 
 const int registered = (register_all(), 0);

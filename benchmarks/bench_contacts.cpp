@@ -12,6 +12,7 @@
 
 #include "bench_data.h"
 #include "gauss6/contacts.h"
+#include "gauss6/runtime.h"
 #include "latency.h"
 
 namespace gauss6::bench {
@@ -23,18 +24,11 @@ struct StopCase {
 };
 
 std::vector<StopCase> stop_poses(const CcdSet& set) {
-  CcdStepSettings settings;
-  settings.narrow.min_separation = set.delta;
-  CcdStepWorkspace ws;
-  CcdStepResult r;
   std::vector<StopCase> out;
-  for (const CcdSetStep& st : set.steps) {
-    const CcdMeshPair& p = *set.pairs[st.pair];
-    const CcdBody obstacle = p.obstacle_body();
-    ccd_step(&obstacle, 1, p.god_body(), st.x0, st.x1, settings, &ws, &r);
+  for_each_set_step(set, [&](const CcdSetStep& st, const CcdStepResult& r) {
     const bool stopped = r.hit && r.status != CcdStatus::kHalfTurn && r.status != CcdStatus::kInvalidInput;
-    out.push_back({st.pair, stopped ? make_stop_pose(r.motion, r.u_hit, p.god_bvh.radius).pose : st.x1});
-  }
+    out.push_back({st.pair, stopped ? make_stop_pose(r.motion, r.u_hit, set.pairs[st.pair]->god_bvh.radius).pose : st.x1});
+  });
   return out;
 }
 
@@ -42,33 +36,28 @@ void BM_Contacts(benchmark::State& state, const std::string& set_name) {
   const CcdSet& set = ccd_set(set_name);
   const std::vector<StopCase> cases = stop_poses(set);
   ContactSettings settings;
-  settings.distance = 1.5 * set.delta;
+  settings.distance = (1 + RuntimeSettings{}.contact_factor) * set.delta;  // the runtime's band
   std::vector<ContactWorkspace> ws;
   for (const auto& p : set.pairs) ws.emplace_back(p->god);
   ContactSet contacts(64);
-  LatencyRecorder rec;
-  size_t i = 0;
-  double num_contacts = 0, num_within = 0, calls = 0;
-  for (auto _ : state) {
-    const StopCase& c = cases[i++ % cases.size()];
-    const CcdMeshPair& p = *set.pairs[c.pair];
-    const CcdBody obstacle = p.obstacle_body();
-    rec.time(state, [&] { generate_contacts(&obstacle, 1, p.god_body(), c.pose, settings, &ws[c.pair], &contacts); });
-    benchmark::DoNotOptimize(contacts.num_contacts);
-    num_contacts += contacts.num_contacts;
-    num_within += contacts.num_pairs_within;
-    calls += 1;
-  }
-  rec.report(state);
-  state.counters["contacts_per_call"] = num_contacts / calls;
-  state.counters["pairs_within_per_call"] = num_within / calls;
+  PerCallCounters counters("call");
+  time_each(
+      state, cases, &counters,
+      [&](const StopCase& c) {
+        const CcdMeshPair& p = *set.pairs[c.pair];
+        const CcdBody obstacle = p.obstacle_body();
+        generate_contacts(&obstacle, 1, p.god_body(), c.pose, settings, &ws[c.pair], &contacts);
+      },
+      [&](const StopCase&) {
+        benchmark::DoNotOptimize(contacts.num_contacts);
+        counters.add("contacts", contacts.num_contacts);
+        counters.add("pairs_within", contacts.num_pairs_within);
+      });
 }
 
 void register_all() {
   for (const char* s : {"peg_script", "grazing", "bunny_script"})
-    benchmark::RegisterBenchmark(("Contacts/" + std::string(s)).c_str(), BM_Contacts, std::string(s))
-        ->UseManualTime()
-        ->Unit(benchmark::kMicrosecond);
+    register_latency("Contacts/" + std::string(s), BM_Contacts, std::string(s));
 }
 
 const int registered = (register_all(), 0);

@@ -1,11 +1,17 @@
 // Data the benchmark fixtures own, loaded once per process (load time: these
-// functions allocate and throw): the rigid CCD step sets of datasets_generated/ccd/
-// (README.md there: one obstacle in the world frame, a god-object mesh in its own
-// frame with G at `offset`, poses X0 -> X1 of G), with their meshes and BVHs built
-// at a chosen leaf size. The Python sweeps (python/gauss6/sweeps.py) read the same
-// files, so that speed measured here and error measured there are on the same data.
+// functions allocate and throw):
+//   - the rigid CCD step sets of datasets_generated/ccd/ (README.md there: one
+//     obstacle in the world frame, a god-object mesh in its own frame with G at
+//     `offset`, poses X0 -> X1 of G), with their meshes and BVHs built at a chosen
+//     leaf size. The Python sweeps (python/gauss6/sweeps.py) read the same files,
+//     so that speed measured here and error measured there are on the same data;
+//   - the scenes of datasets_generated/scenes/ as the runtime builds them
+//     (RuntimeModel: obstacles in the world frame, BVHs, the runtime's CCD and
+//     contact settings), and the CCD inputs of every sim step of their scripted
+//     scenarios (what `gauss6 reproduce` runs), recorded once in lockstep.
 #pragma once
 
+#include <cmath>
 #include <cstdlib>
 #include <fstream>
 #include <map>
@@ -19,6 +25,10 @@
 #include "gauss6/bvh.h"
 #include "gauss6/mesh_io.h"
 #include "gauss6/pose.h"
+#include "gauss6/runtime.h"
+#include "gauss6/scenario.h"
+#include "gauss6/scene.h"
+#include "gauss6/simulated_device.h"
 
 namespace gauss6::bench {
 
@@ -100,6 +110,87 @@ inline const CcdSet& ccd_set(const std::string& name, int leaf_size = 4) {
   static std::map<std::pair<std::string, int>, std::unique_ptr<CcdSet>> cache;
   auto& slot = cache[{name, leaf_size}];
   if (!slot) slot = load_ccd_set(name, leaf_size);
+  return *slot;
+}
+
+// ccd_step of one step of a set (its one obstacle against its god-object).
+inline void run_set_step(const CcdSet& set, const CcdSetStep& step, const CcdStepSettings& settings,
+                         CcdStepWorkspace* ws, CcdStepResult* r) {
+  const CcdMeshPair& p = *set.pairs[step.pair];
+  const CcdBody obstacle = p.obstacle_body();
+  ccd_step(&obstacle, 1, p.god_body(), step.x0, step.x1, settings, ws, r);
+}
+
+// Runs ccd_step at the set's delta over every step of the set, in order, and
+// calls visit(step, result) after each.
+template <class Visit>
+void for_each_set_step(const CcdSet& set, Visit&& visit) {
+  CcdStepSettings settings;
+  settings.narrow.min_separation = set.delta;
+  CcdStepWorkspace ws;
+  CcdStepResult r;
+  for (const CcdSetStep& st : set.steps) {
+    run_set_step(set, st, settings, &ws, &r);
+    visit(st, r);
+  }
+}
+
+// datasets_generated/scenes/<name>.toml as the runtime builds it, default
+// RuntimeSettings (delta from the scene; ccd.narrow.min_separation = delta,
+// distance_tolerance = 0.1 delta; contacts within delta (1 + contact_factor)).
+// Cached per name; never freed (fixtures hold references).
+inline const RuntimeModel& scene_model(const std::string& name) {
+  static std::map<std::string, std::unique_ptr<RuntimeModel>> cache;
+  auto& slot = cache[name];
+  if (!slot) slot = std::make_unique<RuntimeModel>(load_scene(datasets_dir() + "/scenes/" + name + ".toml"),
+                                                   RuntimeSettings{});
+  return *slot;
+}
+
+// One sim step's collision work as the runtime did it (SimStepInfo): the first
+// leg x_start -> x_target and the residual of a settling leg; replay it with
+// advance_god_object(model, x_start, x_target, residual, ...).
+struct ScenarioStep {
+  Pose x_start, x_target;
+  Vec6 residual = Vec6::Zero();
+};
+
+// Every sim step with a handle sample (kNoHandle steps do no collision work) of
+// the scene's scripted scenario (scene.device.script), run to the script's end
+// in lockstep (one sim step per haptic tick, as `gauss6 reproduce` runs it) on
+// the simulated device with its default parameters, through the runtime API
+// with an observer: the same run as run_scenario, without its trace.
+inline std::vector<ScenarioStep> record_scenario_steps(const std::string& scene_name) {
+  const Scene scene = load_scene(datasets_dir() + "/scenes/" + scene_name + ".toml");
+  const HandScript script = load_scene_script(scene);
+  const RuntimeModel& model = scene_model(scene_name);
+  SimulatedHandleParams handle;
+  handle.rate_hz = scene.device.rate_hz;
+  handle.max_force = scene.device.max_force;
+  handle.max_torque = scene.device.max_torque;
+  SimulatedDevice device(script, handle, "simulated: " + scene.device.script);
+  device.reset(0);
+  auto data = std::make_unique<RuntimeData>(model);
+  const double end = script.end_time >= 0 ? script.end_time : script.keys.back().t;
+  const long num_ticks = static_cast<long>(std::floor(end * scene.device.rate_hz + 1e-9)) + 1;
+  std::vector<ScenarioStep> steps;
+  steps.reserve(static_cast<size_t>(num_ticks));  // at most one sim step per tick: the hook never reallocates
+  RuntimeObserver observer;
+  observer.user = &steps;
+  observer.on_sim_step = [](void* user, const SimStepInfo& info) {
+    auto* out = static_cast<std::vector<ScenarioStep>*>(user);
+    if (info.status != SimStepStatus::kNoHandle && out->size() < out->capacity())
+      out->push_back({info.x_start, info.x_target, info.residual});
+  };
+  run_lockstep(model, &device, num_ticks, observer, data.get());
+  return steps;
+}
+
+// Cached per scene name.
+inline const std::vector<ScenarioStep>& scenario_steps(const std::string& scene_name) {
+  static std::map<std::string, std::unique_ptr<std::vector<ScenarioStep>>> cache;
+  auto& slot = cache[scene_name];
+  if (!slot) slot = std::make_unique<std::vector<ScenarioStep>>(record_scenario_steps(scene_name));
   return *slot;
 }
 

@@ -220,47 +220,86 @@ Vec6 constrain_motion(const RuntimeModel& model, const Vec6& au, SimState* s) {
   return s->projection.ac;
 }
 
-// Step 4: target xt = xs (+) ac, CCD along the Cayley motion xs -> xt (split in
-// halves on a half turn), then xs = xt or the stop pose, M at xs, and the
-// contact set at the new xs.
-void advance_god_object(const RuntimeModel& model, const Vec6& ac, SimState* s, SimStepInfo* info) {
-  const Pose xt = pose_update(s->xs, ac);
+// One CCD leg along the Cayley motion x0 -> x1, split in halves on a half turn
+// (each half turns by at most 90 degrees); s->ccd holds the result of the last
+// call. When the leg can run, s->xs becomes the motion's own pose at u_hit (its
+// end when no hit: the CCD's guarantee holds for it, up to make_stop_pose's
+// deviation bound) and the function returns true; on invalid input or a half
+// turn left after splitting, s->xs is left as it was and it returns false.
+bool ccd_leg(const RuntimeModel& model, const Pose& x0, const Pose& x1, SimState* s, int* num_halves) {
   const int num_obstacles = static_cast<int>(model.obstacles.size());
   const CcdBody* obstacles = model.obstacles.data();
   CcdStepResult& r = s->ccd;
-  ccd_step(obstacles, num_obstacles, model.god, s->xs, xt, model.settings.ccd, &s->ccd_ws, &r);
+  ccd_step(obstacles, num_obstacles, model.god, x0, x1, model.settings.ccd, &s->ccd_ws, &r);
   if (r.status == CcdStatus::kHalfTurn) {
-    // Each half turns by at most 90 degrees.
-    const Pose mid = split_step(s->xs, xt);
-    info->num_halves = 2;
-    ccd_step(obstacles, num_obstacles, model.god, s->xs, mid, model.settings.ccd, &s->ccd_ws, &r);
+    const Pose mid = split_step(x0, x1);
+    *num_halves = 2;
+    ccd_step(obstacles, num_obstacles, model.god, x0, mid, model.settings.ccd, &s->ccd_ws, &r);
     if (r.status != CcdStatus::kInvalidInput && r.status != CcdStatus::kHalfTurn && !r.hit)
-      ccd_step(obstacles, num_obstacles, model.god, mid, xt, model.settings.ccd, &s->ccd_ws, &r);
+      ccd_step(obstacles, num_obstacles, model.god, mid, x1, model.settings.ccd, &s->ccd_ws, &r);
   }
-  info->ccd = r.status;
-  info->u_hit = r.u_hit;
-  if (r.status == CcdStatus::kInvalidInput || r.status == CcdStatus::kHalfTurn) {
-    info->status = SimStepStatus::kInvalidStep;  // xs stays
-  } else {
-    // The pose is the motion's own (its end when no hit): the CCD's guarantee
-    // holds for it, up to make_stop_pose's deviation bound.
-    s->xs = make_stop_pose(r.motion, r.hit ? r.u_hit : 1.0, model.god_radius).pose;
-    info->status = r.hit ? SimStepStatus::kContact : SimStepStatus::kFree;
-  }
-  s->M = mass_matrix_at(model, s->xs.q);
+  if (r.status == CcdStatus::kInvalidInput || r.status == CcdStatus::kHalfTurn) return false;
+  s->xs = make_stop_pose(r.motion, r.hit ? r.u_hit : 1.0, model.god_radius).pose;
+  return true;
+}
 
-  // Contact set at xs: every pair within delta (1 + contact_factor), and at
-  // least the pair that stopped the motion.
+// The contact set at s->xs: every pair within delta (1 + contact_factor), and
+// at least the pair that stopped the last leg (s->ccd). Sets the overflow event.
+void update_contacts(const RuntimeModel& model, SimState* s) {
+  const CcdStepResult& r = s->ccd;
   ContactSettings cs = model.contact_generation;
   if (r.hit && std::isfinite(r.distance_reached))
     cs.distance = std::max(cs.distance, r.distance_reached + model.contact.delta * model.settings.contact_factor);
-  const ContactStatus status = generate_contacts(obstacles, num_obstacles, model.god, s->xs, cs, &s->contact_ws,
-                                                 &s->contacts);
+  const ContactStatus status = generate_contacts(model.obstacles.data(), static_cast<int>(model.obstacles.size()),
+                                                 model.god, s->xs, cs, &s->contact_ws, &s->contacts);
   if (status == ContactStatus::kInvalidInput) s->contacts.num_contacts = 0;
-  info->num_contacts = s->contacts.num_contacts;
   if (status == ContactStatus::kOverflow || status == ContactStatus::kStackFull)
     s->step_events |= bit(RuntimeEventKind::kContactOverflow);
 }
+
+}  // namespace
+
+// Step 4: CCD along x_start -> x_target, then xs = its end or the stop pose and
+// the contact set at xs; then, when that leg ended free and out of contact while
+// the previous contacts withheld part of the command, the settling leg by the
+// withheld part (runtime.h).
+void advance_god_object(const RuntimeModel& model, const Pose& x_start, const Pose& x_target, const Vec6& residual,
+                        SimState* s, SimStepInfo* info) {
+  info->x_start = x_start;
+  info->x_target = x_target;
+  info->residual = residual;
+  info->settled = false;
+  info->num_halves = 1;
+  s->xs = x_start;
+  const bool moved = ccd_leg(model, x_start, x_target, s, &info->num_halves);
+  info->ccd = s->ccd.status;
+  info->u_hit = s->ccd.u_hit;
+  info->status = !moved ? SimStepStatus::kInvalidStep
+                        : (s->ccd.hit ? SimStepStatus::kContact : SimStepStatus::kFree);
+  update_contacts(model, s);
+
+  // Settling leg: the linearised constraints J a >= 0 hold to first order only,
+  // so a motion along a contact's tangent plane lifts off a surface that curves
+  // or creases away under it. The god-object then moves on by what the previous
+  // contacts withheld, au - ac, from where it ended (the total command is at
+  // most au, as without contacts), and stops delta before the surface again.
+  const bool lifted_off = moved && !s->ccd.hit && s->contacts.num_contacts == 0;
+  if (lifted_off && residual.allFinite() && residual != Vec6::Zero()) {
+    info->settled = true;
+    const Pose from = s->xs;
+    int halves = 1;
+    if (ccd_leg(model, from, pose_update(from, residual), s, &halves)) {
+      if (s->ccd.hit) info->status = SimStepStatus::kContact;
+      update_contacts(model, s);
+    }
+    if (info->ccd == CcdStatus::kOk) info->ccd = s->ccd.status;
+    info->u_hit = s->ccd.u_hit;
+  }
+  s->M = mass_matrix_at(model, s->xs.q);
+  info->num_contacts = s->contacts.num_contacts;
+}
+
+namespace {
 
 // Step 5: publish xs, M, J and the contacts.
 void publish_god_object(double t, SimState* s, RuntimeChannels* ch) {
@@ -298,10 +337,14 @@ const SimStepInfo& sim_step(const RuntimeModel& model, double t, RuntimeChannels
     // 3. ac: projection with the previous step's contacts.
     info.ac = constrain_motion(model, info.au, s);
     info.projection = s->projection.status;
-    // 4. xt = xs (+) ac; CCD; xs = xt or the stop pose; the new contact set.
-    advance_god_object(model, info.ac, s, &info);
+    // 4. xt = xs (+) ac; CCD; xs = xt or the stop pose; the new contact set
+    //    (and the settling leg by au - ac if the previous contacts' surface fell away).
+    const Vec6 residual = s->contacts.num_contacts > 0 ? Vec6(info.au - info.ac) : Vec6::Zero();
+    const Pose x_start = s->xs;  // a copy: the step overwrites s->xs
+    advance_god_object(model, x_start, pose_update(x_start, info.ac), residual, s, &info);
   } else {
     info.status = SimStepStatus::kNoHandle;
+    info.x_start = info.x_target = s->xs;
     info.num_contacts = s->contacts.num_contacts;
   }
   // 5. Publish xs, M, J, the contacts (a new sequence number is the flag).

@@ -18,7 +18,12 @@
 //
 // Choices the method leaves open (see runtime.cpp for the reasons):
 //   - the sim loop regenerates the contact set at every new xs (hit or not), so
-//     a god-object sliding off an edge drops that edge's rows;
+//     a god-object sliding off an edge drops that edge's rows; when the step's
+//     motion (projected on the previous contacts' tangent cone) ends free and
+//     out of contact while those contacts withheld part of the command, the step
+//     settles: it moves on by the withheld part au - ac (CCD again), so that a
+//     god-object pressed on a convex crease or a curved surface stays on it
+//     (advance_god_object);
 //   - the CCD stops delta before contact, and the sim loop's projection keeps
 //     each contact's gap near delta (1 + gap_factor) (J_k a >= gap_target -
 //     separation_k), so that sliding is never taken for a new contact; the
@@ -194,9 +199,22 @@ struct SimStepInfo {
   Vec6 au = Vec6::Zero(), ac = Vec6::Zero();
   ProjectionStatus projection = ProjectionStatus::kOptimal;
   CcdStatus ccd = CcdStatus::kOk;
-  double u_hit = 1;
+  double u_hit = 1;                    // of the last CCD leg
   int num_contacts = 0;
-  int num_halves = 1;                  // 2 when the step was split (half turn)
+  int num_halves = 1;                  // 2 when the first leg was split (half turn)
+  // The CCD's inputs (step 4), so that a run's collision work can be replayed
+  // exactly (advance_god_object): the first leg's motion x_start -> x_target, with
+  // x_start the god-object's pose before the step and x_target = x_start (+) ac.
+  // A leg split in halves (num_halves = 2, near a half turn) is still recorded
+  // whole: its halves are x_start -> split_step(x_start, x_target) -> x_target.
+  // residual = au - ac, the part of the command the previous contacts withheld
+  // (zero when the previous set was empty); settled: the settling leg ran (the
+  // first leg ended free and out of contact: the god-object moved on by
+  // `residual` from where it ended, see advance_god_object). Both poses are the
+  // god-object's, world frame; they equal xs when status is kNoHandle.
+  Pose x_start, x_target;
+  Vec6 residual = Vec6::Zero();
+  bool settled = false;
   double update_seconds = 0;           // wall time of the whole step (steady_clock)
   const ContactSet* contacts = nullptr;  // the contact set at xs (valid during the hook call only)
 };
@@ -355,6 +373,22 @@ struct RuntimeData {
 // One sim step (METHOD.md section 2). Fills and returns s->info. Without a
 // handle sample yet, the god-object stays put (and is still published).
 const SimStepInfo& sim_step(const RuntimeModel& model, double t, RuntimeChannels* channels, SimState* s);
+
+// Step 4 of a sim step alone, from its recorded inputs (SimStepInfo::x_start,
+// x_target, residual): the CCD along the Cayley motion x_start -> x_target (split
+// in halves on a half turn), s->xs = its end or its stop pose (delta before the
+// first contact), s->M at s->xs, and s->contacts, the contact set at s->xs. If
+// that leg ends free with an empty contact set while residual != 0 (the previous
+// contacts withheld part of the command, and their surface fell away under the
+// linearised constraints: a convex crease or a curved surface), a settling leg
+// moves on from s->xs by residual, with its own CCD and contact set, so that a
+// god-object pressed against a surface follows it instead of floating off it
+// for a step (which the force would show as a dropout). Each leg's motion is
+// free of contact (the CCD's guarantee). Sets info's x_start, x_target,
+// residual, settled, ccd (the first status other than kOk over the legs),
+// u_hit, num_halves, status and num_contacts. Real time: no allocation.
+void advance_god_object(const RuntimeModel& model, const Pose& x_start, const Pose& x_target, const Vec6& residual,
+                        SimState* s, SimStepInfo* info);
 
 // One coupling step (METHOD.md section 3). Fills and returns s->info.
 const CouplingStepInfo& coupling_step(const RuntimeModel& model, double t, RuntimeChannels* channels,
