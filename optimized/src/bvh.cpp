@@ -322,6 +322,13 @@ void ccd_step(const CcdBody* obstacles, int num_obstacles, const CcdBody& god, c
     ws->swept.next_interval();  // e changed: every cached god box is stale
     // Node pairs whose world boxes meet are then tested as oriented boxes, grown
     // by what the god-object's points may move over the sub-interval, plus d.
+    // Only elongated boxes gain from it (a compact box's world box is nearly as
+    // tight): measured on the scenarios, the bunnies' compact nodes paid for the
+    // test and the peg's long strips gained.
+    const auto elongated = [](const Aabb& b) {
+      const Vec3 e = b.hi - b.lo;
+      return e.maxCoeff() > 4 * e.minCoeff();
+    };
     const double grow = next_up(next_up(start.static_error + d) + next_up(next_up(u1 - u0) * start.speed));
     const OrientedBoxFilter oriented(start.R, start.p,
                                      std::isfinite(grow) ? grow : std::numeric_limits<double>::infinity());
@@ -360,7 +367,7 @@ void ccd_step(const CcdBody* obstacles, int num_obstacles, const CcdBody& god, c
           for_each_candidate_pair_indexed(*god.mesh, *god.bvh, *ob.mesh, *ob.bvh, god_node_box, god_face_box,
                                           /*margin=*/0, &ws->stack, visit, &result->num_node_pairs,
                                           [&](const Aabb& body, const Aabb& world) {
-                                            return oriented.separated(body, world);
+                                            return elongated(body) && oriented.separated(body, world);
                                           });
       if (ts == TraversalStatus::kStackFull) {
         // Unknown beyond here: stop conservatively at the sub-interval's start.
