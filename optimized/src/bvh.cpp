@@ -1,11 +1,14 @@
-// AABB trees over triangle meshes (build, feature ownership, swept boxes) and
-// the mesh-level CCD step: simultaneous descent of the god-object's and each
-// obstacle's tree per sub-interval of the motion, then the narrow-phase tests of
-// the owned feature pairs of each candidate triangle pair, earliest hit kept.
+// Bounding volume trees over triangle meshes (surface-area build, oriented-box
+// fitting, feature ownership, swept boxes) and the mesh-level CCD step: the
+// hinted pairs first, then per sub-interval of the motion a simultaneous
+// descent of the god-object's and each obstacle's tree, a time bound for each
+// candidate triangle pair, and the narrow-phase tests of the owned feature
+// pairs of the candidates, earliest first, earliest hit kept.
 #include "gauss6/bvh.h"
 
 #include <algorithm>
 #include <chrono>
+#include <Eigen/Eigenvalues>
 #include <cmath>
 #include <limits>
 #include <map>
@@ -35,6 +38,43 @@ Aabb swept_box(const MotionEnclosure& e, const Aabb& body) {
   return {Vec3(w[0].lo, w[1].lo, w[2].lo), Vec3(w[0].hi, w[1].hi, w[2].hi)};
 }
 
+Obb fit_obb(const Vec3* points, int num_points) {
+  Obb best;
+  if (num_points <= 0) return best;
+  Vec3 mean = Vec3::Zero();
+  for (int i = 0; i < num_points; ++i) mean += points[i];
+  mean /= num_points;
+  Mat3 cov = Mat3::Zero();
+  for (int i = 0; i < num_points; ++i) cov += (points[i] - mean) * (points[i] - mean).transpose();
+  const Eigen::SelfAdjointEigenSolver<Mat3> eig(cov);
+  double best_size = std::numeric_limits<double>::infinity();
+  const Mat3 frames[2] = {Mat3::Identity(), eig.eigenvectors()};
+  for (const Mat3& axes : frames) {
+    if (!axes.allFinite()) continue;
+    Vec3 lo = Vec3::Constant(std::numeric_limits<double>::infinity()), hi = -lo;
+    double scale = 0;
+    for (int i = 0; i < num_points; ++i) {
+      const Vec3 x = axes.transpose() * points[i];
+      lo = lo.cwiseMin(x);
+      hi = hi.cwiseMax(x);
+      scale = std::max(scale, points[i].cwiseAbs().maxCoeff());
+    }
+    Obb b;
+    b.axes = axes;
+    b.center = axes * (0.5 * (lo + hi));
+    // Each projection is within 1e-15 |x|_inf of the exact one on the rounded
+    // axes; the centre's own rounding likewise: 1e-13 scale covers both.
+    b.half = 0.5 * (hi - lo) + Vec3::Constant(1e-13 * scale + 1e-300);
+    const Vec3 grown = b.half + Vec3::Constant(1e-3 * b.half.norm());
+    const double size = grown.prod();
+    if (size < best_size) {
+      best_size = size;
+      best = b;
+    }
+  }
+  return best;
+}
+
 namespace {
 
 struct Builder {
@@ -53,24 +93,71 @@ struct Builder {
     return b;
   }
   // Builds the subtree of triangles[begin, end) into node `index`; returns its depth.
+  std::vector<Vec3> corners;  // scratch: the vertices of a node's triangles
+  Obb fit(int begin, int end) {
+    corners.clear();
+    for (int i = begin; i < end; ++i)
+      for (int k = 0; k < 3; ++k) corners.push_back(mesh.V.row(mesh.F(bvh->triangles[i], k)).transpose());
+    return fit_obb(corners.data(), static_cast<int>(corners.size()));
+  }
+  // Orders triangles[begin, end) and returns where to split them: the
+  // surface-area heuristic (MacDonald and Booth 1990) over the triangles sorted
+  // by centroid along each axis, the split that minimises area(left) n_left +
+  // area(right) n_right of the two children's boxes. A median split by
+  // centroid goes wrong on long triangles: the two triangles of a 6 cm strip of
+  // the hole's wall have centroids 2 cm apart along it, and splitting there
+  // gives two children as long as their parent, where splitting across the
+  // strips halves the arcs.
+  std::vector<int32_t> order[3];
+  std::vector<double> right_area;
+  int split(int begin, int end) {
+    const int n = end - begin;
+    const auto area = [](const Aabb& b) {
+      const Vec3 e = b.hi - b.lo;
+      return e.x() * e.y() + e.y() * e.z() + e.z() * e.x();
+    };
+    double best_cost = std::numeric_limits<double>::infinity();
+    int best_axis = -1, best_at = n / 2;
+    right_area.resize(static_cast<size_t>(n) + 1);
+    for (int axis = 0; axis < 3; ++axis) {
+      std::vector<int32_t>& o = order[axis];
+      o.assign(bvh->triangles.begin() + begin, bvh->triangles.begin() + end);
+      std::stable_sort(o.begin(), o.end(), [&](int a, int b) { return centroid[a][axis] < centroid[b][axis]; });
+      Aabb acc = tri_box[o[n - 1]];
+      for (int i = n - 1; i >= 1; --i) {  // right_area[i]: triangles o[i, n)
+        acc.lo = acc.lo.cwiseMin(tri_box[o[i]].lo);
+        acc.hi = acc.hi.cwiseMax(tri_box[o[i]].hi);
+        right_area[i] = area(acc);
+      }
+      acc = tri_box[o[0]];
+      for (int i = 1; i < n; ++i) {  // left: o[0, i)
+        const double cost = area(acc) * i + right_area[i] * (n - i);
+        if (cost < best_cost) {
+          best_cost = cost;
+          best_axis = axis;
+          best_at = i;
+        }
+        acc.lo = acc.lo.cwiseMin(tri_box[o[i]].lo);
+        acc.hi = acc.hi.cwiseMax(tri_box[o[i]].hi);
+      }
+    }
+    if (best_axis < 0) {  // non-finite boxes: split in the middle as they come
+      return begin + n / 2;
+    }
+    std::copy(order[best_axis].begin(), order[best_axis].end(), bvh->triangles.begin() + begin);
+    return begin + best_at;
+  }
   int build(int index, int begin, int end) {
     bvh->nodes[index].box = bounds(begin, end);
+    BvhNode& node = bvh->nodes[index];
+    node.obb = fit(begin, end);
+    node.obb_pays = obb_volume_ratio(node.obb.half, 0.5 * (node.box.hi - node.box.lo)) < 0.5;
     if (end - begin <= leaf_size) {
       bvh->nodes[index].first = begin;
       bvh->nodes[index].count = end - begin;
       return 1;
     }
-    // Split at the median centroid along the longest axis of the centroids' bounds.
-    Vec3 lo = centroid[bvh->triangles[begin]], hi = lo;
-    for (int i = begin + 1; i < end; ++i) {
-      lo = lo.cwiseMin(centroid[bvh->triangles[i]]);
-      hi = hi.cwiseMax(centroid[bvh->triangles[i]]);
-    }
-    int axis;
-    (hi - lo).maxCoeff(&axis);
-    const int mid = begin + (end - begin) / 2;
-    std::nth_element(bvh->triangles.begin() + begin, bvh->triangles.begin() + mid, bvh->triangles.begin() + end,
-                     [&](int a, int b) { return centroid[a][axis] < centroid[b][axis]; });
+    const int mid = split(begin, end);
     const int left = static_cast<int>(bvh->nodes.size());
     bvh->nodes.emplace_back();
     bvh->nodes.emplace_back();
@@ -116,7 +203,7 @@ Bvh build_bvh(const TriangleMesh& mesh, int leaf_size) {
       }
     }
   if (nf > 0) {
-    Builder b{mesh, std::max(leaf_size, 1), {}, {}, &bvh};
+    Builder b{mesh, std::max(leaf_size, 1), {}, {}, &bvh, {}, {}, {}};
     b.centroid.resize(static_cast<size_t>(nf));
     b.tri_box.resize(static_cast<size_t>(nf));
     for (int f = 0; f < nf; ++f) {
@@ -149,49 +236,84 @@ Vec3 vertex(const TriangleMesh& m, int f, int k) { return m.V.row(m.F(f, k)).tra
 //     exact motion) plus the double evaluation of R(q) r_B + p and of one
 //     projection n.X (|n| = 1 up to rounding): a few roundings of terms bounded
 //     by |p|_inf + rho, well within 1e-13 (|p|_inf + rho);
-//   - speed: |p(u) - p(u0)| <= (u - u0) |dp|, and R(u) R(u0)^T is the turn about
-//     g by 2 (atan(u |g|) - atan(u0 |g|)) <= 2 (u - u0) |g| (atan is
-//     1-Lipschitz), so a body point moves by at most (u - u0)(|dp| + 2 |g| rho).
+//   - the motion: p(u) - p(u0) = (u - u0) dp, with dp within drift of its
+//     midpoint dp_mid, and R(u) R(u0)^T is the turn about g by 2 (atan(u |g|) -
+//     atan(u0 |g|)) <= 2 (u - u0) |g| (atan is 1-Lipschitz), so a body point r_B
+//     moves by at most (u - u0)(|dp_mid| + drift + turn_rate |r_B|), turn_rate
+//     = 2 |g| (speed: that for |r_B| = rho), and along a direction n by at most
+//     (u - u0)(|n.dp_mid| + drift + turn_rate |r_B|).
 struct StartFrame {
   Mat3 R = Mat3::Identity();
-  Vec3 p = Vec3::Zero();
-  double u0 = 0, static_error = 0, speed = 0;
-  void set(const CcdMotion& m, double u, double rho) {
-    const StopPose sp = make_stop_pose(m, u, rho);
+  Vec3 p = Vec3::Zero(), dp_mid = Vec3::Zero();
+  double u0 = 0, static_error = 0, speed = 0, drift = 0, turn_rate = 0, rho = 0;
+  void set(const CcdMotion& m, double u, double rho_in) {
+    const StopPose sp = make_stop_pose(m, u, rho_in);
     u0 = u;
+    rho = rho_in;
     R = rotation_matrix(sp.pose.q);
     p = sp.pose.p;
-    double dp2 = 0;
-    for (const Interval& c : m.dp) {
+    double dp2 = 0, drift2 = 0;
+    for (int i = 0; i < 3; ++i) {
+      const Interval& c = m.dp[i];
       const double a = std::max(std::abs(c.lo), std::abs(c.hi));
       dp2 = next_up(dp2 + next_up(a * a));
+      dp_mid[i] = 0.5 * c.lo + 0.5 * c.hi;
+      const double r = std::max(next_up(c.hi - dp_mid[i]), next_up(dp_mid[i] - c.lo));
+      drift2 = next_up(drift2 + next_up(r * r));
     }
-    speed = next_up(next_up(std::sqrt(dp2)) + next_up(2 * next_up(std::sqrt(m.g2.hi)) * rho));
+    drift = next_up(std::sqrt(drift2));
+    turn_rate = next_up(2 * next_up(std::sqrt(m.g2.hi)));
+    speed = next_up(next_up(std::sqrt(dp2)) + next_up(turn_rate * rho));
     static_error = next_up(sp.deviation + next_up(1e-13 * next_up(p.cwiseAbs().maxCoeff() + rho)));
-    if (!std::isfinite(static_error) || !std::isfinite(speed)) static_error = speed = std::numeric_limits<double>::infinity();
+    if (!std::isfinite(static_error) || !std::isfinite(speed) || !std::isfinite(drift) || !dp_mid.allFinite())
+      static_error = speed = drift = turn_rate = std::numeric_limits<double>::infinity();
+  }
+
+  // The oriented-box frame of the sub-interval [u0, u1] (bvh.h, PosedObb),
+  // grown by the distance sought d.
+  SweptObbFrame obb_frame(double u1, double d) const {
+    SweptObbFrame f;
+    f.R = R;
+    f.p = p;
+    const double span = next_up(u1 - u0);
+    f.step = (u1 - u0) * dp_mid;
+    // The step's own rounding (relative 2^-53 per coordinate) joins the drift.
+    const double step_error = next_up(1e-15 * f.step.cwiseAbs().maxCoeff() * 2);
+    f.grow = next_up(next_up(static_error + d) + next_up(next_up(span * drift) + step_error));
+    f.turn = next_up(span * turn_rate);
+    if (!std::isfinite(f.grow) || !std::isfinite(f.turn) || !f.step.allFinite()) {
+      f.grow = std::numeric_limits<double>::infinity();
+      f.step.setZero();
+    }
+    return f;
   }
 
   // A lower bound of the first u >= u0 at which the god triangle gf can come
   // within min_separation d of the obstacle triangle `of` (u0 when unknown). At
-  // u the god-object has moved at most (u - u0) speed from its double pose at
-  // u0, whose corners X = p + R r_B are within static_error of the exact
-  // motion's; so a gap g between the double triangles (triangle_gap_lower_bound:
-  // face normals, and edge cross products, which separate a long side strip of
-  // the peg from the wide fan triangles around the hole's rim where no face
-  // normal does) keeps every feature pair farther than g - static_error -
-  // (u - u0) speed. The search for a larger gap stops once g passes u_limit.
+  // u the god-object's points are within static_error of their double positions
+  // X = p + R r_B at u0 moved as above; so a separating axis of the double
+  // triangles (triangle_time_lower_bound: face normals, and edge cross products,
+  // which separate a long side strip of the peg from the wide fan triangles
+  // around the hole's rim where no face normal does) with gap g, along which the
+  // triangle approaches at most at |n.dp_mid| + drift + turn_rate r (r: the
+  // largest |r_B| of its corners), keeps every feature pair farther than d until
+  // (g - static_error - d) / that. The search stops once the bound passes u_limit.
   double earliest(const TriangleMesh& gm, int gf, const TriangleMesh& om, int of, double d, double u_limit) const {
     Vec3 X[3], Y[3];
+    double r2 = 0;
     for (int k = 0; k < 3; ++k) {
-      X[k] = R * gm.V.row(gm.F(gf, k)).transpose() + p;
+      const Vec3 r_B = gm.V.row(gm.F(gf, k)).transpose();
+      r2 = std::max(r2, r_B.squaredNorm());
+      X[k] = R * r_B + p;
       Y[k] = om.V.row(om.F(of, k)).transpose();
     }
-    const double reach = next_up(next_up(static_error + d) + next_up(next_up(u_limit - u0) * speed));
-    const double gap = triangle_gap_lower_bound(X, Y, reach);
-    const double clear = next_down(next_down(gap - static_error) - d);
-    if (!(clear > 0)) return u0;
-    if (!(speed > 0)) return std::numeric_limits<double>::infinity();
-    return next_down(u0 + next_down(clear / speed));
+    // |r_B| of any point of the triangle <= that of its farthest corner.
+    const double r = std::min(rho, next_up(std::sqrt(r2) * (1 + 1e-15)));
+    const double w = next_up(drift + next_up(turn_rate * r));
+    const double reach = next_up(static_error + d);
+    const double tau = triangle_time_lower_bound(X, Y, dp_mid, w, reach, next_up(u_limit - u0));
+    if (!(tau > 0)) return u0;
+    return next_down(u0 + tau);
   }
 };
 
@@ -278,7 +400,8 @@ struct PairTester {
 }  // namespace
 
 void ccd_step(const CcdBody* obstacles, int num_obstacles, const CcdBody& god, const Pose& X0, const Pose& X1,
-              const CcdStepSettings& settings, CcdStepWorkspace* ws, CcdStepResult* result) {
+              const CcdStepSettings& settings, CcdStepWorkspace* ws, CcdStepResult* result, const FeaturePair* hints,
+              int num_hints) {
   *result = CcdStepResult{};
   const bool inputs_ok = god.mesh && god.bvh && ws && (num_obstacles == 0 || obstacles) &&
                          settings.max_sub_intervals >= 1 && settings.sub_interval_angle > 0 &&
@@ -306,9 +429,46 @@ void ccd_step(const CcdBody* obstacles, int num_obstacles, const CcdBody& god, c
   CcdStepWorkspace::Candidate* const cand = ws->candidates.data();
   const int cand_capacity = static_cast<int>(ws->candidates.size());
   const double d = settings.narrow.min_separation;
-  for (int i = 0; i < n; ++i) {
-    const double u0 = static_cast<double>(i) / n;
-    const double u1 = (i + 1 == n) ? 1.0 : static_cast<double>(i + 1) / n;
+  // The boxes and the pairs' time bounds take the larger of d and the near
+  // distance: the candidates are then the near pairs too (a pair that cannot
+  // come within the near distance cannot come within d).
+  const double reach = std::max(d, settings.near_distance);
+  // The hints' triangle pairs first, over the whole step (each distinct pair once).
+  if (hints && num_hints > 0) {
+    enclose_motion(motion, {0, 1}, &e);
+    ws->swept.next_interval();
+    tester.u0 = 0;
+    tester.u1 = 1;
+    for (int h = 0; h < num_hints && !tester.done(); ++h) {
+      const FeaturePair& f = hints[h];
+      const bool valid = f.obstacle >= 0 && f.obstacle < num_obstacles && obstacles[f.obstacle].mesh &&
+                         obstacles[f.obstacle].bvh && f.god_face >= 0 && f.god_face < god.mesh->F.rows() &&
+                         f.obstacle_face >= 0 && f.obstacle_face < obstacles[f.obstacle].mesh->F.rows();
+      bool seen = false;
+      for (int k = 0; k < h && !seen; ++k)
+        seen = hints[k].obstacle == f.obstacle && hints[k].god_face == f.god_face &&
+               hints[k].obstacle_face == f.obstacle_face;
+      if (!valid || seen) continue;
+      const CcdBody& ob = obstacles[f.obstacle];
+      tester.test(*god.mesh, *god.bvh, f.god_face, *ob.mesh, *ob.bvh, f.obstacle_face, f.obstacle);
+    }
+  }
+  // A god-object that was in contact at X0 (hints given) and was not stopped by
+  // those pairs is likely to meet a neighbouring pair soon (a contact sliding
+  // onto the next triangles, a bunny's ear turned onto the back it rests on):
+  // a short probe [0, u_probe] comes first, over which no point moves more
+  // than probe_distance, and a hit there ends the step without sweeping the
+  // boxes over the whole step.
+  double u_probe = 0;
+  if (hints && num_hints > 0 && !result->hit && settings.probe_distance > 0) {
+    start.set(motion, 0.0, god.bvh->radius);
+    u_probe = settings.probe_distance / start.speed;  // 0 when the speed is infinite
+    if (!(u_probe < 0.5 / n)) u_probe = 0;             // not short enough to pay (or NaN)
+  }
+  const bool probe = u_probe > 0;
+  for (int i = probe ? -1 : 0; i < n; ++i) {
+    const double u0 = i < 0 ? 0.0 : (i == 0 && probe ? u_probe : static_cast<double>(i) / n);
+    const double u1 = i < 0 ? u_probe : ((i + 1 == n) ? 1.0 : static_cast<double>(i + 1) / n);
     if (result->hit && result->u_hit - settings.narrow.time_tolerance <= u0) break;  // nothing left to search
     enclose_motion(motion, {u0, std::min(u1, result->u_hit)}, &e);
     start.set(motion, u0, god.bvh->radius);
@@ -319,23 +479,21 @@ void ccd_step(const CcdBody* obstacles, int num_obstacles, const CcdBody& god, c
     // sub-interval's end are dropped here. When the buffer is full the rest are
     // tested at once, in traversal order (same result, less pruning).
     int num_cand = 0;
+    bool listed = true;  // every candidate of this sub-interval is in cand (no overflow, no early stop)
     ws->swept.next_interval();  // e changed: every cached god box is stale
-    // Node pairs whose world boxes meet are then tested as oriented boxes, grown
-    // by what the god-object's points may move over the sub-interval, plus d.
-    // Only elongated boxes gain from it (a compact box's world box is nearly as
-    // tight): measured on the scenarios, the bunnies' compact nodes paid for the
-    // test and the peg's long strips gained.
-    const auto elongated = [](const Aabb& b) {
-      const Vec3 e = b.hi - b.lo;
-      return e.maxCoeff() > 4 * e.minCoeff();
+    // Node pairs whose world boxes meet are then tested as oriented boxes (bvh.h:
+    // the god node's posed at u0, swept along the sub-interval's translation,
+    // grown by what else its points may move, plus d).
+    const SweptObbFrame obb_frame = start.obb_frame(std::min(u1, result->u_hit), reach);
+    const BvhNode* ob_nodes = nullptr;  // the obstacle being traversed
+    const auto separated = [&](int gi, int oi) {
+      const PosedObb& a = ws->swept.get(ws->swept.node_obbs, gi, [&] { return obb_frame.pose(god.bvh->nodes[gi].obb); });
+      return (a.pays || ob_nodes[oi].obb_pays) && obb_separated(a, ob_nodes[oi].obb);
     };
-    const double grow = next_up(next_up(start.static_error + d) + next_up(next_up(u1 - u0) * start.speed));
-    const OrientedBoxFilter oriented(start.R, start.p,
-                                     std::isfinite(grow) ? grow : std::numeric_limits<double>::infinity());
     // God boxes grown by d once here (outward rounded), so the traversal compares
     // them with the obstacles' exact boxes as they are (margin 0 below): the same
     // test as growing each obstacle box by d, without its roundings per node pair.
-    const auto box_over = [&](const Aabb& body) { return inflate(swept_box(e, body), d); };
+    const auto box_over = [&](const Aabb& body) { return inflate(swept_box(e, body), reach); };
     const auto god_node_box = [&](int node) {
       return ws->swept.get(ws->swept.nodes, node, [&] { return box_over(god.bvh->nodes[node].box); });
     };
@@ -348,9 +506,10 @@ void ccd_step(const CcdBody* obstacles, int num_obstacles, const CcdBody& god, c
         result->status = CcdStatus::kInvalidInput;
         return;
       }
+      ob_nodes = ob.bvh->nodes.data();
       const auto visit = [&](int gf, int of) {
         ++result->num_triangle_pairs;
-        const double t = start.earliest(*god.mesh, gf, *ob.mesh, of, d, tester.end());
+        const double t = start.earliest(*god.mesh, gf, *ob.mesh, of, reach, tester.end());
         if (t > tester.end()) {
           ++result->num_slab_culls;
           return true;
@@ -359,16 +518,14 @@ void ccd_step(const CcdBody* obstacles, int num_obstacles, const CcdBody& god, c
           cand[num_cand++] = {t, gf, of, o};
           return true;
         }
+        listed = false;
         tester.test(*god.mesh, *god.bvh, gf, *ob.mesh, *ob.bvh, of, o);
         // A hit at the sub-interval's start cannot be bettered: stop.
         return !tester.done();
       };
       const TraversalStatus ts =
           for_each_candidate_pair_indexed(*god.mesh, *god.bvh, *ob.mesh, *ob.bvh, god_node_box, god_face_box,
-                                          /*margin=*/0, &ws->stack, visit, &result->num_node_pairs,
-                                          [&](const Aabb& body, const Aabb& world) {
-                                            return elongated(body) && oriented.separated(body, world);
-                                          });
+                                          /*margin=*/0, &ws->stack, visit, &result->num_node_pairs, separated);
       if (ts == TraversalStatus::kStackFull) {
         // Unknown beyond here: stop conservatively at the sub-interval's start.
         result->status = CcdStatus::kWorkspaceFull;
@@ -376,7 +533,17 @@ void ccd_step(const CcdBody* obstacles, int num_obstacles, const CcdBody& god, c
         result->u_hit = std::min(result->u_hit, u0);
         return;
       }
-      if (ts == TraversalStatus::kStopped) break;
+      if (ts == TraversalStatus::kStopped) {
+        listed = false;
+        break;
+      }
+    }
+    // The near pairs: whatever the testing below finds, u_hit stays <= the
+    // window end at which each pair was dropped.
+    if (settings.near_distance > 0) {
+      result->num_near_pairs = listed ? num_cand : -1;
+      result->near_u0 = u0;
+      result->near_reach = reach;
     }
     // Earliest-first: each hit shortens the windows of the pairs after it, and
     // once a pair's bound passes the best u so far, so do all the rest.

@@ -161,7 +161,14 @@ RuntimeModel::RuntimeModel(const Scene& scene, const RuntimeSettings& s) : setti
   // at least delta (the guarantee) and the search ends well before rounding-level widths
   // (the default 1e-9 is meant for unit-size queries; docs/benchmarks.md, the delta sweep).
   settings.ccd.narrow.distance_tolerance = 0.1 * contact.delta;
+  // A leg that starts in contact first searches the range over which no point
+  // moves more than 16 delta (ccd_step's probe).
+  settings.ccd.probe_distance = 16 * contact.delta;
   contact_generation.distance = contact.delta * (1 + settings.contact_factor);
+  // The CCD lists the pairs that may come within the contact distance (and the
+  // distance a hit may be accepted at, 0.1 delta more: update_contacts) of each
+  // other by the stop pose, so the contact set needs no descent of its own.
+  settings.ccd.near_distance = contact_generation.distance + 0.2 * contact.delta;
   match_distance = settings.match_distance > 0 ? settings.match_distance : 1e-3 * god_radius;
 }
 
@@ -221,25 +228,30 @@ Vec6 constrain_motion(const RuntimeModel& model, const Vec6& au, SimState* s) {
 }
 
 // One CCD leg along the Cayley motion x0 -> x1, split in halves on a half turn
-// (each half turns by at most 90 degrees); s->ccd holds the result of the last
-// call. When the leg can run, s->xs becomes the motion's own pose at u_hit (its
+// (each half turns by at most 90 degrees), with s->ccd_hints[0 .. num_hints)
+// tested first; s->ccd holds the result of the last call. When the leg can run, s->xs becomes the motion's own pose at u_hit (its
 // end when no hit: the CCD's guarantee holds for it, up to make_stop_pose's
 // deviation bound) and the function returns true; on invalid input or a half
 // turn left after splitting, s->xs is left as it was and it returns false.
-bool ccd_leg(const RuntimeModel& model, const Pose& x0, const Pose& x1, SimState* s, int* num_halves) {
+bool ccd_leg(const RuntimeModel& model, const Pose& x0, const Pose& x1, int num_hints, SimState* s,
+             int* num_halves) {
   const int num_obstacles = static_cast<int>(model.obstacles.size());
   const CcdBody* obstacles = model.obstacles.data();
   CcdStepResult& r = s->ccd;
-  ccd_step(obstacles, num_obstacles, model.god, x0, x1, model.settings.ccd, &s->ccd_ws, &r);
+  ccd_step(obstacles, num_obstacles, model.god, x0, x1, model.settings.ccd, &s->ccd_ws, &r, s->ccd_hints.data(),
+           num_hints);
   if (r.status == CcdStatus::kHalfTurn) {
     const Pose mid = split_step(x0, x1);
     *num_halves = 2;
-    ccd_step(obstacles, num_obstacles, model.god, x0, mid, model.settings.ccd, &s->ccd_ws, &r);
+    ccd_step(obstacles, num_obstacles, model.god, x0, mid, model.settings.ccd, &s->ccd_ws, &r, s->ccd_hints.data(),
+             num_hints);
     if (r.status != CcdStatus::kInvalidInput && r.status != CcdStatus::kHalfTurn && !r.hit)
       ccd_step(obstacles, num_obstacles, model.god, mid, x1, model.settings.ccd, &s->ccd_ws, &r);
   }
   if (r.status == CcdStatus::kInvalidInput || r.status == CcdStatus::kHalfTurn) return false;
-  s->xs = make_stop_pose(r.motion, r.hit ? r.u_hit : 1.0, model.god_radius).pose;
+  const StopPose stop = make_stop_pose(r.motion, r.hit ? r.u_hit : 1.0, model.god_radius);
+  s->xs = stop.pose;
+  s->stop_deviation = stop.deviation;
   return true;
 }
 
@@ -250,8 +262,15 @@ void update_contacts(const RuntimeModel& model, SimState* s) {
   ContactSettings cs = model.contact_generation;
   if (r.hit && std::isfinite(r.distance_reached))
     cs.distance = std::max(cs.distance, r.distance_reached + model.contact.delta * model.settings.contact_factor);
-  const ContactStatus status = generate_contacts(model.obstacles.data(), static_cast<int>(model.obstacles.size()),
-                                                 model.god, s->xs, cs, &s->contact_ws, &s->contacts);
+  // The CCD's near pairs hold every pair within its near reach at xs, less how
+  // far the double pose xs may lie from the motion's (its deviation, and the
+  // rounding of posing the vertices in doubles): when the contact distance is
+  // within that, they are the only pairs to test.
+  const double slack = next_up(s->stop_deviation + 1e-13 * (s->xs.p.cwiseAbs().maxCoeff() + model.god_radius));
+  const bool near = r.num_near_pairs >= 0 && (r.hit ? r.u_hit : 1.0) >= r.near_u0 && cs.distance + slack <= r.near_reach;
+  const ContactStatus status =
+      generate_contacts(model.obstacles.data(), static_cast<int>(model.obstacles.size()), model.god, s->xs, cs,
+                        &s->contact_ws, &s->contacts, s->ccd_ws.candidates.data(), near ? r.num_near_pairs : -1);
   if (status == ContactStatus::kInvalidInput) s->contacts.num_contacts = 0;
   if (status == ContactStatus::kOverflow || status == ContactStatus::kStackFull)
     s->step_events |= bit(RuntimeEventKind::kContactOverflow);
@@ -271,7 +290,11 @@ void advance_god_object(const RuntimeModel& model, const Pose& x_start, const Po
   info->settled = false;
   info->num_halves = 1;
   s->xs = x_start;
-  const bool moved = ccd_leg(model, x_start, x_target, s, &info->num_halves);
+  // The contacts at x_start (the set of the last step, at s->xs) are the pairs
+  // most likely to stop either leg: ccd_step tests them first.
+  const int num_hints = std::min(s->contacts.num_contacts, kMaxContacts);
+  for (int k = 0; k < num_hints; ++k) s->ccd_hints[k] = s->contacts.contacts[k].features;
+  const bool moved = ccd_leg(model, x_start, x_target, num_hints, s, &info->num_halves);
   info->ccd = s->ccd.status;
   info->u_hit = s->ccd.u_hit;
   info->status = !moved ? SimStepStatus::kInvalidStep
@@ -288,7 +311,7 @@ void advance_god_object(const RuntimeModel& model, const Pose& x_start, const Po
     info->settled = true;
     const Pose from = s->xs;
     int halves = 1;
-    if (ccd_leg(model, from, pose_update(from, residual), s, &halves)) {
+    if (ccd_leg(model, from, pose_update(from, residual), num_hints, s, &halves)) {
       if (s->ccd.hit) info->status = SimStepStatus::kContact;
       update_contacts(model, s);
     }

@@ -189,6 +189,31 @@ TEST_CASE("BVH: every truly colliding triangle pair is a candidate; ccd_step agr
     ccd_step(&ob_body, 1, {&god, &gb}, x0, x1, settings, &ws_unordered, &r_unordered);
     CHECK(r_unordered.hit == r.hit);
     if (r.hit && r_unordered.hit) CHECK(std::abs(r.u_hit - r_unordered.u_hit) <= 1e-5);
+    // With hints (a hitting pair when there is one, a random pair, invalid
+    // ones) and with a probe first: the same first contact (same 1e-5 bound).
+    std::vector<FeaturePair> hints;
+    FeaturePair h;
+    h.obstacle = 0;
+    h.god_face = static_cast<int>(rng() % god.F.rows());
+    h.obstacle_face = static_cast<int>(rng() % om.F.rows());
+    hints.push_back(h);
+    if (!bf.hitting_pairs.empty() && i % 4 < 2) {
+      h.god_face = bf.hitting_pairs.begin()->first;
+      h.obstacle_face = bf.hitting_pairs.begin()->second;
+      hints.push_back(h);
+    }
+    h.obstacle = 3;  // out of range: ignored
+    hints.push_back(h);
+    h.obstacle = 0;
+    h.god_face = -1;
+    hints.push_back(h);
+    CcdStepSettings probing = settings;
+    probing.probe_distance = i % 3 == 0 ? 0.0 : 0.01;
+    CcdStepResult r_hinted;
+    ccd_step(&ob_body, 1, {&god, &gb}, x0, x1, probing, &ws, &r_hinted, hints.data(), static_cast<int>(hints.size()));
+    REQUIRE(r_hinted.status == CcdStatus::kOk);
+    CHECK(r_hinted.hit == bf.hit);
+    if (r_hinted.hit && bf.hit) CHECK(std::abs(r_hinted.u_hit - bf.u_hit) <= 1e-5);
   }
   CHECK(hits >= 10);
 }
@@ -419,36 +444,166 @@ TEST_CASE("triangle_gap_lower_bound: never above the distance, and useful", "[bv
   CHECK(triangle_gap_lower_bound(T, N, 0) == 0);
 }
 
-TEST_CASE("OrientedBoxFilter: never separates boxes that share a point, separates far ones", "[bvh]") {
+TEST_CASE("triangle_time_lower_bound: no motion within its bounds comes within reach before it", "[bvh]") {
+  // A moves by tau v plus a turn about a random centre c at rate omega, with w
+  // >= |omega| max |x - c| over A's corners (so each point's extra speed <= w);
+  // at sampled tau below the bound, A must stay farther than reach from B
+  // (the reference distance of the test above, in long double).
+  std::mt19937 rng(43);
+  std::normal_distribution<double> n(0, 1);
+  std::uniform_real_distribution<double> U(0, 1);
+  int bounded = 0, infinite = 0, receding = 0;
+  for (int i = 0; i < 4000; ++i) {
+    const double scale = std::pow(10.0, 4 * U(rng) - 2);
+    const Vec3 c0 = scale * 10 * Vec3(n(rng), n(rng), n(rng));
+    Vec3 A[3], B[3];
+    for (int k = 0; k < 3; ++k) A[k] = c0 + scale * Vec3(n(rng), n(rng), n(rng));
+    if (i % 4 == 0) A[2] = A[0] + 1e-2 * (A[2] - A[0]) + 30 * (A[1] - A[0]);  // long and thin
+    const Vec3 m = Vec3(n(rng), n(rng), n(rng)).normalized();
+    double top = -1e300;
+    for (const Vec3& a : A) top = std::max(top, m.dot(a));
+    const double gap = scale * std::pow(10.0, -3 * U(rng));
+    for (int k = 0; k < 3; ++k) {
+      const Vec3 v = c0 + scale * Vec3(n(rng), n(rng), n(rng));
+      B[k] = v + m * (top + gap - m.dot(v) + scale * std::abs(n(rng)) * (i % 3 == 0 ? 0 : 1));
+    }
+    const double reach = i % 5 == 0 ? 0.0 : gap * U(rng);
+    // The motion: towards B, across, or away (v), and a turn.
+    Vec3 v = scale * Vec3(n(rng), n(rng), n(rng));
+    if (i % 3 == 1) v = scale * (m + 0.1 * Vec3(n(rng), n(rng), n(rng)));
+    if (i % 3 == 2) v = -scale * m;
+    const Vec3 centre = c0 + scale * Vec3(n(rng), n(rng), n(rng));
+    const Vec3 omega = (i % 2 ? 0.0 : 0.3) * Vec3(n(rng), n(rng), n(rng));
+    double lever = 0;
+    for (const Vec3& a : A) lever = std::max(lever, (a - centre).norm());
+    const double w = omega.norm() * lever * (1 + 1e-9);
+    const double tau = triangle_time_lower_bound(A, B, v, w, reach, std::numeric_limits<double>::infinity());
+    REQUIRE(tau >= 0);
+    if (std::isinf(tau)) {
+      ++infinite;
+      REQUIRE(w == 0);  // only a pure translation can never close the gap
+    }
+    if (!(tau > 0)) continue;
+    ++bounded;
+    receding += i % 3 == 2 && w == 0 && tau > 1e6;  // moving away: only the rounding slack bounds it
+    const double t_end = std::isinf(tau) ? 10.0 : tau;
+    for (int s = 0; s <= 16; ++s) {
+      const double t = t_end * s / 16 * (s == 16 ? 0.999999 : 1.0);
+      Vec3 At[3];
+      const Mat3 Rt = rotation_matrix(normalized(quat_exp(t * omega)));
+      for (int k = 0; k < 3; ++k) At[k] = centre + Rt * (A[k] - centre) + t * v;
+      const long double dist = triangle_distance(At, B);
+      // Rounding of the posed corners and the reference: 1e-14 of the coordinates.
+      REQUIRE(dist >= static_cast<long double>(reach) - 1e-14L * (c0.norm() + 40 * scale));
+    }
+  }
+  std::printf("triangle_time_lower_bound: %d pairs with a positive bound, %d receding ones above 1e6, %d infinite\n",
+              bounded, receding, infinite);
+  CHECK(bounded > 2000);
+  CHECK(receding > 100);
+  // Touching triangles: no time at all.
+  const Vec3 T[3] = {Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(0, 1, 0)};
+  const Vec3 S[3] = {Vec3(0.2, 0.2, 0), Vec3(0.2, 0.2, 1), Vec3(1, 1, 1)};
+  CHECK(triangle_time_lower_bound(T, S, Vec3(0, 0, 1), 1, 0, 1) == 0);
+  const Vec3 N[3] = {Vec3(0, 0, std::nan("")), Vec3(1, 0, 2), Vec3(0, 1, 2)};
+  CHECK(triangle_time_lower_bound(T, N, Vec3(0, 0, 1), 1, 0, 1) == 0);
+}
+
+TEST_CASE("obb_separated: never separates a swept box from a box it reaches, separates far ones", "[bvh]") {
+  // The god box (body frame) posed by (R, p), swept along `step` and grown by
+  // grow + turn |r_B| (SweptObbFrame::pose); a world point of that swept set is
+  // put on the boundary or inside a random oriented world box, which must then
+  // not be separated. A world box beyond the swept set's bounding sphere must be.
   std::mt19937 rng(37);
   std::normal_distribution<double> n(0, 1);
   std::uniform_real_distribution<double> U(0, 1);
+  const auto random_axes = [&](int i) {
+    if (i % 5 == 0) return Mat3(Mat3::Identity());
+    return rotation_matrix(normalized(Quat{n(rng), n(rng), n(rng), n(rng)}));
+  };
   int separated_far = 0, far = 0;
   for (int i = 0; i < 20000; ++i) {
     const double scale = std::pow(10.0, 4 * U(rng) - 2);
-    Mat3 R = rotation_matrix(normalized(Quat{n(rng), n(rng), n(rng), n(rng)}));
-    if (i % 5 == 0) R = rotation_matrix(normalized(quat_exp(1e-3 * Vec3(n(rng), n(rng), n(rng)))));  // tilted a bit
-    const Vec3 p = scale * 10 * Vec3(n(rng), n(rng), n(rng));
-    const OrientedBoxFilter f(R, p, scale * std::pow(10.0, -8 * U(rng)) * (i % 3 == 0 ? 0 : 1));
-    Vec3 h = scale * Vec3(n(rng), n(rng), n(rng)).cwiseAbs();
-    if (i % 4 == 0) h[i % 3] *= 100;  // long and thin
-    const Vec3 cb = scale * Vec3(n(rng), n(rng), n(rng));
-    const Aabb body{cb - h, cb + h};
-    // A point of the posed box grown by `grow` (a corner, pushed out by up to grow).
-    Vec3 x;
-    for (int k = 0; k < 3; ++k) x[k] = U(rng) < 0.5 ? body.lo[k] : body.hi[k];
-    if (i % 2) x = body.lo + (body.hi - body.lo).cwiseProduct(Vec3(U(rng), U(rng), U(rng)));
-    const Vec3 y = f.R * x + f.p + f.grow * 0.999 * Vec3(n(rng), n(rng), n(rng)).normalized();
-    // A world box with y on its boundary or inside.
-    const Vec3 lo = y - scale * Vec3(U(rng), U(rng), U(rng)) * (i % 3 == 1 ? 0 : 1);
-    const Vec3 hi = y + scale * Vec3(U(rng), U(rng), U(rng)) * (i % 3 == 2 ? 0 : 1);
-    REQUIRE_FALSE(f.separated(body, {lo, hi}));
-    // A world box beyond the grown posed box's bounding sphere: separated.
-    const double radius = (h + Vec3::Constant(f.grow)).norm();
+    SweptObbFrame f;
+    f.R = rotation_matrix(normalized(Quat{n(rng), n(rng), n(rng), n(rng)}));
+    if (i % 7 == 0) f.R = rotation_matrix(normalized(quat_exp(1e-3 * Vec3(n(rng), n(rng), n(rng)))));
+    f.p = scale * 10 * Vec3(n(rng), n(rng), n(rng));
+    f.step = i % 3 == 0 ? Vec3::Zero() : Vec3(scale * std::pow(10.0, -4 * U(rng)) * Vec3(n(rng), n(rng), n(rng)));
+    f.grow = i % 4 == 0 ? 0.0 : scale * std::pow(10.0, -8 * U(rng));
+    f.turn = i % 2 == 0 ? 0.0 : 1e-3 * U(rng);
+    Obb body;
+    body.axes = random_axes(i);
+    body.half = scale * Vec3(n(rng), n(rng), n(rng)).cwiseAbs();
+    if (i % 4 == 1) body.half[i % 3] *= 100;  // long and thin
+    if (i % 6 == 2) body.half[(i + 1) % 3] = 0;  // flat
+    body.center = scale * Vec3(n(rng), n(rng), n(rng));
+    const PosedObb a = f.pose(body);
+    // A point of the body box (a corner or inside), posed, moved along the
+    // step, and pushed out by up to its grow (turn included).
+    Vec3 x_local;
+    for (int k = 0; k < 3; ++k) x_local[k] = (i % 2 ? 2 * U(rng) - 1 : (U(rng) < 0.5 ? -1 : 1)) * body.half[k];
+    const Vec3 x_B = body.center + body.axes * x_local;
+    const double reach = f.grow + f.turn * x_B.norm();
+    const Vec3 y = f.R * x_B + f.p + U(rng) * f.step + 0.999 * reach * Vec3(n(rng), n(rng), n(rng)).normalized();
+    REQUIRE(reach <= a.grow);
+    // A world box with y inside or on its boundary.
+    Obb world;
+    world.axes = random_axes(i + 1);
+    world.half = scale * Vec3(U(rng), U(rng), U(rng));
+    if (i % 3 == 1) world.half[i % 3] = 0;
+    Vec3 offset;
+    for (int k = 0; k < 3; ++k) offset[k] = (i % 5 == 3 ? (U(rng) < 0.5 ? -1 : 1) : 2 * U(rng) - 1) * world.half[k];
+    world.center = y - world.axes * offset;
+    REQUIRE_FALSE(obb_separated(a, world));
+    // A world box beyond the swept set's bounding sphere: separated.
+    const double radius = body.half.norm() + 0.5 * f.step.norm() + a.grow;
     const Vec3 dir = Vec3(n(rng), n(rng), n(rng)).normalized();
-    const Vec3 centre = f.R * cb + f.p + dir * (radius * 1.01 + 2 * scale);
+    Obb away;
+    away.axes = random_axes(i + 2);
+    away.half = Vec3::Constant(scale);
+    away.center = a.center + a.half_step + dir * (radius * 1.01 + 2 * std::sqrt(3.0) * scale);
     ++far;
-    separated_far += f.separated(body, {centre - Vec3::Constant(scale), centre + Vec3::Constant(scale)});
+    separated_far += obb_separated(a, away);
   }
   CHECK(separated_far == far);
+  // NaN: never separated.
+  PosedObb bad;
+  bad.center = Vec3(std::nan(""), 0, 0);
+  CHECK_FALSE(obb_separated(bad, Obb{}));
+}
+
+TEST_CASE("fit_obb: holds every point, and is thin for points on a thin arc", "[bvh]") {
+  std::mt19937 rng(41);
+  std::normal_distribution<double> n(0, 1);
+  std::uniform_real_distribution<double> U(0, 1);
+  for (int i = 0; i < 2000; ++i) {
+    const double scale = std::pow(10.0, 6 * U(rng) - 3);
+    const Vec3 c = 10 * scale * Vec3(n(rng), n(rng), n(rng));
+    std::vector<Vec3> pts(3 + i % 20);
+    const Vec3 dir = Vec3(n(rng), n(rng), n(rng)).normalized();
+    for (Vec3& x : pts) {
+      x = c + scale * Vec3(n(rng), n(rng), n(rng));
+      if (i % 3 == 0) x = c + scale * n(rng) * dir;                     // collinear
+      if (i % 3 == 1) x -= dir * dir.dot(x - c);                        // coplanar
+    }
+    const Obb b = fit_obb(pts.data(), static_cast<int>(pts.size()));
+    REQUIRE((b.axes.transpose() * b.axes - Mat3::Identity()).cwiseAbs().maxCoeff() < 1e-14);
+    for (const Vec3& x : pts) {
+      const Vec3 local = b.axes.transpose() * (x - b.center);
+      // The test's own rounding: the subtraction and product, 1e-15 of the coordinates.
+      REQUIRE((local.cwiseAbs() - b.half).maxCoeff() <= 1e-15 * (c.norm() + 10 * scale));
+    }
+  }
+  // Two 10 cm strips of a 1 cm cylinder, 5 degrees each (a peg's leaf): its
+  // thickness is the arc's sagitta, where its axis-aligned box at 45 degrees
+  // is half a millimetre thick.
+  std::vector<Vec3> strip;
+  for (int k = 0; k < 3; ++k)
+    for (double y : {-0.05, 0.05}) {
+      const double a = M_PI / 4 + (k - 1) * 5 * M_PI / 180;
+      strip.push_back(Vec3(0.01 * std::cos(a), y, 0.01 * std::sin(a)));
+    }
+  const Obb s = fit_obb(strip.data(), static_cast<int>(strip.size()));
+  CHECK(s.half.minCoeff() < 0.01 * (1 - std::cos(5 * M_PI / 180)));
+  CHECK(obb_volume_ratio(s.half, Vec3(0.0006, 0.05, 0.0006)) < 0.5);
 }

@@ -1,6 +1,7 @@
 // Tests of contacts.h: a box resting on a box (four corner contacts, normals +z,
 // the Jacobian rows), duplicates merged, the edge/edge normal's sign, and the
-// closest-point primitives against dense sampling.
+// closest-point primitives against dense sampling, and the contact sets
+// found from the CCD's near pairs against those of a full descent.
 #include <catch2/catch.hpp>
 
 #include <cmath>
@@ -126,4 +127,72 @@ TEST_CASE("contacts: closest points agree with dense sampling", "[contacts]") {
       for (int j = 0; j <= 200; ++j) bs = std::min(bs, ((a + (k / 200.0) * (b - a)) - (q0 + (j / 200.0) * (q1 - q0))).norm());
     CHECK(ds <= bs + 1e-12);
   }
+}
+
+TEST_CASE("contacts: the CCD's near pairs give the same set as the descent", "[contacts]") {
+  // Steps that slide a box or a small ball over a slab or a large ball, about
+  // a contact distance above it, some pressing into it: at each stop pose the
+  // contact set from ccd_step's near pairs (when the runtime's conditions let
+  // it be used) must equal the set found by descending the trees, contact for
+  // contact (point, normal and separation are computed the same way; the order
+  // may differ, and where two feature pairs tie the merge may keep either).
+  const TriangleMesh box = make_box(1, 1, 1), slab = make_box(4, 4, 1, Vec3(0, 0, -0.5));
+  const TriangleMesh ball = gauss6::test::make_icosphere(2, 0.5), big = gauss6::test::make_icosphere(3, 2.0);
+  const Bvh box_bvh = build_bvh(box), slab_bvh = build_bvh(slab), ball_bvh = build_bvh(ball), big_bvh = build_bvh(big);
+  CcdStepSettings settings;
+  settings.narrow.min_separation = kDelta;
+  settings.narrow.distance_tolerance = 0.1 * kDelta;
+  settings.near_distance = 1.7 * kDelta;
+  CcdStepWorkspace ccd_ws;
+  std::mt19937 rng(53);
+  std::uniform_real_distribution<double> U(-1, 1);
+  int used = 0, with_contacts = 0;
+  for (int i = 0; i < 400; ++i) {
+    const bool balls = i % 2;
+    const TriangleMesh& gm = balls ? ball : box;
+    const Bvh& gb = balls ? ball_bvh : box_bvh;
+    const CcdBody god{&gm, &gb};
+    const CcdBody obstacle{balls ? &big : &slab, balls ? &big_bvh : &slab_bvh};
+    ContactWorkspace ws(gm);
+    ContactSet listed(64), descended(64);
+    // Start 1.05 to 1.4 delta above the top (the slab's face z = 0, or the big
+    // ball's pole: the small ball's lowest vertex), tilted a little.
+    const Quat q0 = balls ? normalized(quat_exp(0.3 * Vec3(U(rng), U(rng), U(rng)))) : Quat{};
+    double lowest = 1e300;
+    const Mat3 R0 = rotation_matrix(q0);
+    for (int v = 0; v < gm.V.rows(); ++v) lowest = std::min(lowest, (R0 * gm.V.row(v).transpose()).z());
+    const double top = balls ? big.V.col(2).maxCoeff() : 0.0;
+    const Vec3 p0(0.05 * U(rng), 0.05 * U(rng), top - lowest + (1.225 + 0.175 * U(rng)) * kDelta);
+    const Pose x0{p0, q0};
+    const Pose x1{p0 + Vec3(0.01 * U(rng), 0.01 * U(rng), kDelta * (U(rng) - 0.5)),
+                  normalized(quat_exp(1e-6 * Vec3(U(rng), U(rng), U(rng))) * q0)};
+    CcdStepResult r;
+    ccd_step(&obstacle, 1, god, x0, x1, settings, &ccd_ws, &r);
+    REQUIRE(r.status == CcdStatus::kOk);
+    const double u = r.hit ? r.u_hit : 1.0;
+    const StopPose stop = make_stop_pose(r.motion, u, gb.radius);
+    ContactSettings cs;
+    cs.distance = 1.5 * kDelta;
+    const double slack = stop.deviation + 1e-13 * (stop.pose.p.cwiseAbs().maxCoeff() + gb.radius);
+    REQUIRE(generate_contacts(&obstacle, 1, god, stop.pose, cs, &ws, &descended) == ContactStatus::kOk);
+    if (!(r.num_near_pairs >= 0 && u >= r.near_u0 && cs.distance + slack <= r.near_reach)) continue;
+    ++used;
+    REQUIRE(generate_contacts(&obstacle, 1, god, stop.pose, cs, &ws, &listed, ccd_ws.candidates.data(),
+                              r.num_near_pairs) == ContactStatus::kOk);
+    with_contacts += descended.num_contacts > 0;
+    REQUIRE(listed.num_contacts == descended.num_contacts);
+    for (int k = 0; k < descended.num_contacts; ++k) {
+      const Contact& c = descended.contacts[k];
+      bool found = false;
+      for (int j = 0; j < listed.num_contacts && !found; ++j) {
+        const Contact& o = listed.contacts[j];
+        found = (o.point - c.point).norm() <= 1e-12 && (o.normal - c.normal).norm() <= 1e-12 &&
+                o.separation == c.separation;
+      }
+      CHECK(found);
+    }
+  }
+  std::printf("near pairs: used at %d of 400 stop poses, %d of them with contacts\n", used, with_contacts);
+  CHECK(used > 300);
+  CHECK(with_contacts > 100);
 }

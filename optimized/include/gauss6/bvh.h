@@ -1,7 +1,8 @@
-// Bounding volume hierarchies (axis-aligned boxes) over triangle meshes, their
-// conservative traversal under the Cayley motion, and the mesh-level CCD step
-// ccd_step(): the first contact between the moving god-object and the static
-// obstacles along the in-between motion of METHOD.md section 4.
+// Bounding volume hierarchies over triangle meshes (each node: an axis-aligned
+// box and an oriented box), their conservative traversal under the Cayley
+// motion, and the mesh-level CCD step ccd_step(): the first contact between the
+// moving god-object and the static obstacles along the in-between motion of
+// METHOD.md section 4.
 //
 // Frames: an obstacle's mesh and BVH are in the world frame W (apply a fixed
 // pose to the vertices once at load time); the god-object's are in its body
@@ -16,6 +17,7 @@
 
 #include <algorithm>
 #include <cstdint>
+#include <limits>
 #include <utility>
 #include <vector>
 
@@ -34,8 +36,21 @@ inline bool overlap(const Aabb& a, const Aabb& b) {
   return (a.lo.array() <= b.hi.array()).all() && (b.lo.array() <= a.hi.array()).all();
 }
 
+// An oriented box: the points center + axes x with |x_i| <= half_i (axes:
+// orthonormal columns, up to rounding). Fitted to the node's vertices at build
+// time (the principal axes of their spread, or the frame's axes when that box
+// is smaller), so that a node of long thin triangles on a curved wall (a peg's
+// side strips, the hole's wall) stays as thin as the wall's sagitta in every
+// orientation, where its axis-aligned box is as wide as it is long.
+struct Obb {
+  Mat3 axes = Mat3::Identity();
+  Vec3 center = Vec3::Zero(), half = Vec3::Zero();
+};
+
 struct BvhNode {
   Aabb box;            // the mesh's own frame
+  Obb obb;             // the mesh's own frame; holds every vertex of the node's triangles
+  bool obb_pays = false;  // the oriented box is less than half the axis-aligned one (obb_volume_ratio)
   int32_t first = 0;   // leaf: first slot in Bvh::triangles; inner: left child (right = first + 1)
   int32_t count = 0;   // leaf: number of triangles (> 0); inner: 0
 };
@@ -55,8 +70,15 @@ struct Bvh {
 };
 
 // Top-down build: median split of the triangles' centroids along the longest
-// axis of their bounds, leaves of at most leaf_size triangles. Load time.
+// axis of their bounds, leaves of at most leaf_size triangles, each node's
+// oriented box fitted to its vertices (fit_obb). Load time.
 Bvh build_bvh(const TriangleMesh& mesh, int leaf_size = 4);
+
+// The oriented box of the given points: the eigenvectors of their covariance
+// or the frame's axes, whichever box is smaller (volume of the box grown by a
+// thousandth of its diagonal, so that flat boxes compare by area); extents
+// grown to cover the roundings of the projections. Load time.
+Obb fit_obb(const Vec3* points, int num_points);
 
 // Exact box of triangle f of the mesh (its own frame). Inline: the traversal
 // calls it for every leaf triangle pair.
@@ -79,11 +101,12 @@ inline Aabb inflate(const Aabb& box, double margin) {
   return out;
 }
 
-// Separating-axis bound of the distance of two triangles A and B given by their
-// corners (one frame, doubles): the largest gap proven along the two face
-// normals and the nine edge cross products, rounding included (0 when none
-// proves a positive gap), returned as soon as one axis proves more than
-// `enough`.
+// Separating axes of two triangles A and B given by their corners (one frame,
+// doubles): the two face normals and the nine edge cross products. Calls
+// on_axis(a, gap, side) for each axis a that proves a positive gap, with gap a
+// lower bound of the distance of the two triangles' projections on a / |a| and
+// side = +1 when B lies beyond A along a (-1 when before it); on_axis returns
+// true to stop.
 //
 // Proof. For convex sets and any vector a != 0, dist(A, B) >= (min_B a.y -
 // max_A a.x) / |a| (or the mirror). Whatever the rounded axis a is, each
@@ -92,12 +115,11 @@ inline Aabb inflate(const Aabb& box, double margin) {
 // own rounding; so raw - 1e-13 |a|_1 s, s the largest coordinate of the six
 // corners, is below the exact gap along a. Dividing by |a| (1 + 1e-12), with
 // the quotient rounded down, covers the roundings of the norm and the quotient.
-// Inline: the mesh step and the contact generation call it for every candidate
-// triangle pair.
-inline double triangle_gap_lower_bound(const Vec3 A[3], const Vec3 B[3], double enough) {
+// A zero or non-finite axis proves nothing (NaN or inf is dropped).
+template <class OnAxis>
+GAUSS6_ALWAYS_INLINE void for_each_separating_axis(const Vec3 A[3], const Vec3 B[3], OnAxis&& on_axis) {
   double s = 0;
   for (int k = 0; k < 3; ++k) s = std::max(s, std::max(A[k].cwiseAbs().maxCoeff(), B[k].cwiseAbs().maxCoeff()));
-  double best = 0;
   const auto along = [&](const Vec3& a) GAUSS6_ALWAYS_INLINE_LAMBDA {
     double a_lo = a.dot(A[0]), a_hi = a_lo, b_lo = a.dot(B[0]), b_hi = b_lo;
     for (int k = 1; k < 3; ++k) {
@@ -107,78 +129,166 @@ inline double triangle_gap_lower_bound(const Vec3 A[3], const Vec3 B[3], double 
       b_lo = std::min(b_lo, pb);
       b_hi = std::max(b_hi, pb);
     }
+    const double side = b_lo - a_hi >= a_lo - b_hi ? 1.0 : -1.0;
     const double proven = std::max(b_lo - a_hi, a_lo - b_hi) - 1e-13 * a.cwiseAbs().sum() * s;
     if (!(proven > 0)) return false;  // also on NaN
     const double g = next_down(proven / next_up(a.norm() * (1 + 1e-12)));
-    if (g > best) best = g;           // a zero axis gives +inf or NaN: dropped below
-    if (!(best < std::numeric_limits<double>::infinity())) best = 0;
-    return best > enough;
+    if (!(g < std::numeric_limits<double>::infinity())) return false;
+    return on_axis(a, g, side);
   };
   const Vec3 ea[3] = {A[1] - A[0], A[2] - A[1], A[0] - A[2]}, eb[3] = {B[1] - B[0], B[2] - B[1], B[0] - B[2]};
-  if (along(ea[0].cross(ea[1])) || along(eb[0].cross(eb[1]))) return best;
+  if (along(ea[0].cross(ea[1])) || along(eb[0].cross(eb[1]))) return;
   for (int i = 0; i < 3; ++i)
     for (int j = 0; j < 3; ++j)
-      if (along(ea[i].cross(eb[j]))) return best;
+      if (along(ea[i].cross(eb[j]))) return;
+}
+
+// Separating-axis bound of the distance of two triangles: the largest gap
+// proven along the 11 axes (for_each_separating_axis), rounding included (0
+// when none proves a positive gap), returned as soon as one axis proves more
+// than `enough`. Inline: the contact generation calls it for every candidate
+// triangle pair.
+inline double triangle_gap_lower_bound(const Vec3 A[3], const Vec3 B[3], double enough) {
+  double best = 0;
+  for_each_separating_axis(A, B, [&](const Vec3&, double g, double) GAUSS6_ALWAYS_INLINE_LAMBDA {
+    best = std::max(best, g);
+    return best > enough;
+  });
+  return best;
+}
+
+// A lower bound of the time (in units of the motion's parameter, from the
+// triangles' current positions) before the moving triangle A can come within
+// `reach` of the fixed triangle B, when every point of A moves by at most
+// tau v + tau w (a translation along v plus any motion of speed w) in time tau:
+// along a separating axis with unit direction n and gap g, A approaches B at
+// most at max(0, side n.v) + w, so it needs (g - reach) / that; the largest such
+// time over the 11 axes, or 0 when none proves g > reach; +inf when an axis
+// proves a gap that the motion never closes. Returns as soon as one axis
+// proves more than `enough`. Rounding: n.v from the rounded axis is within
+// 1e-14 |a|_1 |v|_inf / |a| of the exact one's, and each quotient is rounded
+// up or down the safe way. Inline: the mesh step calls it for every candidate
+// triangle pair.
+inline double triangle_time_lower_bound(const Vec3 A[3], const Vec3 B[3], const Vec3& v, double w, double reach,
+                                        double enough) {
+  const double v_inf = v.cwiseAbs().maxCoeff();
+  double best = 0;
+  for_each_separating_axis(A, B, [&](const Vec3& a, double g, double side) GAUSS6_ALWAYS_INLINE_LAMBDA {
+    const double clear = next_down(g - reach);
+    if (!(clear > 0)) return false;
+    const double toward = std::max(0.0, side * a.dot(v)) + 1e-14 * a.cwiseAbs().sum() * v_inf;
+    const double speed = next_up(next_up(toward / next_down(a.norm() * (1 - 1e-12))) + w);
+    const double t = speed > 0 ? next_down(clear / speed) : std::numeric_limits<double>::infinity();
+    if (!(t <= std::numeric_limits<double>::infinity())) return false;  // NaN
+    best = std::max(best, t);
+    return best > enough;
+  });
   return best;
 }
 
 // Oriented-box test of the simultaneous descent. A god node's box is tight in the
 // body frame, but its world box (swept_box) grows with the rotation: a 10 cm
 // side strip of the peg tilted by half a degree gets a world box about 1 mm
-// wide, five times the hole's clearance, and meets every box near the hole.
-// Posed as an oriented box, it stays as thin as it is. `pose` is the
-// god-object's double pose (X = R r_B + p) and `grow` must cover how far the
-// node's mesh points may lie from their double posed positions over the range
-// tested, plus the distance sought (the mesh step: static_error + (u1 - u0)
-// speed + d, see StartFrame in bvh.cpp); the box grown by `grow` along its own
-// axes holds the ball of that radius around each of its points.
-struct OrientedBoxFilter {
-  OrientedBoxFilter() = default;
-  OrientedBoxFilter(const Mat3& R_in, const Vec3& p_in, double grow_in) : R(R_in), p(p_in), grow(grow_in) {
-    A = R.cwiseAbs();
-    A.array() += 1e-15;
-  }
+// wide, five times the hole's clearance; and the hole's wall, a ring of strips,
+// has axis-aligned boxes as wide as its arcs. Their oriented boxes stay as thin
+// as the arcs' sagittas: a peg resting in the hole (0.2 mm of clearance) has
+// no node pair of facing arcs of up to 20 degrees left, where the axis-aligned
+// boxes of all of them meet.
+//
+// Over a sub-interval [u0, u1] of the motion, every point r_B of the god-object
+// is at X(u) = p(u) + R(u) r_B with p(u) = p(u0) + (u - u0) dp, so X(u) lies in
+//   Xd + s step + ball(grow),  s = (u - u0) / (u1 - u0) in [0, 1],
+// where Xd = p + R r_B is its double position at u0 (StartFrame in bvh.cpp:
+// within static_error of the exact one), step = (u1 - u0) dp_mid (dp's
+// midpoint), and grow = static_error + (u1 - u0) (|dp - dp_mid| + 2 |g| |r_B|)
+// (R(u) R(u0)^T turns by at most 2 (u - u0) |g|); plus the distance sought d.
+// The swept set of a node's oriented box is then the posed box plus the
+// segment [0, step] plus that ball, and the node pair is apart when one of the
+// 15 axes of the two boxes separates the projections: along an axis L the
+// swept set's projection is the posed box's, centred at its centre plus step/2,
+// widened by |L.step| / 2 and grow |L| (|L| <= 1 for the 15 axes, so grow).
+// The segment is what lets a peg sliding 50 um a step along the hole's axis
+// keep its facing arcs apart: the motion does not approach them.
+struct PosedObb {
+  Mat3 axes = Mat3::Identity();   // world frame
+  Vec3 center = Vec3::Zero(), half = Vec3::Zero();
+  Vec3 half_step = Vec3::Zero();  // step / 2
+  double grow = 0;
+  bool pays = false;              // less than half its world axis-aligned box (obb_volume_ratio)
+};
+
+// Volume of an oriented box over that of the axis-aligned box with the given
+// half extents, both grown by a thousandth of the oriented box's diagonal (so
+// flat boxes compare by area). The traversals test oriented boxes only for a
+// node pair where one of the two is below 1/2: where both boxes are about as
+// tight as their axis-aligned ones (a bunny's compact nodes, the flat fans of
+// an axis-aligned face) the 15-axis test costs more than it saves.
+inline double obb_volume_ratio(const Vec3& obb_half, const Vec3& aabb_half) {
+  const double e = 1e-3 * obb_half.norm();
+  return (obb_half + Vec3::Constant(e)).prod() / (aabb_half + Vec3::Constant(e)).prod();
+}
+
+// The pose and motion bounds of one sub-interval (or of a fixed pose: step 0,
+// turn 0), which pose() applies to a god node's body-frame box.
+struct SweptObbFrame {
   Mat3 R = Mat3::Identity();
   Vec3 p = Vec3::Zero();
-  double grow = 0;
-  Mat3 A = Mat3::Constant(1e-15) + Mat3::Identity();  // |R| + 1e-15
-  // True when the posed god box (body frame), grown, provably misses the world
-  // box: a separating axis among the 15 of the two boxes (Gottschalk, Lin and
-  // Manocha 1996). Rounding: every side of every comparison is a sum of at most
-  // a dozen products of an |R| entry (<= 1 + 1e-15) and a number <= s (the
-  // largest coordinate or half extent involved), each rounded to within 2^-53
-  // of itself, and the centres' differences are rounded likewise; 1e-11 s
-  // covers them many times over, and |R| + 1e-15 keeps the
-  // edge axes of near-parallel edges from proving a gap out of rounding noise.
-  GAUSS6_ALWAYS_INLINE bool separated(const Aabb& body_box, const Aabb& world_box) const {
-    const Vec3 ha = 0.5 * (body_box.hi - body_box.lo) + Vec3::Constant(grow);
-    const Vec3 hb = 0.5 * (world_box.hi - world_box.lo);
-    const Vec3 cb = 0.5 * (body_box.lo + body_box.hi), cw = 0.5 * (world_box.lo + world_box.hi);
-    const Vec3 ca = R * cb + p;
-    const Vec3 t_w = cw - ca;             // world frame
-    const Vec3 t = R.transpose() * t_w;   // the god box's frame
-    const double s = std::max({ha.maxCoeff(), hb.maxCoeff(), t_w.cwiseAbs().maxCoeff(), ca.cwiseAbs().maxCoeff(),
-                               cb.cwiseAbs().maxCoeff(), cw.cwiseAbs().maxCoeff(), p.cwiseAbs().maxCoeff()});
-    const double eps = 1e-11 * s;
-    // Axes of the god box (rows of R^T), then the world axes.
-    for (int i = 0; i < 3; ++i)
-      if (std::abs(t[i]) > ha[i] + A.col(i).dot(hb) + eps) return true;
-    for (int j = 0; j < 3; ++j)
-      if (std::abs(t_w[j]) > hb[j] + A.row(j).dot(ha) + eps) return true;
-    // Cross products of a god box axis i (world direction R.col(i)) and world axis j.
-    for (int i = 0; i < 3; ++i) {
-      const int i1 = (i + 1) % 3, i2 = (i + 2) % 3;
-      for (int j = 0; j < 3; ++j) {
-        const int j1 = (j + 1) % 3, j2 = (j + 2) % 3;
-        const double dist = std::abs(t[i2] * R(j, i1) - t[i1] * R(j, i2));
-        const double ra = ha[i1] * A(j, i2) + ha[i2] * A(j, i1);
-        const double rb = hb[j1] * A(j2, i) + hb[j2] * A(j1, i);
-        if (dist > ra + rb + eps) return true;
-      }
-    }
-    return false;  // also on NaN
+  Vec3 step = Vec3::Zero();  // world translation of G over the sub-interval (its midpoint)
+  double grow = 0;           // static_error + d + (u1 - u0) |dp - dp_mid| (any point)
+  double turn = 0;           // (u1 - u0) 2 |g|: times |r_B| for a point's turn
+  PosedObb pose(const Obb& b) const {
+    PosedObb out;
+    out.axes = R * b.axes;
+    out.center = R * b.center + p;
+    out.half = b.half;
+    out.half_step = 0.5 * step;
+    // |r_B| <= |center| + |half| for every point of the box.
+    const double radius = next_up(next_up(b.center.norm() + b.half.norm()) * (1 + 1e-12));
+    out.grow = turn > 0 ? next_up(grow + next_up(turn * radius)) : grow;
+    if (!(out.grow < std::numeric_limits<double>::infinity())) out.grow = std::numeric_limits<double>::infinity();
+    out.pays = obb_volume_ratio(b.half, out.axes.cwiseAbs() * b.half) < 0.5;
+    return out;
   }
 };
+
+// True when a separating axis among the 15 of the two boxes (Gottschalk, Lin
+// and Manocha 1996) proves the swept posed god box `a` (see above) apart from
+// the obstacle's box `b` (world frame). Rounding: every side of every
+// comparison is a sum of at most a dozen products of an entry of |C| (<= 1 +
+// 1e-15) and a number <= s (the largest coordinate, extent or step involved),
+// each within a few units of 2^-53 of itself, and the axes are orthonormal to
+// within 1e-15; 1e-11 s covers all of it many times over, and |C| + 1e-15
+// keeps the cross axes of near-parallel edges from proving a gap out of
+// rounding noise. False on NaN.
+GAUSS6_ALWAYS_INLINE bool obb_separated(const PosedObb& a, const Obb& b) {
+  const Mat3 C = a.axes.transpose() * b.axes;  // C(i, j) = a_i . b_j
+  Mat3 A = C.cwiseAbs();
+  A.array() += 1e-15;
+  const Vec3 t_w = b.center - (a.center + a.half_step);
+  const Vec3 ta = a.axes.transpose() * t_w, tb = b.axes.transpose() * t_w;
+  const Vec3 da = a.axes.transpose() * a.half_step, db = b.axes.transpose() * a.half_step;
+  const Vec3 &ha = a.half, &hb = b.half;
+  const double s = std::max({ha.maxCoeff(), hb.maxCoeff(), t_w.cwiseAbs().maxCoeff(), a.center.cwiseAbs().maxCoeff(),
+                             b.center.cwiseAbs().maxCoeff(), a.half_step.cwiseAbs().maxCoeff(), a.grow});
+  const double g = a.grow + 1e-11 * s;
+  for (int i = 0; i < 3; ++i)
+    if (std::abs(ta[i]) > ha[i] + A.row(i).dot(hb) + std::abs(da[i]) + g) return true;
+  for (int j = 0; j < 3; ++j)
+    if (std::abs(tb[j]) > hb[j] + A.col(j).dot(ha) + std::abs(db[j]) + g) return true;
+  for (int i = 0; i < 3; ++i) {
+    const int i1 = (i + 1) % 3, i2 = (i + 2) % 3;
+    for (int j = 0; j < 3; ++j) {
+      const int j1 = (j + 1) % 3, j2 = (j + 2) % 3;
+      // L = a_i x b_j, in a's frame: (0, ...) with t.L = t[i2] C(i1, j) - t[i1] C(i2, j).
+      const double dist = std::abs(ta[i2] * C(i1, j) - ta[i1] * C(i2, j));
+      const double sweep = std::abs(da[i2] * C(i1, j) - da[i1] * C(i2, j));
+      const double ra = ha[i1] * A(i2, j) + ha[i2] * A(i1, j);
+      const double rb = hb[j1] * A(i, j2) + hb[j2] * A(i, j1);
+      if (dist > ra + rb + sweep + g) return true;
+    }
+  }
+  return false;
+}
 
 // Fixed-capacity stack of node pairs for the simultaneous descent.
 struct BvhStack {
@@ -198,8 +308,8 @@ enum class TraversalStatus { kDone = 0, kStopped, kStackFull };
 // given by index: god_node_box(int node) -> Aabb world for god.nodes[node], and
 // god_face_box(int face) -> Aabb world for face `face` of god_mesh (so a caller
 // can cache them: see SweptBoxCache); and node pairs whose world boxes overlap
-// are then dropped when separated(god_node_box_body, obstacle_node_box) proves
-// them apart (an OrientedBoxFilter, or nothing: see the overload).
+// are then dropped when separated(god_node, obstacle_node) proves them apart
+// (obb_separated, or nothing: see the overload).
 template <class GodNodeBox, class GodFaceBox, class Visit, class Separated>
 TraversalStatus for_each_candidate_pair_indexed([[maybe_unused]] const TriangleMesh& god_mesh, const Bvh& god,
                                                 const TriangleMesh& obs_mesh, const Bvh& obs,
@@ -217,7 +327,7 @@ TraversalStatus for_each_candidate_pair_indexed([[maybe_unused]] const TriangleM
     const BvhNode& on = obs.nodes[oi];
     ++*num_node_pairs;
     const Aabb gw = god_node_box(gi);
-    if (!overlap(gw, inflate(on.box, margin)) || separated(gn.box, on.box)) continue;
+    if (!overlap(gw, inflate(on.box, margin)) || separated(gi, oi)) continue;
     if (gn.count > 0 && on.count > 0) {
       // Leaf pair: test triangle boxes, then hand the pair over.
       for (int i = 0; i < gn.count; ++i) {
@@ -251,7 +361,7 @@ TraversalStatus for_each_candidate_pair_indexed(const TriangleMesh& god_mesh, co
                                                 double margin, BvhStack* stack, Visit&& visit, int* num_node_pairs) {
   return for_each_candidate_pair_indexed(god_mesh, god, obs_mesh, obs, god_node_box, god_face_box, margin, stack,
                                          std::forward<Visit>(visit), num_node_pairs,
-                                         [](const Aabb&, const Aabb&) { return false; });
+                                         [](int, int) { return false; });
 }
 template <class GodBox, class Visit>
 TraversalStatus for_each_candidate_pair(const TriangleMesh& god_mesh, const Bvh& god, const TriangleMesh& obs_mesh,
@@ -290,6 +400,10 @@ struct CcdStepSettings {
   int max_sub_intervals = 16;              // u-ranges whose swept boxes are computed separately
   double sub_interval_angle = 0.1;         // radians of rotation per sub-interval (at most)
   double sub_interval_travel = 0.25;       // travel of G per sub-interval, in god-object radii (at most)
+  double probe_distance = 0;               // with hints, first search [0, u] over which no point moves more than
+                                           // this (scene units; 0: no probe; the runtime uses 16 delta)
+  double near_distance = 0;                // also list the triangle pairs that may come within this (>=
+                                           // min_separation) by the stop pose: the near pairs (CcdStepResult)
 };
 
 struct CcdStepResult {
@@ -303,42 +417,58 @@ struct CcdStepResult {
   int num_sub_intervals = 0, num_node_pairs = 0, num_triangle_pairs = 0, num_pair_tests = 0;
   int num_slab_culls = 0;                  // triangle pairs dropped whole by a separating-axis bound (no pair test)
   long num_box_iterations = 0;             // narrow-phase boxes, all tests together
+  // Near pairs (settings.near_distance > 0): when num_near_pairs >= 0, ws->candidates[0 .. num_near_pairs)
+  // hold every triangle pair that can come within near_reach (= max(min_separation, near_distance)) of
+  // each other under the exact motion at any u in [near_u0, u_hit] (the last sub-interval searched), so
+  // the contact generation at the stop pose can test those instead of descending the trees again (with
+  // the stop pose's deviation taken off near_reach). -1: no such list (the step stopped before any
+  // descent, or the candidate buffer overflowed).
+  int num_near_pairs = -1;
+  double near_u0 = 0, near_reach = 0;
 };
 
 // Everything ccd_step needs, allocated once.
-// World boxes of god nodes, faces and vertices over the current sub-interval (ccd_step
-// keeps node and face boxes grown by min_separation, vertex boxes as they are), so
-// each is enclosed once per sub-interval however many obstacle nodes it meets: a
-// direct-mapped cache (index & mask -> entry; a collision just recomputes), of
-// fixed size, so any mesh fits without allocation. Entries are valid while
-// their stamp equals `stamp` (next_interval() invalidates them all in O(1)).
+// World boxes of god nodes, faces and vertices over the current sub-interval
+// (ccd_step keeps node and face boxes grown by min_separation, vertex boxes as
+// they are) and the nodes' posed oriented boxes, so each is computed once per
+// sub-interval however many obstacle nodes it meets: direct-mapped caches
+// (index & mask -> entry; a collision just recomputes), of fixed size, so any
+// mesh fits without allocation. Entries are valid while their stamp equals
+// `stamp` (next_interval() invalidates them all in O(1)).
 struct SweptBoxCache {
+  template <class T>
   struct Entry {
-    Aabb box;
+    T value;
     int32_t key = -1;
     uint32_t stamp = 0;
   };
+  template <class T>
+  using Table = std::vector<Entry<T>>;
   explicit SweptBoxCache(int capacity_log2 = 12)
-      : nodes(size_t{1} << std::clamp(capacity_log2, 0, 24)), faces(nodes.size()), vertices(nodes.size()) {}
+      : nodes(size_t{1} << std::clamp(capacity_log2, 0, 24)), faces(nodes.size()), vertices(nodes.size()),
+        node_obbs(nodes.size()) {}
   void next_interval() {
     if (++stamp != 0) return;
-    for (Entry& e : nodes) e.stamp = 0;  // wrapped around (every 2^32 sub-intervals)
-    for (Entry& e : faces) e.stamp = 0;
-    for (Entry& e : vertices) e.stamp = 0;
+    // Wrapped around (every 2^32 sub-intervals).
+    for (auto& e : nodes) e.stamp = 0;
+    for (auto& e : faces) e.stamp = 0;
+    for (auto& e : vertices) e.stamp = 0;
+    for (auto& e : node_obbs) e.stamp = 0;
     stamp = 1;
   }
-  // The cached box of `index` in `table`, computed by make() when missing.
-  template <class Make>
-  const Aabb& get(std::vector<Entry>& table, int index, const Make& make) {
-    Entry& e = table[static_cast<size_t>(index) & (table.size() - 1)];
+  // The cached value of `index` in `table`, computed by make() when missing.
+  template <class T, class Make>
+  const T& get(Table<T>& table, int index, const Make& make) {
+    Entry<T>& e = table[static_cast<size_t>(index) & (table.size() - 1)];
     if (e.key != index || e.stamp != stamp) {
-      e.box = make();
+      e.value = make();
       e.key = index;
       e.stamp = stamp;
     }
-    return e.box;
+    return e.value;
   }
-  std::vector<Entry> nodes, faces, vertices;  // god BVH nodes, faces, vertices (by mesh index)
+  Table<Aabb> nodes, faces, vertices;  // god BVH nodes, faces, vertices (by mesh index)
+  Table<PosedObb> node_obbs;           // god BVH nodes
   uint32_t stamp = 0;
 };
 
@@ -369,7 +499,17 @@ struct CcdStepWorkspace {
 // (poses of G). Stop pose: make_stop_pose(result.motion, result.u_hit,
 // god.bvh->radius) when hit (u = 1 otherwise); with narrow.min_separation = d
 // its exact separation is >= d - deviation.
+//
+// hints[0 .. num_hints): feature pairs likely to touch first (the runtime
+// passes the contacts at X0); their triangle pairs are tested over the whole
+// step before the descent. A pair pressed against an obstacle then gives a hit
+// near u = 0 at once, and the descent searches only up to it, with boxes swept
+// over that short range: the peg pressed into the hole's rim, commanded a
+// millimetre into it, no longer sweeps that millimetre through the hole. Any
+// hint is a real pair, so the answer's guarantee is the same with or without
+// them; out-of-range hints are ignored.
 void ccd_step(const CcdBody* obstacles, int num_obstacles, const CcdBody& god, const Pose& X0, const Pose& X1,
-              const CcdStepSettings& settings, CcdStepWorkspace* ws, CcdStepResult* result);
+              const CcdStepSettings& settings, CcdStepWorkspace* ws, CcdStepResult* result,
+              const FeaturePair* hints = nullptr, int num_hints = 0);
 
 }  // namespace gauss6

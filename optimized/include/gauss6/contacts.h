@@ -59,20 +59,27 @@ struct ContactSet {
 };
 
 // World positions of the god-object's vertices, posed on first use in each call
-// (a vertex is current when its stamp equals `stamp`), and the traversal stack.
+// (a vertex is current when its stamp equals `stamp`), the god nodes' world
+// and oriented boxes likewise (each computed once per call however many
+// obstacle nodes it meets), and the traversal stack.
 struct ContactWorkspace {
   explicit ContactWorkspace(const TriangleMesh& god_mesh, int stack_capacity = 1024)
       : god_world(static_cast<size_t>(god_mesh.V.rows())), posed(god_world.size(), 0), stack(stack_capacity) {}
   std::vector<Vec3> god_world;
   std::vector<uint32_t> posed;
   uint32_t stamp = 0;
+  SweptBoxCache boxes;  // nodes, faces and node_obbs at the call's pose
   BvhStack stack;
 };
 
 // The contact set of the god-object at pose X_WB (G = X_WB.p) against the
-// obstacles (world frame).
+// obstacles (world frame). With num_pairs >= 0, the triangle pairs
+// pairs[0 .. num_pairs) are tested instead of a descent of the trees: a list
+// that holds every pair within settings.distance at X_WB (ccd_step's near
+// pairs: CcdStepResult::num_near_pairs), which gives the same set.
 ContactStatus generate_contacts(const CcdBody* obstacles, int num_obstacles, const CcdBody& god, const Pose& X_WB,
-                                const ContactSettings& settings, ContactWorkspace* ws, ContactSet* set);
+                                const ContactSettings& settings, ContactWorkspace* ws, ContactSet* set,
+                                const CcdStepWorkspace::Candidate* pairs = nullptr, int num_pairs = -1);
 
 // Closest points, exposed for tests. Point/triangle: the closest point of
 // triangle (a, b, c) to p. Segment/segment: parameters s on [p0, p1] and t on

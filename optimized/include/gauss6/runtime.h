@@ -298,6 +298,8 @@ struct SimState {
   ProjectionResult projection;
   CcdStepWorkspace ccd_ws;
   CcdStepResult ccd;
+  std::array<FeaturePair, kMaxContacts> ccd_hints{};  // the contacts at a leg's start, tested first (ccd_step)
+  double stop_deviation = 0;           // of xs from the motion's exact pose (make_stop_pose)
   ContactWorkspace contact_ws;
   HandleSample handle;                 // last sample read
   GodObjectSnapshot snapshot;          // what step 5 publishes
