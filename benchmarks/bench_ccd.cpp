@@ -229,7 +229,7 @@ void time_steps(benchmark::State& state, const RuntimeModel& model, const std::v
       counters.add("pair_tests", r.num_pair_tests);
       counters.add("boxes", static_cast<double>(r.num_box_iterations));
       counters.add("triangle_pairs", r.num_triangle_pairs);
-      counters.add("slab_culls", r.num_slab_culls);
+      counters.add("axis_culls", r.num_axis_culls);
       counters.add("contacts", info.num_contacts);
       counters.next_call();
     }

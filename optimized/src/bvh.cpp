@@ -511,7 +511,7 @@ void ccd_step(const CcdBody* obstacles, int num_obstacles, const CcdBody& god, c
         ++result->num_triangle_pairs;
         const double t = start.earliest(*god.mesh, gf, *ob.mesh, of, reach, tester.end());
         if (t > tester.end()) {
-          ++result->num_slab_culls;
+          ++result->num_axis_culls;
           return true;
         }
         if (num_cand < cand_capacity) {

@@ -155,30 +155,49 @@ TEST_CASE("u-filter keeps every exact contact: static vertex against a body face
   });
 }
 
-TEST_CASE("u-filter keeps every exact contact: edge/edge", "[ccd]") {
+namespace {
+
+// An edge/edge query with an exact contact built in: the body edge a0 a1 at a
+// random u_c, and a static edge crossing it at a point x* of it, offset along
+// their common normal by up to 0.9 d; every fourth query nearly parallel (1e-3
+// rad: line contacts). within: the static edge is within d of the body edge
+// at u_c, verified in rationals (the query has a contact at u_c).
+struct PlacedEdgeEdge {
+  RigidEdgeEdgeQuery q;
+  double u_c = 0;
+  bool within = false;
+};
+PlacedEdgeEdge place_edge_edge(int i, std::mt19937& rng, const CcdMotion& m, const ExactMotion& em, double d) {
   std::uniform_real_distribution<double> U(0.02, 0.98), H(-1, 1), S(0.2, 0.8);
+  PlacedEdgeEdge out;
+  const Vec3 a0 = rnd(rng, 0.03), a1 = a0 + rnd(rng, 0.01);
+  out.u_c = U(rng);
+  const double t = S(rng);
+  const Q3 A0 = em.point(Q(out.u_c), q3(a0)), A1 = em.point(Q(out.u_c), q3(a1));
+  const Q3 x_star = A0 + Q(t) * (A1 - A0);
+  Vec3 eb = rnd(rng, 0.01);
+  const Vec3 ea = to_double(A1 - A0);
+  if (i % 4 == 1) eb = ea + 1e-3 * ea.norm() * rnd(rng, 1);
+  const Vec3 nrm = ea.cross(eb).normalized();
+  const Vec3 P = to_double(x_star) + 0.9 * d * H(rng) * nrm;
+  const double sb = S(rng);
+  out.q.motion = &m;
+  out.q.edge_body = {a0, a1};
+  out.q.edge_world = {P - sb * eb, P + (1 - sb) * eb};
+  out.within = within_of_segment(A0, A1, q3(out.q.edge_world[0]), q3(out.q.edge_world[1]), Q(d));
+  return out;
+}
+
+}  // namespace
+
+TEST_CASE("u-filter keeps every exact contact: edge/edge", "[ccd]") {
   check_exact_contacts(303, alternating_separation, [&](int i, std::mt19937& rng, const CcdMotion& m,
                                                         const ExactMotion& em, const CcdSettings& s,
                                                         CcdWorkspace* ws, CcdResult* r) {
-    const Vec3 a0 = rnd(rng, 0.03), a1 = a0 + rnd(rng, 0.01);
-    const double u_c = U(rng), t = S(rng);
-    const Q3 A0 = em.point(Q(u_c), q3(a0)), A1 = em.point(Q(u_c), q3(a1));
-    const Q3 x_star = A0 + Q(t) * (A1 - A0);
-    // The static edge crosses the body edge at x*, offset along their common
-    // normal by up to 0.9 d; every fourth query nearly parallel (1e-3 rad).
-    Vec3 eb = rnd(rng, 0.01);
-    const Vec3 ea = to_double(A1 - A0);
-    if (i % 4 == 1) eb = ea + 1e-3 * ea.norm() * rnd(rng, 1);
-    const Vec3 nrm = ea.cross(eb).normalized();
-    const Vec3 P = to_double(x_star) + 0.9 * s.min_separation * H(rng) * nrm;
-    const double sb = S(rng);
-    RigidEdgeEdgeQuery q;
-    q.motion = &m;
-    q.edge_body = {a0, a1};
-    q.edge_world = {P - sb * eb, P + (1 - sb) * eb};
-    if (!within_of_segment(A0, A1, q3(q.edge_world[0]), q3(q.edge_world[1]), Q(s.min_separation))) return -1.0;
-    ccd_rigid_edge_edge(q, s, ws, r);
-    return u_c;
+    const PlacedEdgeEdge placed = place_edge_edge(i, rng, m, em, s.min_separation);
+    if (!placed.within) return -1.0;
+    ccd_rigid_edge_edge(placed.q, s, ws, r);
+    return placed.u_c;
   });
 }
 
@@ -226,7 +245,6 @@ TEST_CASE("early hit: never after an exact contact, never after the bisection, g
   // contact u_c (verified in rationals) nor after the query without it, and an
   // early hit reports a pair proven within d + distance_tolerance.
   std::mt19937 rng(505);
-  std::uniform_real_distribution<double> U(0.02, 0.98), H(-1, 1), S(0.2, 0.8);
   CcdWorkspace ws;
   CcdResult on, off;
   int verified = 0, misses = 0, later_than_bisection = 0, earlier = 0, too_far = 0;
@@ -240,21 +258,10 @@ TEST_CASE("early hit: never after an exact contact, never after the bisection, g
     CcdSettings s;
     s.min_separation = 1e-5;
     s.distance_tolerance = 1e-6;
-    const Vec3 a0 = rnd(rng, 0.03), a1 = a0 + rnd(rng, 0.01);
-    const double u_c = U(rng), t = S(rng);
-    const Q3 A0 = em.point(Q(u_c), q3(a0)), A1 = em.point(Q(u_c), q3(a1));
-    const Q3 x_star = A0 + Q(t) * (A1 - A0);
-    Vec3 eb = rnd(rng, 0.01);
-    const Vec3 ea = to_double(A1 - A0);
-    if (i % 4 == 1) eb = ea + 1e-3 * ea.norm() * rnd(rng, 1);  // nearly parallel: line contacts
-    const Vec3 nrm = ea.cross(eb).normalized();
-    const Vec3 P = to_double(x_star) + 0.9 * s.min_separation * H(rng) * nrm;
-    const double sb = S(rng);
-    RigidEdgeEdgeQuery q;
-    q.motion = &m;
-    q.edge_body = {a0, a1};
-    q.edge_world = {P - sb * eb, P + (1 - sb) * eb};
-    if (!within_of_segment(A0, A1, q3(q.edge_world[0]), q3(q.edge_world[1]), Q(s.min_separation))) continue;
+    const PlacedEdgeEdge placed = place_edge_edge(i, rng, m, em, s.min_separation);
+    if (!placed.within) continue;
+    const RigidEdgeEdgeQuery& q = placed.q;
+    const double u_c = placed.u_c;
     ++verified;
     ccd_rigid_edge_edge(q, s, &ws, &on);
     CcdSettings s_off = s;

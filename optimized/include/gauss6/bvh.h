@@ -415,7 +415,7 @@ struct CcdStepResult {
   double time_tolerance_reached = 0, distance_reached = 0;  // of that pair's test
   CcdMotion motion;                        // the enclosed motion used (for make_stop_pose)
   int num_sub_intervals = 0, num_node_pairs = 0, num_triangle_pairs = 0, num_pair_tests = 0;
-  int num_slab_culls = 0;                  // triangle pairs dropped whole by a separating-axis bound (no pair test)
+  int num_axis_culls = 0;                  // triangle pairs dropped whole by a separating-axis time bound (no pair test)
   long num_box_iterations = 0;             // narrow-phase boxes, all tests together
   // Near pairs (settings.near_distance > 0): when num_near_pairs >= 0, ws->candidates[0 .. num_near_pairs)
   // hold every triangle pair that can come within near_reach (= max(min_separation, near_distance)) of
