@@ -2,9 +2,9 @@
 // against a static one under the Cayley motion (conservative box culling, then
 // the exact primitives of ccd_exact.cpp), exact triangle/triangle intersection
 // count and exact separation distance at a pose. The posed-mesh queries cull
-// pairs with CGAL's box_intersection_d on conservative boxes and decide each
-// pair with CGAL's filtered predicates: interval arithmetic first, Gmpq only
-// when the intervals cannot decide. See gauss6/reference/ccd.h.
+// pairs on conservative boxes (groups of body faces against a walk of the
+// obstacle's face tree) and decide each pair with CGAL's filtered predicates:
+// interval arithmetic first, Gmpq only when the intervals cannot decide. See gauss6/reference/ccd.h.
 #include "gauss6/reference/ccd.h"
 
 #include <algorithm>
@@ -18,7 +18,6 @@
 #include <CGAL/Gmpq.h>
 #include <CGAL/Interval_nt.h>
 #include <CGAL/Simple_cartesian.h>
-#include <CGAL/box_intersection_d.h>
 #include <CGAL/intersections.h>
 #include <CGAL/squared_distance_3.h>
 
@@ -306,8 +305,6 @@ struct ToExact {
 using DoIntersect = CGAL::Filtered_predicate<ExactKernel::Do_intersect_3, IntervalKernel::Do_intersect_3, ToExact,
                                              ToInterval>;
 
-using FaceBox = CGAL::Box_intersection_d::Box_with_info_d<double, 3, int32_t>;
-
 CGAL::Bbox_3 obstacle_face_bbox(const TriangleMesh& m, int f) {
   CGAL::Bbox_3 b;
   for (int k = 0; k < 3; ++k) {
@@ -315,18 +312,6 @@ CGAL::Bbox_3 obstacle_face_bbox(const TriangleMesh& m, int f) {
     b += CGAL::Bbox_3(x.x(), x.y(), x.z(), x.x(), x.y(), x.z());  // exact
   }
   return b;
-}
-
-// CGAL's box_intersection_d on two box sets, through pointers (the algorithm
-// reorders its input; pointers are cheaper to move than boxes). Calls
-// visit(info of a, info of b) once per overlapping (closed) pair.
-template <class Visit>
-void intersect_boxes(const std::vector<FaceBox>& a, const std::vector<FaceBox>& b, Visit&& visit) {
-  std::vector<const FaceBox*> pa(a.size()), pb(b.size());
-  for (size_t i = 0; i < a.size(); ++i) pa[i] = &a[i];
-  for (size_t i = 0; i < b.size(); ++i) pb[i] = &b[i];
-  CGAL::box_intersection_d(pa.begin(), pa.end(), pb.begin(), pb.end(),
-                           [&](const FaceBox* x, const FaceBox* y) { visit(x->info(), y->info()); });
 }
 
 CGAL::Bbox_3 to_bbox(const Aabb& b) { return {b.lo.x(), b.lo.y(), b.lo.z(), b.hi.x(), b.hi.y(), b.hi.z()}; }
@@ -344,9 +329,13 @@ CGAL::Bbox_3 grown(const CGAL::Bbox_3& b, double margin) {
 // posed triangle's exact position, so no pair within `margin` (in each
 // coordinate) is missed. Narrowing, each step keeping every overlapping pair:
 // (1) the region where the posed body's box and the obstacle's overlap;
-// (2) CGAL's box_intersection_d on the face groups (ExactMeshPair::kFaceGroup
-// nearby faces each) that reach the region; (3) box_intersection_d on the
-// faces of the groups that met.
+// (2) for each body face group (ExactMeshPair::kFaceGroup nearby faces) that
+// reaches the region, the obstacle faces whose boxes meet the group's box, by
+// a walk of the obstacle's face tree; (3) those against each face of the group
+// (its box holds the face's, so every overlapping pair is found, once).
+// A walk per group, where CGAL's box_intersection_d sorted the boxes of every
+// group and face in the region at each pose: the bunnies' poses, half a bunny
+// in the region, spent most of their check sorting.
 template <class Visit>
 void candidate_pairs(const ExactMeshPair& mp, const PosedBody& posed, double margin, Visit&& visit) {
   constexpr int kGroup = ExactMeshPair::kFaceGroup;
@@ -376,38 +365,26 @@ void candidate_pairs(const ExactMeshPair& mp, const PosedBody& posed, double mar
   const CGAL::Bbox_3 region(std::max(all.xmin(), obstacle_all.xmin()), std::max(all.ymin(), obstacle_all.ymin()),
                             std::max(all.zmin(), obstacle_all.zmin()), std::min(all.xmax(), obstacle_all.xmax()),
                             std::min(all.ymax(), obstacle_all.ymax()), std::min(all.zmax(), obstacle_all.zmax()));
-  // (2) Groups that reach the region, then the pairs of groups that meet.
-  std::vector<FaceBox> body_groups, obstacle_groups;
-  for (size_t g = 0; g < body_group_boxes.size(); ++g)
-    if (CGAL::do_overlap(body_group_boxes[g], region)) body_groups.emplace_back(body_group_boxes[g], int32_t(g));
-  for (size_t g = 0; g < mp.obstacle_face_groups.size(); ++g) {
-    const CGAL::Bbox_3 b = to_bbox(mp.obstacle_face_groups[g]);
-    if (CGAL::do_overlap(b, region)) obstacle_groups.emplace_back(b, int32_t(g));
-  }
-  if (body_groups.empty() || obstacle_groups.empty()) return;
-  std::vector<int32_t> body_met, obstacle_met;
-  intersect_boxes(body_groups, obstacle_groups, [&](int32_t g, int32_t og) {
-    body_met.push_back(g);
-    obstacle_met.push_back(og);
-  });
-  for (auto* met : {&body_met, &obstacle_met}) {
-    std::sort(met->begin(), met->end());
-    met->erase(std::unique(met->begin(), met->end()), met->end());
-  }
-  // (3) The faces of the groups that met, within the region.
-  std::vector<FaceBox> body_faces, obstacle_faces;
-  for (const int32_t g : body_met)
-    for (size_t i = size_t(g) * kGroup; i < std::min(body_order.size(), size_t(g + 1) * kGroup); ++i) {
+  std::vector<std::pair<int32_t, CGAL::Bbox_3>> near;  // obstacle faces meeting a group, with their boxes
+  for (size_t g = 0; g < body_group_boxes.size(); ++g) {
+    const CGAL::Bbox_3& gb = body_group_boxes[g];
+    if (!CGAL::do_overlap(gb, region)) continue;
+    // (2) The obstacle faces whose boxes meet the group's.
+    near.clear();
+    const Aabb query{Vec3(gb.xmin(), gb.ymin(), gb.zmin()), Vec3(gb.xmax(), gb.ymax(), gb.zmax())};
+    query_tree(mp.obstacle_faces, query, [&](int of) {
+      const CGAL::Bbox_3 b = obstacle_face_bbox(obs, of);
+      if (CGAL::do_overlap(b, gb)) near.emplace_back(of, b);
+    });
+    if (near.empty()) continue;
+    // (3) Each face of the group against them.
+    for (size_t i = g * kGroup; i < std::min(body_order.size(), (g + 1) * kGroup); ++i) {
       const CGAL::Bbox_3 b = face_bbox(body_order[i]);
-      if (CGAL::do_overlap(b, region)) body_faces.emplace_back(b, body_order[i]);
+      if (!CGAL::do_overlap(b, region)) continue;
+      for (const auto& [of, ob] : near)
+        if (CGAL::do_overlap(b, ob)) visit(body_order[i], of);
     }
-  const std::vector<int32_t>& obstacle_order = mp.obstacle_faces.item;
-  for (const int32_t g : obstacle_met)
-    for (size_t i = size_t(g) * kGroup; i < std::min(obstacle_order.size(), size_t(g + 1) * kGroup); ++i) {
-      const CGAL::Bbox_3 b = obstacle_face_bbox(obs, obstacle_order[i]);
-      if (CGAL::do_overlap(b, region)) obstacle_faces.emplace_back(b, obstacle_order[i]);
-    }
-  intersect_boxes(body_faces, obstacle_faces, visit);
+  }
 }
 
 Aabb face_box(const std::vector<Aabb>& vertex_boxes, const TriangleMesh& m, int f) {
@@ -471,7 +448,6 @@ ExactMeshPair make_exact_mesh_pair(const TriangleMesh& body_B, const TriangleMes
     return g;
   };
   mp.body_face_groups = groups(mp.body_faces, body_fb);
-  mp.obstacle_face_groups = groups(mp.obstacle_faces, fb);
   for (int v = 0; v < body_B.V.rows(); ++v) mp.body_radius = std::max(mp.body_radius, vertex(body_B, v).norm());
   mp.body_radius = std::nextafter(mp.body_radius, HUGE_VAL);
   return mp;

@@ -134,12 +134,11 @@ struct ExactMeshPair {
   TriangleMesh obstacle;                          // static, world frame
   std::vector<std::array<int32_t, 2>> body_edges, obstacle_edges;  // unique, sorted
   AabbTree obstacle_faces, obstacle_vertices, obstacle_edge_tree;  // exact boxes (doubles)
-  // Faces in groups of kFaceGroup consecutive items of the trees' item order
-  // (nearby faces): group g's box holds the boxes of faces item[g * kFaceGroup ..].
+  // Body faces in groups of kFaceGroup consecutive items of the tree's item
+  // order (nearby faces): group g's box holds the boxes of faces item[g * kFaceGroup ..].
   static constexpr int kFaceGroup = 8;
   AabbTree body_faces;                       // body frame, exact boxes
   std::vector<Aabb> body_face_groups;        // body frame
-  std::vector<Aabb> obstacle_face_groups;    // world frame
   double body_radius = 0;  // max |r_B| over body vertices (rounded up)
 };
 
@@ -169,9 +168,9 @@ struct MeshContact {
 MeshContact mesh_first_contact(const ExactMeshPair& meshes, const Pose& X0, const Pose& X1);
 
 // Number of (body triangle, obstacle triangle) pairs that intersect (share at
-// least a point) with the body at pose X, exactly. Pairs are culled with
-// CGAL's box_intersection_d on boxes that contain the exact posed triangles,
-// then decided by CGAL's filtered predicate: interval arithmetic on enclosures
+// least a point) with the body at pose X, exactly. Pairs are culled on boxes
+// that contain the exact posed triangles (groups of body faces against a walk
+// of the obstacle's face tree), then decided by CGAL's filtered predicate: interval arithmetic on enclosures
 // of the exact posed vertices, Gmpq on the exact ones when the intervals
 // cannot decide. Throws std::domain_error on a zero quaternion or a non-finite
 // coordinate.
