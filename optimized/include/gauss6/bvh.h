@@ -191,9 +191,9 @@ inline double triangle_time_lower_bound(const Vec3 A[3], const Vec3 B[3], const 
 // side strip of the peg tilted by half a degree gets a world box about 1 mm
 // wide, five times the hole's clearance; and the hole's wall, a ring of strips,
 // has axis-aligned boxes as wide as its arcs. Their oriented boxes stay as thin
-// as the arcs' sagittas: a peg resting in the hole (0.2 mm of clearance) has
-// no node pair of facing arcs of up to 20 degrees left, where the axis-aligned
-// boxes of all of them meet.
+// as the arcs' sagittas: for a peg resting in the hole (0.2 mm of clearance)
+// they keep the leaves of facing strips apart, where the axis-aligned boxes of
+// all of them meet.
 //
 // Over a sub-interval [u0, u1] of the motion, every point r_B of the god-object
 // is at X(u) = p(u) + R(u) r_B with p(u) = p(u0) + (u - u0) dp, so X(u) lies in
