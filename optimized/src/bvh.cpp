@@ -485,14 +485,13 @@ void ccd_step(const CcdBody* obstacles, int num_obstacles, const CcdBody& god, c
     // the god node's posed at u0, swept along the sub-interval's translation,
     // grown by what else its points may move, plus d).
     const SweptObbFrame obb_frame = start.obb_frame(std::min(u1, result->u_hit), reach);
-    const BvhNode* ob_nodes = nullptr;  // the obstacle being traversed
-    const auto separated = [&](int gi, int oi) {
-      const PosedObb& a = ws->swept.get(ws->swept.node_obbs, gi, [&] { return obb_frame.pose(god.bvh->nodes[gi].obb); });
-      return (a.pays || ob_nodes[oi].obb_pays) && obb_separated(a, ob_nodes[oi].obb);
+    const auto god_node_obb = [&](int node) -> const PosedObb& {
+      return ws->swept.get(ws->swept.node_obbs, node, [&] { return obb_frame.pose(god.bvh->nodes[node].obb); });
     };
-    // God boxes grown by d once here (outward rounded), so the traversal compares
-    // them with the obstacles' exact boxes as they are (margin 0 below): the same
-    // test as growing each obstacle box by d, without its roundings per node pair.
+    // God boxes grown by the reach once here (outward rounded), so the traversal
+    // compares them with the obstacles' exact boxes as they are (margin 0 below):
+    // the same test as growing each obstacle box, without its roundings per node
+    // pair.
     const auto box_over = [&](const Aabb& body) { return inflate(swept_box(e, body), reach); };
     const auto god_node_box = [&](int node) {
       return ws->swept.get(ws->swept.nodes, node, [&] { return box_over(god.bvh->nodes[node].box); });
@@ -506,7 +505,7 @@ void ccd_step(const CcdBody* obstacles, int num_obstacles, const CcdBody& god, c
         result->status = CcdStatus::kInvalidInput;
         return;
       }
-      ob_nodes = ob.bvh->nodes.data();
+      const auto separated = [&](int gi, int oi) { return node_pair_separated(god_node_obb(gi), ob.bvh->nodes[oi]); };
       const auto visit = [&](int gf, int of) {
         ++result->num_triangle_pairs;
         const double t = start.earliest(*god.mesh, gf, *ob.mesh, of, reach, tester.end());

@@ -225,9 +225,9 @@ ContactStatus generate_contacts(const CcdBody* obstacles, int num_obstacles, con
       return ws->boxes.get(ws->boxes.faces, face, [&] { return god_box(triangle_box(gm, face)); });
     };
     const auto separated = [&](int gi, int oi) {
-      const PosedObb& a =
-          ws->boxes.get(ws->boxes.node_obbs, gi, [&] { return obb_frame.pose(god.bvh->nodes[gi].obb); });
-      return (a.pays || ob.nodes[oi].obb_pays) && obb_separated(a, ob.nodes[oi].obb);
+      return node_pair_separated(
+          ws->boxes.get(ws->boxes.node_obbs, gi, [&] { return obb_frame.pose(god.bvh->nodes[gi].obb); }),
+          ob.nodes[oi]);
     };
     if (for_each_candidate_pair_indexed(gm, *god.bvh, om, ob, node_box, face_box, d, &ws->stack, visit, &node_pairs,
                                         separated) ==

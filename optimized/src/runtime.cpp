@@ -229,10 +229,11 @@ Vec6 constrain_motion(const RuntimeModel& model, const Vec6& au, SimState* s) {
 
 // One CCD leg along the Cayley motion x0 -> x1, split in halves on a half turn
 // (each half turns by at most 90 degrees), with s->ccd_hints[0 .. num_hints)
-// tested first; s->ccd holds the result of the last call. When the leg can run, s->xs becomes the motion's own pose at u_hit (its
-// end when no hit: the CCD's guarantee holds for it, up to make_stop_pose's
-// deviation bound) and the function returns true; on invalid input or a half
-// turn left after splitting, s->xs is left as it was and it returns false.
+// tested first; s->ccd holds the result of the last call. When the leg can
+// run, s->xs becomes the motion's own pose at u_hit (its end when no hit: the
+// CCD's guarantee holds for it, up to make_stop_pose's deviation bound) and the
+// function returns true; on invalid input or a half turn left after splitting,
+// s->xs is left as it was and it returns false.
 bool ccd_leg(const RuntimeModel& model, const Pose& x0, const Pose& x1, int num_hints, SimState* s,
              int* num_halves) {
   const int num_obstacles = static_cast<int>(model.obstacles.size());

@@ -392,6 +392,35 @@ long double triangle_distance(const Vec3 A[3], const Vec3 B[3]) {
   return best;
 }
 
+// Two disjoint triangles at `scale`: A about a random centre c (every fourth
+// long and thin, a peg's side strip), B placed gap = scale 10^(-gap_decades U)
+// beyond a random plane (normal m) through A's extreme point, two thirds of
+// them farther still; with nearly_parallel, B lies almost in that plane.
+struct DisjointPair {
+  Vec3 A[3], B[3], c, m;
+  double gap = 0;
+};
+// n and U are the caller's (a normal distribution keeps a spare draw).
+DisjointPair disjoint_pair(std::mt19937& rng, std::normal_distribution<double>& n,
+                           std::uniform_real_distribution<double>& U, int i, double scale, double gap_decades,
+                           bool nearly_parallel) {
+  DisjointPair out;
+  out.c = scale * 10 * Vec3(n(rng), n(rng), n(rng));
+  for (int k = 0; k < 3; ++k) out.A[k] = out.c + scale * Vec3(n(rng), n(rng), n(rng));
+  if (i % 4 == 0) out.A[2] = out.A[0] + 1e-2 * (out.A[2] - out.A[0]) + 30 * (out.A[1] - out.A[0]);
+  out.m = Vec3(n(rng), n(rng), n(rng)).normalized();
+  const Vec3& m = out.m;
+  double top = -1e300;
+  for (const Vec3& a : out.A) top = std::max(top, m.dot(a));
+  out.gap = scale * std::pow(10.0, -gap_decades * U(rng));
+  for (int k = 0; k < 3; ++k) {
+    Vec3 v = out.c + scale * Vec3(n(rng), n(rng), n(rng));
+    if (nearly_parallel) v -= m * m.dot(v - out.c) * 0.999;
+    out.B[k] = v + m * (top + out.gap - m.dot(v) + scale * std::abs(n(rng)) * (i % 3 == 0 ? 0 : 1));
+  }
+  return out;
+}
+
 }  // namespace
 
 TEST_CASE("triangle_gap_lower_bound: never above the distance, and useful", "[bvh]") {
@@ -404,19 +433,9 @@ TEST_CASE("triangle_gap_lower_bound: never above the distance, and useful", "[bv
     // plane through A's extreme point (so they are disjoint), at scales from
     // 1e-3 to 1e3, some long and thin (a peg's side strip), some coplanar-ish.
     const double scale = std::pow(10.0, 6 * U(rng) - 3);
-    const Vec3 c = scale * 10 * Vec3(n(rng), n(rng), n(rng));
-    Vec3 A[3], B[3];
-    for (int k = 0; k < 3; ++k) A[k] = c + scale * Vec3(n(rng), n(rng), n(rng));
-    if (i % 4 == 0) A[2] = A[0] + 1e-2 * (A[2] - A[0]) + 30 * (A[1] - A[0]);  // long and thin
-    const Vec3 m = Vec3(n(rng), n(rng), n(rng)).normalized();
-    double top = -1e300;
-    for (const Vec3& a : A) top = std::max(top, m.dot(a));
-    const double gap = scale * std::pow(10.0, -9 * U(rng));
-    for (int k = 0; k < 3; ++k) {
-      Vec3 v = c + scale * Vec3(n(rng), n(rng), n(rng));
-      if (i % 7 == 0) v -= m * m.dot(v - c) * 0.999;  // nearly parallel to the plane
-      B[k] = v + m * (top + gap - m.dot(v) + scale * std::abs(n(rng)) * (i % 3 == 0 ? 0 : 1));
-    }
+    const DisjointPair pair = disjoint_pair(rng, n, U, i, scale, 9, /*nearly_parallel=*/i % 7 == 0);
+    const Vec3 *A = pair.A, *B = pair.B, &c = pair.c;
+    const double gap = pair.gap;
     const long double exact = triangle_distance(A, B);
     if (!(exact > 0)) continue;
     const double bound = triangle_gap_lower_bound(A, B, std::numeric_limits<double>::infinity());
@@ -455,18 +474,9 @@ TEST_CASE("triangle_time_lower_bound: no motion within its bounds comes within r
   int bounded = 0, infinite = 0, receding = 0;
   for (int i = 0; i < 4000; ++i) {
     const double scale = std::pow(10.0, 4 * U(rng) - 2);
-    const Vec3 c0 = scale * 10 * Vec3(n(rng), n(rng), n(rng));
-    Vec3 A[3], B[3];
-    for (int k = 0; k < 3; ++k) A[k] = c0 + scale * Vec3(n(rng), n(rng), n(rng));
-    if (i % 4 == 0) A[2] = A[0] + 1e-2 * (A[2] - A[0]) + 30 * (A[1] - A[0]);  // long and thin
-    const Vec3 m = Vec3(n(rng), n(rng), n(rng)).normalized();
-    double top = -1e300;
-    for (const Vec3& a : A) top = std::max(top, m.dot(a));
-    const double gap = scale * std::pow(10.0, -3 * U(rng));
-    for (int k = 0; k < 3; ++k) {
-      const Vec3 v = c0 + scale * Vec3(n(rng), n(rng), n(rng));
-      B[k] = v + m * (top + gap - m.dot(v) + scale * std::abs(n(rng)) * (i % 3 == 0 ? 0 : 1));
-    }
+    const DisjointPair pair = disjoint_pair(rng, n, U, i, scale, 3, /*nearly_parallel=*/false);
+    const Vec3 *A = pair.A, *B = pair.B, &c0 = pair.c, &m = pair.m;
+    const double gap = pair.gap;
     const double reach = i % 5 == 0 ? 0.0 : gap * U(rng);
     // The motion: towards B, across, or away (v), and a turn.
     Vec3 v = scale * Vec3(n(rng), n(rng), n(rng));
@@ -475,7 +485,7 @@ TEST_CASE("triangle_time_lower_bound: no motion within its bounds comes within r
     const Vec3 centre = c0 + scale * Vec3(n(rng), n(rng), n(rng));
     const Vec3 omega = (i % 2 ? 0.0 : 0.3) * Vec3(n(rng), n(rng), n(rng));
     double lever = 0;
-    for (const Vec3& a : A) lever = std::max(lever, (a - centre).norm());
+    for (int k = 0; k < 3; ++k) lever = std::max(lever, (A[k] - centre).norm());
     const double w = omega.norm() * lever * (1 + 1e-9);
     const double tau = triangle_time_lower_bound(A, B, v, w, reach, std::numeric_limits<double>::infinity());
     REQUIRE(tau >= 0);

@@ -219,10 +219,8 @@ struct PosedObb {
 
 // Volume of an oriented box over that of the axis-aligned box with the given
 // half extents, both grown by a thousandth of the oriented box's diagonal (so
-// flat boxes compare by area). The traversals test oriented boxes only for a
-// node pair where one of the two is below 1/2: where both boxes are about as
-// tight as their axis-aligned ones (a bunny's compact nodes, the flat fans of
-// an axis-aligned face) the 15-axis test costs more than it saves.
+// flat boxes compare by area): below 1/2, the box pays for its test
+// (node_pair_separated).
 inline double obb_volume_ratio(const Vec3& obb_half, const Vec3& aabb_half) {
   const double e = 1e-3 * obb_half.norm();
   return (obb_half + Vec3::Constant(e)).prod() / (aabb_half + Vec3::Constant(e)).prod();
@@ -290,6 +288,16 @@ GAUSS6_ALWAYS_INLINE bool obb_separated(const PosedObb& a, const Obb& b) {
   return false;
 }
 
+// The traversals' oriented-box test of a node pair (the god node's box posed
+// and swept, the obstacle node): run only where one of the two boxes is under
+// half its axis-aligned one (PosedObb::pays, BvhNode::obb_pays), since where
+// both are about as tight as their axis-aligned boxes (a bunny's compact
+// nodes, the flat fans of an axis-aligned face) the 15-axis test costs more
+// than it saves.
+GAUSS6_ALWAYS_INLINE bool node_pair_separated(const PosedObb& god_node, const BvhNode& obstacle_node) {
+  return (god_node.pays || obstacle_node.obb_pays) && obb_separated(god_node, obstacle_node.obb);
+}
+
 // Fixed-capacity stack of node pairs for the simultaneous descent.
 struct BvhStack {
   explicit BvhStack(int capacity = 1024) : items(static_cast<size_t>(capacity)) {}
@@ -309,7 +317,7 @@ enum class TraversalStatus { kDone = 0, kStopped, kStackFull };
 // god_face_box(int face) -> Aabb world for face `face` of god_mesh (so a caller
 // can cache them: see SweptBoxCache); and node pairs whose world boxes overlap
 // are then dropped when separated(god_node, obstacle_node) proves them apart
-// (obb_separated, or nothing: see the overload).
+// (node_pair_separated; for_each_candidate_pair drops none).
 template <class GodNodeBox, class GodFaceBox, class Visit, class Separated>
 TraversalStatus for_each_candidate_pair_indexed([[maybe_unused]] const TriangleMesh& god_mesh, const Bvh& god,
                                                 const TriangleMesh& obs_mesh, const Bvh& obs,
@@ -354,15 +362,6 @@ TraversalStatus for_each_candidate_pair_indexed([[maybe_unused]] const TriangleM
   }
   return TraversalStatus::kDone;
 }
-template <class GodNodeBox, class GodFaceBox, class Visit>
-TraversalStatus for_each_candidate_pair_indexed(const TriangleMesh& god_mesh, const Bvh& god,
-                                                const TriangleMesh& obs_mesh, const Bvh& obs,
-                                                const GodNodeBox& god_node_box, const GodFaceBox& god_face_box,
-                                                double margin, BvhStack* stack, Visit&& visit, int* num_node_pairs) {
-  return for_each_candidate_pair_indexed(god_mesh, god, obs_mesh, obs, god_node_box, god_face_box, margin, stack,
-                                         std::forward<Visit>(visit), num_node_pairs,
-                                         [](int, int) { return false; });
-}
 template <class GodBox, class Visit>
 TraversalStatus for_each_candidate_pair(const TriangleMesh& god_mesh, const Bvh& god, const TriangleMesh& obs_mesh,
                                         const Bvh& obs, const GodBox& god_box, double margin, BvhStack* stack,
@@ -370,7 +369,7 @@ TraversalStatus for_each_candidate_pair(const TriangleMesh& god_mesh, const Bvh&
   return for_each_candidate_pair_indexed(
       god_mesh, god, obs_mesh, obs, [&](int node) { return god_box(god.nodes[node].box); },
       [&](int face) { return god_box(triangle_box(god_mesh, face)); }, margin, stack, std::forward<Visit>(visit),
-      num_node_pairs);
+      num_node_pairs, [](int, int) { return false; });
 }
 
 // ---------------------------------------------------------------------------
