@@ -300,13 +300,7 @@ struct StartFrame {
   // (g - static_error - d) / that. The search stops once the bound passes u_limit.
   double earliest(const TriangleMesh& gm, int gf, const TriangleMesh& om, int of, double d, double u_limit) const {
     Vec3 X[3], Y[3];
-    double r2 = 0;
-    for (int k = 0; k < 3; ++k) {
-      const Vec3 r_B = gm.V.row(gm.F(gf, k)).transpose();
-      r2 = std::max(r2, r_B.squaredNorm());
-      X[k] = R * r_B + p;
-      Y[k] = om.V.row(om.F(of, k)).transpose();
-    }
+    const double r2 = place(gm, gf, om, of, X, Y);
     // |r_B| of any point of the triangle <= that of its farthest corner.
     const double r = std::min(rho, next_up(std::sqrt(r2) * (1 + 1e-15)));
     const double w = next_up(drift + next_up(turn_rate * r));
@@ -315,7 +309,49 @@ struct StartFrame {
     if (!(tau > 0)) return u0;
     return next_down(u0 + tau);
   }
+
+  // True when the god triangle gf at u0 is proven farther than d from the
+  // obstacle triangle `of` (the separating-axis bound of the double triangles,
+  // less static_error).
+  bool apart(const TriangleMesh& gm, int gf, const TriangleMesh& om, int of, double d) const {
+    Vec3 X[3], Y[3];
+    place(gm, gf, om, of, X, Y);
+    const double reach = next_up(static_error + d);
+    return triangle_gap_lower_bound(X, Y, reach) > reach;
+  }
+
+ private:
+  // The god triangle's corners at u0 (doubles) and the obstacle triangle's;
+  // returns the largest |r_B|^2 of the god corners.
+  double place(const TriangleMesh& gm, int gf, const TriangleMesh& om, int of, Vec3 X[3], Vec3 Y[3]) const {
+    double r2 = 0;
+    for (int k = 0; k < 3; ++k) {
+      const Vec3 r_B = gm.V.row(gm.F(gf, k)).transpose();
+      r2 = std::max(r2, r_B.squaredNorm());
+      X[k] = R * r_B + p;
+      Y[k] = om.V.row(om.F(of, k)).transpose();
+    }
+    return r2;
+  }
 };
+
+// A bound on how far any point r_B (|r_B| <= rho) of a body lies at pose b from
+// where it lies at pose a, both exact (p + R(q) r_B, R(q) the rotation of the
+// unit quaternion q / |q|): |p_b - p_a| + |R(q_b) - R(q_a)| rho, where for unit
+// quaternions R(a)^T R(b) = R(conj(a) b) turns by theta with |vec(conj(a) b)| =
+// sin(theta / 2), and a turn by theta moves a point by at most 2 sin(theta / 2)
+// |r_B|. In doubles the two normalisations and the product's components are
+// within a few units of 2^-53 (every term is at most 1 in magnitude): 1e-14
+// covers them, and 1e-15 the rounding of |p_b - p_a|. Infinite on non-finite
+// input.
+double displacement_bound(const Pose& a, const Pose& b, double rho) {
+  const Quat qa = normalized(a.q), qb = normalized(b.q);
+  const Vec3 v = qa.w * qb.vec() - qb.w * qa.vec() - qa.vec().cross(qb.vec());  // vec(conj(qa) qb)
+  const double turn = next_up(next_up(2 * v.norm()) + 1e-14);
+  const double shift = next_up((b.p - a.p).norm() * (1 + 1e-15));
+  const double out = next_up(shift + next_up(turn * rho));
+  return out < std::numeric_limits<double>::infinity() ? out : std::numeric_limits<double>::infinity();
+}
 
 // Runs the owned feature pairs of one (god triangle, obstacle triangle) pair on
 // the window [u0, *u_best]; lowers *u_best and records the pair on a hit.
@@ -403,9 +439,10 @@ void ccd_step(const CcdBody* obstacles, int num_obstacles, const CcdBody& god, c
               const CcdStepSettings& settings, CcdStepWorkspace* ws, CcdStepResult* result, const FeaturePair* hints,
               int num_hints) {
   *result = CcdStepResult{};
-  const bool inputs_ok = god.mesh && god.bvh && ws && (num_obstacles == 0 || obstacles) &&
-                         settings.max_sub_intervals >= 1 && settings.sub_interval_angle > 0 &&
-                         settings.sub_interval_travel > 0;
+  bool inputs_ok = god.mesh && god.bvh && ws && (num_obstacles == 0 || obstacles) &&
+                   settings.max_sub_intervals >= 1 && settings.sub_interval_angle > 0 &&
+                   settings.sub_interval_travel > 0;
+  for (int o = 0; inputs_ok && o < num_obstacles; ++o) inputs_ok = obstacles[o].mesh && obstacles[o].bvh;
   if (!inputs_ok) {
     result->status = CcdStatus::kInvalidInput;
     return;
@@ -453,46 +490,22 @@ void ccd_step(const CcdBody* obstacles, int num_obstacles, const CcdBody& god, c
       tester.test(*god.mesh, *god.bvh, f.god_face, *ob.mesh, *ob.bvh, f.obstacle_face, f.obstacle);
     }
   }
-  // A god-object that was in contact at X0 (hints given) and was not stopped by
-  // those pairs is likely to meet a neighbouring pair soon (a contact sliding
-  // onto the next triangles, a bunny's ear turned onto the back it rests on):
-  // a short probe [0, u_probe] comes first, over which no point moves more
-  // than probe_distance, and a hit there ends the step without sweeping the
-  // boxes over the whole step.
-  double u_probe = 0;
-  if (hints && num_hints > 0 && !result->hit && settings.probe_distance > 0) {
-    start.set(motion, 0.0, god.bvh->radius);
-    u_probe = settings.probe_distance / start.speed;  // 0 when the speed is infinite
-    if (!(u_probe < 0.5 / n)) u_probe = 0;             // not short enough to pay (or NaN)
-  }
-  const bool probe = u_probe > 0;
-  for (int i = probe ? -1 : 0; i < n; ++i) {
-    const double u0 = i < 0 ? 0.0 : (i == 0 && probe ? u_probe : static_cast<double>(i) / n);
-    const double u1 = i < 0 ? u_probe : ((i + 1 == n) ? 1.0 : static_cast<double>(i + 1) / n);
-    if (result->hit && result->u_hit - settings.narrow.time_tolerance <= u0) break;  // nothing left to search
-    enclose_motion(motion, {u0, std::min(u1, result->u_hit)}, &e);
-    start.set(motion, u0, god.bvh->radius);
-    tester.u0 = u0;
-    tester.u1 = u1;
-    // Candidate triangle pairs of every obstacle, each with a lower bound of its
-    // first contact (StartFrame::earliest); those that cannot touch before the
-    // sub-interval's end are dropped here. When the buffer is full the rest are
-    // tested at once, in traversal order (same result, less pruning).
-    int num_cand = 0;
-    bool listed = true;  // every candidate of this sub-interval is in cand (no overflow, no early stop)
-    ws->swept.next_interval();  // e changed: every cached god box is stale
-    // Node pairs whose world boxes meet are then tested as oriented boxes (bvh.h:
-    // the god node's posed at u0, swept along the sub-interval's translation,
-    // grown by what else its points may move, plus d).
-    const SweptObbFrame obb_frame = start.obb_frame(std::min(u1, result->u_hit), reach);
+  // Lists the candidate triangle pairs of every obstacle over the motion
+  // enclosed in e (start: its frame at u0), the god boxes grown by `dist`:
+  // node pairs whose world boxes meet are then tested as oriented boxes (bvh.h:
+  // the god node's posed at u0, swept along the translation up to u_end, grown
+  // by what else its points may move, plus dist), and visit(gf, of, o) gets the
+  // rest (false: stop). Call ws->swept.next_interval() first whenever e changed.
+  const auto descend = [&](double u_end, double dist, const auto& visit) {
+    const SweptObbFrame obb_frame = start.obb_frame(u_end, dist);
     const auto god_node_obb = [&](int node) -> const PosedObb& {
       return ws->swept.get(ws->swept.node_obbs, node, [&] { return obb_frame.pose(god.bvh->nodes[node].obb); });
     };
-    // God boxes grown by the reach once here (outward rounded), so the traversal
-    // compares them with the obstacles' exact boxes as they are (margin 0 below):
-    // the same test as growing each obstacle box, without its roundings per node
-    // pair.
-    const auto box_over = [&](const Aabb& body) { return inflate(swept_box(e, body), reach); };
+    // God boxes grown by dist once here (outward rounded), so the traversal
+    // compares them with the obstacles' exact boxes as they are (margin 0
+    // below): the same test as growing each obstacle box, without its roundings
+    // per node pair.
+    const auto box_over = [&](const Aabb& body) { return inflate(swept_box(e, body), dist); };
     const auto god_node_box = [&](int node) {
       return ws->swept.get(ws->swept.nodes, node, [&] { return box_over(god.bvh->nodes[node].box); });
     };
@@ -501,51 +514,17 @@ void ccd_step(const CcdBody* obstacles, int num_obstacles, const CcdBody& god, c
     };
     for (int o = 0; o < num_obstacles; ++o) {
       const CcdBody& ob = obstacles[o];
-      if (!ob.mesh || !ob.bvh) {
-        result->status = CcdStatus::kInvalidInput;
-        return;
-      }
       const auto separated = [&](int gi, int oi) { return node_pair_separated(god_node_obb(gi), ob.bvh->nodes[oi]); };
-      const auto visit = [&](int gf, int of) {
-        ++result->num_triangle_pairs;
-        const double t = start.earliest(*god.mesh, gf, *ob.mesh, of, reach, tester.end());
-        if (t > tester.end()) {
-          ++result->num_axis_culls;
-          return true;
-        }
-        if (num_cand < cand_capacity) {
-          cand[num_cand++] = {t, gf, of, o};
-          return true;
-        }
-        listed = false;
-        tester.test(*god.mesh, *god.bvh, gf, *ob.mesh, *ob.bvh, of, o);
-        // A hit at the sub-interval's start cannot be bettered: stop.
-        return !tester.done();
-      };
-      const TraversalStatus ts =
-          for_each_candidate_pair_indexed(*god.mesh, *god.bvh, *ob.mesh, *ob.bvh, god_node_box, god_face_box,
-                                          /*margin=*/0, &ws->stack, visit, &result->num_node_pairs, separated);
-      if (ts == TraversalStatus::kStackFull) {
-        // Unknown beyond here: stop conservatively at the sub-interval's start.
-        result->status = CcdStatus::kWorkspaceFull;
-        result->hit = true;
-        result->u_hit = std::min(result->u_hit, u0);
-        return;
-      }
-      if (ts == TraversalStatus::kStopped) {
-        listed = false;
-        break;
-      }
+      const TraversalStatus ts = for_each_candidate_pair_indexed(
+          *god.mesh, *god.bvh, *ob.mesh, *ob.bvh, god_node_box, god_face_box, /*margin=*/0, &ws->stack,
+          [&](int gf, int of) { return visit(gf, of, o); }, &result->num_node_pairs, separated);
+      if (ts != TraversalStatus::kDone) return ts;
     }
-    // The near pairs: whatever the testing below finds, u_hit stays <= the
-    // window end at which each pair was dropped.
-    if (settings.near_distance > 0) {
-      result->num_near_pairs = listed ? num_cand : -1;
-      result->near_u0 = u0;
-      result->near_reach = reach;
-    }
-    // Earliest-first: each hit shortens the windows of the pairs after it, and
-    // once a pair's bound passes the best u so far, so do all the rest.
+    return TraversalStatus::kDone;
+  };
+  // Earliest-first: each hit shortens the windows of the pairs after it, and
+  // once a pair's bound passes the best u so far, so do all the rest.
+  const auto test_candidates = [&](int num_cand) {
     std::sort(cand, cand + num_cand, [](const auto& a, const auto& b) { return a.earliest < b.earliest; });
     for (int c = 0; c < num_cand; ++c) {
       if (cand[c].earliest > tester.end() || tester.done()) break;
@@ -553,6 +532,139 @@ void ccd_step(const CcdBody* obstacles, int num_obstacles, const CcdBody& god, c
       tester.test(*god.mesh, *god.bvh, cand[c].god_face, *ob.mesh, *ob.bvh, cand[c].obstacle_face,
                   cand[c].obstacle);
     }
+  };
+  // Whatever the testing finds, u_hit stays <= the end of the window the near
+  // pairs were listed for.
+  const auto set_near_pairs = [&](int num_cand, double u0) {
+    if (settings.near_distance <= 0) return;
+    result->num_near_pairs = num_cand;
+    result->near_u0 = u0;
+    result->near_reach = reach;
+  };
+
+  // Coherence (CcdStepWorkspace::ProximityCache): [0, u_cached] is the range
+  // over which no point moves farther than the margin from the cache's pose;
+  // there the cached pairs are the candidates, with no descent. The range is
+  // used when it covers the rest of the step (up to a hint's hit), or, when
+  // the god-object starts in contact and no hint hit, as a short first search
+  // (under half a sub-interval: a contact likely to be met soon, as a bunny's
+  // ear turned back onto the back it rests on, ends the step there without
+  // sweeping the boxes over the whole step). A range covering only part of a
+  // step would search the pairs near X0 twice: not used. The cache is refilled
+  // at X0 when its range would then be used and the god-object has moved more
+  // than half the margin since the last fill.
+  double u_cached = 0;
+  if (settings.cache_margin > 0 && !tester.done()) {
+    CcdStepWorkspace::ProximityCache& pc = ws->cache;
+    const double margin = settings.cache_margin, rho = god.bvh->radius;
+    start.set(motion, 0.0, rho);
+    const double u_rest = result->hit ? result->u_hit : 1.0;
+    const bool probing = hints && num_hints > 0 && !result->hit;
+    const auto range = [&](double moved) {  // [0, u] keeps every point within the margin of ref (0: none)
+      const double u = start.speed > 0 ? next_down(next_down(margin - moved) / start.speed) : 1.0;
+      return u > 0 ? std::min(u, 1.0) : 0.0;  // also NaN
+    };
+    const auto usable = [&](double u) { return u > 0 && (u >= u_rest || (probing && u < 0.5 / n)); };
+    const auto same = [](const CcdBody& a, const CcdBody& b) { return a.mesh == b.mesh && a.bvh == b.bvh; };
+    bool keyed = pc.num_pairs >= 0 && same(pc.god, god) && pc.reach == reach && pc.margin == margin &&
+                 static_cast<int>(pc.obstacles.size()) == num_obstacles;
+    for (int o = 0; keyed && o < num_obstacles; ++o) keyed = same(pc.obstacles[static_cast<size_t>(o)], obstacles[o]);
+    const double moved = keyed ? displacement_bound(pc.ref, X0, rho) : std::numeric_limits<double>::infinity();
+    u_cached = keyed ? range(moved) : 0.0;
+    const bool fresh = moved <= 0.5 * margin && usable(u_cached);
+    if (!fresh && usable(range(displacement_bound(X0, X0, rho)))) {
+      // Fill: every pair not proven apart by reach + margin at X0 (u = 0).
+      pc.clear();
+      u_cached = 0;
+      enclose_motion(motion, {0, 0}, &e);
+      ws->swept.next_interval();
+      const double dist = next_up(reach + margin);
+      const int capacity = static_cast<int>(pc.pairs.size());
+      int num = 0;
+      const TraversalStatus ts = descend(0.0, dist, [&](int gf, int of, int o) {
+        if (start.apart(*god.mesh, gf, *obstacles[o].mesh, of, dist)) return true;
+        if (num == capacity) return false;  // does not fit: no cache
+        pc.pairs[static_cast<size_t>(num++)] = {0, gf, of, o};
+        return true;
+      });
+      if (ts == TraversalStatus::kDone) {
+        pc.num_pairs = num;
+        pc.ref = X0;
+        pc.reach = reach;
+        pc.margin = margin;
+        pc.god = god;
+        pc.obstacles.assign(obstacles, obstacles + num_obstacles);
+        result->cache_filled = true;
+        u_cached = range(displacement_bound(X0, X0, rho));
+      }
+    }
+    if (!usable(u_cached)) u_cached = 0;
+    result->u_cached = u_cached;
+    if (u_cached > 0) {
+      enclose_motion(motion, {0, std::min(u_cached, result->u_hit)}, &e);
+      ws->swept.next_interval();
+      tester.u0 = 0;
+      tester.u1 = u_cached;
+      int num_cand = 0;
+      for (int k = 0; k < pc.num_pairs; ++k) {
+        const CcdStepWorkspace::Candidate& c = pc.pairs[static_cast<size_t>(k)];
+        ++result->num_triangle_pairs;
+        const double t = start.earliest(*god.mesh, c.god_face, *obstacles[c.obstacle].mesh, c.obstacle_face,
+                                        reach, tester.end());
+        if (t > tester.end()) {
+          ++result->num_axis_culls;
+          continue;
+        }
+        cand[num_cand++] = {t, c.god_face, c.obstacle_face, c.obstacle};  // fits: the cache has cand's capacity
+      }
+      set_near_pairs(num_cand, 0.0);
+      test_candidates(num_cand);
+    }
+  }
+
+  for (int i = 0; i < n; ++i) {
+    const double u0 = std::max(static_cast<double>(i) / n, u_cached);
+    const double u1 = (i + 1 == n) ? 1.0 : static_cast<double>(i + 1) / n;
+    if (!(u0 < u1)) continue;  // inside the cached range
+    if (result->hit && result->u_hit - settings.narrow.time_tolerance <= u0) break;  // nothing left to search
+    enclose_motion(motion, {u0, std::min(u1, result->u_hit)}, &e);
+    start.set(motion, u0, god.bvh->radius);
+    tester.u0 = u0;
+    tester.u1 = u1;
+    // Candidate triangle pairs, each with a lower bound of its first contact
+    // (StartFrame::earliest); those that cannot touch before the
+    // sub-interval's end are dropped here. When the buffer is full the rest are
+    // tested at once, in traversal order (same result, less pruning).
+    int num_cand = 0;
+    bool listed = true;  // every candidate of this sub-interval is in cand (no overflow, no early stop)
+    ws->swept.next_interval();  // e changed: every cached god box is stale
+    const TraversalStatus ts = descend(std::min(u1, result->u_hit), reach, [&](int gf, int of, int o) {
+      const CcdBody& ob = obstacles[o];
+      ++result->num_triangle_pairs;
+      const double t = start.earliest(*god.mesh, gf, *ob.mesh, of, reach, tester.end());
+      if (t > tester.end()) {
+        ++result->num_axis_culls;
+        return true;
+      }
+      if (num_cand < cand_capacity) {
+        cand[num_cand++] = {t, gf, of, o};
+        return true;
+      }
+      listed = false;
+      tester.test(*god.mesh, *god.bvh, gf, *ob.mesh, *ob.bvh, of, o);
+      // A hit at the sub-interval's start cannot be bettered: stop.
+      return !tester.done();
+    });
+    if (ts == TraversalStatus::kStackFull) {
+      // Unknown beyond here: stop conservatively at the sub-interval's start.
+      result->status = CcdStatus::kWorkspaceFull;
+      result->hit = true;
+      result->u_hit = std::min(result->u_hit, u0);
+      return;
+    }
+    if (ts == TraversalStatus::kStopped) listed = false;
+    set_near_pairs(listed ? num_cand : -1, u0);
+    test_candidates(num_cand);
   }
   if (!result->hit) {
     result->u_hit = 1;

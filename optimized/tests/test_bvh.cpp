@@ -15,6 +15,7 @@
 #include "mesh_shapes.h"
 
 using namespace gauss6;
+using gauss6::test::concatenate;
 using gauss6::test::make_box;
 using gauss6::test::make_icosphere;
 
@@ -208,7 +209,7 @@ TEST_CASE("BVH: every truly colliding triangle pair is a candidate; ccd_step agr
     h.god_face = -1;
     hints.push_back(h);
     CcdStepSettings probing = settings;
-    probing.probe_distance = i % 3 == 0 ? 0.0 : 0.01;
+    probing.cache_margin = i % 3 == 0 ? 0.0 : 0.01;
     CcdStepResult r_hinted;
     ccd_step(&ob_body, 1, {&god, &gb}, x0, x1, probing, &ws, &r_hinted, hints.data(), static_cast<int>(hints.size()));
     REQUIRE(r_hinted.status == CcdStatus::kOk);
@@ -216,6 +217,121 @@ TEST_CASE("BVH: every truly colliding triangle pair is a candidate; ccd_step agr
     if (r_hinted.hit && bf.hit) CHECK(std::abs(r_hinted.u_hit - bf.u_hit) <= 1e-5);
   }
   CHECK(hits >= 10);
+}
+
+TEST_CASE("ccd_step: steps served by the proximity cache find the first contact of a fresh search", "[bvh]") {
+  // A ball kept near a slab with a block standing on it, by a chain of steps
+  // each from the last one's stop pose, as the runtime's are: small jitters
+  // (within the margin: served from the cache), presses into the slab or the
+  // block (hits), and every tenth step a long move (the cache is refilled
+  // where the next step starts in contact). Each step must agree with the
+  // brute force (the same 1e-5 bound as above) and with a step on a workspace
+  // without the cache.
+  const TriangleMesh god = make_icosphere(1, 0.5);
+  const TriangleMesh slab = concatenate(make_box(3, 3, 1, Vec3(0, 0, -0.5)), make_box(0.4, 0.4, 0.6, Vec3(0.6, 0, 0.3)));
+  const Bvh gb = build_bvh(god, 2), sb = build_bvh(slab, 2);
+  std::mt19937 rng(29);
+  std::uniform_real_distribution<double> U(-1, 1);
+  CcdStepSettings settings, plain;
+  settings.narrow.min_separation = plain.narrow.min_separation = 1e-4;
+  settings.cache_margin = 0.02;
+  CcdStepWorkspace ws, ws_plain;
+  const CcdBody obstacle{&slab, &sb};
+  Pose x{Vec3(0.1, 0, 0.5 + 0.01), Quat{}};  // 1 cm above the slab
+  std::vector<FeaturePair> hints;
+  int served = 0, fills = 0, hits = 0, gave_up = 0;
+  for (int k = 0; k < 120; ++k) {
+    Vec3 dp = 0.003 * Vec3(U(rng), U(rng), U(rng));
+    Vec3 turn = 0.004 * Vec3(U(rng), U(rng), U(rng));
+    if (k % 3 == 2) dp += Vec3(0.01 * U(rng), 0.01 * U(rng), -0.02);  // press down
+    if (k % 10 == 9) dp += Vec3(0.15 * U(rng), 0.15 * U(rng), 0.05), turn *= 20;  // a long move
+    Pose target{x.p + dp, normalized(quat_exp(turn) * x.q)};
+    // Keep the ball over the slab, away from its far edges.
+    target.p.x() = std::clamp(target.p.x(), -0.3, 0.3);
+    target.p.y() = std::clamp(target.p.y(), -1.0, 1.0);
+    CcdStepResult r, r_plain;
+    ccd_step(&obstacle, 1, {&god, &gb}, x, target, settings, &ws, &r, hints.data(), static_cast<int>(hints.size()));
+    ccd_step(&obstacle, 1, {&god, &gb}, x, target, plain, &ws_plain, &r_plain);
+    INFO("step " << k);
+    CcdMotion m;
+    REQUIRE(make_ccd_motion(x, target, &m) == MotionStatus::kOk);
+    const BruteForce bf = brute_force(god, gb, slab, sb, m, settings.narrow);
+    if (r.status == CcdStatus::kMaxIterations || r_plain.status == CcdStatus::kMaxIterations) {
+      // A pair sliding at about d exhausts the bisection: a conservative hit,
+      // never later than the brute force's (which then gives up too).
+      ++gave_up;
+      CHECK(r.hit);
+      CHECK(r.u_hit <= bf.u_hit + 1e-5);
+    } else {
+      REQUIRE(r.status == CcdStatus::kOk);
+      REQUIRE(r_plain.status == CcdStatus::kOk);
+      CHECK(r.hit == bf.hit);
+      CHECK(r_plain.hit == bf.hit);
+      if (r.hit && bf.hit) CHECK(std::abs(r.u_hit - bf.u_hit) <= 1e-5);
+      if (r.hit && r_plain.hit) CHECK(std::abs(r.u_hit - r_plain.u_hit) <= 1e-5);
+    }
+    served += r.u_cached > 0;
+    fills += r.cache_filled;
+    hits += r.hit;
+    // The next step starts at this one's stop pose, lifted by 3 d (a motion
+    // sliding at exactly d is undecidable at the default distance tolerance);
+    // the pair that stopped it is its hint (the runtime passes the contacts there).
+    x = make_stop_pose(r.motion, r.u_hit, gb.radius).pose;
+    x.p.z() += 3e-4;
+    hints.clear();
+    if (r.hit) hints.push_back(r.pair);
+  }
+  std::printf("proximity cache: %d of 120 steps served from it, %d fills, %d hits, %d give-ups\n", served, fills, hits,
+              gave_up);
+  CHECK(gave_up <= 6);
+  CHECK(served >= 30);
+  CHECK(fills >= 3);
+  CHECK(hits >= 20);
+}
+
+TEST_CASE("ccd_step: the proximity cache is not served for another mesh behind the same CcdBody", "[bvh]") {
+  // A ball 2 d above a slab, in contact (a hint given): a first small step
+  // fills the cache. The obstacle's CcdBody, the same variable, then points to
+  // a new mesh: the slab plus a cube 5 mm beside the ball, which the next step
+  // pushes the ball into (1.5 cm, within the 2 cm margin). That step must find
+  // the cube, as the brute force does; on the old mesh the same step is served
+  // from the cache (the control).
+  const TriangleMesh god = make_icosphere(1, 0.5), slab = make_box(3, 3, 1, Vec3(0, 0, -0.5));
+  const Bvh gb = build_bvh(god, 2), sb = build_bvh(slab, 2);
+  CcdStepSettings settings;
+  settings.narrow.min_separation = 1e-4;
+  settings.cache_margin = 0.02;
+  double z_min = 1e300, y_max = -1e300;
+  for (Eigen::Index v = 0; v < god.V.rows(); ++v) {
+    z_min = std::min(z_min, god.V(v, 2));
+    y_max = std::max(y_max, god.V(v, 1));
+  }
+  const Pose x0{Vec3(0, 0, 2e-4 - z_min), Quat{}};
+  const Pose x1{x0.p + Vec3(1e-3, 0, 0), x0.q}, x2{x1.p + Vec3(0, 0.015, 0), x1.q};
+  const TriangleMesh slab_cube = concatenate(slab, make_box(0.1, 0.1, 0.1, Vec3(x1.p.x(), y_max + 0.005 + 0.05, x1.p.z())));
+  const Bvh scb = build_bvh(slab_cube, 2);
+  FeaturePair hint;
+  hint.obstacle = 0;
+  hint.god_face = hint.obstacle_face = 0;
+  for (const bool swap : {false, true}) {
+    CcdStepWorkspace ws;
+    CcdBody obstacle{&slab, &sb};
+    CcdStepResult r;
+    ccd_step(&obstacle, 1, {&god, &gb}, x0, x1, settings, &ws, &r, &hint, 1);
+    REQUIRE(r.status == CcdStatus::kOk);
+    CHECK(r.cache_filled);
+    CHECK_FALSE(r.hit);
+    if (swap) obstacle = {&slab_cube, &scb};
+    ccd_step(&obstacle, 1, {&god, &gb}, x1, x2, settings, &ws, &r, &hint, 1);
+    REQUIRE(r.status == CcdStatus::kOk);
+    CcdMotion m;
+    REQUIRE(make_ccd_motion(x1, x2, &m) == MotionStatus::kOk);
+    const BruteForce bf = brute_force(god, gb, swap ? slab_cube : slab, swap ? scb : sb, m, settings.narrow);
+    CHECK(bf.hit == swap);
+    CHECK(r.hit == bf.hit);
+    if (r.hit && bf.hit) CHECK(std::abs(r.u_hit - bf.u_hit) <= 1e-5);
+    if (!swap) CHECK((r.u_cached == 1.0 && !r.cache_filled));  // served whole from the cache
+  }
 }
 
 TEST_CASE("ccd_step: a box falling flat onto a slab, and one tipping onto it", "[bvh]") {

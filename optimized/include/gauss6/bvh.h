@@ -399,8 +399,10 @@ struct CcdStepSettings {
   int max_sub_intervals = 16;              // u-ranges whose swept boxes are computed separately
   double sub_interval_angle = 0.1;         // radians of rotation per sub-interval (at most)
   double sub_interval_travel = 0.25;       // travel of G per sub-interval, in god-object radii (at most)
-  double probe_distance = 0;               // with hints, first search [0, u] over which no point moves more than
-                                           // this (scene units; 0: no probe; the runtime uses 16 delta)
+  double cache_margin = 0;                 // coherence between steps: keep the pairs within the reach plus this
+                                           // (scene units) at a pose in contact, and take a later step's candidates
+                                           // from them while no point has moved farther than this from that pose
+                                           // (CcdStepWorkspace::ProximityCache; 0: off; the runtime uses 16 delta)
   double near_distance = 0;                // also list the triangle pairs that may come within this (>=
                                            // min_separation) by the stop pose: the near pairs (CcdStepResult)
 };
@@ -424,6 +426,8 @@ struct CcdStepResult {
   // descent, or the candidate buffer overflowed).
   int num_near_pairs = -1;
   double near_u0 = 0, near_reach = 0;
+  bool cache_filled = false;               // the proximity cache was (re)filled at X0 (CcdStepWorkspace)
+  double u_cached = 0;                     // [0, u_cached] searched from the proximity cache (0: not used)
 };
 
 // Everything ccd_step needs, allocated once.
@@ -473,17 +477,43 @@ struct SweptBoxCache {
 
 struct CcdStepWorkspace {
   explicit CcdStepWorkspace(int box_capacity = 1 << 14, int stack_capacity = 1024, int candidate_capacity = 1 << 14)
-      : narrow(box_capacity), stack(stack_capacity), candidates(static_cast<size_t>(std::max(candidate_capacity, 0))) {}
+      : narrow(box_capacity),
+        stack(stack_capacity),
+        candidates(static_cast<size_t>(std::max(candidate_capacity, 0))),
+        cache(std::max(candidate_capacity, 0)) {}
   // A candidate triangle pair of one sub-interval and a lower bound of its first contact parameter.
   struct Candidate {
     double earliest;
     int32_t god_face, obstacle_face, obstacle;
   };
+  // Coherence between steps (CcdStepSettings::cache_margin). pairs[0 ..
+  // num_pairs) hold every triangle pair not proven farther than reach + margin
+  // apart with the god-object at the exact pose ref: so at any god pose whose
+  // every point lies within `margin` of its place at ref, every pair that may
+  // lie within `reach` is among them. A pose of the god-object in contact
+  // hardly moves from one step to the next (resting, or pressed into an edge
+  // and stopped at once): while a step's motion keeps within the margin of ref,
+  // ccd_step takes its candidates from here instead of descending the trees.
+  // ccd_step refills it (at the step's start) when the god-object has moved
+  // more than half the margin from ref and the step starts in contact (hints
+  // given). It is keyed by the god-object's and the obstacles' meshes and
+  // BVHs (pointers), the reach and the margin; clear() it when a mesh behind
+  // the same pointers changes.
+  struct ProximityCache {
+    explicit ProximityCache(int capacity) : pairs(static_cast<size_t>(capacity)) {}
+    std::vector<Candidate> pairs;  // `earliest` unused
+    int num_pairs = -1;            // -1: empty (never filled, or the pairs did not fit)
+    Pose ref;
+    double reach = 0, margin = 0;
+    CcdBody god;
+    std::vector<CcdBody> obstacles;  // grows (allocates) only when a fill sees more obstacles than ever before
+    void clear() { num_pairs = -1; }
+  };
   CcdWorkspace narrow;
   BvhStack stack;
   std::vector<Candidate> candidates;  // tested earliest-first; overflow is tested in traversal order
   SweptBoxCache swept;                // god boxes of the current sub-interval
-
+  ProximityCache cache;
 };
 
 // The first contact of the god-object moving from X0 to X1 (the Cayley motion)
