@@ -6,6 +6,8 @@
 // pairs of the candidates, earliest first, earliest hit kept.
 #include "gauss6/bvh.h"
 
+#include "gauss6/contacts.h"
+
 #include <algorithm>
 #include <chrono>
 #include <Eigen/Eigenvalues>
@@ -246,6 +248,12 @@ struct StartFrame {
   Mat3 R = Mat3::Identity();
   Vec3 p = Vec3::Zero(), dp_mid = Vec3::Zero();
   double u0 = 0, static_error = 0, speed = 0, drift = 0, turn_rate = 0, rho = 0;
+  double dp_max = 0;  // |dp| for every dp in the motion's enclosure (rounded up)
+  // The turn: R(u) R(u0)^T turns about the exact g by at most 2 (u - u0) |g|;
+  // omega = 2 g_mid (g's midpoint), within omega_error of 2 g for every g in
+  // its enclosure, and omega2 >= |2 g|^2.
+  Vec3 omega = Vec3::Zero();
+  double omega_error = 0, omega2 = 0;
   void set(const CcdMotion& m, double u, double rho_in) {
     const StopPose sp = make_stop_pose(m, u, rho_in);
     u0 = u;
@@ -263,10 +271,23 @@ struct StartFrame {
     }
     drift = next_up(std::sqrt(drift2));
     turn_rate = next_up(2 * next_up(std::sqrt(m.g2.hi)));
-    speed = next_up(next_up(std::sqrt(dp2)) + next_up(turn_rate * rho));
+    double g_err2 = 0;
+    for (int i = 0; i < 3; ++i) {
+      const Interval& c = m.g[i];
+      omega[i] = c.lo + c.hi;  // 2 g_mid (exact: doubling)
+      const double r = std::max(next_up(c.hi - 0.5 * (c.lo + c.hi)), next_up(0.5 * (c.lo + c.hi) - c.lo));
+      g_err2 = next_up(g_err2 + next_up(r * r));
+    }
+    omega_error = next_up(2 * next_up(std::sqrt(g_err2)));
+    omega2 = next_up(4 * m.g2.hi);
+    dp_max = next_up(std::sqrt(dp2));
+    speed = next_up(dp_max + next_up(turn_rate * rho));
     static_error = next_up(sp.deviation + next_up(1e-13 * next_up(p.cwiseAbs().maxCoeff() + rho)));
-    if (!std::isfinite(static_error) || !std::isfinite(speed) || !std::isfinite(drift) || !dp_mid.allFinite())
-      static_error = speed = drift = turn_rate = std::numeric_limits<double>::infinity();
+    if (!std::isfinite(static_error) || !std::isfinite(speed) || !std::isfinite(drift) || !dp_mid.allFinite() ||
+        !omega.allFinite() || !std::isfinite(omega_error) || !std::isfinite(omega2)) {
+      static_error = speed = drift = turn_rate = dp_max = std::numeric_limits<double>::infinity();
+      omega.setZero();
+    }
   }
 
   // The oriented-box frame of the sub-interval [u0, u1] (bvh.h, PosedObb),
@@ -295,30 +316,58 @@ struct StartFrame {
   // triangles (triangle_time_lower_bound: face normals, and edge cross products,
   // which separate a long side strip of the peg from the wide fan triangles
   // around the hole's rim where no face normal does) with gap g, along which the
-  // triangle approaches at most at |n.dp_mid| + drift + turn_rate r (r: the
-  // largest |r_B| of its corners), keeps every feature pair farther than d until
-  // (g - static_error - d) / that. The search stops once the bound passes u_limit.
+  // triangle approaches at most at |n.dp_mid| + drift plus its turn about G
+  // (TriangleMotion: the directional part from omega, the rest in w), keeps
+  // every feature pair farther than d until (g - static_error - d) / that. The
+  // search stops once the bound passes u_limit, and the bound is used for
+  // u <= u_limit only: the turn's second-order term is taken for tau_max =
+  // u_limit - u0. w, for r the largest |r_B| of the triangle's corners (>= that
+  // of any of its points): drift; (omega_error + tau_max omega2 / 2) r (the
+  // exact turn rate's distance from omega, and the second-order term);
+  // turn_rate (static_error + 1e-12 r) (the double corners' offsets from G are
+  // within static_error of the exact ones).
   double earliest(const TriangleMesh& gm, int gf, const TriangleMesh& om, int of, double d, double u_limit) const {
     Vec3 X[3], Y[3];
     const double r2 = place(gm, gf, om, of, X, Y);
     // |r_B| of any point of the triangle <= that of its farthest corner.
-    const double r = std::min(rho, next_up(std::sqrt(r2) * (1 + 1e-15)));
-    const double w = next_up(drift + next_up(turn_rate * r));
+    return earliest(X, Y, radius(r2), d, u_limit);
+  }
+  // The same for a god triangle X (its corners at u0, doubles; r >= the
+  // largest |r_B| of them) and an obstacle triangle Y, either possibly
+  // degenerate (a feature: see for_each_separating_axis), `extra` an axis to
+  // try first.
+  double earliest(const Vec3 X[3], const Vec3 Y[3], double r, double d, double u_limit,
+                  const Vec3* extra = nullptr) const {
+    const double tau_max = next_up(u_limit - u0);
+    TriangleMotion m;
+    m.v = dp_mid;
+    m.omega = omega;
+    m.centre = p;
+    const double second = next_up(0.5 * next_up(tau_max * omega2));
+    const double offsets = next_up(turn_rate * next_up(static_error + 1e-12 * r));
+    m.w = next_up(next_up(drift + next_up(next_up(omega_error + second) * r)) + offsets);
+    if (!(m.w < std::numeric_limits<double>::infinity())) return u0;
     const double reach = next_up(static_error + d);
-    const double tau = triangle_time_lower_bound(X, Y, dp_mid, w, reach, next_up(u_limit - u0));
+    const double tau = triangle_time_lower_bound(X, Y, m, reach, tau_max, extra);
     if (!(tau > 0)) return u0;
     return next_down(u0 + tau);
   }
 
-  // True when the god triangle gf at u0 is proven farther than d from the
-  // obstacle triangle `of` (the separating-axis bound of the double triangles,
-  // less static_error).
-  bool apart(const TriangleMesh& gm, int gf, const TriangleMesh& om, int of, double d) const {
+  // A lower bound of the distance of the god triangle gf at u0 (exact) from
+  // the obstacle triangle `of`: the separating-axis bound of the double
+  // triangles less static_error (0 when none proves more), computed until it
+  // exceeds `enough`; *radius: the largest |r_B| of gf's corners.
+  double gap(const TriangleMesh& gm, int gf, const TriangleMesh& om, int of, double enough, double* r) const {
     Vec3 X[3], Y[3];
-    place(gm, gf, om, of, X, Y);
-    const double reach = next_up(static_error + d);
-    return triangle_gap_lower_bound(X, Y, reach) > reach;
+    *r = radius(place(gm, gf, om, of, X, Y));
+    const double g = triangle_gap_lower_bound(X, Y, next_up(static_error + enough));
+    return std::max(0.0, next_down(g - static_error));
   }
+
+  // A body point's double position at u0.
+  Vec3 pose(const Vec3& r_B) const { return R * r_B + p; }
+  // A bound >= sqrt(r2) and <= rho (every body point's |r_B| is).
+  double radius(double r2) const { return std::min(rho, next_up(std::sqrt(r2) * (1 + 1e-15))); }
 
  private:
   // The god triangle's corners at u0 (doubles) and the obstacle triangle's;
@@ -335,23 +384,33 @@ struct StartFrame {
   }
 };
 
-// A bound on how far any point r_B (|r_B| <= rho) of a body lies at pose b from
-// where it lies at pose a, both exact (p + R(q) r_B, R(q) the rotation of the
-// unit quaternion q / |q|): |p_b - p_a| + |R(q_b) - R(q_a)| rho, where for unit
-// quaternions R(a)^T R(b) = R(conj(a) b) turns by theta with |vec(conj(a) b)| =
-// sin(theta / 2), and a turn by theta moves a point by at most 2 sin(theta / 2)
-// |r_B|. In doubles the two normalisations and the product's components are
-// within a few units of 2^-53 (every term is at most 1 in magnitude): 1e-14
-// covers them, and 1e-15 the rounding of |p_b - p_a|. Infinite on non-finite
-// input.
-double displacement_bound(const Pose& a, const Pose& b, double rho) {
-  const Quat qa = normalized(a.q), qb = normalized(b.q);
-  const Vec3 v = qa.w * qb.vec() - qb.w * qa.vec() - qa.vec().cross(qb.vec());  // vec(conj(qa) qb)
-  const double turn = next_up(next_up(2 * v.norm()) + 1e-14);
-  const double shift = next_up((b.p - a.p).norm() * (1 + 1e-15));
-  const double out = next_up(shift + next_up(turn * rho));
-  return out < std::numeric_limits<double>::infinity() ? out : std::numeric_limits<double>::infinity();
-}
+// How far any point r_B of a body lies at pose b from where it lies at pose
+// a, both exact (p + R(q) r_B, R(q) the rotation of the unit quaternion
+// q / |q|): at most shift + turn |r_B|, with shift >= |p_b - p_a| and turn >=
+// |R(q_b) - R(q_a)|: for unit quaternions R(a)^T R(b) = R(conj(a) b) turns by
+// theta with |vec(conj(a) b)| = sin(theta / 2), and a turn by theta moves a
+// point by at most 2 sin(theta / 2) |r_B|. In doubles the two normalisations
+// and the product's components are within a few units of 2^-53 (every term is
+// at most 1 in magnitude): 1e-14 covers them, and 1e-15 the rounding of
+// |p_b - p_a|. Infinite on non-finite input.
+struct Displacement {
+  double shift = 0, turn = 0;
+  Displacement(const Pose& a, const Pose& b) {
+    const Quat qa = normalized(a.q), qb = normalized(b.q);
+    const Vec3 v = qa.w * qb.vec() - qb.w * qa.vec() - qa.vec().cross(qb.vec());  // vec(conj(qa) qb)
+    turn = next_up(next_up(2 * v.norm()) + 1e-14);
+    shift = next_up((b.p - a.p).norm() * (1 + 1e-15));
+    if (!(turn < std::numeric_limits<double>::infinity() && shift < std::numeric_limits<double>::infinity()))
+      turn = shift = std::numeric_limits<double>::infinity();
+  }
+  // Grown by a motion from b over [0, u] (StartFrame at 0: |dp| <= dp_max, and
+  // R(u) R(0)^T turns by at most u turn_rate).
+  void add(const StartFrame& f, double u) {
+    shift = next_up(shift + next_up(u * f.dp_max));
+    turn = next_up(turn + next_up(u * f.turn_rate));
+  }
+  double bound(double radius) const { return next_up(shift + next_up(turn * radius)); }
+};
 
 // Runs the owned feature pairs of one (god triangle, obstacle triangle) pair on
 // the window [u0, *u_best]; lowers *u_best and records the pair on a hit.
@@ -363,6 +422,8 @@ struct PairTester {
   CcdStepResult* result;
   double u0, u1;  // the sub-interval; tests search [u0, min(u1, best u so far)]
   SweptBoxCache* swept = nullptr;  // god vertex boxes over *sub, shared by the pairs of the sub-interval
+  const StartFrame* start = nullptr;  // the god-object at u0 and its motion bounds
+  double reach = 0;                   // the narrow phase's min_separation
 
   // Once a pair hit at u_b, later pairs search only up to u_b - time_tolerance:
   // a contact in (u_b - tol, u_b] cannot lower the step's answer by more than
@@ -404,8 +465,23 @@ struct PairTester {
     const auto hull_of = [](const Aabb& a, const Aabb& b) { return Aabb{a.lo.cwiseMin(b.lo), a.hi.cwiseMax(b.hi)}; };
     for (int k = 0; k < 3; ++k) god_edge_swept[k] = hull_of(god_swept[k], god_swept[(k + 1) % 3]);
     const Aabb god_face_swept = hull_of(god_edge_swept[0], god_swept[2]);
+    // Each feature pair's own time bound (StartFrame::earliest on the features
+    // as degenerate triangles, the axis between their closest points at u0
+    // tried first): a pair sliding along at its gap, or turning across it,
+    // needs no test.
+    const Vec3 X[3] = {start->pose(god_face[0]), start->pose(god_face[1]), start->pose(god_face[2])};
+    const double rad[3] = {start->radius(god_face[0].squaredNorm()), start->radius(god_face[1].squaredNorm()),
+                           start->radius(god_face[2].squaredNorm())};
+    const Vec3* Y = obs_face.data();
+    const auto apart = [&](const Vec3 A[3], const Vec3 B[3], double radius, const Vec3& axis) {
+      if (start->earliest(A, B, radius, reach, end(), &axis) <= end()) return false;
+      ++result->num_feature_culls;
+      return true;
+    };
     for (int k = 0; k < 3; ++k) {
       if (!(go & (1u << k)) || !(u0 <= end()) || !overlap(god_swept[k], obs_face_box)) continue;
+      const Vec3 A[3] = {X[k], X[k], X[k]};
+      if (apart(A, Y, rad[k], X[k] - closest_point_on_triangle(X[k], Y[0], Y[1], Y[2]))) continue;
       RigidVertexFaceQuery q{motion, /*vertex_on_body=*/true, god_face[k], obs_face, u0, end()};
       ccd_rigid_vertex_face(q, settings->narrow, ws, &r);
       consider(r, {PairKind::kGodVertexObstacleFace, obstacle, gf, k, of, -1});
@@ -413,6 +489,9 @@ struct PairTester {
     for (int k = 0; k < 3; ++k) {
       if (!(oo & (1u << k)) || !(u0 <= end()) ||
           !overlap(god_face_swept, inflate(box_of(obs_face[k], obs_face[k]), margin)))
+        continue;
+      const Vec3 B[3] = {Y[k], Y[k], Y[k]};
+      if (apart(X, B, std::max({rad[0], rad[1], rad[2]}), closest_point_on_triangle(Y[k], X[0], X[1], X[2]) - Y[k]))
         continue;
       RigidVertexFaceQuery q{motion, /*vertex_on_body=*/false, obs_face[k], god_face, u0, end()};
       ccd_rigid_vertex_face(q, settings->narrow, ws, &r);
@@ -424,6 +503,11 @@ struct PairTester {
         if (!(oo & (8u << j)) || !(u0 <= end()) ||
             !overlap(god_edge_swept[k], inflate(box_of(obs_face[j], obs_face[(j + 1) % 3]), margin)))
           continue;
+        const int k1 = (k + 1) % 3, j1 = (j + 1) % 3;
+        const Vec3 A[3] = {X[k], X[k1], X[k1]}, B[3] = {Y[j], Y[j1], Y[j1]};
+        double s = 0, t = 0;
+        closest_segment_parameters(X[k], X[k1], Y[j], Y[j1], &s, &t);
+        if (apart(A, B, std::max(rad[k], rad[k1]), (X[k] + s * (X[k1] - X[k])) - (Y[j] + t * (Y[j1] - Y[j])))) continue;
         RigidEdgeEdgeQuery q{motion, {god_face[k], god_face[(k + 1) % 3]}, {obs_face[j], obs_face[(j + 1) % 3]},
                              u0, end()};
         ccd_rigid_edge_edge(q, settings->narrow, ws, &r);
@@ -462,7 +546,8 @@ void ccd_step(const CcdBody* obstacles, int num_obstacles, const CcdBody& god, c
   result->num_sub_intervals = n;
   MotionEnclosure e;
   StartFrame start;
-  PairTester tester{&motion, &e, &settings, &ws->narrow, result, 0, 0, &ws->swept};
+  PairTester tester{&motion, &e, &settings, &ws->narrow, result, 0, 0, &ws->swept, &start,
+                    settings.narrow.min_separation};
   CcdStepWorkspace::Candidate* const cand = ws->candidates.data();
   const int cand_capacity = static_cast<int>(ws->candidates.size());
   const double d = settings.narrow.min_separation;
@@ -473,6 +558,7 @@ void ccd_step(const CcdBody* obstacles, int num_obstacles, const CcdBody& god, c
   // The hints' triangle pairs first, over the whole step (each distinct pair once).
   if (hints && num_hints > 0) {
     enclose_motion(motion, {0, 1}, &e);
+    start.set(motion, 0.0, god.bvh->radius);
     ws->swept.next_interval();
     tester.u0 = 0;
     tester.u1 = 1;
@@ -569,10 +655,11 @@ void ccd_step(const CcdBody* obstacles, int num_obstacles, const CcdBody& god, c
     bool keyed = pc.num_pairs >= 0 && same(pc.god, god) && pc.reach == reach && pc.margin == margin &&
                  static_cast<int>(pc.obstacles.size()) == num_obstacles;
     for (int o = 0; keyed && o < num_obstacles; ++o) keyed = same(pc.obstacles[static_cast<size_t>(o)], obstacles[o]);
-    const double moved = keyed ? displacement_bound(pc.ref, X0, rho) : std::numeric_limits<double>::infinity();
+    Displacement since(keyed ? pc.ref : X0, X0);  // from the cache's pose to X0
+    const double moved = keyed ? since.bound(rho) : std::numeric_limits<double>::infinity();
     u_cached = keyed ? range(moved) : 0.0;
     const bool fresh = moved <= 0.5 * margin && usable(u_cached);
-    if (!fresh && usable(range(displacement_bound(X0, X0, rho)))) {
+    if (!fresh && usable(range(Displacement(X0, X0).bound(rho)))) {
       // Fill: every pair not proven apart by reach + margin at X0 (u = 0).
       pc.clear();
       u_cached = 0;
@@ -582,9 +669,11 @@ void ccd_step(const CcdBody* obstacles, int num_obstacles, const CcdBody& god, c
       const int capacity = static_cast<int>(pc.pairs.size());
       int num = 0;
       const TraversalStatus ts = descend(0.0, dist, [&](int gf, int of, int o) {
-        if (start.apart(*god.mesh, gf, *obstacles[o].mesh, of, dist)) return true;
+        double radius = 0;
+        const double gap = start.gap(*god.mesh, gf, *obstacles[o].mesh, of, dist, &radius);
+        if (gap > dist) return true;
         if (num == capacity) return false;  // does not fit: no cache
-        pc.pairs[static_cast<size_t>(num++)] = {0, gf, of, o};
+        pc.pairs[static_cast<size_t>(num++)] = {gap, radius, gf, of, o};
         return true;
       });
       if (ts == TraversalStatus::kDone) {
@@ -595,7 +684,8 @@ void ccd_step(const CcdBody* obstacles, int num_obstacles, const CcdBody& god, c
         pc.god = god;
         pc.obstacles.assign(obstacles, obstacles + num_obstacles);
         result->cache_filled = true;
-        u_cached = range(displacement_bound(X0, X0, rho));
+        since = Displacement(X0, X0);
+        u_cached = range(since.bound(rho));
       }
     }
     if (!usable(u_cached)) u_cached = 0;
@@ -605,10 +695,19 @@ void ccd_step(const CcdBody* obstacles, int num_obstacles, const CcdBody& god, c
       ws->swept.next_interval();
       tester.u0 = 0;
       tester.u1 = u_cached;
+      // Each pair's own certificate first: its gap at the cache's pose less how
+      // far its points can move from there by u_cached (a few flops); the
+      // time bound only for the pairs it does not keep beyond the reach.
+      Displacement moving = since;
+      moving.add(start, u_cached);
       int num_cand = 0;
       for (int k = 0; k < pc.num_pairs; ++k) {
-        const CcdStepWorkspace::Candidate& c = pc.pairs[static_cast<size_t>(k)];
+        const CcdStepWorkspace::ProximityCache::Pair& c = pc.pairs[static_cast<size_t>(k)];
         ++result->num_triangle_pairs;
+        if (next_down(c.gap - moving.bound(c.radius)) > reach) {
+          ++result->num_axis_culls;
+          continue;
+        }
         const double t = start.earliest(*god.mesh, c.god_face, *obstacles[c.obstacle].mesh, c.obstacle_face,
                                         reach, tester.end());
         if (t > tester.end()) {

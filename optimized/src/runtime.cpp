@@ -161,10 +161,11 @@ RuntimeModel::RuntimeModel(const Scene& scene, const RuntimeSettings& s) : setti
   // at least delta (the guarantee) and the search ends well before rounding-level widths
   // (the default 1e-9 is meant for unit-size queries; docs/benchmarks.md, the delta sweep).
   settings.ccd.narrow.distance_tolerance = 0.1 * contact.delta;
-  // Coherence: a leg that starts in contact keeps the pairs within 16 delta
+  // Coherence: a leg that starts in contact keeps the pairs within 64 delta
   // more than the reach, and the legs after it take their candidates from them
-  // while no point has moved 16 delta from there (ccd_step's proximity cache).
-  settings.ccd.cache_margin = 16 * contact.delta;
+  // while no point has moved 64 delta from there (ccd_step's proximity cache;
+  // docs/benchmarks.md has the sweep of this margin).
+  settings.ccd.cache_margin = 64 * contact.delta;
   contact_generation.distance = contact.delta * (1 + settings.contact_factor);
   // The CCD lists the pairs that may come within the contact distance (and the
   // distance a hit may be accepted at, 0.1 delta more: update_contacts) of each

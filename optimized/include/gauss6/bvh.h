@@ -116,8 +116,13 @@ inline Aabb inflate(const Aabb& box, double margin) {
 // corners, is below the exact gap along a. Dividing by |a| (1 + 1e-12), with
 // the quotient rounded down, covers the roundings of the norm and the quotient.
 // A zero or non-finite axis proves nothing (NaN or inf is dropped).
+// extra: one more axis to try first (any vector; nullptr: none), e.g. the
+// direction between the closest points of two features given as degenerate
+// triangles (a vertex: its point thrice; an edge: its ends, one twice), whose
+// normals and cross products are then zero or few.
 template <class OnAxis>
-GAUSS6_ALWAYS_INLINE void for_each_separating_axis(const Vec3 A[3], const Vec3 B[3], OnAxis&& on_axis) {
+GAUSS6_ALWAYS_INLINE void for_each_separating_axis(const Vec3 A[3], const Vec3 B[3], OnAxis&& on_axis,
+                                                   const Vec3* extra = nullptr) {
   double s = 0;
   for (int k = 0; k < 3; ++k) s = std::max(s, std::max(A[k].cwiseAbs().maxCoeff(), B[k].cwiseAbs().maxCoeff()));
   const auto along = [&](const Vec3& a) GAUSS6_ALWAYS_INLINE_LAMBDA {
@@ -136,6 +141,7 @@ GAUSS6_ALWAYS_INLINE void for_each_separating_axis(const Vec3 A[3], const Vec3 B
     if (!(g < std::numeric_limits<double>::infinity())) return false;
     return on_axis(a, g, side);
   };
+  if (extra && along(*extra)) return;
   const Vec3 ea[3] = {A[1] - A[0], A[2] - A[1], A[0] - A[2]}, eb[3] = {B[1] - B[0], B[2] - B[1], B[0] - B[2]};
   if (along(ea[0].cross(ea[1])) || along(eb[0].cross(eb[1]))) return;
   for (int i = 0; i < 3; ++i)
@@ -157,32 +163,63 @@ inline double triangle_gap_lower_bound(const Vec3 A[3], const Vec3 B[3], double 
   return best;
 }
 
+// How a triangle moves in time tau (units of the motion's parameter), as
+// triangle_time_lower_bound() takes it: each point x moves by at most
+//   tau v + (rotation of x - centre by an angle <= tau |omega| about omega)
+//   + tau w (any further motion of speed w).
+// A turn by phi about the unit axis e moves x - centre = r by sin(phi) e x r +
+// (1 - cos(phi)) e x (e x r): along a unit n by at most phi |n.(e x r)| +
+// phi^2 / 2 |r| <= tau |n.(omega x r)| + tau^2 |omega|^2 / 2 |r|. The second
+// term is the caller's to put in w (as tau_max |omega|^2 / 2 max |r| for the
+// horizon tau <= tau_max it uses the bound for); the first is directional: a
+// peg turning about its centre moves its tip across the rim's wall, not into
+// it. omega = 0: no turn (w holds all of it).
+struct TriangleMotion {
+  Vec3 v = Vec3::Zero(), omega = Vec3::Zero(), centre = Vec3::Zero();
+  double w = 0;
+};
+
 // A lower bound of the time (in units of the motion's parameter, from the
 // triangles' current positions) before the moving triangle A can come within
-// `reach` of the fixed triangle B, when every point of A moves by at most
-// tau v + tau w (a translation along v plus any motion of speed w) in time tau:
-// along a separating axis with unit direction n and gap g, A approaches B at
-// most at max(0, side n.v) + w, so it needs (g - reach) / that; the largest such
-// time over the 11 axes, or 0 when none proves g > reach; +inf when an axis
-// proves a gap that the motion never closes. Returns as soon as one axis
+// `reach` of the fixed triangle B, A moving as `m` says: along a separating
+// axis with unit direction n and gap g (B beyond A on side = +-1), a corner x
+// of A moves towards B by at most tau side n.v + s side n.(omega x r) (r = x -
+// centre), s = sin(phi) / |omega| in [0, tau] the same for all corners, plus
+// the rest (second order, w): so A's projection approaches B's at most at
+// max(0, side n.v + max over corners of max(0, side n.(omega x r))) + w (the
+// corners' projections bound every point's), and it needs (g - reach) / that;
+// the largest such time over the 11 axes (and `extra`:
+// for_each_separating_axis), or 0 when none proves g > reach; +inf when an
+// axis proves a gap that the motion never closes. Returns as soon as one axis
 // proves more than `enough`. Rounding: n.v from the rounded axis is within
-// 1e-14 |a|_1 |v|_inf / |a| of the exact one's, and each quotient is rounded
-// up or down the safe way. Inline: the mesh step calls it for every candidate
-// triangle pair.
-inline double triangle_time_lower_bound(const Vec3 A[3], const Vec3 B[3], const Vec3& v, double w, double reach,
-                                        double enough) {
-  const double v_inf = v.cwiseAbs().maxCoeff();
+// 1e-14 |a|_1 |v|_inf / |a| of the exact one's; a.(omega x r) = r.(a x omega),
+// a sum of a few products of magnitude <= |a|_1 |omega|_inf |r|_inf, within
+// 1e-13 of that; each quotient is rounded up or down the safe way. Inline: the
+// mesh step calls it for every candidate triangle pair and feature pair.
+inline double triangle_time_lower_bound(const Vec3 A[3], const Vec3 B[3], const TriangleMotion& m, double reach,
+                                        double enough, const Vec3* extra = nullptr) {
+  const double v_inf = m.v.cwiseAbs().maxCoeff(), omega_inf = m.omega.cwiseAbs().maxCoeff();
+  const Vec3 r[3] = {A[0] - m.centre, A[1] - m.centre, A[2] - m.centre};
+  double r_inf = 0;
+  for (int k = 0; k < 3; ++k) r_inf = std::max(r_inf, r[k].cwiseAbs().maxCoeff());
   double best = 0;
   for_each_separating_axis(A, B, [&](const Vec3& a, double g, double side) GAUSS6_ALWAYS_INLINE_LAMBDA {
     const double clear = next_down(g - reach);
     if (!(clear > 0)) return false;
-    const double toward = std::max(0.0, side * a.dot(v)) + 1e-14 * a.cwiseAbs().sum() * v_inf;
-    const double speed = next_up(next_up(toward / next_down(a.norm() * (1 - 1e-12))) + w);
+    const double a_1 = a.cwiseAbs().sum();
+    double turn = 0, slack = 1e-14 * a_1 * v_inf;
+    if (omega_inf > 0) {
+      const Vec3 c = a.cross(m.omega);
+      turn = std::max({0.0, side * r[0].dot(c), side * r[1].dot(c), side * r[2].dot(c)});
+      slack += 1e-13 * a_1 * omega_inf * r_inf;
+    }
+    const double toward = next_up(std::max(0.0, next_up(side * a.dot(m.v) + turn)) + slack);
+    const double speed = next_up(next_up(toward / next_down(a.norm() * (1 - 1e-12))) + m.w);
     const double t = speed > 0 ? next_down(clear / speed) : std::numeric_limits<double>::infinity();
     if (!(t <= std::numeric_limits<double>::infinity())) return false;  // NaN
     best = std::max(best, t);
     return best > enough;
-  });
+  }, extra);
   return best;
 }
 
@@ -402,7 +439,7 @@ struct CcdStepSettings {
   double cache_margin = 0;                 // coherence between steps: keep the pairs within the reach plus this
                                            // (scene units) at a pose in contact, and take a later step's candidates
                                            // from them while no point has moved farther than this from that pose
-                                           // (CcdStepWorkspace::ProximityCache; 0: off; the runtime uses 16 delta)
+                                           // (CcdStepWorkspace::ProximityCache; 0: off; the runtime uses 64 delta)
   double near_distance = 0;                // also list the triangle pairs that may come within this (>=
                                            // min_separation) by the stop pose: the near pairs (CcdStepResult)
 };
@@ -417,6 +454,7 @@ struct CcdStepResult {
   CcdMotion motion;                        // the enclosed motion used (for make_stop_pose)
   int num_sub_intervals = 0, num_node_pairs = 0, num_triangle_pairs = 0, num_pair_tests = 0;
   int num_axis_culls = 0;                  // triangle pairs dropped whole by a separating-axis time bound (no pair test)
+  int num_feature_culls = 0;               // feature pairs dropped by their own time bound (no pair test)
   long num_box_iterations = 0;             // narrow-phase boxes, all tests together
   // Near pairs (settings.near_distance > 0): when num_near_pairs >= 0, ws->candidates[0 .. num_near_pairs)
   // hold every triangle pair that can come within near_reach (= max(min_separation, near_distance)) of
@@ -501,7 +539,15 @@ struct CcdStepWorkspace {
   // the same pointers changes.
   struct ProximityCache {
     explicit ProximityCache(int capacity) : pairs(static_cast<size_t>(capacity)) {}
-    std::vector<Candidate> pairs;  // `earliest` unused
+    // gap: a lower bound of the pair's distance at ref; radius: the largest
+    // |r_B| of the god triangle's corners. A step whose points move at most
+    // shift + turn |r_B| from ref keeps the pair farther apart than
+    // gap - shift - turn radius.
+    struct Pair {
+      double gap, radius;
+      int32_t god_face, obstacle_face, obstacle;
+    };
+    std::vector<Pair> pairs;
     int num_pairs = -1;            // -1: empty (never filled, or the pairs did not fit)
     Pose ref;
     double reach = 0, margin = 0;
