@@ -1,9 +1,11 @@
 // Bounding volume trees over triangle meshes (surface-area build, oriented-box
 // fitting, feature ownership, swept boxes) and the mesh-level CCD step: the
-// hinted pairs first, then per sub-interval of the motion a simultaneous
-// descent of the god-object's and each obstacle's tree, a time bound for each
-// candidate triangle pair, and the narrow-phase tests of the owned feature
-// pairs of the candidates, earliest first, earliest hit kept.
+// hinted pairs first, then the candidates of the proximity cache (coherence
+// between steps) where it covers the step, else per sub-interval of the
+// motion a simultaneous descent of the god-object's and each obstacle's tree;
+// a time bound for each candidate triangle pair and then for each of its owned
+// feature pairs, and the narrow-phase tests of the rest, earliest first,
+// earliest hit kept.
 #include "gauss6/bvh.h"
 
 #include "gauss6/contacts.h"
@@ -637,8 +639,8 @@ void ccd_step(const CcdBody* obstacles, int num_obstacles, const CcdBody& god, c
   // ear turned back onto the back it rests on, ends the step there without
   // sweeping the boxes over the whole step). A range covering only part of a
   // step would search the pairs near X0 twice: not used. The cache is refilled
-  // at X0 when its range would then be used and the god-object has moved more
-  // than half the margin since the last fill.
+  // at X0 when its own range cannot be used for this step and a fresh one's
+  // would (a step that moves less than the margin, or a short first search).
   double u_cached = 0;
   if (settings.cache_margin > 0 && !tester.done()) {
     CcdStepWorkspace::ProximityCache& pc = ws->cache;
@@ -658,8 +660,15 @@ void ccd_step(const CcdBody* obstacles, int num_obstacles, const CcdBody& god, c
     Displacement since(keyed ? pc.ref : X0, X0);  // from the cache's pose to X0
     const double moved = keyed ? since.bound(rho) : std::numeric_limits<double>::infinity();
     u_cached = keyed ? range(moved) : 0.0;
-    const bool fresh = moved <= 0.5 * margin && usable(u_cached);
-    if (!fresh && usable(range(Displacement(X0, X0).bound(rho)))) {
+    const bool fresh = usable(u_cached);
+    if (fresh) ++pc.uses;
+    // A fill pays when later steps use it. One for a step that moves less than
+    // the margin always does (the god-object is settling or resting); one that
+    // only covers the step up to a hint's hit, or a short first search, is
+    // skipped after a fill that no later step used (steps that each start
+    // far from the last: the synthetic pressing scripts).
+    const double u_fill = range(Displacement(X0, X0).bound(rho));
+    if (!fresh && usable(u_fill) && (u_fill >= 1 || pc.uses > 0 || pc.num_pairs < 0)) {
       // Fill: every pair not proven apart by reach + margin at X0 (u = 0).
       pc.clear();
       u_cached = 0;
@@ -683,6 +692,7 @@ void ccd_step(const CcdBody* obstacles, int num_obstacles, const CcdBody& god, c
         pc.margin = margin;
         pc.god = god;
         pc.obstacles.assign(obstacles, obstacles + num_obstacles);
+        pc.uses = 0;
         result->cache_filled = true;
         since = Displacement(X0, X0);
         u_cached = range(since.bound(rho));

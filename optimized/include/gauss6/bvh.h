@@ -532,9 +532,8 @@ struct CcdStepWorkspace {
   // hardly moves from one step to the next (resting, or pressed into an edge
   // and stopped at once): while a step's motion keeps within the margin of ref,
   // ccd_step takes its candidates from here instead of descending the trees.
-  // ccd_step refills it (at the step's start) when the god-object has moved
-  // more than half the margin from ref and the step starts in contact (hints
-  // given). It is keyed by the god-object's and the obstacles' meshes and
+  // ccd_step refills it (at the step's start) when it cannot serve the step
+  // and a fresh one could (see ccd_step). It is keyed by the god-object's and the obstacles' meshes and
   // BVHs (pointers), the reach and the margin; clear() it when a mesh behind
   // the same pointers changes.
   struct ProximityCache {
@@ -551,6 +550,7 @@ struct CcdStepWorkspace {
     int num_pairs = -1;            // -1: empty (never filled, or the pairs did not fit)
     Pose ref;
     double reach = 0, margin = 0;
+    int uses = 0;  // later steps served since the fill
     CcdBody god;
     std::vector<CcdBody> obstacles;  // grows (allocates) only when a fill sees more obstacles than ever before
     void clear() { num_pairs = -1; }
@@ -583,6 +583,10 @@ struct CcdStepWorkspace {
 // millimetre into it, no longer sweeps that millimetre through the hole. Any
 // hint is a real pair, so the answer's guarantee is the same with or without
 // them; out-of-range hints are ignored.
+//
+// With settings.cache_margin > 0, ws->cache carries candidates from one step
+// to the next (CcdStepWorkspace::ProximityCache): the same answer as a fresh
+// descent, for a fraction of its cost while the god-object stays near a pose.
 void ccd_step(const CcdBody* obstacles, int num_obstacles, const CcdBody& god, const Pose& X0, const Pose& X1,
               const CcdStepSettings& settings, CcdStepWorkspace* ws, CcdStepResult* result,
               const FeaturePair* hints = nullptr, int num_hints = 0);
