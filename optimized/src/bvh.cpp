@@ -471,9 +471,17 @@ struct PairTester {
     // as degenerate triangles, the axis between their closest points at u0
     // tried first): a pair sliding along at its gap, or turning across it,
     // needs no test.
-    const Vec3 X[3] = {start->pose(god_face[0]), start->pose(god_face[1]), start->pose(god_face[2])};
-    const double rad[3] = {start->radius(god_face[0].squaredNorm()), start->radius(god_face[1].squaredNorm()),
-                           start->radius(god_face[2].squaredNorm())};
+    Vec3 X[3];
+    double rad[3];
+    bool posed = false;
+    const auto pose_god_face = [&] {  // once, for the first feature past the box filter
+      if (posed) return;
+      posed = true;
+      for (int k = 0; k < 3; ++k) {
+        X[k] = start->pose(god_face[k]);
+        rad[k] = start->radius(god_face[k].squaredNorm());
+      }
+    };
     const Vec3* Y = obs_face.data();
     const auto apart = [&](const Vec3 A[3], const Vec3 B[3], double radius, const Vec3& axis) {
       if (start->earliest(A, B, radius, reach, end(), &axis) <= end()) return false;
@@ -482,6 +490,7 @@ struct PairTester {
     };
     for (int k = 0; k < 3; ++k) {
       if (!(go & (1u << k)) || !(u0 <= end()) || !overlap(god_swept[k], obs_face_box)) continue;
+      pose_god_face();
       const Vec3 A[3] = {X[k], X[k], X[k]};
       if (apart(A, Y, rad[k], X[k] - closest_point_on_triangle(X[k], Y[0], Y[1], Y[2]))) continue;
       RigidVertexFaceQuery q{motion, /*vertex_on_body=*/true, god_face[k], obs_face, u0, end()};
@@ -492,6 +501,7 @@ struct PairTester {
       if (!(oo & (1u << k)) || !(u0 <= end()) ||
           !overlap(god_face_swept, inflate(box_of(obs_face[k], obs_face[k]), margin)))
         continue;
+      pose_god_face();
       const Vec3 B[3] = {Y[k], Y[k], Y[k]};
       if (apart(X, B, std::max({rad[0], rad[1], rad[2]}), closest_point_on_triangle(Y[k], X[0], X[1], X[2]) - Y[k]))
         continue;
@@ -505,6 +515,7 @@ struct PairTester {
         if (!(oo & (8u << j)) || !(u0 <= end()) ||
             !overlap(god_edge_swept[k], inflate(box_of(obs_face[j], obs_face[(j + 1) % 3]), margin)))
           continue;
+        pose_god_face();
         const int k1 = (k + 1) % 3, j1 = (j + 1) % 3;
         const Vec3 A[3] = {X[k], X[k1], X[k1]}, B[3] = {Y[j], Y[j1], Y[j1]};
         double s = 0, t = 0;
@@ -652,7 +663,18 @@ void ccd_step(const CcdBody* obstacles, int num_obstacles, const CcdBody& god, c
       const double u = start.speed > 0 ? next_down(next_down(margin - moved) / start.speed) : 1.0;
       return u > 0 ? std::min(u, 1.0) : 0.0;  // also NaN
     };
-    const auto usable = [&](double u) { return u > 0 && (u >= u_rest || (probing && u < 0.5 / n)); };
+    // The part of a cache range [0, u] to search from the cache (0: none): all
+    // of it when it covers the rest of the step; as a first search, at most
+    // the range over which no point moves a quarter of the margin, and only
+    // when that is under half a sub-interval (a longer one saves no descent).
+    const double u_probe = start.speed > 0 ? next_down(0.25 * margin / start.speed) : 1.0;
+    const auto window = [&](double u) {
+      if (!(u > 0)) return 0.0;  // also NaN
+      if (u >= u_rest) return u;
+      const double w = std::min(u, u_probe);
+      return probing && w > 0 && w < 0.5 / n ? w : 0.0;
+    };
+    const auto usable = [&](double u) { return window(u) > 0; };
     const auto same = [](const CcdBody& a, const CcdBody& b) { return a.mesh == b.mesh && a.bvh == b.bvh; };
     bool keyed = pc.num_pairs >= 0 && same(pc.god, god) && pc.reach == reach && pc.margin == margin &&
                  static_cast<int>(pc.obstacles.size()) == num_obstacles;
@@ -662,13 +684,19 @@ void ccd_step(const CcdBody* obstacles, int num_obstacles, const CcdBody& god, c
     u_cached = keyed ? range(moved) : 0.0;
     const bool fresh = usable(u_cached);
     if (fresh) ++pc.uses;
-    // A fill pays when later steps use it. One for a step that moves less than
-    // the margin always does (the god-object is settling or resting); one that
-    // only covers the step up to a hint's hit, or a short first search, is
-    // skipped after a fill that no later step used (steps that each start
-    // far from the last: the synthetic pressing scripts).
-    const double u_fill = range(Displacement(X0, X0).bound(rho));
-    if (!fresh && usable(u_fill) && (u_fill >= 1 || pc.uses > 0 || pc.num_pairs < 0)) {
+    // A fill costs more than a descent over the step (its boxes are grown by
+    // the margin) and pays only when later steps use it: after a fill that
+    // served fewer than two later steps (a peg sliding half the margin a step,
+    // steps that each start far from the last), the next 8 chances to fill
+    // are passed over (plain descents), and the one after that fills.
+    bool fill = !fresh && usable(range(Displacement(X0, X0).bound(rho)));
+    if (fill && pc.rest > 0) {
+      fill = --pc.rest == 0;
+    } else if (fill && pc.num_pairs >= 0 && pc.uses < 2) {
+      pc.rest = 8;
+      fill = false;
+    }
+    if (fill) {
       // Fill: every pair not proven apart by reach + margin at X0 (u = 0).
       pc.clear();
       u_cached = 0;
@@ -698,7 +726,7 @@ void ccd_step(const CcdBody* obstacles, int num_obstacles, const CcdBody& god, c
         u_cached = range(since.bound(rho));
       }
     }
-    if (!usable(u_cached)) u_cached = 0;
+    u_cached = window(u_cached);
     result->u_cached = u_cached;
     if (u_cached > 0) {
       enclose_motion(motion, {0, std::min(u_cached, result->u_hit)}, &e);

@@ -551,6 +551,7 @@ struct CcdStepWorkspace {
     Pose ref;
     double reach = 0, margin = 0;
     int uses = 0;  // later steps served since the fill
+    int rest = 0;  // chances to refill still to pass over (see ccd_step)
     CcdBody god;
     std::vector<CcdBody> obstacles;  // grows (allocates) only when a fill sees more obstacles than ever before
     void clear() { num_pairs = -1; }
