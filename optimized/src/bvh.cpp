@@ -483,8 +483,14 @@ struct PairTester {
       }
     };
     const Vec3* Y = obs_face.data();
+    // The bound also starts the feature pair's search: nothing comes within
+    // reach before it, so the narrow phase searches [from, end()] only (a
+    // contact sliding along at its gap is then searched from where the
+    // motion can first close it, not across the whole step).
+    double from = u0;
     const auto apart = [&](const Vec3 A[3], const Vec3 B[3], double radius, const Vec3& axis) {
-      if (start->earliest(A, B, radius, reach, end(), &axis) <= end()) return false;
+      from = std::max(u0, start->earliest(A, B, radius, reach, end(), &axis));
+      if (from <= end()) return false;
       ++result->num_feature_culls;
       return true;
     };
@@ -493,7 +499,7 @@ struct PairTester {
       pose_god_face();
       const Vec3 A[3] = {X[k], X[k], X[k]};
       if (apart(A, Y, rad[k], X[k] - closest_point_on_triangle(X[k], Y[0], Y[1], Y[2]))) continue;
-      RigidVertexFaceQuery q{motion, /*vertex_on_body=*/true, god_face[k], obs_face, u0, end()};
+      RigidVertexFaceQuery q{motion, /*vertex_on_body=*/true, god_face[k], obs_face, from, end()};
       ccd_rigid_vertex_face(q, settings->narrow, ws, &r);
       consider(r, {PairKind::kGodVertexObstacleFace, obstacle, gf, k, of, -1});
     }
@@ -505,7 +511,7 @@ struct PairTester {
       const Vec3 B[3] = {Y[k], Y[k], Y[k]};
       if (apart(X, B, std::max({rad[0], rad[1], rad[2]}), closest_point_on_triangle(Y[k], X[0], X[1], X[2]) - Y[k]))
         continue;
-      RigidVertexFaceQuery q{motion, /*vertex_on_body=*/false, obs_face[k], god_face, u0, end()};
+      RigidVertexFaceQuery q{motion, /*vertex_on_body=*/false, obs_face[k], god_face, from, end()};
       ccd_rigid_vertex_face(q, settings->narrow, ws, &r);
       consider(r, {PairKind::kObstacleVertexGodFace, obstacle, gf, -1, of, k});
     }
@@ -522,7 +528,7 @@ struct PairTester {
         closest_segment_parameters(X[k], X[k1], Y[j], Y[j1], &s, &t);
         if (apart(A, B, std::max(rad[k], rad[k1]), (X[k] + s * (X[k1] - X[k])) - (Y[j] + t * (Y[j1] - Y[j])))) continue;
         RigidEdgeEdgeQuery q{motion, {god_face[k], god_face[(k + 1) % 3]}, {obs_face[j], obs_face[(j + 1) % 3]},
-                             u0, end()};
+                             from, end()};
         ccd_rigid_edge_edge(q, settings->narrow, ws, &r);
         consider(r, {PairKind::kEdgeEdge, obstacle, gf, k, of, j});
       }
@@ -569,6 +575,16 @@ void ccd_step(const CcdBody* obstacles, int num_obstacles, const CcdBody& god, c
   // come within the near distance cannot come within d).
   const double reach = std::max(d, settings.near_distance);
   // The hints' triangle pairs first, over the whole step (each distinct pair once).
+  // A pair searched here over [0, e] needs no second search: every later
+  // window [u0, end()] ends at or before e (end() only shrinks), and the
+  // search returned the pair's first contact in [0, e], if any. The sliding
+  // contacts are the dearest pairs to search (their gap stays near delta).
+  int num_searched = 0;  // hints[0 .. num_searched) were searched (valid or not)
+  const auto searched = [&](int gf, int of, int o) {
+    for (int h = 0; h < num_searched; ++h)
+      if (hints[h].god_face == gf && hints[h].obstacle_face == of && hints[h].obstacle == o) return true;
+    return false;
+  };
   if (hints && num_hints > 0) {
     enclose_motion(motion, {0, 1}, &e);
     start.set(motion, 0.0, god.bvh->radius);
@@ -587,6 +603,7 @@ void ccd_step(const CcdBody* obstacles, int num_obstacles, const CcdBody& god, c
       if (!valid || seen) continue;
       const CcdBody& ob = obstacles[f.obstacle];
       tester.test(*god.mesh, *god.bvh, f.god_face, *ob.mesh, *ob.bvh, f.obstacle_face, f.obstacle);
+      num_searched = h + 1;
     }
   }
   // Lists the candidate triangle pairs of every obstacle over the motion
@@ -627,6 +644,7 @@ void ccd_step(const CcdBody* obstacles, int num_obstacles, const CcdBody& god, c
     std::sort(cand, cand + num_cand, [](const auto& a, const auto& b) { return a.earliest < b.earliest; });
     for (int c = 0; c < num_cand; ++c) {
       if (cand[c].earliest > tester.end() || tester.done()) break;
+      if (searched(cand[c].god_face, cand[c].obstacle_face, cand[c].obstacle)) continue;
       const CcdBody& ob = obstacles[cand[c].obstacle];
       tester.test(*god.mesh, *god.bvh, cand[c].god_face, *ob.mesh, *ob.bvh, cand[c].obstacle_face,
                   cand[c].obstacle);
@@ -788,7 +806,7 @@ void ccd_step(const CcdBody* obstacles, int num_obstacles, const CcdBody& god, c
         return true;
       }
       listed = false;
-      tester.test(*god.mesh, *god.bvh, gf, *ob.mesh, *ob.bvh, of, o);
+      if (!searched(gf, of, o)) tester.test(*god.mesh, *god.bvh, gf, *ob.mesh, *ob.bvh, of, o);
       // A hit at the sub-interval's start cannot be bettered: stop.
       return !tester.done();
     });

@@ -219,6 +219,56 @@ TEST_CASE("BVH: every truly colliding triangle pair is a candidate; ccd_step agr
   CHECK(hits >= 10);
 }
 
+TEST_CASE("ccd_step: a hint's pair is not searched twice, and a pair sharing one face with a hint is", "[bvh]") {
+  // Hints that do not hit, each sharing one face with a pair that does (the
+  // god face with another obstacle face, or the obstacle face with another
+  // god face): the step searches the hints over the whole step first, then
+  // skips exactly those pairs later. Skipping by one face alone would drop the
+  // hitting pairs and stop late or not at all: the brute force's first contact
+  // (the 1e-5 bound of the tests above) must still be found.
+  const TriangleMesh god = make_icosphere(1, 0.5);
+  const TriangleMesh obs = make_icosphere(1, 0.4);
+  const Bvh gb = build_bvh(god, 2), ob = build_bvh(obs, 2);
+  std::mt19937 rng(23);
+  std::uniform_real_distribution<double> U(-1, 1);
+  CcdStepSettings settings;
+  CcdStepWorkspace ws;
+  const CcdBody ob_body{&obs, &ob};
+  int checked = 0;
+  for (int i = 0; i < 30; ++i) {
+    const Pose x0{Vec3(1.2 * U(rng), 1.2 * U(rng), 1.2), normalized(Quat{1 + U(rng), U(rng), U(rng), U(rng)})};
+    const Pose x1{Vec3(0.3 * U(rng), 0.3 * U(rng), 0.3 * U(rng)),
+                  normalized(quat_exp(Vec3(U(rng), U(rng), U(rng))) * x0.q)};
+    CcdMotion m;
+    REQUIRE(make_ccd_motion(x0, x1, &m) == MotionStatus::kOk);
+    const BruteForce bf = brute_force(god, gb, obs, ob, m, settings.narrow);
+    if (!bf.hit) continue;
+    std::vector<FeaturePair> hints;
+    // The first pair pair_of(k), k = 1, 2, ..., that never comes within d.
+    const auto add_free = [&](int n, const auto& pair_of) {
+      for (int k = 1; k < n; ++k) {
+        const auto [g, o] = pair_of(k);
+        if (bf.hitting_pairs.count({g, o})) continue;
+        hints.push_back({PairKind::kEdgeEdge, 0, g, 0, o, 0});
+        return;
+      }
+    };
+    const int num_god = static_cast<int>(god.F.rows()), num_obs = static_cast<int>(obs.F.rows());
+    for (const auto& [gf, of] : bf.hitting_pairs) {
+      add_free(num_obs, [&](int k) { return std::pair<int, int>{gf, (of + k) % num_obs}; });  // the god face's
+      add_free(num_god, [&](int k) { return std::pair<int, int>{(gf + k) % num_god, of}; });  // the obstacle face's
+    }
+    CcdStepResult r;
+    ccd_step(&ob_body, 1, {&god, &gb}, x0, x1, settings, &ws, &r, hints.data(), static_cast<int>(hints.size()));
+    INFO("step " << i << ", " << hints.size() << " hints");
+    REQUIRE(r.status == CcdStatus::kOk);
+    CHECK(r.hit);
+    CHECK(std::abs(r.u_hit - bf.u_hit) <= 1e-5);
+    ++checked;
+  }
+  CHECK(checked >= 10);
+}
+
 TEST_CASE("ccd_step: steps served by the proximity cache find the first contact of a fresh search", "[bvh]") {
   // A ball kept near a slab with a block standing on it, by a chain of steps
   // each from the last one's stop pose, as the runtime's are: small jitters

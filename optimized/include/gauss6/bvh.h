@@ -578,12 +578,12 @@ struct CcdStepWorkspace {
 //
 // hints[0 .. num_hints): feature pairs likely to touch first (the runtime
 // passes the contacts at X0); their triangle pairs are tested over the whole
-// step before the descent. A pair pressed against an obstacle then gives a hit
-// near u = 0 at once, and the descent searches only up to it, with boxes swept
-// over that short range: the peg pressed into the hole's rim, commanded a
-// millimetre into it, no longer sweeps that millimetre through the hole. Any
-// hint is a real pair, so the answer's guarantee is the same with or without
-// them; out-of-range hints are ignored.
+// step before the descent (and not again after it). A pair pressed against an
+// obstacle then gives a hit near u = 0 at once, and the descent searches only
+// up to it, with boxes swept over that short range: the peg pressed into the
+// hole's rim, commanded a millimetre into it, no longer sweeps that millimetre
+// through the hole. Any hint is a real pair, so the answer's guarantee is the
+// same with or without them; out-of-range hints are ignored.
 //
 // With settings.cache_margin > 0, ws->cache carries candidates from one step
 // to the next (CcdStepWorkspace::ProximityCache): the same answer as a fresh
