@@ -393,14 +393,11 @@ TEST_CASE("Cayley motion refuses half turns and zero quaternions", "[refccd]") {
 
 #include "../../optimized/tests/mesh_shapes.h"
 #include "off_reader.h"
+#include "stopwatch.h"
 
 namespace {
 
 using gauss6::test::read_off;
-
-double seconds_since(std::chrono::steady_clock::time_point t0) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-}
 
 }  // namespace
 

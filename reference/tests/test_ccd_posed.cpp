@@ -24,6 +24,7 @@
 #include "gauss6/reference/ccd.h"
 #include "../../optimized/tests/mesh_shapes.h"
 #include "off_reader.h"
+#include "stopwatch.h"
 
 namespace {
 
@@ -119,10 +120,6 @@ double rest_on(const TriangleMesh& body, const Quat& q, double target, double* x
   if (x_low) *x_low = low[0].get_d();
   if (y_low) *y_low = low[1].get_d();
   return z.get_d();
-}
-
-double seconds_since(std::chrono::steady_clock::time_point t0) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }
 
 }  // namespace
