@@ -579,28 +579,28 @@ void ccd_step(const CcdBody* obstacles, int num_obstacles, const CcdBody& god, c
   // window [u0, end()] ends at or before e (end() only shrinks), and the
   // search returned the pair's first contact in [0, e], if any. The sliding
   // contacts are the dearest pairs to search (their gap stays near delta).
-  int num_searched = 0;  // hints[0 .. num_searched) were searched (valid or not)
-  const auto searched = [&](int gf, int of, int o) {
-    for (int h = 0; h < num_searched; ++h)
+  // among(count, ...): the triangle pair is one of hints[0 .. count).
+  const auto among = [&](int count, int gf, int of, int o) {
+    for (int h = 0; h < count; ++h)
       if (hints[h].god_face == gf && hints[h].obstacle_face == of && hints[h].obstacle == o) return true;
     return false;
   };
+  int num_searched = 0;  // hints[0 .. num_searched) were searched (valid or not)
+  const auto searched = [&](int gf, int of, int o) { return among(num_searched, gf, of, o); };
+  // The hints and the proximity cache both start from the god-object at u = 0.
+  if ((hints && num_hints > 0) || settings.cache_margin > 0) start.set(motion, 0.0, god.bvh->radius);
   if (hints && num_hints > 0) {
     enclose_motion(motion, {0, 1}, &e);
-    start.set(motion, 0.0, god.bvh->radius);
     ws->swept.next_interval();
     tester.u0 = 0;
     tester.u1 = 1;
     for (int h = 0; h < num_hints && !tester.done(); ++h) {
       const FeaturePair& f = hints[h];
-      const bool valid = f.obstacle >= 0 && f.obstacle < num_obstacles && obstacles[f.obstacle].mesh &&
-                         obstacles[f.obstacle].bvh && f.god_face >= 0 && f.god_face < god.mesh->F.rows() &&
-                         f.obstacle_face >= 0 && f.obstacle_face < obstacles[f.obstacle].mesh->F.rows();
-      bool seen = false;
-      for (int k = 0; k < h && !seen; ++k)
-        seen = hints[k].obstacle == f.obstacle && hints[k].god_face == f.god_face &&
-               hints[k].obstacle_face == f.obstacle_face;
-      if (!valid || seen) continue;
+      // (Every obstacle's mesh and tree were checked with the inputs.)
+      const bool valid = f.obstacle >= 0 && f.obstacle < num_obstacles && f.god_face >= 0 &&
+                         f.god_face < god.mesh->F.rows() && f.obstacle_face >= 0 &&
+                         f.obstacle_face < obstacles[f.obstacle].mesh->F.rows();
+      if (!valid || among(h, f.god_face, f.obstacle_face, f.obstacle)) continue;  // each distinct pair once
       const CcdBody& ob = obstacles[f.obstacle];
       tester.test(*god.mesh, *god.bvh, f.god_face, *ob.mesh, *ob.bvh, f.obstacle_face, f.obstacle);
       num_searched = h + 1;
@@ -673,8 +673,7 @@ void ccd_step(const CcdBody* obstacles, int num_obstacles, const CcdBody& god, c
   double u_cached = 0;
   if (settings.cache_margin > 0 && !tester.done()) {
     CcdStepWorkspace::ProximityCache& pc = ws->cache;
-    const double margin = settings.cache_margin, rho = god.bvh->radius;
-    start.set(motion, 0.0, rho);
+    const double margin = settings.cache_margin, rho = god.bvh->radius;  // start: at u = 0 (above)
     const double u_rest = result->hit ? result->u_hit : 1.0;
     const bool probing = hints && num_hints > 0 && !result->hit;
     const auto range = [&](double moved) {  // [0, u] keeps every point within the margin of ref (0: none)
