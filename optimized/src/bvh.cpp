@@ -256,6 +256,8 @@ struct StartFrame {
   // its enclosure, and omega2 >= |2 g|^2.
   Vec3 omega = Vec3::Zero();
   double omega_error = 0, omega2 = 0;
+  double omega_norm = 0;  // >= |omega|
+  double g2 = 0;          // >= |g|^2
   void set(const CcdMotion& m, double u, double rho_in) {
     const StopPose sp = make_stop_pose(m, u, rho_in);
     u0 = u;
@@ -282,6 +284,8 @@ struct StartFrame {
     }
     omega_error = next_up(2 * next_up(std::sqrt(g_err2)));
     omega2 = next_up(4 * m.g2.hi);
+    g2 = m.g2.hi;
+    omega_norm = next_up(omega.norm() * (1 + 1e-15));
     dp_max = next_up(std::sqrt(dp2));
     speed = next_up(dp_max + next_up(turn_rate * rho));
     static_error = next_up(sp.deviation + next_up(1e-13 * next_up(p.cwiseAbs().maxCoeff() + rho)));
@@ -289,24 +293,51 @@ struct StartFrame {
         !omega.allFinite() || !std::isfinite(omega_error) || !std::isfinite(omega2)) {
       static_error = speed = drift = turn_rate = dp_max = std::numeric_limits<double>::infinity();
       omega.setZero();
+      omega_norm = 0;
     }
   }
 
-  // The oriented-box frame of the sub-interval [u0, u1] (bvh.h, PosedObb),
-  // grown by the distance sought d.
+  // How far the turn by phi over [u0, u0 + tau], tau <= tau_max, may fall
+  // behind tau omega (TriangleMotion::lag): phi = 2 (atan(u |g|) - atan(u0 |g|))
+  // lies between 2 tau |g| / (1 + u1^2 |g|^2) and 2 tau |g| (u1 = u0 + tau_max),
+  // and sin(phi) >= phi (1 - phi^2 / 6); so sin(phi) / (2 tau |g|) >= 1 - u1^2
+  // |g|^2 - (2 tau |g|)^2 / 6. At most 1.
+  double lag(double tau_max) const {
+    const double u1 = std::min(1.0, next_up(u0 + tau_max));
+    const double a = next_up(tau_max * turn_rate);
+    const double l = next_up(next_up(next_up(u1 * u1) * g2) + next_up(next_up(a * a) / 6));
+    return l < 1 ? l : 1.0;  // also NaN
+  }
+
+  // The oriented-box frame of the sub-interval [u0, u1] (bvh.h, PosedObb,
+  // SweptObbFrame: directional), grown by the distance sought d. A point at
+  // offset r (exact, at u0) from G moves by tau dp + (lambda tau 2 g) x r +
+  // (1 - cos(phi)) e x (e x r), tau = u - u0 <= span, lambda in [1 - lag, 1]:
+  // that is tau (dp_mid + omega x r) plus at most span (drift + (omega_error +
+  // lag |omega| + span omega2 / 2) |r|) (the lag, 2 g's distance from omega,
+  // 1 - cos(phi) <= phi^2 / 2); with r taken from the double pose, within 2
+  // static_error of the exact one, plus span (turn_rate + |omega|) 2
+  // static_error.
   SweptObbFrame obb_frame(double u1, double d) const {
     SweptObbFrame f;
     f.R = R;
     f.p = p;
     const double span = next_up(u1 - u0);
     f.step = (u1 - u0) * dp_mid;
+    f.spin = (u1 - u0) * omega;
+    f.spread = next_up(span * omega_norm);
     // The step's own rounding (relative 2^-53 per coordinate) joins the drift.
     const double step_error = next_up(1e-15 * f.step.cwiseAbs().maxCoeff() * 2);
-    f.grow = next_up(next_up(static_error + d) + next_up(next_up(span * drift) + step_error));
-    f.turn = next_up(span * turn_rate);
-    if (!std::isfinite(f.grow) || !std::isfinite(f.turn) || !f.step.allFinite()) {
+    const double offsets = next_up(next_up(span * next_up(turn_rate + omega_norm)) * next_up(2 * static_error));
+    f.grow = next_up(next_up(next_up(static_error + d) + next_up(next_up(span * drift) + step_error)) + offsets);
+    const double rest = next_up(next_up(omega_error + next_up(lag(span) * omega_norm)) + next_up(0.5 * next_up(span * omega2)));
+    f.turn = next_up(span * rest);
+    if (!std::isfinite(f.grow) || !std::isfinite(f.turn) || !std::isfinite(f.spread) || !f.step.allFinite() ||
+        !f.spin.allFinite()) {
       f.grow = std::numeric_limits<double>::infinity();
       f.step.setZero();
+      f.spin.setZero();
+      f.spread = 0;
     }
     return f;
   }
@@ -345,6 +376,7 @@ struct StartFrame {
     m.v = dp_mid;
     m.omega = omega;
     m.centre = p;
+    m.lag = lag(tau_max);
     const double second = next_up(0.5 * next_up(tau_max * omega2));
     const double offsets = next_up(turn_rate * next_up(static_error + 1e-12 * r));
     m.w = next_up(next_up(drift + next_up(next_up(omega_error + second) * r)) + offsets);
@@ -594,7 +626,20 @@ void ccd_step(const CcdBody* obstacles, int num_obstacles, const CcdBody& god, c
     ws->swept.next_interval();
     tester.u0 = 0;
     tester.u1 = 1;
-    for (int h = 0; h < num_hints && !tester.done(); ++h) {
+    // The hint on the triangle pair that stopped the workspace's last step, if
+    // any, goes first (CcdStepWorkspace::last_hit); the others keep their
+    // order: lead, 0, 1, .., lead - 1, lead + 1, ... Either way, once hints[h]
+    // is done, so are all of hints[0 .. h].
+    const FeaturePair& last = ws->last_hit;
+    int lead = 0;
+    for (int h = 0; h < num_hints; ++h)
+      if (hints[h].god_face == last.god_face && hints[h].obstacle_face == last.obstacle_face &&
+          hints[h].obstacle == last.obstacle) {
+        lead = h;
+        break;
+      }
+    for (int k = 0; k < num_hints && !tester.done(); ++k) {
+      const int h = k == 0 ? lead : (k <= lead ? k - 1 : k);
       const FeaturePair& f = hints[h];
       // (Every obstacle's mesh and tree were checked with the inputs.)
       const bool valid = f.obstacle >= 0 && f.obstacle < num_obstacles && f.god_face >= 0 &&
@@ -603,7 +648,7 @@ void ccd_step(const CcdBody* obstacles, int num_obstacles, const CcdBody& god, c
       if (!valid || among(h, f.god_face, f.obstacle_face, f.obstacle)) continue;  // each distinct pair once
       const CcdBody& ob = obstacles[f.obstacle];
       tester.test(*god.mesh, *god.bvh, f.god_face, *ob.mesh, *ob.bvh, f.obstacle_face, f.obstacle);
-      num_searched = h + 1;
+      if (k > 0 || lead == 0) num_searched = h + 1;  // (the lead alone is not hints[0 .. lead])
     }
   }
   // Lists the candidate triangle pairs of every obstacle over the motion
@@ -825,6 +870,7 @@ void ccd_step(const CcdBody* obstacles, int num_obstacles, const CcdBody& god, c
   } else {
     // Pairs searched only up to u_b - tol (PairTester::end): stop there.
     result->u_hit = std::max(0.0, result->u_hit - settings.narrow.time_tolerance);
+    ws->last_hit = result->pair;
     result->time_tolerance_reached += settings.narrow.time_tolerance;
   }
 }

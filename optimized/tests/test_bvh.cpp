@@ -225,7 +225,10 @@ TEST_CASE("ccd_step: a hint's pair is not searched twice, and a pair sharing one
   // god face): the step searches the hints over the whole step first, then
   // skips exactly those pairs later. Skipping by one face alone would drop the
   // hitting pairs and stop late or not at all: the brute force's first contact
-  // (the 1e-5 bound of the tests above) must still be found.
+  // (the 1e-5 bound of the tests above) must still be found. Also on a
+  // workspace whose last step was stopped by one of the hints (first, in the
+  // middle, or last of them), which is then searched first
+  // (CcdStepWorkspace::last_hit) and the rest in their order.
   const TriangleMesh god = make_icosphere(1, 0.5);
   const TriangleMesh obs = make_icosphere(1, 0.4);
   const Bvh gb = build_bvh(god, 2), ob = build_bvh(obs, 2);
@@ -258,12 +261,26 @@ TEST_CASE("ccd_step: a hint's pair is not searched twice, and a pair sharing one
       add_free(num_obs, [&](int k) { return std::pair<int, int>{gf, (of + k) % num_obs}; });  // the god face's
       add_free(num_god, [&](int k) { return std::pair<int, int>{(gf + k) % num_god, of}; });  // the obstacle face's
     }
+    // Every other step, a hitting pair among them too (so the lead may hit).
+    if (i % 2 == 0) {
+      const auto [gf, of] = *bf.hitting_pairs.begin();
+      hints.insert(hints.begin() + static_cast<long>(hints.size() / 2), FeaturePair{PairKind::kEdgeEdge, 0, gf, 0, of, 0});
+    }
     CcdStepResult r;
+    ws.last_hit = FeaturePair{};
     ccd_step(&ob_body, 1, {&god, &gb}, x0, x1, settings, &ws, &r, hints.data(), static_cast<int>(hints.size()));
     INFO("step " << i << ", " << hints.size() << " hints");
     REQUIRE(r.status == CcdStatus::kOk);
     CHECK(r.hit);
     CHECK(std::abs(r.u_hit - bf.u_hit) <= 1e-5);
+    for (const size_t lead : {size_t{0}, hints.size() / 2, hints.size() - 1}) {
+      ws.last_hit = hints[lead];
+      ccd_step(&ob_body, 1, {&god, &gb}, x0, x1, settings, &ws, &r, hints.data(), static_cast<int>(hints.size()));
+      INFO("last hit: hint " << lead);
+      REQUIRE(r.status == CcdStatus::kOk);
+      CHECK(r.hit);
+      CHECK(std::abs(r.u_hit - bf.u_hit) <= 1e-5);
+    }
     ++checked;
   }
   CHECK(checked >= 10);
@@ -440,6 +457,61 @@ TEST_CASE("ccd_step: a box falling flat onto a slab, and one tipping onto it", "
              &r);
     CHECK(r.status == CcdStatus::kHalfTurn);
   }
+}
+
+TEST_CASE("ccd_step: a bar pivoting about its lowest corner over a slab agrees with the brute force", "[bvh]") {
+  // A 10 x 2 x 2 bar tilted over a slab, its lowest corner a small gap above
+  // it, turned about that corner (G moving by the turn of its offset from the
+  // corner), plus a small translation that sometimes presses the corner in:
+  // the motion whose translation and turn cancel near the contact, which the
+  // swept oriented boxes and time bounds take as such (bvh.h: SweptObbFrame,
+  // TriangleMotion::lag). Each step must agree with the brute force (the 1e-5
+  // bound of the tests above), with and without hints and the cache.
+  const TriangleMesh god = make_box(0.1, 0.02, 0.02);
+  const TriangleMesh slab = concatenate(make_box(1, 1, 0.1, Vec3(0, 0, -0.05)), make_box(0.02, 0.4, 0.1, Vec3(0.12, 0, 0.05)));
+  const Bvh gb = build_bvh(god, 2), sb = build_bvh(slab, 2);
+  const CcdBody obstacle{&slab, &sb};
+  std::mt19937 rng(53);
+  std::uniform_real_distribution<double> U(-1, 1);
+  CcdStepSettings settings, cached;
+  settings.narrow.min_separation = cached.narrow.min_separation = 1e-5;
+  cached.cache_margin = 1e-3;
+  CcdStepWorkspace ws, ws_cached;
+  int hits = 0;
+  for (int i = 0; i < 40; ++i) {
+    const Quat q0 = normalized(quat_exp(Vec3(0.3 * U(rng), 0.3 + 0.2 * U(rng), 0.3 * U(rng))));
+    const Mat3 R0 = rotation_matrix(q0);
+    Vec3 lowest(0, 0, 1e300);
+    for (int k = 0; k < god.V.rows(); ++k) {
+      const Vec3 x = R0 * god.V.row(k).transpose();
+      if (x.z() < lowest.z()) lowest = x;
+    }
+    const double gap = std::pow(10.0, -2 - 2 * std::abs(U(rng)));
+    const Vec3 G0 = Vec3(0.02 * U(rng), 0.02 * U(rng), gap - lowest.z());
+    const Vec3 pivot = G0 + lowest;
+    const Vec3 turn = (i % 4 == 0 ? 0.01 : 0.2) * Vec3(U(rng), U(rng), U(rng));
+    const Mat3 Q = rotation_matrix(normalized(quat_exp(turn)));
+    const Vec3 press = (i % 3 == 0 ? 2 * gap : 0.0) * Vec3(0.3 * U(rng), 0.3 * U(rng), -1);
+    const Pose x0{G0, q0}, x1{pivot + Q * (G0 - pivot) + press, normalized(quat_exp(turn) * q0)};
+    CcdMotion m;
+    REQUIRE(make_ccd_motion(x0, x1, &m) == MotionStatus::kOk);
+    const BruteForce bf = brute_force(god, gb, slab, sb, m, settings.narrow);
+    INFO("step " << i << ", gap " << gap);
+    CcdStepResult r;
+    ccd_step(&obstacle, 1, {&god, &gb}, x0, x1, settings, &ws, &r);
+    REQUIRE(r.status == CcdStatus::kOk);
+    CHECK(r.hit == bf.hit);
+    if (r.hit && bf.hit) CHECK(std::abs(r.u_hit - bf.u_hit) <= 1e-5);
+    hits += bf.hit;
+    // Hinted by a pair of faces near the pivot, through the proximity cache.
+    const FeaturePair hint{PairKind::kEdgeEdge, 0, 0, 0, 2, 0};
+    ccd_step(&obstacle, 1, {&god, &gb}, x0, x1, cached, &ws_cached, &r, &hint, 1);
+    REQUIRE(r.status == CcdStatus::kOk);
+    CHECK(r.hit == bf.hit);
+    if (r.hit && bf.hit) CHECK(std::abs(r.u_hit - bf.u_hit) <= 1e-5);
+  }
+  CHECK(hits >= 8);
+  CHECK(hits <= 32);
 }
 
 TEST_CASE("ccd_step timing on spheres", "[bvh][timing]") {
@@ -639,7 +711,7 @@ TEST_CASE("triangle_time_lower_bound: no motion within its bounds comes within r
   std::mt19937 rng(43);
   std::normal_distribution<double> n(0, 1);
   std::uniform_real_distribution<double> U(0, 1);
-  int bounded = 0, infinite = 0, receding = 0, tighter = 0, turning = 0;
+  int bounded = 0, infinite = 0, receding = 0, tighter = 0, turning = 0, pivots = 0, pivots_tighter = 0;
   for (int i = 0; i < 4000; ++i) {
     const double scale = std::pow(10.0, 4 * U(rng) - 2);
     const DisjointPair pair = disjoint_pair(rng, n, U, i, scale, 3, /*nearly_parallel=*/false);
@@ -650,19 +722,40 @@ TEST_CASE("triangle_time_lower_bound: no motion within its bounds comes within r
     Vec3 v = scale * Vec3(n(rng), n(rng), n(rng));
     if (i % 3 == 1) v = scale * (m + 0.1 * Vec3(n(rng), n(rng), n(rng)));
     if (i % 3 == 2) v = -scale * m;
-    const Vec3 centre = c0 + scale * Vec3(n(rng), n(rng), n(rng));
+    Vec3 centre = c0 + scale * Vec3(n(rng), n(rng), n(rng));
     Vec3 omega = (i % 2 ? 0.0 : 0.3) * Vec3(n(rng), n(rng), n(rng));
     double lever = 0;
     for (int k = 0; k < 3; ++k) lever = std::max(lever, (A[k] - centre).norm());
-    const bool directional = i % 4 == 0;
+    const bool directional = i % 4 == 0 || i % 4 == 2;
     // Given as a turn, one fast enough to close the gap within tau = 1.
     if (directional) omega = 2 * gap / lever * Vec3(n(rng), n(rng), n(rng)).normalized();
+    // A pivot (i % 4 == 2), as a peg's tip pressed on a wall while G moves
+    // towards it: the turn swings A's centroid away from B about A's corner
+    // nearest B (omega along m x (centroid - corner)), and the centre sits
+    // beside that corner so that G's translation v = -omega x (corner -
+    // centre), which keeps the corner in place to first order, points at B.
+    const bool pivot = i % 4 == 2;
+    if (pivot) {
+      int p = 0;
+      for (int k = 1; k < 3; ++k)
+        if (m.dot(A[k]) > m.dot(A[p])) p = k;
+      const Vec3 axis = m.cross((A[0] + A[1] + A[2]) / 3 - A[p]);
+      if (axis.norm() > 0) omega = omega.norm() * axis.normalized();
+      if (omega.norm() > 0) centre = A[p] + scale * m.cross(omega.normalized());
+      lever = 0;
+      for (int k = 0; k < 3; ++k) lever = std::max(lever, (A[k] - centre).norm());
+      v = -omega.cross(A[p] - centre);
+    }
     TriangleMotion isotropic, turn;
     isotropic.v = turn.v = v;
     isotropic.w = omega.norm() * lever * (1 + 1e-9);
     turn.omega = omega;
     turn.centre = centre;
     turn.w = 0.5 * omega.squaredNorm() * lever * (1 + 1e-9);
+    // The turn by t |omega| (quat_exp below) moves x - c by sin(t |omega|) e x
+    // (x - c) + ...: lambda = sin(t |omega|) / (t |omega|) >= 1 - (t |omega|)^2 / 6
+    // for t <= 1.
+    if (directional) turn.lag = std::min(1.0, omega.squaredNorm() / 6 * (1 + 1e-9));
     const double tau = triangle_time_lower_bound(A, B, directional ? turn : isotropic, reach,
                                                  std::numeric_limits<double>::infinity());
     REQUIRE(tau >= 0);
@@ -670,6 +763,18 @@ TEST_CASE("triangle_time_lower_bound: no motion within its bounds comes within r
       ++turning;
       const double tau_iso = triangle_time_lower_bound(A, B, isotropic, reach, std::numeric_limits<double>::infinity());
       tighter += std::min(tau, 1.0) > std::min(tau_iso, 1.0);
+      if (pivot) {
+        // Without the lag bound (lag 1: the turn may fall behind entirely, and
+        // the translation alone moves the pivot corner) the bound is never later.
+        TriangleMotion lagging = turn;
+        lagging.lag = 1;
+        const double tau_lagging =
+            triangle_time_lower_bound(A, B, lagging, reach, std::numeric_limits<double>::infinity());
+        ++pivots;
+        REQUIRE(tau >= tau_lagging);
+        pivots_tighter += tau > 1.01 * tau_lagging;
+
+      }
     }
     if (std::isinf(tau)) {
       ++infinite;
@@ -690,11 +795,13 @@ TEST_CASE("triangle_time_lower_bound: no motion within its bounds comes within r
     }
   }
   std::printf("triangle_time_lower_bound: %d pairs with a positive bound, %d receding ones above 1e6, %d infinite; "
-              "the turn's direction gives a later bound (up to 1) on %d of %d turning pairs\n",
-              bounded, receding, infinite, tighter, turning);
+              "the turn's direction gives a later bound (up to 1) on %d of %d turning pairs, the lag bound a later "
+              "one on %d of %d pivots\n",
+              bounded, receding, infinite, tighter, turning, pivots_tighter, pivots);
   CHECK(bounded > 2000);
   CHECK(receding > 100);
   CHECK(tighter > turning / 10);
+  CHECK(pivots_tighter > pivots / 2);
   // Touching triangles: no time at all.
   const Vec3 T[3] = {Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(0, 1, 0)};
   const Vec3 S[3] = {Vec3(0.2, 0.2, 0), Vec3(0.2, 0.2, 1), Vec3(1, 1, 1)};
@@ -728,6 +835,11 @@ TEST_CASE("obb_separated: never separates a swept box from a box it reaches, sep
     f.step = i % 3 == 0 ? Vec3::Zero() : Vec3(scale * std::pow(10.0, -4 * U(rng)) * Vec3(n(rng), n(rng), n(rng)));
     f.grow = i % 4 == 0 ? 0.0 : scale * std::pow(10.0, -8 * U(rng));
     f.turn = i % 2 == 0 ? 0.0 : 1e-3 * U(rng);
+    // Directional (every third): the turn's first order swept with the box.
+    if (i % 3 == 2) {
+      f.spin = 1e-2 * U(rng) * Vec3(n(rng), n(rng), n(rng)).normalized();
+      f.spread = f.spin.norm() * (1 + 1e-15);
+    }
     Obb body;
     body.axes = random_axes(i);
     body.half = scale * Vec3(n(rng), n(rng), n(rng)).cwiseAbs();
@@ -736,12 +848,14 @@ TEST_CASE("obb_separated: never separates a swept box from a box it reaches, sep
     body.center = scale * Vec3(n(rng), n(rng), n(rng));
     const PosedObb a = f.pose(body);
     // A point of the body box (a corner or inside), posed, moved along the
-    // step, and pushed out by up to its grow (turn included).
+    // step (and its turn's first order spin x (R x_B)), and pushed out by up to
+    // its grow (turn included).
     Vec3 x_local;
     for (int k = 0; k < 3; ++k) x_local[k] = (i % 2 ? 2 * U(rng) - 1 : (U(rng) < 0.5 ? -1 : 1)) * body.half[k];
     const Vec3 x_B = body.center + body.axes * x_local;
     const double reach = f.grow + f.turn * x_B.norm();
-    const Vec3 y = f.R * x_B + f.p + U(rng) * f.step + 0.999 * reach * Vec3(n(rng), n(rng), n(rng)).normalized();
+    const Vec3 y = f.R * x_B + f.p + U(rng) * (f.step + f.spin.cross(f.R * x_B)) +
+                   0.999 * reach * Vec3(n(rng), n(rng), n(rng)).normalized();
     REQUIRE(reach <= a.grow);
     // A world box with y inside or on its boundary.
     Obb world;
@@ -753,7 +867,7 @@ TEST_CASE("obb_separated: never separates a swept box from a box it reaches, sep
     world.center = y - world.axes * offset;
     REQUIRE_FALSE(obb_separated(a, world));
     // A world box beyond the swept set's bounding sphere: separated.
-    const double radius = body.half.norm() + 0.5 * f.step.norm() + a.grow;
+    const double radius = body.half.norm() + a.half_step.norm() + a.grow;
     const Vec3 dir = Vec3(n(rng), n(rng), n(rng)).normalized();
     Obb away;
     away.axes = random_axes(i + 2);

@@ -174,20 +174,31 @@ inline double triangle_gap_lower_bound(const Vec3 A[3], const Vec3 B[3], double 
 // horizon tau <= tau_max it uses the bound for); the first is directional: a
 // peg turning about its centre moves its tip across the rim's wall, not into
 // it. omega = 0: no turn (w holds all of it).
+//
+// lag: how far the turn may fall behind tau omega. The turn by phi (tau) moves
+// r by sin(phi) e x r = lambda tau omega x r with lambda in [1 - lag, 1] (1:
+// anything from no turn to the full one). A small lag is what lets a pivoting
+// motion cancel: a peg turned about its tip while G moves by tau v = -tau
+// omega x r_tip moves its tip by (lambda - 1) tau omega x r_tip only, where
+// the translation and a turn that may lag entirely would move it by up to
+// tau |v|. For the Cayley motion, lambda = sin(phi) / (tau 2 |g|) and lag =
+// u1^2 |g|^2 + (tau 2 |g|)^2 / 6 (StartFrame in bvh.cpp).
 struct TriangleMotion {
   Vec3 v = Vec3::Zero(), omega = Vec3::Zero(), centre = Vec3::Zero();
   double w = 0;
+  double lag = 1;  // in [0, 1]
 };
 
 // A lower bound of the time (in units of the motion's parameter, from the
 // triangles' current positions) before the moving triangle A can come within
 // `reach` of the fixed triangle B, A moving as `m` says: along a separating
 // axis with unit direction n and gap g (B beyond A on side = +-1), a corner x
-// of A moves towards B by at most tau side n.v + s side n.(omega x r) (r = x -
-// centre), s = sin(phi) / |omega| in [0, tau] the same for all corners, plus
-// the rest (second order, w): so A's projection approaches B's at most at
-// max(0, side n.v + max over corners of max(0, side n.(omega x r))) + w (the
-// corners' projections bound every point's), and it needs (g - reach) / that;
+// of A moves towards B by at most tau (side n.v + lambda b), b = side n.(omega
+// x r) (r = x - centre), lambda in [1 - lag, 1] the same for all corners, plus
+// the rest (second order, w); lambda b <= b + lag max(0, -b). So A's
+// projection approaches B's at most at max(0, max over corners of side n.v + b
+// + lag max(0, -b)) + w (the corners' projections bound every point's: the
+// first-order motion is affine in x), and it needs (g - reach) / that;
 // the largest such time over the 11 axes (and `extra`:
 // for_each_separating_axis), or 0 when none proves g > reach; +inf when an
 // axis proves a gap that the motion never closes. Returns as soon as one axis
@@ -207,13 +218,18 @@ inline double triangle_time_lower_bound(const Vec3 A[3], const Vec3 B[3], const 
     const double clear = next_down(g - reach);
     if (!(clear > 0)) return false;
     const double a_1 = a.cwiseAbs().sum();
-    double turn = 0, slack = 1e-14 * a_1 * v_inf;
+    const double along_v = side * a.dot(m.v);
+    double approach = along_v, slack = 1e-14 * a_1 * v_inf;
     if (omega_inf > 0) {
-      const Vec3 c = a.cross(m.omega);
-      turn = std::max({0.0, side * r[0].dot(c), side * r[1].dot(c), side * r[2].dot(c)});
+      const Vec3 c = a.cross(m.omega);  // r.(a x omega) = a.(omega x r)
+      approach = -std::numeric_limits<double>::infinity();
+      for (int k = 0; k < 3; ++k) {
+        const double b = side * r[k].dot(c);
+        approach = std::max(approach, along_v + b + m.lag * std::max(0.0, -b));
+      }
       slack += 1e-13 * a_1 * omega_inf * r_inf;
     }
-    const double toward = next_up(std::max(0.0, next_up(side * a.dot(m.v) + turn)) + slack);
+    const double toward = next_up(std::max(0.0, next_up(approach)) + slack);
     const double speed = next_up(next_up(toward / next_down(a.norm() * (1 - 1e-12))) + m.w);
     const double t = speed > 0 ? next_down(clear / speed) : std::numeric_limits<double>::infinity();
     if (!(t <= std::numeric_limits<double>::infinity())) return false;  // NaN
@@ -265,21 +281,44 @@ inline double obb_volume_ratio(const Vec3& obb_half, const Vec3& aabb_half) {
 
 // The pose and motion bounds of one sub-interval (or of a fixed pose: step 0,
 // turn 0), which pose() applies to a god node's body-frame box.
+//
+// The turn, two ways. Isotropic (spin zero): every point r_B may move by a
+// further turn |r_B| in any direction, so a node 5 cm from G turned by 6 mrad
+// gets 0.3 mm more on every side. Directional (spin = (u1 - u0) omega, the
+// turn's first order): a point at offset r = R r_B from G moves by s (step +
+// spin x r) up to the rest, s in [0, 1]; for the node's box, r = c + e (c = R
+// center, |e| <= |half|), so the box sweeps along its own segment step + spin
+// x c, grown by |spin| |half| for its spread and by turn |r_B| for the rest
+// (the second order, the turn's lag behind spin and the enclosure's width:
+// StartFrame::obb_frame). A peg pivoting about its tip, G moving by -spin x
+// r_tip, then sweeps its tip's boxes by almost nothing.
 struct SweptObbFrame {
   Mat3 R = Mat3::Identity();
   Vec3 p = Vec3::Zero();
   Vec3 step = Vec3::Zero();  // world translation of G over the sub-interval (its midpoint)
+  Vec3 spin = Vec3::Zero();  // directional: the turn's first order over the sub-interval (zero: isotropic)
   double grow = 0;           // static_error + d + (u1 - u0) |dp - dp_mid| (any point)
-  double turn = 0;           // (u1 - u0) 2 |g|: times |r_B| for a point's turn
+  double turn = 0;           // times |r_B| for a point's turn (isotropic) or its rest (directional)
+  double spread = 0;         // directional: >= |spin| (times |half|)
   PosedObb pose(const Obb& b) const {
     PosedObb out;
     out.axes = R * b.axes;
-    out.center = R * b.center + p;
+    const Vec3 c = R * b.center;
+    out.center = c + p;
     out.half = b.half;
-    out.half_step = 0.5 * step;
     // |r_B| <= |center| + |half| for every point of the box.
     const double radius = next_up(next_up(b.center.norm() + b.half.norm()) * (1 + 1e-12));
     out.grow = turn > 0 ? next_up(grow + next_up(turn * radius)) : grow;
+    if (spread > 0) {
+      const Vec3 node_step = step + spin.cross(c);
+      out.half_step = 0.5 * node_step;
+      // The spread; the roundings of c (as R r_B's), the cross product and the
+      // sum: a few units of 2^-53 of |spin|_inf radius and |step|_inf.
+      const double rounding = 1e-14 * (spin.cwiseAbs().maxCoeff() * radius + step.cwiseAbs().maxCoeff());
+      out.grow = next_up(out.grow + next_up(next_up(spread * next_up(b.half.norm() * (1 + 1e-15))) + rounding));
+    } else {
+      out.half_step = 0.5 * step;
+    }
     if (!(out.grow < std::numeric_limits<double>::infinity())) out.grow = std::numeric_limits<double>::infinity();
     out.pays = obb_volume_ratio(b.half, out.axes.cwiseAbs() * b.half) < 0.5;
     return out;
@@ -556,6 +595,13 @@ struct CcdStepWorkspace {
     std::vector<CcdBody> obstacles;  // grows (allocates) only when a fill sees more obstacles than ever before
     void clear() { num_pairs = -1; }
   };
+  // The triangle pair that stopped the last step run in this workspace
+  // (coherence): when it is among a step's hints it is searched first. A
+  // god-object pressed into a corner is stopped by the same pair step after
+  // step, at once; found first, its hit ends the searches of the sliding
+  // contacts there, where each would otherwise search the whole step (a
+  // hundred narrow-phase boxes or more each).
+  FeaturePair last_hit;
   CcdWorkspace narrow;
   BvhStack stack;
   std::vector<Candidate> candidates;  // tested earliest-first; overflow is tested in traversal order
