@@ -657,8 +657,12 @@ void ccd_step(const CcdBody* obstacles, int num_obstacles, const CcdBody& god, c
   // the god node's posed at u0, swept along the translation up to u_end, grown
   // by what else its points may move, plus dist), and visit(gf, of, o) gets the
   // rest (false: stop). Call ws->swept.next_interval() first whenever e changed.
-  const auto descend = [&](double u_end, double dist, const auto& visit) {
-    const SweptObbFrame obb_frame = start.obb_frame(u_end, dist);
+  // traverse(): the same for the motion enclosed in `enc` from `frame`, one
+  // obstacle o, from the node pairs pending on `stack` (resume_candidate_pairs)
+  // for at most `budget` node pairs, counted in *num_node_pairs.
+  const auto traverse = [&](const StartFrame& frame, const MotionEnclosure& enc, double u_end, double dist, int o,
+                            BvhStack* stack, int* pending, long budget, int* num_node_pairs, const auto& visit) {
+    const SweptObbFrame obb_frame = frame.obb_frame(u_end, dist);
     const auto god_node_obb = [&](int node) -> const PosedObb& {
       return ws->swept.get(ws->swept.node_obbs, node, [&] { return obb_frame.pose(god.bvh->nodes[node].obb); });
     };
@@ -666,19 +670,27 @@ void ccd_step(const CcdBody* obstacles, int num_obstacles, const CcdBody& god, c
     // compares them with the obstacles' exact boxes as they are (margin 0
     // below): the same test as growing each obstacle box, without its roundings
     // per node pair.
-    const auto box_over = [&](const Aabb& body) { return inflate(swept_box(e, body), dist); };
+    const auto box_over = [&](const Aabb& body) { return inflate(swept_box(enc, body), dist); };
     const auto god_node_box = [&](int node) {
       return ws->swept.get(ws->swept.nodes, node, [&] { return box_over(god.bvh->nodes[node].box); });
     };
     const auto god_face_box = [&](int face) {
       return ws->swept.get(ws->swept.faces, face, [&] { return box_over(triangle_box(*god.mesh, face)); });
     };
+    const CcdBody& ob = obstacles[o];
+    const auto separated = [&](int gi, int oi) { return node_pair_separated(god_node_obb(gi), ob.bvh->nodes[oi]); };
+    return resume_candidate_pairs(*god.mesh, *god.bvh, *ob.mesh, *ob.bvh, god_node_box, god_face_box, /*margin=*/0,
+                                  stack, pending, budget, [&](int gf, int of) { return visit(gf, of, o); },
+                                  num_node_pairs, separated);
+  };
+  const auto descend = [&](double u_end, double dist, const auto& visit) {
     for (int o = 0; o < num_obstacles; ++o) {
-      const CcdBody& ob = obstacles[o];
-      const auto separated = [&](int gi, int oi) { return node_pair_separated(god_node_obb(gi), ob.bvh->nodes[oi]); };
-      const TraversalStatus ts = for_each_candidate_pair_indexed(
-          *god.mesh, *god.bvh, *ob.mesh, *ob.bvh, god_node_box, god_face_box, /*margin=*/0, &ws->stack,
-          [&](int gf, int of) { return visit(gf, of, o); }, &result->num_node_pairs, separated);
+      if (god.bvh->nodes.empty() || obstacles[o].bvh->nodes.empty()) continue;
+      if (ws->stack.items.empty()) return TraversalStatus::kStackFull;
+      ws->stack.items[0] = {0, 0};
+      int pending = 1;
+      const TraversalStatus ts = traverse(start, e, u_end, dist, o, &ws->stack, &pending,
+                                          std::numeric_limits<long>::max(), &result->num_node_pairs, visit);
       if (ts != TraversalStatus::kDone) return ts;
     }
     return TraversalStatus::kDone;
@@ -716,9 +728,101 @@ void ccd_step(const CcdBody* obstacles, int num_obstacles, const CcdBody& god, c
   // at X0 when its own range cannot be used for this step and a fresh one's
   // would (a step that moves less than the margin, or a short first search).
   double u_cached = 0;
-  if (settings.cache_margin > 0 && !tester.done()) {
-    CcdStepWorkspace::ProximityCache& pc = ws->cache;
-    const double margin = settings.cache_margin, rho = god.bvh->radius;  // start: at u = 0 (above)
+  CcdStepWorkspace::ProximityCache& pc = ws->cache;
+  CcdStepWorkspace::ProximityCache::Fill& pf = pc.fill;
+  const double margin = settings.cache_margin, rho = god.bvh->radius;  // start: at u = 0 (above)
+  const double fill_dist = next_up(reach + margin);
+  const auto same = [](const CcdBody& a, const CcdBody& b) { return a.mesh == b.mesh && a.bvh == b.bvh; };
+  const auto is_keyed = [&] {
+    bool k = pc.num_pairs >= 0 && same(pc.god, god) && pc.reach == reach && pc.margin == margin &&
+             static_cast<int>(pc.obstacles.size()) == num_obstacles;
+    for (int o = 0; k && o < num_obstacles; ++o) k = same(pc.obstacles[static_cast<size_t>(o)], obstacles[o]);
+    return k;
+  };
+  // Fills: every pair not proven apart by reach + margin with the god-object
+  // at pf.ref (X0, or the pose a background fill is started at: see the end of
+  // this function), descended into pf.pairs obstacle by obstacle, a budget of
+  // node pairs at a time (run_fill: true once complete; a fill that does not
+  // fit is dropped), then swapped in (put_fill).
+  const auto next_obstacle = [&] {
+    while (pf.obstacle < num_obstacles &&
+           (god.bvh->nodes.empty() || obstacles[pf.obstacle].bvh->nodes.empty() || pf.stack.items.empty()))
+      ++pf.obstacle;
+    if (pf.obstacle < num_obstacles) {
+      pf.stack.items[0] = {0, 0};
+      pf.pending = 1;
+    }
+  };
+  const auto start_fill = [&](const Pose& at) {
+    pf.ref = X0;
+    pf.motion = motion;
+    if (&at != &X0) {
+      CcdMotion still;
+      if (make_ccd_motion(at, at, &still) == MotionStatus::kOk) {
+        pf.ref = at;
+        pf.motion = still;
+      }
+    }
+    pf.cost = 0;
+    pf.num_pairs = 0;
+    pf.obstacle = 0;
+    pf.active = true;
+    pf.complete = false;
+    next_obstacle();
+  };
+  const auto fill_some = [&](long budget) {
+    StartFrame frame;
+    frame.set(pf.motion, 0.0, rho);
+    MotionEnclosure enc;
+    enclose_motion(pf.motion, {0, 0}, &enc);
+    ws->swept.next_interval();
+    const int capacity = static_cast<int>(pf.pairs.size());
+    while (pf.obstacle < num_obstacles) {
+      int used = 0;
+      const TraversalStatus ts = traverse(frame, enc, 0.0, fill_dist, pf.obstacle, &pf.stack, &pf.pending, budget,
+                                          &used, [&](int gf, int of, int o) {
+        double radius = 0;
+        const double gap = frame.gap(*god.mesh, gf, *obstacles[o].mesh, of, fill_dist, &radius);
+        if (gap > fill_dist) return true;
+        if (pf.num_pairs == capacity) return false;  // does not fit: no cache
+        pf.pairs[static_cast<size_t>(pf.num_pairs++)] = {gap, radius, gf, of, o};
+        return true;
+      });
+      result->num_fill_node_pairs += used;
+      pf.cost += used;
+      budget -= used;
+      if (ts == TraversalStatus::kPaused) return false;
+      if (ts != TraversalStatus::kDone) {
+        pf.active = false;
+        return false;
+      }
+      ++pf.obstacle;
+      next_obstacle();
+    }
+    pf.complete = true;
+    pc.fill_cost = pf.cost;
+    return true;
+  };
+  const auto run_fill = [&](long budget) {
+    const bool complete = fill_some(budget);
+    ws->swept.next_interval();  // the boxes cached were the fill's, not e's
+    return complete;
+  };
+  const auto put_fill = [&] {
+    std::swap(pc.pairs, pf.pairs);
+    pc.num_pairs = pf.num_pairs;
+    pc.ref = pf.ref;
+    pc.reach = reach;
+    pc.margin = margin;
+    pc.god = god;
+    pc.obstacles.assign(obstacles, obstacles + num_obstacles);
+    pc.uses = 0;
+    pf.active = false;
+  };
+  bool keyed = margin > 0 && is_keyed();
+  if (margin > 0 && !keyed) pf.active = false;  // a fill for other meshes or settings
+  double moved = std::numeric_limits<double>::infinity();  // from the cache's pose to X0
+  if (margin > 0 && !tester.done()) {
     const double u_rest = result->hit ? result->u_hit : 1.0;
     const bool probing = hints && num_hints > 0 && !result->hit;
     const auto range = [&](double moved) {  // [0, u] keeps every point within the margin of ref (0: none)
@@ -737,13 +841,26 @@ void ccd_step(const CcdBody* obstacles, int num_obstacles, const CcdBody& god, c
       return probing && w > 0 && w < 0.5 / n ? w : 0.0;
     };
     const auto usable = [&](double u) { return window(u) > 0; };
-    const auto same = [](const CcdBody& a, const CcdBody& b) { return a.mesh == b.mesh && a.bvh == b.bvh; };
-    bool keyed = pc.num_pairs >= 0 && same(pc.god, god) && pc.reach == reach && pc.margin == margin &&
-                 static_cast<int>(pc.obstacles.size()) == num_obstacles;
-    for (int o = 0; keyed && o < num_obstacles; ++o) keyed = same(pc.obstacles[static_cast<size_t>(o)], obstacles[o]);
-    Displacement since(keyed ? pc.ref : X0, X0);  // from the cache's pose to X0
-    const double moved = keyed ? since.bound(rho) : std::numeric_limits<double>::infinity();
+    Displacement since(keyed ? pc.ref : X0, X0);
+    moved = keyed ? since.bound(rho) : std::numeric_limits<double>::infinity();
     u_cached = keyed ? range(moved) : 0.0;
+    if (keyed && pf.active) {
+      // The fill's pose is ahead of the god-object's path (see below): put it
+      // in use once it leaves more of the margin than the list in use does, or
+      // (finished now if need be) when that list cannot serve this step.
+      const Displacement ahead(pf.ref, X0);
+      const double moved_ahead = ahead.bound(rho);
+      const bool better = moved_ahead < moved, needed = !usable(u_cached) && usable(range(moved_ahead));
+      if (!usable(u_cached) && !needed) {
+        pf.active = false;  // the god-object went elsewhere
+      } else if ((better && pf.complete) || (needed && run_fill(std::numeric_limits<long>::max()))) {
+        put_fill();
+        result->cache_refilled = true;
+        since = ahead;
+        moved = moved_ahead;
+        u_cached = range(moved);
+      }
+    }
     const bool fresh = usable(u_cached);
     if (fresh) ++pc.uses;
     // A fill costs more than a descent over the step (its boxes are grown by
@@ -751,41 +868,31 @@ void ccd_step(const CcdBody* obstacles, int num_obstacles, const CcdBody& god, c
     // served fewer than two later steps (a peg sliding half the margin a step,
     // steps that each start far from the last), the next 8 chances to fill
     // are passed over (plain descents), and the one after that fills.
+    // A step that moves at most a quarter of the margin fills regardless (the
+    // list then serves the next steps unless the god-object speeds up).
     bool fill = !fresh && usable(range(Displacement(X0, X0).bound(rho)));
-    if (fill && pc.rest > 0) {
+    if (fill && 4 * start.speed <= margin) {
+      pc.rest = 0;
+    } else if (fill && pc.rest > 0) {
       fill = --pc.rest == 0;
     } else if (fill && pc.num_pairs >= 0 && pc.uses < 2) {
       pc.rest = 8;
       fill = false;
     }
     if (fill) {
-      // Fill: every pair not proven apart by reach + margin at X0 (u = 0).
+      // At once, at X0 (u = 0).
+      start_fill(X0);
+      const bool filled = run_fill(std::numeric_limits<long>::max());
       pc.clear();
       u_cached = 0;
-      enclose_motion(motion, {0, 0}, &e);
-      ws->swept.next_interval();
-      const double dist = next_up(reach + margin);
-      const int capacity = static_cast<int>(pc.pairs.size());
-      int num = 0;
-      const TraversalStatus ts = descend(0.0, dist, [&](int gf, int of, int o) {
-        double radius = 0;
-        const double gap = start.gap(*god.mesh, gf, *obstacles[o].mesh, of, dist, &radius);
-        if (gap > dist) return true;
-        if (num == capacity) return false;  // does not fit: no cache
-        pc.pairs[static_cast<size_t>(num++)] = {gap, radius, gf, of, o};
-        return true;
-      });
-      if (ts == TraversalStatus::kDone) {
-        pc.num_pairs = num;
-        pc.ref = X0;
-        pc.reach = reach;
-        pc.margin = margin;
-        pc.god = god;
-        pc.obstacles.assign(obstacles, obstacles + num_obstacles);
-        pc.uses = 0;
+      keyed = false;
+      if (filled) {
+        put_fill();
+        keyed = true;
         result->cache_filled = true;
         since = Displacement(X0, X0);
-        u_cached = range(since.bound(rho));
+        moved = since.bound(rho);
+        u_cached = range(moved);
       }
     }
     u_cached = window(u_cached);
@@ -864,6 +971,33 @@ void ccd_step(const CcdBody* obstacles, int num_obstacles, const CcdBody& god, c
     if (ts == TraversalStatus::kStopped) listed = false;
     set_near_pairs(listed ? num_cand : -1, u0);
     test_candidates(num_cand);
+  }
+  // The background fill (CcdStepSettings::cache_fill_budget node pairs per
+  // step, while the list in use serves). Each step is taken to move the
+  // god-object as much as the last one did (v), and a fill to take as many
+  // steps as the last one did (j). A fill is started when the list in use has
+  // about j steps left, at the pose the god-object will reach if it goes on
+  // so for j steps and 3/4 of the margin further: put in use about j steps
+  // from now, that list then serves from 3/4 of the margin behind its pose to
+  // the margin ahead. Any pose is sound (the list is for the pose it was
+  // filled at); a good guess only makes the list serve longer.
+  if (margin > 0 && settings.cache_fill_budget > 0 && keyed) {
+    if (!pf.active && result->u_cached > 0 && pc.has_last) {
+      const double v = Displacement(pc.last_x0, X0).bound(rho);
+      const double j = std::ceil(static_cast<double>(std::max(pc.fill_cost, 1L)) /
+                                 static_cast<double>(settings.cache_fill_budget));
+      if (v > 0 && v < margin && margin - moved <= (j + 1) * v) {
+        const double k = j + std::max(0.0, 0.75 * margin / v - 1);
+        const Quat dq = normalized(X0.q * conjugate(pc.last_x0.q));
+        const Pose ahead{X0.p + k * (X0.p - pc.last_x0.p), normalized(quat_exp(k * quat_log(dq)) * X0.q)};
+        start_fill(ahead);
+      }
+    }
+    if (pf.active && !pf.complete) run_fill(settings.cache_fill_budget);
+  }
+  if (margin > 0) {
+    pc.last_x0 = X0;
+    pc.has_last = true;
   }
   if (!result->hit) {
     result->u_hit = 1;

@@ -293,20 +293,26 @@ TEST_CASE("ccd_step: steps served by the proximity cache find the first contact 
   // block (hits), and every tenth step a long move (the cache is refilled
   // where the next step starts in contact). Each step must agree with the
   // brute force (the same 1e-5 bound as above) and with a step on a workspace
-  // without the cache.
+  // without the cache. Run with the cache refilled at once, and refilled in
+  // the background a few node pairs per step (cache_fill_budget: the served
+  // steps then take their pairs from a list that was completed steps after the
+  // pose it holds).
   const TriangleMesh god = make_icosphere(1, 0.5);
   const TriangleMesh slab = concatenate(make_box(3, 3, 1, Vec3(0, 0, -0.5)), make_box(0.4, 0.4, 0.6, Vec3(0.6, 0, 0.3)));
   const Bvh gb = build_bvh(god, 2), sb = build_bvh(slab, 2);
+  for (const long budget : {0L, 12L}) {
+  INFO("cache_fill_budget " << budget);
   std::mt19937 rng(29);
   std::uniform_real_distribution<double> U(-1, 1);
   CcdStepSettings settings, plain;
   settings.narrow.min_separation = plain.narrow.min_separation = 1e-4;
   settings.cache_margin = 0.02;
+  settings.cache_fill_budget = budget;
   CcdStepWorkspace ws, ws_plain;
   const CcdBody obstacle{&slab, &sb};
   Pose x{Vec3(0.1, 0, 0.5 + 0.01), Quat{}};  // 1 cm above the slab
   std::vector<FeaturePair> hints;
-  int served = 0, fills = 0, hits = 0, gave_up = 0;
+  int served = 0, fills = 0, refills = 0, hits = 0, gave_up = 0;
   for (int k = 0; k < 120; ++k) {
     Vec3 dp = 0.003 * Vec3(U(rng), U(rng), U(rng));
     Vec3 turn = 0.004 * Vec3(U(rng), U(rng), U(rng));
@@ -339,6 +345,7 @@ TEST_CASE("ccd_step: steps served by the proximity cache find the first contact 
     }
     served += r.u_cached > 0;
     fills += r.cache_filled;
+    refills += r.cache_refilled;
     hits += r.hit;
     // The next step starts at this one's stop pose, lifted by 3 d (a motion
     // sliding at exactly d is undecidable at the default distance tolerance);
@@ -348,12 +355,66 @@ TEST_CASE("ccd_step: steps served by the proximity cache find the first contact 
     hints.clear();
     if (r.hit) hints.push_back(r.pair);
   }
-  std::printf("proximity cache: %d of 120 steps served from it, %d fills, %d hits, %d give-ups\n", served, fills, hits,
-              gave_up);
+  std::printf("proximity cache (fill budget %ld): %d of 120 steps served from it, %d fills, %d background refills, "
+              "%d hits, %d give-ups\n", budget, served, fills, refills, hits, gave_up);
   CHECK(gave_up <= 6);
   CHECK(served >= 30);
   CHECK(fills >= 3);
   CHECK(hits >= 20);
+  if (budget == 0) CHECK(refills == 0);
+  }
+}
+
+TEST_CASE("ccd_step: a ball sliding on a slab into a wall, its cache refilled in the background", "[bvh]") {
+  // The ball slides 2e-4 above a slab (a hint given, as in contact) towards a
+  // wall, 4 mm a step, with the cache refilled in the background a few node
+  // pairs per step: each list completed serves from the pose its fill started
+  // at, steps behind. The wall comes within reach of pairs that were not in
+  // the list where the ball was; every step must still agree with the brute
+  // force, and the step that meets the wall must stop where it does. (Serving
+  // such a list as if it were filled where it is swapped in misses the wall.)
+  const TriangleMesh god = make_icosphere(1, 0.5);
+  double z_min = 1e300, x_max = -1e300;
+  for (Eigen::Index v = 0; v < god.V.rows(); ++v) {
+    z_min = std::min(z_min, god.V(v, 2));
+    x_max = std::max(x_max, god.V(v, 0));
+  }
+  const double wall_x = x_max + 0.25;
+  const TriangleMesh scene = concatenate(make_box(3, 3, 1, Vec3(0, 0, -0.5)), make_box(0.2, 2, 1, Vec3(wall_x + 0.1, 0, 0.5)));
+  const Bvh gb = build_bvh(god, 2), sb = build_bvh(scene, 2);
+  CcdStepSettings settings;
+  settings.narrow.min_separation = 1e-4;
+  settings.cache_margin = 0.03;
+  settings.cache_fill_budget = 6;
+  CcdStepWorkspace ws;
+  const CcdBody obstacle{&scene, &sb};
+  FeaturePair hint;
+  hint.obstacle = 0;
+  hint.god_face = hint.obstacle_face = 0;
+  Pose x{Vec3(0, 0, 2e-4 - z_min), Quat{}};
+  int served = 0, refills = 0, steps = 0;
+  bool met_wall = false;
+  for (; steps < 100 && !met_wall; ++steps) {
+    const Pose target{x.p + Vec3(0.004, 0, 0), x.q};
+    CcdStepResult r;
+    ccd_step(&obstacle, 1, {&god, &gb}, x, target, settings, &ws, &r, &hint, 1);
+    INFO("step " << steps);
+    REQUIRE(r.status == CcdStatus::kOk);
+    CcdMotion m;
+    REQUIRE(make_ccd_motion(x, target, &m) == MotionStatus::kOk);
+    const BruteForce bf = brute_force(god, gb, scene, sb, m, settings.narrow);
+    REQUIRE(r.hit == bf.hit);
+    if (r.hit) CHECK(std::abs(r.u_hit - bf.u_hit) <= 1e-5);
+    served += r.u_cached > 0;
+    refills += r.cache_refilled;
+    met_wall = r.hit;
+    x = target;
+  }
+  std::printf("sliding into a wall: %d steps, %d served from the cache, %d background refills\n", steps, served,
+              refills);
+  CHECK(met_wall);
+  CHECK(served >= steps / 2);
+  CHECK(refills >= 3);
 }
 
 TEST_CASE("ccd_step: the proximity cache is not served for another mesh behind the same CcdBody", "[bvh]") {

@@ -380,7 +380,7 @@ struct BvhStack {
   std::vector<std::pair<int32_t, int32_t>> items;
 };
 
-enum class TraversalStatus { kDone = 0, kStopped, kStackFull };
+enum class TraversalStatus { kDone = 0, kStopped, kStackFull, kPaused };
 
 // Calls visit(god_triangle, obstacle_triangle) for every pair whose boxes may
 // overlap: god boxes mapped to the world by god_box(Aabb body) -> Aabb world
@@ -394,18 +394,27 @@ enum class TraversalStatus { kDone = 0, kStopped, kStackFull };
 // can cache them: see SweptBoxCache); and node pairs whose world boxes overlap
 // are then dropped when separated(god_node, obstacle_node) proves them apart
 // (node_pair_separated; for_each_candidate_pair drops none).
+//
+// resume_candidate_pairs() runs the same traversal from the node pairs
+// pending in stack->items[0 .. *size) (the root pair {0, 0} to start one) for
+// at most `budget` node pairs, and returns kPaused with the rest pending there
+// when the budget runs out: a traversal spread over several calls (the
+// proximity cache's background fill, ccd_step). On kStopped the pairs of the
+// leaf pair being visited are not all visited.
 template <class GodNodeBox, class GodFaceBox, class Visit, class Separated>
-TraversalStatus for_each_candidate_pair_indexed([[maybe_unused]] const TriangleMesh& god_mesh, const Bvh& god,
-                                                const TriangleMesh& obs_mesh, const Bvh& obs,
-                                                const GodNodeBox& god_node_box, const GodFaceBox& god_face_box,
-                                                double margin, BvhStack* stack, Visit&& visit, int* num_node_pairs,
-                                                const Separated& separated) {
-  if (god.nodes.empty() || obs.nodes.empty()) return TraversalStatus::kDone;
+TraversalStatus resume_candidate_pairs([[maybe_unused]] const TriangleMesh& god_mesh, const Bvh& god,
+                                       const TriangleMesh& obs_mesh, const Bvh& obs, const GodNodeBox& god_node_box,
+                                       const GodFaceBox& god_face_box, double margin, BvhStack* stack, int* pending,
+                                       long budget, Visit&& visit, int* num_node_pairs, const Separated& separated) {
   const int capacity = static_cast<int>(stack->items.size());
   auto* items = stack->items.data();
-  int size = 0;
-  items[size++] = {0, 0};
+  int size = *pending;
+  const auto leave = [&](TraversalStatus status) {
+    *pending = size;
+    return status;
+  };
   while (size > 0) {
+    if (budget-- <= 0) return leave(TraversalStatus::kPaused);
     const auto [gi, oi] = items[--size];
     const BvhNode& gn = god.nodes[gi];
     const BvhNode& on = obs.nodes[oi];
@@ -420,12 +429,12 @@ TraversalStatus for_each_candidate_pair_indexed([[maybe_unused]] const TriangleM
         for (int j = 0; j < on.count; ++j) {
           const int of = obs.triangles[on.first + j];
           if (!overlap(gt, inflate(triangle_box(obs_mesh, of), margin))) continue;
-          if (!visit(gf, of)) return TraversalStatus::kStopped;
+          if (!visit(gf, of)) return leave(TraversalStatus::kStopped);
         }
       }
       continue;
     }
-    if (size + 2 > capacity) return TraversalStatus::kStackFull;
+    if (size + 2 > capacity) return leave(TraversalStatus::kStackFull);
     // Descend the inner node with the larger box (or the only inner one).
     const double gs = (gw.hi - gw.lo).sum(), os = (on.box.hi - on.box.lo).sum();
     if (on.count > 0 || (gn.count == 0 && gs >= os)) {
@@ -436,7 +445,21 @@ TraversalStatus for_each_candidate_pair_indexed([[maybe_unused]] const TriangleM
       items[size++] = {gi, on.first};
     }
   }
-  return TraversalStatus::kDone;
+  return leave(TraversalStatus::kDone);
+}
+template <class GodNodeBox, class GodFaceBox, class Visit, class Separated>
+TraversalStatus for_each_candidate_pair_indexed(const TriangleMesh& god_mesh, const Bvh& god,
+                                                const TriangleMesh& obs_mesh, const Bvh& obs,
+                                                const GodNodeBox& god_node_box, const GodFaceBox& god_face_box,
+                                                double margin, BvhStack* stack, Visit&& visit, int* num_node_pairs,
+                                                const Separated& separated) {
+  if (god.nodes.empty() || obs.nodes.empty()) return TraversalStatus::kDone;
+  if (stack->items.empty()) return TraversalStatus::kStackFull;
+  stack->items[0] = {0, 0};
+  int pending = 1;
+  return resume_candidate_pairs(god_mesh, god, obs_mesh, obs, god_node_box, god_face_box, margin, stack, &pending,
+                                std::numeric_limits<long>::max(), std::forward<Visit>(visit), num_node_pairs,
+                                separated);
 }
 template <class GodBox, class Visit>
 TraversalStatus for_each_candidate_pair(const TriangleMesh& god_mesh, const Bvh& god, const TriangleMesh& obs_mesh,
@@ -475,6 +498,8 @@ struct CcdStepSettings {
   int max_sub_intervals = 16;              // u-ranges whose swept boxes are computed separately
   double sub_interval_angle = 0.1;         // radians of rotation per sub-interval (at most)
   double sub_interval_travel = 0.25;       // travel of G per sub-interval, in god-object radii (at most)
+  long cache_fill_budget = 0;              // node pairs per step that refill the cache in the background
+                                           // (0: no background fill)
   double cache_margin = 0;                 // coherence between steps: keep the pairs within the reach plus this
                                            // (scene units) at a pose in contact, and take a later step's candidates
                                            // from them while no point has moved farther than this from that pose
@@ -504,6 +529,8 @@ struct CcdStepResult {
   int num_near_pairs = -1;
   double near_u0 = 0, near_reach = 0;
   bool cache_filled = false;               // the proximity cache was (re)filled at X0 (CcdStepWorkspace)
+  bool cache_refilled = false;             // a background fill of the cache was completed and put in use
+  int num_fill_node_pairs = 0;             // node pairs that the cache's fills (at once or in the background) tested
   double u_cached = 0;                     // [0, u_cached] searched from the proximity cache (0: not used)
 };
 
@@ -557,7 +584,7 @@ struct CcdStepWorkspace {
       : narrow(box_capacity),
         stack(stack_capacity),
         candidates(static_cast<size_t>(std::max(candidate_capacity, 0))),
-        cache(std::max(candidate_capacity, 0)) {}
+        cache(std::max(candidate_capacity, 0), stack_capacity) {}
   // A candidate triangle pair of one sub-interval and a lower bound of its first contact parameter.
   struct Candidate {
     double earliest;
@@ -576,7 +603,8 @@ struct CcdStepWorkspace {
   // BVHs (pointers), the reach and the margin; clear() it when a mesh behind
   // the same pointers changes.
   struct ProximityCache {
-    explicit ProximityCache(int capacity) : pairs(static_cast<size_t>(capacity)) {}
+    ProximityCache(int capacity, int stack_capacity)
+        : pairs(static_cast<size_t>(capacity)), fill(capacity, stack_capacity) {}
     // gap: a lower bound of the pair's distance at ref; radius: the largest
     // |r_B| of the god triangle's corners. A step whose points move at most
     // shift + turn |r_B| from ref keeps the pair farther apart than
@@ -593,7 +621,30 @@ struct CcdStepWorkspace {
     int rest = 0;  // chances to refill still to pass over (see ccd_step)
     CcdBody god;
     std::vector<CcdBody> obstacles;  // grows (allocates) only when a fill sees more obstacles than ever before
-    void clear() { num_pairs = -1; }
+    // A fill in progress (CcdStepSettings::cache_fill_budget): the same list
+    // for the pose `ref` (a served step's start, motion.nominal at u = 0),
+    // built a budget of node pairs per step in the background while the list
+    // above still serves, then swapped in; finished at once when a step needs
+    // it first. Same keys as the list above.
+    struct Fill {
+      Fill(int capacity, int stack_capacity) : pairs(static_cast<size_t>(capacity)), stack(stack_capacity) {}
+      std::vector<Pair> pairs;
+      int num_pairs = 0;
+      Pose ref;
+      CcdMotion motion;  // the step it started in (its frame at u = 0)
+      BvhStack stack;    // the descent's pending node pairs: stack.items[0 .. pending)
+      int pending = 0;
+      int obstacle = 0;  // the obstacle being descended
+      long cost = 0;     // node pairs tested so far
+      bool active = false, complete = false;
+    } fill;
+    long fill_cost = 0;  // node pairs of the last fill completed
+    Pose last_x0;        // the start of the last step (for the background fill's pose)
+    bool has_last = false;
+    void clear() {
+      num_pairs = -1;
+      fill.active = false;
+    }
   };
   // The triangle pair that stopped the last step run in this workspace
   // (coherence): when it is among a step's hints it is searched first. A
@@ -634,6 +685,9 @@ struct CcdStepWorkspace {
 // With settings.cache_margin > 0, ws->cache carries candidates from one step
 // to the next (CcdStepWorkspace::ProximityCache): the same answer as a fresh
 // descent, for a fraction of its cost while the god-object stays near a pose.
+// With settings.cache_fill_budget > 0 as well, the next list is filled that
+// many node pairs per step, at the pose the god-object is heading for, while
+// the list in use serves.
 void ccd_step(const CcdBody* obstacles, int num_obstacles, const CcdBody& god, const Pose& X0, const Pose& X1,
               const CcdStepSettings& settings, CcdStepWorkspace* ws, CcdStepResult* result,
               const FeaturePair* hints = nullptr, int num_hints = 0);
