@@ -731,15 +731,19 @@ void ccd_step(const CcdBody* obstacles, int num_obstacles, const CcdBody& god, c
   CcdStepWorkspace::ProximityCache& pc = ws->cache;
   CcdStepWorkspace::ProximityCache::Fill& pf = pc.fill;
   const double margin = settings.cache_margin, rho = god.bvh->radius;  // start: at u = 0 (above)
-  const double fill_dist = next_up(reach + margin);
+  const double margin_max = std::max(settings.cache_margin_max, margin);
+  // The margin of a list filled now: about six steps like the last one (v),
+  // within [margin, margin_max]: a wide one while the god-object slides
+  // steadily (fewer fills), the narrow one at rest (a shorter list to scan).
+  const auto list_margin = [&](double v) { return std::clamp(6 * v, margin, margin_max); };
   const auto same = [](const CcdBody& a, const CcdBody& b) { return a.mesh == b.mesh && a.bvh == b.bvh; };
   const auto is_keyed = [&] {
-    bool k = pc.num_pairs >= 0 && same(pc.god, god) && pc.reach == reach && pc.margin == margin &&
-             static_cast<int>(pc.obstacles.size()) == num_obstacles;
+    bool k = pc.num_pairs >= 0 && same(pc.god, god) && pc.reach == reach && pc.margin_min == margin &&
+             pc.margin_max == margin_max && static_cast<int>(pc.obstacles.size()) == num_obstacles;
     for (int o = 0; k && o < num_obstacles; ++o) k = same(pc.obstacles[static_cast<size_t>(o)], obstacles[o]);
     return k;
   };
-  // Fills: every pair not proven apart by reach + margin with the god-object
+  // Fills: every pair not proven apart by reach + pf.margin with the god-object
   // at pf.ref (X0, or the pose a background fill is started at: see the end of
   // this function), descended into pf.pairs obstacle by obstacle, a budget of
   // node pairs at a time (run_fill: true once complete; a fill that does not
@@ -753,7 +757,8 @@ void ccd_step(const CcdBody* obstacles, int num_obstacles, const CcdBody& god, c
       pf.pending = 1;
     }
   };
-  const auto start_fill = [&](const Pose& at) {
+  const auto start_fill = [&](const Pose& at, double m) {
+    pf.margin = m;
     pf.ref = X0;
     pf.motion = motion;
     if (&at != &X0) {
@@ -777,6 +782,7 @@ void ccd_step(const CcdBody* obstacles, int num_obstacles, const CcdBody& god, c
     enclose_motion(pf.motion, {0, 0}, &enc);
     ws->swept.next_interval();
     const int capacity = static_cast<int>(pf.pairs.size());
+    const double fill_dist = next_up(reach + pf.margin);
     while (pf.obstacle < num_obstacles) {
       int used = 0;
       const TraversalStatus ts = traverse(frame, enc, 0.0, fill_dist, pf.obstacle, &pf.stack, &pf.pending, budget,
@@ -813,7 +819,9 @@ void ccd_step(const CcdBody* obstacles, int num_obstacles, const CcdBody& god, c
     pc.num_pairs = pf.num_pairs;
     pc.ref = pf.ref;
     pc.reach = reach;
-    pc.margin = margin;
+    pc.margin = pf.margin;
+    pc.margin_min = margin;
+    pc.margin_max = margin_max;
     pc.god = god;
     pc.obstacles.assign(obstacles, obstacles + num_obstacles);
     pc.uses = 0;
@@ -825,8 +833,8 @@ void ccd_step(const CcdBody* obstacles, int num_obstacles, const CcdBody& god, c
   if (margin > 0 && !tester.done()) {
     const double u_rest = result->hit ? result->u_hit : 1.0;
     const bool probing = hints && num_hints > 0 && !result->hit;
-    const auto range = [&](double moved) {  // [0, u] keeps every point within the margin of ref (0: none)
-      const double u = start.speed > 0 ? next_down(next_down(margin - moved) / start.speed) : 1.0;
+    const auto range = [&](double moved, double m) {  // [0, u] keeps every point within m of ref (0: none)
+      const double u = start.speed > 0 ? next_down(next_down(m - moved) / start.speed) : 1.0;
       return u > 0 ? std::min(u, 1.0) : 0.0;  // also NaN
     };
     // The part of a cache range [0, u] to search from the cache (0: none): all
@@ -843,14 +851,15 @@ void ccd_step(const CcdBody* obstacles, int num_obstacles, const CcdBody& god, c
     const auto usable = [&](double u) { return window(u) > 0; };
     Displacement since(keyed ? pc.ref : X0, X0);
     moved = keyed ? since.bound(rho) : std::numeric_limits<double>::infinity();
-    u_cached = keyed ? range(moved) : 0.0;
+    u_cached = keyed ? range(moved, pc.margin) : 0.0;
     if (keyed && pf.active) {
       // The fill's pose is ahead of the god-object's path (see below): put it
-      // in use once it leaves more of the margin than the list in use does, or
+      // in use once it leaves more of its margin than the list in use does, or
       // (finished now if need be) when that list cannot serve this step.
       const Displacement ahead(pf.ref, X0);
       const double moved_ahead = ahead.bound(rho);
-      const bool better = moved_ahead < moved, needed = !usable(u_cached) && usable(range(moved_ahead));
+      const bool better = pf.margin - moved_ahead > pc.margin - moved;
+      const bool needed = !usable(u_cached) && usable(range(moved_ahead, pf.margin));
       if (!usable(u_cached) && !needed) {
         pf.active = false;  // the god-object went elsewhere
       } else if ((better && pf.complete) || (needed && run_fill(std::numeric_limits<long>::max()))) {
@@ -858,7 +867,7 @@ void ccd_step(const CcdBody* obstacles, int num_obstacles, const CcdBody& god, c
         result->cache_refilled = true;
         since = ahead;
         moved = moved_ahead;
-        u_cached = range(moved);
+        u_cached = range(moved, pc.margin);
       }
     }
     const bool fresh = usable(u_cached);
@@ -870,7 +879,8 @@ void ccd_step(const CcdBody* obstacles, int num_obstacles, const CcdBody& god, c
     // are passed over (plain descents), and the one after that fills.
     // A step that moves at most a quarter of the margin fills regardless (the
     // list then serves the next steps unless the god-object speeds up).
-    bool fill = !fresh && usable(range(Displacement(X0, X0).bound(rho)));
+    const double fresh_margin = list_margin(pc.has_last ? Displacement(pc.last_x0, X0).bound(rho) : 0.0);
+    bool fill = !fresh && usable(range(Displacement(X0, X0).bound(rho), fresh_margin));
     if (fill && 4 * start.speed <= margin) {
       pc.rest = 0;
     } else if (fill && pc.rest > 0) {
@@ -881,7 +891,7 @@ void ccd_step(const CcdBody* obstacles, int num_obstacles, const CcdBody& god, c
     }
     if (fill) {
       // At once, at X0 (u = 0).
-      start_fill(X0);
+      start_fill(X0, fresh_margin);
       const bool filled = run_fill(std::numeric_limits<long>::max());
       pc.clear();
       u_cached = 0;
@@ -892,7 +902,7 @@ void ccd_step(const CcdBody* obstacles, int num_obstacles, const CcdBody& god, c
         result->cache_filled = true;
         since = Displacement(X0, X0);
         moved = since.bound(rho);
-        u_cached = range(moved);
+        u_cached = range(moved, pc.margin);
       }
     }
     u_cached = window(u_cached);
@@ -986,11 +996,12 @@ void ccd_step(const CcdBody* obstacles, int num_obstacles, const CcdBody& god, c
       const double v = Displacement(pc.last_x0, X0).bound(rho);
       const double j = std::ceil(static_cast<double>(std::max(pc.fill_cost, 1L)) /
                                  static_cast<double>(settings.cache_fill_budget));
-      if (v > 0 && v < margin && margin - moved <= (j + 1) * v) {
-        const double k = j + std::max(0.0, 0.75 * margin / v - 1);
+      const double m = list_margin(v);
+      if (v > 0 && v < m && pc.margin - moved <= (j + 1) * v) {
+        const double k = j + std::max(0.0, 0.75 * m / v - 1);
         const Quat dq = normalized(X0.q * conjugate(pc.last_x0.q));
         const Pose ahead{X0.p + k * (X0.p - pc.last_x0.p), normalized(quat_exp(k * quat_log(dq)) * X0.q)};
-        start_fill(ahead);
+        start_fill(ahead, m);
       }
     }
     if (pf.active && !pf.complete) run_fill(settings.cache_fill_budget);

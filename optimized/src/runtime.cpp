@@ -166,9 +166,12 @@ RuntimeModel::RuntimeModel(const Scene& scene, const RuntimeSettings& s) : setti
   // while no point has moved 64 delta from there (ccd_step's proximity cache;
   // docs/benchmarks.md has the sweep of this margin).
   settings.ccd.cache_margin = 64 * contact.delta;
-  // The next list is filled 300 node pairs a step (about 60 us on the peg)
-  // while the one in use serves, at the pose the god-object is heading for,
-  // so a sliding god-object seldom waits for a whole fill.
+  // A list's margin grows with the god-object's speed up to 256 delta (about
+  // six steps like the last one), and the next list is filled 300 node pairs
+  // a step (about 60 us on the peg) while the one in use serves, at the pose
+  // the god-object is heading for: a sliding god-object seldom waits for a
+  // whole fill, and a resting one scans a short list.
+  settings.ccd.cache_margin_max = 256 * contact.delta;
   settings.ccd.cache_fill_budget = 300;
   contact_generation.distance = contact.delta * (1 + settings.contact_factor);
   // The CCD lists the pairs that may come within the contact distance (and the

@@ -293,21 +293,22 @@ TEST_CASE("ccd_step: steps served by the proximity cache find the first contact 
   // block (hits), and every tenth step a long move (the cache is refilled
   // where the next step starts in contact). Each step must agree with the
   // brute force (the same 1e-5 bound as above) and with a step on a workspace
-  // without the cache. Run with the cache refilled at once, and refilled in
-  // the background a few node pairs per step (cache_fill_budget: the served
-  // steps then take their pairs from a list that was completed steps after the
-  // pose it holds).
+  // without the cache. Run with the cache refilled at once, refilled in the
+  // background a few node pairs per step (cache_fill_budget: the served steps
+  // then take their pairs from a list that was completed steps after the pose
+  // it holds), and with margins that follow the speed (cache_margin_max).
   const TriangleMesh god = make_icosphere(1, 0.5);
   const TriangleMesh slab = concatenate(make_box(3, 3, 1, Vec3(0, 0, -0.5)), make_box(0.4, 0.4, 0.6, Vec3(0.6, 0, 0.3)));
   const Bvh gb = build_bvh(god, 2), sb = build_bvh(slab, 2);
-  for (const long budget : {0L, 12L}) {
-  INFO("cache_fill_budget " << budget);
+  for (const auto [budget, margin_max] : {std::pair{0L, 0.0}, std::pair{12L, 0.0}, std::pair{12L, 0.06}}) {
+  INFO("cache_fill_budget " << budget << ", cache_margin_max " << margin_max);
   std::mt19937 rng(29);
   std::uniform_real_distribution<double> U(-1, 1);
   CcdStepSettings settings, plain;
   settings.narrow.min_separation = plain.narrow.min_separation = 1e-4;
   settings.cache_margin = 0.02;
   settings.cache_fill_budget = budget;
+  settings.cache_margin_max = margin_max;
   CcdStepWorkspace ws, ws_plain;
   const CcdBody obstacle{&slab, &sb};
   Pose x{Vec3(0.1, 0, 0.5 + 0.01), Quat{}};  // 1 cm above the slab
@@ -355,14 +356,35 @@ TEST_CASE("ccd_step: steps served by the proximity cache find the first contact 
     hints.clear();
     if (r.hit) hints.push_back(r.pair);
   }
-  std::printf("proximity cache (fill budget %ld): %d of 120 steps served from it, %d fills, %d background refills, "
-              "%d hits, %d give-ups\n", budget, served, fills, refills, hits, gave_up);
+  std::printf("proximity cache (fill budget %ld, margins up to %g): %d of 120 steps served from it, %d fills, %d "
+              "background refills, %d hits, %d give-ups\n", budget, std::max(margin_max, settings.cache_margin), served,
+              fills, refills, hits, gave_up);
   CHECK(gave_up <= 6);
   CHECK(served >= 30);
   CHECK(fills >= 3);
   CHECK(hits >= 20);
   if (budget == 0) CHECK(refills == 0);
   }
+}
+
+// The settings of the background-fill tests below: the cache's margin, the
+// widest a list's may grow to, and the fill's node pairs per step.
+static CcdStepSettings background_fill_settings(double margin, double margin_max, long fill_budget) {
+  CcdStepSettings settings;
+  settings.narrow.min_separation = 1e-4;
+  settings.cache_margin = margin;
+  settings.cache_margin_max = margin_max;
+  settings.cache_fill_budget = fill_budget;
+  return settings;
+}
+
+// A hint that only tells ccd_step the step starts in contact (the cache
+// serves only such steps).
+static FeaturePair in_contact_hint() {
+  FeaturePair hint;
+  hint.obstacle = 0;
+  hint.god_face = hint.obstacle_face = 0;
+  return hint;
 }
 
 TEST_CASE("ccd_step: a ball sliding on a slab into a wall, its cache refilled in the background", "[bvh]") {
@@ -373,6 +395,8 @@ TEST_CASE("ccd_step: a ball sliding on a slab into a wall, its cache refilled in
   // the list where the ball was; every step must still agree with the brute
   // force, and the step that meets the wall must stop where it does. (Serving
   // such a list as if it were filled where it is swapped in misses the wall.)
+  // Run with every list's margin 3 cm, and with margins up to 8 cm sized to
+  // the ball's speed (cache_margin_max; the ball then slides 8 mm a step).
   const TriangleMesh god = make_icosphere(1, 0.5);
   double z_min = 1e300, x_max = -1e300;
   for (Eigen::Index v = 0; v < god.V.rows(); ++v) {
@@ -382,20 +406,17 @@ TEST_CASE("ccd_step: a ball sliding on a slab into a wall, its cache refilled in
   const double wall_x = x_max + 0.25;
   const TriangleMesh scene = concatenate(make_box(3, 3, 1, Vec3(0, 0, -0.5)), make_box(0.2, 2, 1, Vec3(wall_x + 0.1, 0, 0.5)));
   const Bvh gb = build_bvh(god, 2), sb = build_bvh(scene, 2);
-  CcdStepSettings settings;
-  settings.narrow.min_separation = 1e-4;
-  settings.cache_margin = 0.03;
-  settings.cache_fill_budget = 6;
+  for (const double margin_max : {0.0, 0.08}) {
+  INFO("cache_margin_max " << margin_max);
+  const CcdStepSettings settings = background_fill_settings(0.03, margin_max, 6);
   CcdStepWorkspace ws;
   const CcdBody obstacle{&scene, &sb};
-  FeaturePair hint;
-  hint.obstacle = 0;
-  hint.god_face = hint.obstacle_face = 0;
+  const FeaturePair hint = in_contact_hint();
   Pose x{Vec3(0, 0, 2e-4 - z_min), Quat{}};
   int served = 0, refills = 0, steps = 0;
   bool met_wall = false;
   for (; steps < 100 && !met_wall; ++steps) {
-    const Pose target{x.p + Vec3(0.004, 0, 0), x.q};
+    const Pose target{x.p + Vec3(margin_max > 0 ? 0.008 : 0.004, 0, 0), x.q};
     CcdStepResult r;
     ccd_step(&obstacle, 1, {&god, &gb}, x, target, settings, &ws, &r, &hint, 1);
     INFO("step " << steps);
@@ -410,11 +431,99 @@ TEST_CASE("ccd_step: a ball sliding on a slab into a wall, its cache refilled in
     met_wall = r.hit;
     x = target;
   }
-  std::printf("sliding into a wall: %d steps, %d served from the cache, %d background refills\n", steps, served,
-              refills);
+  std::printf("sliding into a wall (margins up to %g): %d steps, %d served from the cache, %d background refills\n",
+              std::max(margin_max, settings.cache_margin), steps, served, refills);
   CHECK(met_wall);
   CHECK(served >= steps / 2);
   CHECK(refills >= 3);
+  }
+}
+
+TEST_CASE("ccd_step: a ball wandering among blocks, lists filled ahead of it in the background", "[bvh]") {
+  // The ball wanders 2e-4 above a slab studded with blocks (a hint given, as
+  // in contact), its velocity turning a little each step and its speed
+  // between 1 and 12 mm a step, now and then reversing: the lists filled ahead
+  // of it (cache_fill_budget) are sometimes where it goes and sometimes not,
+  // and their margins follow its speed (cache_margin_max). A step that meets
+  // a block stops there, and the next starts from the stop pose. Every step
+  // must agree with the brute force, and every tenth step the list in use
+  // must hold the pairs its margin promises.
+  const TriangleMesh god = make_icosphere(1, 0.25);
+  double z_min = 1e300;
+  for (Eigen::Index v = 0; v < god.V.rows(); ++v) z_min = std::min(z_min, god.V(v, 2));
+  TriangleMesh scene = make_box(4, 4, 1, Vec3(0, 0, -0.5));
+  for (int i = -2; i <= 2; ++i)
+    for (int j = -2; j <= 2; ++j)
+      if (i != 0 || j != 0) scene = concatenate(scene, make_box(0.12, 0.12, 0.1, Vec3(0.55 * i, 0.55 * j, 0.05)));
+  const Bvh gb = build_bvh(god, 2), sb = build_bvh(scene, 2);
+  const CcdStepSettings settings = background_fill_settings(0.02, 0.06, 30);
+  CcdStepWorkspace ws;
+  const CcdBody obstacle{&scene, &sb};
+  const FeaturePair hint = in_contact_hint();
+  std::mt19937 rng(41);
+  std::uniform_real_distribution<double> U(-1, 1);
+  const double z = 2e-4 - z_min;
+  Pose x{Vec3(0.15, 0.1, z), Quat{}};
+  double heading = 0.8;
+  int served = 0, refills = 0, hits = 0;
+  double widest = 0;  // the widest margin of a list checked
+  for (int k = 0; k < 250; ++k) {
+    heading += 0.15 * U(rng);
+    if (k % 80 == 79) heading += 3.0;  // turn back
+    const double speed = 0.001 + 0.011 * (0.5 + 0.5 * std::sin(k / 15.0));
+    Vec3 p = x.p + speed * Vec3(std::cos(heading), std::sin(heading), 0);
+    p.z() = z;
+    if (std::abs(p.x()) > 1.5 || std::abs(p.y()) > 1.5) heading += 3.0, p = x.p;  // keep over the slab
+    const Pose target{p, normalized(quat_exp(Vec3(0, 0, 0.02 * U(rng))) * x.q)};
+    CcdStepResult r;
+    ccd_step(&obstacle, 1, {&god, &gb}, x, target, settings, &ws, &r, &hint, 1);
+    INFO("step " << k);
+    CcdMotion m;
+    REQUIRE(make_ccd_motion(x, target, &m) == MotionStatus::kOk);
+    const BruteForce bf = brute_force(god, gb, scene, sb, m, settings.narrow);
+    if (r.status == CcdStatus::kMaxIterations) {
+      CHECK(r.hit);
+      CHECK(r.u_hit <= bf.u_hit + 1e-5);
+    } else {
+      REQUIRE(r.status == CcdStatus::kOk);
+      REQUIRE(r.hit == bf.hit);
+      if (r.hit) CHECK(std::abs(r.u_hit - bf.u_hit) <= 1e-5);
+    }
+    served += r.u_cached > 0;
+    refills += r.cache_refilled;
+    hits += r.hit;
+    if (k % 10 == 0 && ws.cache.num_pairs >= 0) {
+      // The list in use holds every pair within its reach plus its margin at
+      // its pose: here, every pair with two corners that close.
+      const CcdStepWorkspace::ProximityCache& pc = ws.cache;
+      std::set<std::pair<int, int>> listed;
+      for (int i = 0; i < pc.num_pairs; ++i) listed.insert({pc.pairs[i].god_face, pc.pairs[i].obstacle_face});
+      const double within = (pc.reach + pc.margin) * (1 - 1e-9);
+      widest = std::max(widest, pc.margin);
+      for (Eigen::Index gf = 0; gf < god.F.rows(); ++gf)
+        for (Eigen::Index of = 0; of < scene.F.rows(); ++of) {
+          double d = 1e300;
+          for (int a = 0; a < 3; ++a)
+            for (int b = 0; b < 3; ++b)
+              d = std::min(d, (transform_point(pc.ref, god.V.row(god.F(gf, a)).transpose()) -
+                               scene.V.row(scene.F(of, b)).transpose()).norm());
+          if (d <= within) CHECK(listed.count({static_cast<int>(gf), static_cast<int>(of)}) == 1);
+        }
+    }
+    if (r.hit) {
+      x = make_stop_pose(r.motion, r.u_hit, gb.radius).pose;
+      x.p.z() = z;
+      heading += 3.0;  // bounce back
+    } else {
+      x = target;
+    }
+  }
+  std::printf("wandering among blocks: %d of 250 steps served from the cache, %d background refills, %d hits, "
+              "margins up to %g\n", served, refills, hits, widest);
+  CHECK(widest > 1.5 * settings.cache_margin);
+  CHECK(served >= 125);
+  CHECK(refills >= 8);
+  CHECK(hits >= 5);
 }
 
 TEST_CASE("ccd_step: the proximity cache is not served for another mesh behind the same CcdBody", "[bvh]") {

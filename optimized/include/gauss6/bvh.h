@@ -504,6 +504,8 @@ struct CcdStepSettings {
                                            // (scene units) at a pose in contact, and take a later step's candidates
                                            // from them while no point has moved farther than this from that pose
                                            // (CcdStepWorkspace::ProximityCache; 0: off; the runtime uses 64 delta)
+  double cache_margin_max = 0;             // a list's margin grows up to this (>= cache_margin) to span about six
+                                           // steps like the last one (0: every list's margin is cache_margin)
   double near_distance = 0;                // also list the triangle pairs that may come within this (>=
                                            // min_separation) by the stop pose: the near pairs (CcdStepResult)
 };
@@ -600,8 +602,9 @@ struct CcdStepWorkspace {
   // ccd_step takes its candidates from here instead of descending the trees.
   // ccd_step refills it (at the step's start) when it cannot serve the step
   // and a fresh one could (see ccd_step). It is keyed by the god-object's and the obstacles' meshes and
-  // BVHs (pointers), the reach and the margin; clear() it when a mesh behind
-  // the same pointers changes.
+  // BVHs (pointers), the reach and the settings' margins; clear() it when a
+  // mesh behind the same pointers changes. Each list has its own margin
+  // (CcdStepSettings::cache_margin_max).
   struct ProximityCache {
     ProximityCache(int capacity, int stack_capacity)
         : pairs(static_cast<size_t>(capacity)), fill(capacity, stack_capacity) {}
@@ -616,22 +619,24 @@ struct CcdStepWorkspace {
     std::vector<Pair> pairs;
     int num_pairs = -1;            // -1: empty (never filled, or the pairs did not fit)
     Pose ref;
-    double reach = 0, margin = 0;
+    double reach = 0, margin = 0;  // margin: this list's
+    double margin_min = 0, margin_max = 0;  // the settings it was filled under (keys)
     int uses = 0;  // later steps served since the fill
     int rest = 0;  // chances to refill still to pass over (see ccd_step)
     CcdBody god;
     std::vector<CcdBody> obstacles;  // grows (allocates) only when a fill sees more obstacles than ever before
-    // A fill in progress (CcdStepSettings::cache_fill_budget): the same list
-    // for the pose `ref` (a served step's start, motion.nominal at u = 0),
-    // built a budget of node pairs per step in the background while the list
-    // above still serves, then swapped in; finished at once when a step needs
-    // it first. Same keys as the list above.
+    // A fill in progress (CcdStepSettings::cache_fill_budget): the same kind
+    // of list for the pose `ref` (where the god-object is heading: ccd_step)
+    // and its own margin, built a budget of node pairs per step in the
+    // background while the list above still serves, then swapped in;
+    // finished at once when a step needs it first. Same keys as the list above.
     struct Fill {
       Fill(int capacity, int stack_capacity) : pairs(static_cast<size_t>(capacity)), stack(stack_capacity) {}
       std::vector<Pair> pairs;
       int num_pairs = 0;
       Pose ref;
-      CcdMotion motion;  // the step it started in (its frame at u = 0)
+      double margin = 0;
+      CcdMotion motion;  // still at ref (or the step it started in, when ref is that step's start)
       BvhStack stack;    // the descent's pending node pairs: stack.items[0 .. pending)
       int pending = 0;
       int obstacle = 0;  // the obstacle being descended
