@@ -390,11 +390,11 @@ static FeaturePair in_contact_hint() {
 TEST_CASE("ccd_step: a ball sliding on a slab into a wall, its cache refilled in the background", "[bvh]") {
   // The ball slides 2e-4 above a slab (a hint given, as in contact) towards a
   // wall, 4 mm a step, with the cache refilled in the background a few node
-  // pairs per step: each list completed serves from the pose its fill started
-  // at, steps behind. The wall comes within reach of pairs that were not in
-  // the list where the ball was; every step must still agree with the brute
-  // force, and the step that meets the wall must stop where it does. (Serving
-  // such a list as if it were filled where it is swapped in misses the wall.)
+  // pairs per step: each list is filled at a pose ahead of the ball and put
+  // in use steps later. The wall comes within reach of pairs that were not in
+  // the lists before; every step must still agree with the brute force, and
+  // the step that meets the wall must stop where it does. (The test below,
+  // with the ball wandering, also checks what each list holds.)
   // Run with every list's margin 3 cm, and with margins up to 8 cm sized to
   // the ball's speed (cache_margin_max; the ball then slides 8 mm a step).
   const TriangleMesh god = make_icosphere(1, 0.5);
