@@ -20,15 +20,6 @@
 
 namespace gauss6 {
 
-const char* to_string(PairKind k) {
-  switch (k) {
-    case PairKind::kGodVertexObstacleFace: return "god_vertex/obstacle_face";
-    case PairKind::kObstacleVertexGodFace: return "obstacle_vertex/god_face";
-    case PairKind::kEdgeEdge: return "edge/edge";
-  }
-  return "unknown";
-}
-
 size_t Bvh::memory_bytes() const {
   return nodes.capacity() * sizeof(BvhNode) + triangles.capacity() * sizeof(int32_t) +
          owned.capacity() * sizeof(uint8_t) + neighbor.capacity() * sizeof(int32_t) +
@@ -685,10 +676,8 @@ void ccd_step(const CcdBody* obstacles, int num_obstacles, const CcdBody& god, c
   };
   const auto descend = [&](double u_end, double dist, const auto& visit) {
     for (int o = 0; o < num_obstacles; ++o) {
-      if (god.bvh->nodes.empty() || obstacles[o].bvh->nodes.empty()) continue;
-      if (ws->stack.items.empty()) return TraversalStatus::kStackFull;
-      ws->stack.items[0] = {0, 0};
-      int pending = 1;
+      int pending = 0;
+      if (!start_candidate_pairs(*god.bvh, *obstacles[o].bvh, &ws->stack, &pending)) return TraversalStatus::kStackFull;
       const TraversalStatus ts = traverse(start, e, u_end, dist, o, &ws->stack, &pending,
                                           std::numeric_limits<long>::max(), &result->num_node_pairs, visit);
       if (ts != TraversalStatus::kDone) return ts;
@@ -747,15 +736,11 @@ void ccd_step(const CcdBody* obstacles, int num_obstacles, const CcdBody& god, c
   // at pf.ref (X0, or the pose a background fill is started at: see the end of
   // this function), descended into pf.pairs obstacle by obstacle, a budget of
   // node pairs at a time (run_fill: true once complete; a fill that does not
-  // fit is dropped), then swapped in (put_fill).
-  const auto next_obstacle = [&] {
-    while (pf.obstacle < num_obstacles &&
-           (god.bvh->nodes.empty() || obstacles[pf.obstacle].bvh->nodes.empty() || pf.stack.items.empty()))
-      ++pf.obstacle;
-    if (pf.obstacle < num_obstacles) {
-      pf.stack.items[0] = {0, 0};
-      pf.pending = 1;
-    }
+  // fit, in pf.pairs or on pf.stack, is dropped), then swapped in (put_fill).
+  const auto start_obstacle = [&] {
+    if (pf.obstacle < num_obstacles &&
+        !start_candidate_pairs(*god.bvh, *obstacles[pf.obstacle].bvh, &pf.stack, &pf.pending))
+      pf.active = false;
   };
   const auto start_fill = [&](const Pose& at, double m) {
     pf.margin = m;
@@ -773,9 +758,10 @@ void ccd_step(const CcdBody* obstacles, int num_obstacles, const CcdBody& god, c
     pf.obstacle = 0;
     pf.active = true;
     pf.complete = false;
-    next_obstacle();
+    start_obstacle();
   };
   const auto fill_some = [&](long budget) {
+    if (!pf.active) return false;
     StartFrame frame;
     frame.set(pf.motion, 0.0, rho);
     MotionEnclosure enc;
@@ -803,7 +789,8 @@ void ccd_step(const CcdBody* obstacles, int num_obstacles, const CcdBody& god, c
         return false;
       }
       ++pf.obstacle;
-      next_obstacle();
+      start_obstacle();
+      if (!pf.active) return false;
     }
     pf.complete = true;
     pc.fill_cost = pf.cost;

@@ -526,6 +526,30 @@ TEST_CASE("ccd_step: a ball wandering among blocks, lists filled ahead of it in 
   CHECK(hits >= 5);
 }
 
+TEST_CASE("ccd_step: a workspace without room to descend is never served an empty cache", "[bvh]") {
+  // A ball pressed into a slab, in contact (a hint given), on a workspace whose
+  // traversal stack holds nothing: every descent, the cache's fill included,
+  // must report the workspace full and stop at the start, as a step without
+  // the cache does, rather than serve the step from a list it never filled.
+  const TriangleMesh god = make_icosphere(1, 0.5), slab = make_box(3, 3, 1, Vec3(0, 0, -0.5));
+  const Bvh gb = build_bvh(god, 2), sb = build_bvh(slab, 2);
+  double z_min = 1e300;
+  for (Eigen::Index v = 0; v < god.V.rows(); ++v) z_min = std::min(z_min, god.V(v, 2));
+  const Pose x0{Vec3(0, 0, 2e-4 - z_min), Quat{}}, x1{x0.p + Vec3(0, 0, -0.01), x0.q};
+  const FeaturePair hint = in_contact_hint();
+  const CcdBody obstacle{&slab, &sb};
+  for (const double margin : {0.0, 0.02}) {
+    INFO("cache_margin " << margin);
+    CcdStepWorkspace ws(1 << 14, /*stack_capacity=*/0);
+    CcdStepResult r;
+    ccd_step(&obstacle, 1, {&god, &gb}, x0, x1, background_fill_settings(margin, 0, 0), &ws, &r, &hint, 1);
+    CHECK(r.status == CcdStatus::kWorkspaceFull);
+    CHECK(r.hit);
+    CHECK(r.u_hit == 0);
+    CHECK_FALSE(r.cache_filled);
+  }
+}
+
 TEST_CASE("ccd_step: the proximity cache is not served for another mesh behind the same CcdBody", "[bvh]") {
   // A ball 2 d above a slab, in contact (a hint given): a first small step
   // fills the cache. The obstacle's CcdBody, the same variable, then points to

@@ -21,20 +21,15 @@
 #include <utility>
 #include <vector>
 
+#include "gauss6/aabb.h"
 #include "gauss6/ccd.h"
+#include "gauss6/feature_pair.h"
 #include "gauss6/mesh.h"
 
 // Forces a hot lambda inline (GCC and Clang), as GAUSS6_ALWAYS_INLINE in ccd.h.
 #define GAUSS6_ALWAYS_INLINE_LAMBDA __attribute__((always_inline))
 
 namespace gauss6 {
-
-struct Aabb {
-  Vec3 lo = Vec3::Zero(), hi = Vec3::Zero();
-};
-inline bool overlap(const Aabb& a, const Aabb& b) {
-  return (a.lo.array() <= b.hi.array()).all() && (b.lo.array() <= a.hi.array()).all();
-}
 
 // An oriented box: the points center + axes x with |x_i| <= half_i (axes:
 // orthonormal columns, up to rounding). Fitted to the node's vertices at build
@@ -89,17 +84,6 @@ inline Aabb triangle_box(const TriangleMesh& mesh, int f) {
 }
 // Conservative world box of every p(u) + R(u) r_B, u in e.u, r_B in body_box.
 Aabb swept_box(const MotionEnclosure& e, const Aabb& body_box);
-// box grown by margin on every side, rounded outward. Inline: the traversal
-// calls it for every node pair.
-inline Aabb inflate(const Aabb& box, double margin) {
-  if (margin == 0) return box;
-  Aabb out;
-  for (int i = 0; i < 3; ++i) {
-    out.lo[i] = next_down(box.lo[i] - margin);
-    out.hi[i] = next_up(box.hi[i] + margin);
-  }
-  return out;
-}
 
 // Separating axes of two triangles A and B given by their corners (one frame,
 // doubles): the two face normals and the nine edge cross products. Calls
@@ -447,16 +431,25 @@ TraversalStatus resume_candidate_pairs([[maybe_unused]] const TriangleMesh& god_
   }
   return leave(TraversalStatus::kDone);
 }
+// Starts a traversal for resume_candidate_pairs: the root pair pending on
+// `stack` (none when a tree is empty: nothing to visit). False when the stack
+// has no room for it (kStackFull).
+inline bool start_candidate_pairs(const Bvh& god, const Bvh& obs, BvhStack* stack, int* pending) {
+  *pending = 0;
+  if (god.nodes.empty() || obs.nodes.empty()) return true;
+  if (stack->items.empty()) return false;
+  stack->items[0] = {0, 0};
+  *pending = 1;
+  return true;
+}
 template <class GodNodeBox, class GodFaceBox, class Visit, class Separated>
 TraversalStatus for_each_candidate_pair_indexed(const TriangleMesh& god_mesh, const Bvh& god,
                                                 const TriangleMesh& obs_mesh, const Bvh& obs,
                                                 const GodNodeBox& god_node_box, const GodFaceBox& god_face_box,
                                                 double margin, BvhStack* stack, Visit&& visit, int* num_node_pairs,
                                                 const Separated& separated) {
-  if (god.nodes.empty() || obs.nodes.empty()) return TraversalStatus::kDone;
-  if (stack->items.empty()) return TraversalStatus::kStackFull;
-  stack->items[0] = {0, 0};
-  int pending = 1;
+  int pending = 0;
+  if (!start_candidate_pairs(god, obs, stack, &pending)) return TraversalStatus::kStackFull;
   return resume_candidate_pairs(god_mesh, god, obs_mesh, obs, god_node_box, god_face_box, margin, stack, &pending,
                                 std::numeric_limits<long>::max(), std::forward<Visit>(visit), num_node_pairs,
                                 separated);
@@ -480,17 +473,6 @@ TraversalStatus for_each_candidate_pair(const TriangleMesh& god_mesh, const Bvh&
 struct CcdBody {
   const TriangleMesh* mesh = nullptr;
   const Bvh* bvh = nullptr;
-};
-
-// Which features touch. A vertex is F(face, corner); an edge runs from
-// F(face, corner) to F(face, (corner + 1) % 3); a face is `face` (corner -1).
-enum class PairKind { kGodVertexObstacleFace = 0, kObstacleVertexGodFace, kEdgeEdge };
-const char* to_string(PairKind k);
-struct FeaturePair {
-  PairKind kind = PairKind::kGodVertexObstacleFace;
-  int obstacle = -1;                       // index into the obstacle list
-  int god_face = -1, god_corner = -1;
-  int obstacle_face = -1, obstacle_corner = -1;
 };
 
 struct CcdStepSettings {
