@@ -2,7 +2,7 @@
 // against a static one under the Cayley motion (conservative box culling, then
 // the exact primitives of ccd_exact.cpp), exact triangle/triangle intersection
 // count and exact separation distance at a pose. The posed-mesh queries cull
-// pairs on conservative boxes (groups of body faces against a walk of the
+// pairs on conservative boxes (groups of god-object faces, "body" here, against a walk of the
 // obstacle's face tree) and decide each pair with CGAL's filtered predicates:
 // interval arithmetic first, Gmpq only when the intervals cannot decide. See gauss6/reference/ccd.h.
 #include "gauss6/reference/ccd.h"
@@ -34,6 +34,10 @@ using IntervalKernel = CGAL::Simple_cartesian<CGAL::Interval_nt_advanced>;
 // dozen operations at 2^-53 each); 1e-9 leaves a margin of five orders.
 constexpr double kBoxInflation = 1e-9;
 
+// The empty box (lo > hi), where grow() starts: the shared Aabb's default is
+// the point 0, not empty.
+Aabb empty_box() { return {Vec3::Constant(1), Vec3::Constant(-1)}; }
+
 Aabb point_box(const Vec3& p) { return {p, p}; }
 
 void grow(Aabb* b, const Aabb& o) {
@@ -44,10 +48,6 @@ void grow(Aabb* b, const Aabb& o) {
   }
   b->lo = b->lo.cwiseMin(o.lo);
   b->hi = b->hi.cwiseMax(o.hi);
-}
-
-bool overlap(const Aabb& a, const Aabb& b) {
-  return (a.lo.array() <= b.hi.array()).all() && (b.lo.array() <= a.hi.array()).all();
 }
 
 // Top-down tree, median split on the longest axis of the centres.
@@ -61,7 +61,7 @@ AabbTree build_tree(const std::vector<Aabb>& boxes) {
     int node, first, count;
   };
   auto new_node = [&t] {
-    t.box.emplace_back();
+    t.box.push_back(empty_box());
     t.child.push_back(-1);
     t.first.push_back(0);
     t.count.push_back(0);
@@ -71,7 +71,7 @@ AabbTree build_tree(const std::vector<Aabb>& boxes) {
   while (!stack.empty()) {
     const Task task = stack.back();
     stack.pop_back();
-    Aabb box, centres;
+    Aabb box = empty_box(), centres = empty_box();
     for (int i = task.first; i < task.first + task.count; ++i) {
       grow(&box, boxes[t.item[i]]);
       grow(&centres, point_box(0.5 * (boxes[t.item[i]].lo + boxes[t.item[i]].hi)));
@@ -339,19 +339,19 @@ CGAL::Bbox_3 grown(const CGAL::Bbox_3& b, double margin) {
 template <class Visit>
 void candidate_pairs(const ExactMeshPair& mp, const PosedBody& posed, double margin, Visit&& visit) {
   constexpr int kGroup = ExactMeshPair::kFaceGroup;
-  const TriangleMesh& body = mp.body;
+  const TriangleMesh& body = mp.god;
   const TriangleMesh& obs = mp.obstacle;
-  if (mp.obstacle_faces.box.empty() || mp.body_faces.box.empty()) return;
+  if (mp.obstacle_faces.box.empty() || mp.god_faces.box.empty()) return;
   auto face_bbox = [&](int f) {
     return grown(posed.box(body.F(f, 0)) + posed.box(body.F(f, 1)) + posed.box(body.F(f, 2)), margin);
   };
   // Posed group boxes (from the body-frame group boxes, or from the faces when
   // the pose is out of the doubles' range).
-  const std::vector<int32_t>& body_order = mp.body_faces.item;
-  std::vector<CGAL::Bbox_3> body_group_boxes(mp.body_face_groups.size());
+  const std::vector<int32_t>& body_order = mp.god_faces.item;
+  std::vector<CGAL::Bbox_3> body_group_boxes(mp.god_face_groups.size());
   CGAL::Bbox_3 all;
   for (size_t g = 0; g < body_group_boxes.size(); ++g) {
-    if (const auto b = posed.box(mp.body_face_groups[g])) {
+    if (const auto b = posed.box(mp.god_face_groups[g])) {
       body_group_boxes[g] = grown(*b, margin);
     } else {
       for (size_t i = g * kGroup; i < std::min(body_order.size(), (g + 1) * kGroup); ++i)
@@ -388,12 +388,12 @@ void candidate_pairs(const ExactMeshPair& mp, const PosedBody& posed, double mar
 }
 
 Aabb face_box(const std::vector<Aabb>& vertex_boxes, const TriangleMesh& m, int f) {
-  Aabb b;
+  Aabb b = empty_box();
   for (int k = 0; k < 3; ++k) grow(&b, vertex_boxes[m.F(f, k)]);
   return b;
 }
 
-void record(const ExactToi& toi, const FeaturePair& pair, MeshContact* out) {
+void record(const ExactToi& toi, const FeaturePairIds& pair, MeshContact* out) {
   if (!toi.hit) return;
   const int c = compare_toi(toi, out->toi);
   if (c < 0) {
@@ -403,6 +403,85 @@ void record(const ExactToi& toi, const FeaturePair& pair, MeshContact* out) {
     out->pairs.push_back(pair);
   }
 }
+
+// The features of one type (kPairKinds' Feature) of a mesh, numbered as the
+// items of the obstacle's trees: vertex v, edge edges[i], face f.
+struct MeshFeatures {
+  const TriangleMesh& mesh;
+  const std::vector<std::array<int32_t, 2>>& edges;
+
+  int count(Feature t) const {
+    switch (t) {
+      case Feature::kVertex: return int(mesh.V.rows());
+      case Feature::kEdge: return int(edges.size());
+      case Feature::kFace: return int(mesh.F.rows());
+    }
+    return 0;
+  }
+  FeatureId id(Feature t, int i) const {
+    switch (t) {
+      case Feature::kVertex: return vertex_id(i);
+      case Feature::kEdge: return edge_id(edges[i][0], edges[i][1]);
+      case Feature::kFace: return face_id(i);
+    }
+    return {};
+  }
+  // The vertex indices of a feature (1, 2 or 3 of them, in corner order).
+  int vertices(const FeatureId& id, int32_t out[3]) const {
+    switch (id.feature) {
+      case Feature::kVertex: out[0] = id.a; return 1;
+      case Feature::kEdge: out[0] = id.a, out[1] = id.b; return 2;
+      case Feature::kFace:
+        for (int k = 0; k < 3; ++k) out[k] = mesh.F(id.a, k);
+        return 3;
+    }
+    return 0;
+  }
+  // Its points (vertices() of them filled).
+  std::array<Vec3, 3> points(const FeatureId& id) const {
+    int32_t v[3];
+    std::array<Vec3, 3> p = {Vec3::Zero(), Vec3::Zero(), Vec3::Zero()};
+    for (int k = 0, n = vertices(id, v); k < n; ++k) p[k] = vertex(mesh, v[k]);
+    return p;
+  }
+  bool valid(const FeatureId& id, Feature t) const {
+    if (id.feature != t) return false;
+    if (t == Feature::kFace) return id.a >= 0 && id.a < mesh.F.rows() && id.b == -1;
+    const auto in = [&](int32_t v) { return v >= 0 && v < mesh.V.rows(); };
+    return t == Feature::kVertex ? in(id.a) && id.b == -1 : in(id.a) && in(id.b);
+  }
+};
+
+const AabbTree& obstacle_tree(const ExactMeshPair& mp, Feature t) {
+  switch (t) {
+    case Feature::kVertex: return mp.obstacle_vertices;
+    case Feature::kEdge: return mp.obstacle_edge_tree;
+    case Feature::kFace: break;
+  }
+  return mp.obstacle_faces;
+}
+
+// The exact solver of each kind of feature pair, indexed by PairKind (the god
+// feature's points in the body frame, the obstacle's in the world frame; a
+// vertex is p[0], an edge p[0], p[1]).
+using PairSolver = ExactToi (*)(const ExactCayleyMotion&, const std::array<Vec3, 3>& god,
+                                const std::array<Vec3, 3>& obstacle, double u_max);
+ExactToi solve_vertex_face(const ExactCayleyMotion& m, const std::array<Vec3, 3>& g, const std::array<Vec3, 3>& o,
+                           double u_max) {
+  return moving_vertex_face_toi(m, g[0], o, u_max);
+}
+ExactToi solve_face_vertex(const ExactCayleyMotion& m, const std::array<Vec3, 3>& g, const std::array<Vec3, 3>& o,
+                           double u_max) {
+  return vertex_moving_face_toi(m, o[0], g, u_max);
+}
+ExactToi solve_edge_edge(const ExactCayleyMotion& m, const std::array<Vec3, 3>& g, const std::array<Vec3, 3>& o,
+                         double u_max) {
+  return moving_edge_edge_toi(m, {g[0], g[1]}, {o[0], o[1]}, u_max);
+}
+constexpr PairSolver kPairSolvers[kNumPairKinds] = {solve_vertex_face, solve_face_vertex, solve_edge_edge};
+static_assert(kPairKinds[0].kind == PairKind::kGodVertexObstacleFace &&
+                  kPairKinds[1].kind == PairKind::kObstacleVertexGodFace && kPairKinds[2].kind == PairKind::kEdgeEdge,
+              "kPairSolvers follows the order of kPairKinds");
 
 }  // namespace
 
@@ -419,16 +498,17 @@ std::vector<std::array<int32_t, 2>> mesh_edges(const TriangleMesh& m) {
   return e;
 }
 
-ExactMeshPair make_exact_mesh_pair(const TriangleMesh& body_B, const TriangleMesh& obstacle_W) {
-  check_mesh(body_B, "body");
+ExactMeshPair make_exact_mesh_pair(const TriangleMesh& god_B, const TriangleMesh& obstacle_W) {
+  check_mesh(god_B, "god-object");
   check_mesh(obstacle_W, "obstacle");
   ExactMeshPair mp;
-  mp.body = body_B;
+  mp.god = god_B;
   mp.obstacle = obstacle_W;
-  mp.body_edges = mesh_edges(body_B);
+  mp.god_edges = mesh_edges(god_B);
   mp.obstacle_edges = mesh_edges(obstacle_W);
   const TriangleMesh& o = obstacle_W;
-  std::vector<Aabb> vb(o.V.rows()), fb(o.F.rows()), eb(mp.obstacle_edges.size());
+  std::vector<Aabb> vb(o.V.rows(), empty_box()), fb(o.F.rows(), empty_box()),
+      eb(mp.obstacle_edges.size(), empty_box());
   for (int v = 0; v < o.V.rows(); ++v) vb[v] = point_box(vertex(o, v));  // exact boxes
   for (int f = 0; f < o.F.rows(); ++f) fb[f] = face_box(vb, o, f);
   for (size_t e = 0; e < eb.size(); ++e) {
@@ -438,27 +518,26 @@ ExactMeshPair make_exact_mesh_pair(const TriangleMesh& body_B, const TriangleMes
   mp.obstacle_vertices = build_tree(vb);
   mp.obstacle_faces = build_tree(fb);
   mp.obstacle_edge_tree = build_tree(eb);
-  std::vector<Aabb> body_vb(body_B.V.rows()), body_fb(body_B.F.rows());
-  for (int v = 0; v < body_B.V.rows(); ++v) body_vb[v] = point_box(vertex(body_B, v));
-  for (int f = 0; f < body_B.F.rows(); ++f) body_fb[f] = face_box(body_vb, body_B, f);
-  mp.body_faces = build_tree(body_fb);
+  std::vector<Aabb> god_vb(god_B.V.rows(), empty_box()), god_fb(god_B.F.rows(), empty_box());
+  for (int v = 0; v < god_B.V.rows(); ++v) god_vb[v] = point_box(vertex(god_B, v));
+  for (int f = 0; f < god_B.F.rows(); ++f) god_fb[f] = face_box(god_vb, god_B, f);
+  mp.god_faces = build_tree(god_fb);
   auto groups = [](const AabbTree& t, const std::vector<Aabb>& face_boxes) {
-    std::vector<Aabb> g((t.item.size() + ExactMeshPair::kFaceGroup - 1) / ExactMeshPair::kFaceGroup);
+    std::vector<Aabb> g((t.item.size() + ExactMeshPair::kFaceGroup - 1) / ExactMeshPair::kFaceGroup, empty_box());
     for (size_t i = 0; i < t.item.size(); ++i) grow(&g[i / ExactMeshPair::kFaceGroup], face_boxes[t.item[i]]);
     return g;
   };
-  mp.body_face_groups = groups(mp.body_faces, body_fb);
-  for (int v = 0; v < body_B.V.rows(); ++v) mp.body_radius = std::max(mp.body_radius, vertex(body_B, v).norm());
-  mp.body_radius = std::nextafter(mp.body_radius, HUGE_VAL);
+  mp.god_face_groups = groups(mp.god_faces, god_fb);
+  for (int v = 0; v < god_B.V.rows(); ++v) mp.god_radius = std::max(mp.god_radius, vertex(god_B, v).norm());
+  mp.god_radius = std::nextafter(mp.god_radius, HUGE_VAL);
   return mp;
 }
 
 MeshContact mesh_first_contact(const ExactMeshPair& mp, const Pose& X0, const Pose& X1) {
   const ExactCayleyMotion motion = make_exact_cayley_motion(X0, X1);
-  const TriangleMesh& body = mp.body;
-  const TriangleMesh& obs = mp.obstacle;
+  const TriangleMesh& god = mp.god;
 
-  // Swept box of each body vertex r over u in [0, 1]: the point is
+  // Swept box of each god-object vertex r over u in [0, 1]: the point is
   // p(u) + C(u g) R0 r with p(u) on the segment [p0, p1], and C(u g) turns
   // R0 r by an angle <= theta1 = 2 atan|g| < pi about one axis, so it stays
   // within 2 |r| sin(theta1 / 2) = 2 |r| |g| / sqrt(1 + |g|^2) of R0 r.
@@ -477,9 +556,9 @@ MeshContact mesh_first_contact(const ExactMeshPair& mp, const Pose& X0, const Po
   }();
   const Vec3 pmin = X0.p.cwiseMin(X1.p), pmax = X0.p.cwiseMax(X1.p);
   const double scale = X0.p.cwiseAbs().maxCoeff() + X1.p.cwiseAbs().maxCoeff();
-  std::vector<Aabb> swept(body.V.rows());
-  for (int v = 0; v < body.V.rows(); ++v) {
-    const Vec3 r = vertex(body, v);
+  std::vector<Aabb> swept(god.V.rows(), empty_box());
+  for (int v = 0; v < god.V.rows(); ++v) {
+    const Vec3 r = vertex(god, v);
     const Vec3 w = R0 * r;
     const double radius = chord * r.norm() + kBoxInflation * (scale + r.norm()) + 1e-300;
     swept[v] = {pmin + w - Vec3::Constant(radius), pmax + w + Vec3::Constant(radius)};
@@ -488,56 +567,54 @@ MeshContact mesh_first_contact(const ExactMeshPair& mp, const Pose& X0, const Po
   MeshContact out;
   // Pairs can only improve on the best contact so far: search [0, its upper bound].
   auto u_max = [&out] { return out.toi.hit ? std::max(out.toi.upper, std::nextafter(0.0, 1.0)) : 1.0; };
-  auto body_face = [&](int f) {
-    return std::array<Vec3, 3>{vertex(body, body.F(f, 0)), vertex(body, body.F(f, 1)), vertex(body, body.F(f, 2))};
-  };
-  auto obstacle_face = [&](int f) {
-    return std::array<Vec3, 3>{vertex(obs, obs.F(f, 0)), vertex(obs, obs.F(f, 1)), vertex(obs, obs.F(f, 2))};
-  };
-  // Body vertex / obstacle face.
-  for (int v = 0; v < body.V.rows(); ++v)
-    query_tree(mp.obstacle_faces, swept[v], [&](int f) {
-      ++out.num_candidate_pairs;
-      record(moving_vertex_face_toi(motion, vertex(body, v), obstacle_face(f), u_max()),
-             {FeaturePair::kBodyVertexObstacleFace, v, f}, &out);
-    });
-  // Obstacle vertex / body face.
-  for (int f = 0; f < body.F.rows(); ++f)
-    query_tree(mp.obstacle_vertices, face_box(swept, body, f), [&](int v) {
-      ++out.num_candidate_pairs;
-      record(vertex_moving_face_toi(motion, vertex(obs, v), body_face(f), u_max()),
-             {FeaturePair::kObstacleVertexBodyFace, f, v}, &out);
-    });
-  // Edge / edge.
-  for (size_t e = 0; e < mp.body_edges.size(); ++e) {
-    const auto& be = mp.body_edges[e];
-    Aabb box = swept[be[0]];
-    grow(&box, swept[be[1]]);
-    query_tree(mp.obstacle_edge_tree, box, [&](int oe) {
-      ++out.num_candidate_pairs;
-      const auto& o = mp.obstacle_edges[oe];
-      record(moving_edge_edge_toi(motion, {vertex(body, be[0]), vertex(body, be[1])},
-                                  {vertex(obs, o[0]), vertex(obs, o[1])}, u_max()),
-             {FeaturePair::kEdgeEdge, int32_t(e), oe}, &out);
-    });
+  // One loop for every kind (kPairKinds): each god-object feature's swept box
+  // (the hull of its vertices' swept boxes) against the obstacle's tree of the
+  // other feature.
+  const MeshFeatures god_features{god, mp.god_edges}, obstacle_features{mp.obstacle, mp.obstacle_edges};
+  for (const PairKindInfo& info : kPairKinds) {
+    const PairSolver solve = kPairSolvers[int(info.kind)];
+    const AabbTree& tree = obstacle_tree(mp, info.obstacle);
+    for (int i = 0, n = god_features.count(info.god); i < n; ++i) {
+      const FeatureId gf = god_features.id(info.god, i);
+      int32_t v[3];
+      const int num_vertices = god_features.vertices(gf, v);
+      Aabb box = swept[v[0]];
+      for (int k = 1; k < num_vertices; ++k) grow(&box, swept[v[k]]);
+      const std::array<Vec3, 3> god_points = god_features.points(gf);
+      query_tree(tree, box, [&](int item) {
+        ++out.num_candidate_pairs;
+        const FeatureId of = obstacle_features.id(info.obstacle, item);
+        record(solve(motion, god_points, obstacle_features.points(of), u_max()), {info.kind, gf, of}, &out);
+      });
+    }
   }
   return out;
 }
 
+ExactToi feature_pair_first_contact(const ExactMeshPair& mp, const ExactCayleyMotion& motion,
+                                    const FeaturePairIds& pair, double u_max) {
+  const int k = int(pair.kind);
+  const MeshFeatures god_features{mp.god, mp.god_edges}, obstacle_features{mp.obstacle, mp.obstacle_edges};
+  if (k < 0 || k >= kNumPairKinds || !god_features.valid(pair.god, kPairKinds[k].god) ||
+      !obstacle_features.valid(pair.obstacle, kPairKinds[k].obstacle))
+    throw std::invalid_argument("feature_pair_first_contact: the features do not match the kind or the meshes");
+  return kPairSolvers[k](motion, god_features.points(pair.god), obstacle_features.points(pair.obstacle), u_max);
+}
+
 int64_t count_intersecting_pairs(const ExactMeshPair& mp, const Pose& X) {
-  const PosedBody posed(mp.body, X);
+  const PosedBody posed(mp.god, X);
   const DoIntersect do_intersect;
   int64_t count = 0;
   candidate_pairs(mp, posed, 0.0, [&](int32_t f, int32_t of) {
-    if (do_intersect(BodyFace{&posed, &mp.body, f}, ObstacleFace{&mp.obstacle, of})) ++count;
+    if (do_intersect(BodyFace{&posed, &mp.god, f}, ObstacleFace{&mp.obstacle, of})) ++count;
   });
   return count;
 }
 
 ExactSeparation separation_distance(const ExactMeshPair& mp, const Pose& X, double max_distance) {
   if (!(max_distance >= 0)) throw std::invalid_argument("separation_distance: max_distance must be >= 0");
-  const PosedBody posed(mp.body, X);
-  const TriangleMesh& body = mp.body;
+  const PosedBody posed(mp.god, X);
+  const TriangleMesh& body = mp.god;
   // Pass 1 (boxes): every pair whose boxes are within max_distance, with a
   // lower bound of its squared distance: the squared gap between the boxes
   // (the body's contain the exact triangle), rounded down by a relative 1e-12,
@@ -571,7 +648,7 @@ ExactSeparation separation_distance(const ExactMeshPair& mp, const Pose& X, doub
     Candidate refined = c;
     CGAL::Protect_FPU_rounding<true> upward;
     try {
-      const IntervalKernel::FT d2 = CGAL::squared_distance(to_interval(BodyFace{&posed, &mp.body, c.f}),
+      const IntervalKernel::FT d2 = CGAL::squared_distance(to_interval(BodyFace{&posed, &mp.god, c.f}),
                                                            to_interval(ObstacleFace{&mp.obstacle, c.of}));
       if (std::isfinite(d2.inf()) && std::isfinite(d2.sup())) {
         refined.lower = std::max(c.lower, d2.inf());
@@ -589,11 +666,11 @@ ExactSeparation separation_distance(const ExactMeshPair& mp, const Pose& X, doub
   for (const Candidate& c : close) {
     if (c.lower > best_upper || (out.within && CGAL::Gmpq(c.lower) > best)) break;
     const CGAL::Gmpq d2 =
-        CGAL::squared_distance(to_exact(BodyFace{&posed, &mp.body, c.f}), to_exact(ObstacleFace{&mp.obstacle, c.of}));
+        CGAL::squared_distance(to_exact(BodyFace{&posed, &mp.god, c.f}), to_exact(ObstacleFace{&mp.obstacle, c.of}));
     if (!out.within || d2 < best) {
       out.within = true;
       best = d2;
-      out.body_face = c.f;
+      out.god_face = c.f;
       out.obstacle_face = c.of;
     }
   }

@@ -22,6 +22,10 @@ namespace {
 using gauss6::Pose;
 using gauss6::Quat;
 using gauss6::Vec3;
+using gauss6::FeaturePairIds;
+using gauss6::kPairKinds;
+using gauss6::PairKind;
+using gauss6::PairKindInfo;
 using namespace gauss6::reference;
 
 ExactPoint P(const mpq_class& x, const mpq_class& y, const mpq_class& z) { return {x, y, z}; }
@@ -409,14 +413,14 @@ TEST_CASE("mesh first contact: a cube dropped onto a slab touches at the exact t
   const auto slab = gauss6::test::make_box(4, 4, 2, Vec3(0, 0, -1));
   const auto cube = gauss6::test::make_box(1, 1, 1);
   const ExactMeshPair mp = make_exact_mesh_pair(cube, slab);
-  CHECK(mp.body_edges.size() == 18);
+  CHECK(mp.god_edges.size() == 18);
   for (const double turn : {0.0, 0.3}) {
     const Pose X0 = pose(Vec3(0.125, -0.25, 2), Quat{}), X1 = pose(Vec3(0.125, -0.25, 0), about_z(turn));
     const MeshContact c = mesh_first_contact(mp, X0, X1);
     require_hit_at(c.toi, Q(3, 4));
     REQUIRE_FALSE(c.pairs.empty());
     bool has_vertex_face = false;
-    for (const auto& p : c.pairs) has_vertex_face |= p.type == FeaturePair::kBodyVertexObstacleFace;
+    for (const auto& p : c.pairs) has_vertex_face |= p.kind == PairKind::kGodVertexObstacleFace;
     CHECK(has_vertex_face);  // the cube's 4 bottom corners land on the slab's top
     CHECK(c.num_candidate_pairs > 0);
   }
@@ -425,6 +429,53 @@ TEST_CASE("mesh first contact: a cube dropped onto a slab touches at the exact t
   CHECK_FALSE(away.toi.hit);
   // Starting in contact: u* = 0.
   require_hit_at(mesh_first_contact(mp, pose(Vec3(0, 0, 0.5), Quat{}), pose(Vec3(0, 0, 2), Quat{})).toi, Q(0));
+}
+
+TEST_CASE("mesh first contact: each touching pair, solved alone, touches at u* (canonical ids)", "[refccd]") {
+  const auto slab = gauss6::test::make_box(4, 4, 2, Vec3(0, 0, -1));
+  const auto cube = gauss6::test::make_box(1, 1, 1);
+  const ExactMeshPair mp = make_exact_mesh_pair(cube, slab);
+  const Pose X0 = pose(Vec3(0.125, -0.25, 2), Quat{}), X1 = pose(Vec3(0.125, -0.25, 0), about_z(0.3));
+  const MeshContact c = mesh_first_contact(mp, X0, X1);
+  REQUIRE(c.toi.hit);
+  const auto m = make_exact_cayley_motion(X0, X1);
+  for (const FeaturePairIds& p : c.pairs) {
+    const PairKindInfo& info = kPairKinds[int(p.kind)];
+    CHECK(p.god.feature == info.god);
+    CHECK(p.obstacle.feature == info.obstacle);
+    if (p.god.feature == gauss6::Feature::kEdge) CHECK(p.god.a < p.god.b);
+    CHECK(compare_toi(feature_pair_first_contact(mp, m, p), c.toi) == 0);
+  }
+  // Ids that do not match the kind, or out of range, are refused.
+  FeaturePairIds wrong = c.pairs.front();
+  wrong.god = gauss6::face_id(0);
+  if (wrong.kind != PairKind::kObstacleVertexGodFace) CHECK_THROWS_AS(feature_pair_first_contact(mp, m, wrong),
+                                                                       std::invalid_argument);
+  const FeaturePairIds far{PairKind::kGodVertexObstacleFace, gauss6::vertex_id(int32_t(cube.V.rows())),
+                           gauss6::face_id(0)};
+  CHECK_THROWS_AS(feature_pair_first_contact(mp, m, far), std::invalid_argument);
+}
+
+TEST_CASE("canonical feature ids of an optimized feature pair (gauss6/feature_ids.h)", "[refccd]") {
+  gauss6::MatrixX3i god_F(2, 3), obstacle_F(1, 3);
+  god_F << 0, 1, 2, 2, 1, 3;
+  obstacle_F << 7, 5, 6;
+  gauss6::FeaturePair p;
+  p.kind = PairKind::kGodVertexObstacleFace;
+  p.god_face = 1, p.god_corner = 2, p.obstacle_face = 0, p.obstacle_corner = -1;
+  CHECK(gauss6::feature_ids(p, god_F, obstacle_F) ==
+        FeaturePairIds{p.kind, gauss6::vertex_id(3), gauss6::face_id(0)});
+  p.kind = PairKind::kObstacleVertexGodFace;
+  p.god_corner = -1, p.obstacle_corner = 1;
+  CHECK(gauss6::feature_ids(p, god_F, obstacle_F) ==
+        FeaturePairIds{p.kind, gauss6::face_id(1), gauss6::vertex_id(5)});
+  // Edges: sorted vertex pairs, whichever triangle (and direction) names them.
+  p.kind = PairKind::kEdgeEdge;
+  p.god_face = 0, p.god_corner = 1, p.obstacle_corner = 2;
+  const FeaturePairIds e = gauss6::feature_ids(p, god_F, obstacle_F);
+  CHECK(e == FeaturePairIds{p.kind, gauss6::edge_id(1, 2), gauss6::edge_id(6, 7)});
+  p.god_face = 1, p.god_corner = 0;  // the same god edge, from the other triangle
+  CHECK(gauss6::feature_ids(p, god_F, obstacle_F) == e);
 }
 
 TEST_CASE("mesh first contact: culling keeps the brute-force minimum (turning stick against a post)", "[refccd]") {
@@ -454,13 +505,13 @@ TEST_CASE("mesh first contact: culling keeps the brute-force minimum (turning st
     for (int f = 0; f < post.F.rows(); ++f) consider(moving_vertex_face_toi(m, V(stick, v), F(post, f)));
   for (int v = 0; v < post.V.rows(); ++v)
     for (int f = 0; f < stick.F.rows(); ++f) consider(vertex_moving_face_toi(m, V(post, v), F(stick, f)));
-  for (const auto& a : mp.body_edges)
+  for (const auto& a : mp.god_edges)
     for (const auto& b : mp.obstacle_edges)
       consider(moving_edge_edge_toi(m, {V(stick, a[0]), V(stick, a[1])}, {V(post, b[0]), V(post, b[1])}));
   REQUIRE(best.hit);
   CHECK(compare_toi(c.toi, best) == 0);
   CHECK(c.num_candidate_pairs < int64_t(stick.V.rows() * post.F.rows() + post.V.rows() * stick.F.rows() +
-                                        mp.body_edges.size() * mp.obstacle_edges.size()));
+                                        mp.god_edges.size() * mp.obstacle_edges.size()));
 }
 
 TEST_CASE("exact non-interpenetration and separation of posed boxes", "[refccd]") {

@@ -88,8 +88,8 @@ mpq_class plain_squared_distance(const TriangleMesh& body, const TriangleMesh& o
 // Checks both queries against the plain computation at pose X; returns the count.
 int64_t check_pose(const ExactMeshPair& mp, const Pose& X, double max_distance) {
   const int64_t n = count_intersecting_pairs(mp, X);
-  CHECK(n == plain_count(mp.body, mp.obstacle, X));
-  const mpq_class d2 = plain_squared_distance(mp.body, mp.obstacle, X);
+  CHECK(n == plain_count(mp.god, mp.obstacle, X));
+  const mpq_class d2 = plain_squared_distance(mp.god, mp.obstacle, X);
   const ExactSeparation s = separation_distance(mp, X, max_distance);
   const bool within = d2 <= mpq_class(max_distance) * mpq_class(max_distance);
   CHECK(s.within == within);

@@ -27,7 +27,9 @@
 
 #include <gmpxx.h>
 
+#include "gauss6/aabb.h"
 #include "gauss6/ccd_queries.h"
+#include "gauss6/feature_ids.h"
 #include "gauss6/mesh.h"
 #include "gauss6/pose.h"
 
@@ -94,7 +96,7 @@ ExactPoint motion_point_exact(const ExactCayleyMotion& m, const mpq_class& u, co
 // Exact world position under the static pose X (METHOD.md section 1).
 ExactPoint transform_point_exact(const Pose& X, const Vec3& r_B);
 
-// The body moves, the obstacle is static. Body features in the body frame (B),
+// The body (the god-object) moves, the obstacle is static. Body features in the body frame (B),
 // obstacle features in the world frame (W). Only contacts at u <= u_max are
 // looked for (u_max in (0, 1], a double taken exactly; std::invalid_argument
 // otherwise): a miss then means no contact in [0, u_max].
@@ -113,12 +115,10 @@ int moving_edge_edge_degree(const ExactCayleyMotion& m, const std::array<Vec3, 2
                             const std::array<Vec3, 2>& e_W);
 
 // ---------------------------------------------------------------------------
-// Mesh level: a moving god-object mesh (body frame) against a static obstacle
-// mesh (world frame).
-
-struct Aabb {
-  Vec3 lo = Vec3::Constant(1), hi = Vec3::Constant(-1);  // empty by default
-};
+// Mesh level: a moving god-object mesh (body frame B) against a static obstacle
+// mesh (world frame W). The moving body of the primitives above is the
+// god-object: the god side of the shared PairKind and FeaturePair
+// (gauss6/feature_pair.h). Boxes are the shared gauss6::Aabb (gauss6/aabb.h).
 
 // Bounding-box tree over items (triangles, vertices or edges). Node i has box
 // box[i]; an inner node has children child[i] and child[i] + 1; a leaf has
@@ -130,48 +130,50 @@ struct AabbTree {
 
 // Everything that depends only on the two meshes, built once.
 struct ExactMeshPair {
-  TriangleMesh body;                              // god-object, body frame
+  TriangleMesh god;                               // god-object, body frame
   TriangleMesh obstacle;                          // static, world frame
-  std::vector<std::array<int32_t, 2>> body_edges, obstacle_edges;  // unique, sorted
+  std::vector<std::array<int32_t, 2>> god_edges, obstacle_edges;  // unique, sorted
   AabbTree obstacle_faces, obstacle_vertices, obstacle_edge_tree;  // exact boxes (doubles)
-  // Body faces in groups of kFaceGroup consecutive items of the tree's item
+  // God-object faces in groups of kFaceGroup consecutive items of the tree's item
   // order (nearby faces): group g's box holds the boxes of faces item[g * kFaceGroup ..].
   static constexpr int kFaceGroup = 8;
-  AabbTree body_faces;                       // body frame, exact boxes
-  std::vector<Aabb> body_face_groups;        // body frame
-  double body_radius = 0;  // max |r_B| over body vertices (rounded up)
+  AabbTree god_faces;                        // body frame, exact boxes
+  std::vector<Aabb> god_face_groups;         // body frame
+  double god_radius = 0;  // max |r_B| over god-object vertices (rounded up)
 };
 
 // Throws std::invalid_argument on an empty mesh or an index out of range.
-ExactMeshPair make_exact_mesh_pair(const TriangleMesh& body_B, const TriangleMesh& obstacle_W);
+ExactMeshPair make_exact_mesh_pair(const TriangleMesh& god_B, const TriangleMesh& obstacle_W);
 // Unique undirected edges (i < j), sorted.
 std::vector<std::array<int32_t, 2>> mesh_edges(const TriangleMesh& m);
 
-struct FeaturePair {
-  enum Type { kBodyVertexObstacleFace, kObstacleVertexBodyFace, kEdgeEdge };
-  Type type;
-  int32_t body;      // body vertex, face or edge (index into body_edges)
-  int32_t obstacle;  // obstacle face, vertex or edge (index into obstacle_edges)
-};
-
 struct MeshContact {
-  ExactToi toi;                      // first contact over all feature pairs
-  std::vector<FeaturePair> pairs;    // every pair touching exactly at u* (empty on a miss)
-  int64_t num_candidate_pairs = 0;   // pairs whose swept boxes overlap (each solved exactly)
+  ExactToi toi;                        // first contact over all feature pairs
+  std::vector<FeaturePairIds> pairs;   // every pair touching exactly at u* (empty on a miss), in
+                                       // canonical ids (gauss6/feature_ids.h)
+  int64_t num_candidate_pairs = 0;     // pairs whose swept boxes overlap (each solved exactly)
 };
 
 // Exact first contact over u in [0, 1] of the Cayley motion X0 -> X1: minimum
-// over body vertex/obstacle face, obstacle vertex/body face and edge/edge
-// pairs. Culling is conservative: a pair is skipped only when the swept box of
-// the body feature (provably containing its whole path) misses the obstacle
-// feature's box. Throws as make_exact_cayley_motion.
+// over god vertex/obstacle face, obstacle vertex/god face and edge/edge
+// pairs (the kinds of kPairKinds, in its order). Culling is conservative: a
+// pair is skipped only when the swept box of the god-object's feature
+// (provably containing its whole path) misses the obstacle feature's box.
+// Throws as make_exact_cayley_motion.
 MeshContact mesh_first_contact(const ExactMeshPair& meshes, const Pose& X0, const Pose& X1);
 
-// Number of (body triangle, obstacle triangle) pairs that intersect (share at
-// least a point) with the body at pose X, exactly. Pairs are culled on boxes
-// that contain the exact posed triangles (groups of body faces against a walk
-// of the obstacle's face tree), then decided by CGAL's filtered predicate: interval arithmetic on enclosures
-// of the exact posed vertices, Gmpq on the exact ones when the intervals
+// Exact first contact over u in [0, u_max] of one feature pair (any vertices
+// of the two meshes: an edge id need not be a mesh edge) under the motion.
+// Throws std::invalid_argument when the ids' features do not match the kind
+// (kPairKinds) or an index is out of range.
+ExactToi feature_pair_first_contact(const ExactMeshPair& meshes, const ExactCayleyMotion& motion,
+                                    const FeaturePairIds& pair, double u_max = 1.0);
+
+// Number of (god triangle, obstacle triangle) pairs that intersect (share at
+// least a point) with the god-object at pose X, exactly. Pairs are culled on boxes
+// that contain the exact posed triangles (groups of god-object faces against a walk
+// of the obstacle's face tree), then decided by CGAL's filtered predicate:
+// interval arithmetic on enclosures of the exact posed vertices, Gmpq on the exact ones when the intervals
 // cannot decide. Throws std::domain_error on a zero quaternion or a non-finite
 // coordinate.
 int64_t count_intersecting_pairs(const ExactMeshPair& meshes, const Pose& X);
@@ -180,9 +182,9 @@ struct ExactSeparation {
   bool within = false;         // some triangle pair is at distance <= max_distance
   mpq_class squared_distance;  // exact minimum squared distance (when within)
   double lower = 0, upper = 0; // bracket of the distance: lower <= d <= upper
-  int32_t body_face = -1, obstacle_face = -1;  // a pair achieving it
+  int32_t god_face = -1, obstacle_face = -1;  // a pair achieving it
 };
-// Exact minimum triangle/triangle distance between the body at pose X and the
+// Exact minimum triangle/triangle distance between the god-object at pose X and the
 // obstacle, over pairs whose boxes are within max_distance (>= 0); within ==
 // false when every pair is farther than max_distance.
 // Same culling; each pair's squared distance is first enclosed in interval
