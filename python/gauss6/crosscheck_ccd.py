@@ -11,7 +11,23 @@ set's separation delta (METHOD.md section 4):
 Violations (any one makes the command exit 1):
 - false negative: an exact contact the optimized step did not report;
 - late hit: u_hit > u*, decided exactly (compare_toi), never by rounding;
-- intersecting stop pose: count_intersecting_pairs(stop pose) > 0, exactly.
+- intersecting stop pose: count_intersecting_pairs(stop pose) > 0, exactly;
+- wrong stop pair (steps where both hit): the feature pair the optimized step
+  stopped on (CcdStepResult::pair, in canonical ids: feature_ids.h) is not one the
+  reference says touches at u*, and its own exact first contact (that one pair
+  alone over [0, 1]) is earlier than u_hit (impossible for a sound step: u_hit <=
+  u* <= the pair's own contact), never comes, or comes later than u* by more than
+  the step's time_tolerance_reached plus PAIR_SLACK_U (below). A different pair
+  within that window is reported as agreement within tolerance.
+
+Why the slack: the step stops where a pair may come within delta (min_separation),
+not where one touches, and tests each pair only up to (best u so far) minus the
+time tolerance, so of pairs that close together (a face landing flat: its corners
+within a few time tolerances of each other) it may report any one. The window is
+u* - u_hit (the time the touching pair took from within delta to contact: a pair
+within delta at u_hit that closes at least half as fast touches within twice
+that) plus PAIR_SLACK_U = 2 time tolerances (the two time tolerances the step
+takes off: the per-pair search limit and the reported u).
 
 Reported: gap = u* - u_hit over steps where both hit (max and 99th percentile),
 the largest exact separation at a hit's stop pose (scene units; separations
@@ -43,6 +59,8 @@ FORMAT = "gauss6-ccd-steps"
 FORMAT_VERSION = 1
 STOP_SEPARATION_WINDOW = 100.0   # deltas: the exact separation is computed up to this distance
 OPTIMIZED_REPEATS = 3            # timing: fastest of this many runs of each step
+TIME_TOLERANCE = 1e-6            # the step's time_tolerance (MeshPair.step's default)
+PAIR_SLACK_U = 2 * TIME_TOLERANCE  # see the top of this file
 
 
 def set_names() -> list[str]:
@@ -97,6 +115,10 @@ class SetResult:
     exact_hits: int = 0
     optimized_hits: int = 0
     statuses: dict[str, int] = field(default_factory=dict)
+    pair_steps: int = 0             # both hit, the optimized step on a feature pair: its pair compared
+    pair_matches: int = 0           # ... stopped on a pair the reference says touches at u*
+    pair_within_tolerance: int = 0  # ... on another pair whose own contact is within the window
+    pair_violations: int = 0        # ... on a pair whose own contact is before u_hit, none, or past the window
     failures: list[str] = field(default_factory=list)
 
     def as_json(self) -> dict:
@@ -107,13 +129,35 @@ class SetResult:
                 "intersecting_stop_poses": self.intersecting_stop_poses,
                 "max_stop_separation": self.max_stop_separation,
                 "optimized_us_per_step": 1e6 * self.optimized_seconds / n,
-                "reference_s_per_step": self.reference_seconds / n}
+                "reference_s_per_step": self.reference_seconds / n,
+                "pair_steps": self.pair_steps, "pair_matches": self.pair_matches,
+                "pair_within_tolerance": self.pair_within_tolerance, "pair_violations": self.pair_violations}
+
+
+def classify_stop_pair(pair, step: dict, opt: dict, ex) -> tuple[str, str]:
+    """Which feature pair stopped a step where both hit: ("match", ""), ("within", ""), or
+    ("violation", why). pair: the MeshPair; opt: its step() dict; ex: the exact contact."""
+    ids = opt["pair_ids"]
+    if ids in ex.pairs:
+        return "match", ""
+    own = pair.pair_first_contact(ids, *poses(step))
+    u_hit = opt["u_hit"]
+    if not own.hit:
+        return "violation", f"stopped on {ids}, which never touches (u* in [{ex.lower!r}, {ex.upper!r}])"
+    if own.compare(u_hit) > 0:
+        return "violation", f"stopped on {ids} at u_hit = {u_hit!r}, after its own contact in [{own.lower!r}, " \
+                            f"{own.upper!r}]"
+    window = opt["time_tolerance_reached"] + max(ex.lower - u_hit, 0.0) + PAIR_SLACK_U
+    if own.lower > ex.upper + window:
+        return "violation", f"stopped on {ids}, whose own contact in [{own.lower!r}, {own.upper!r}] is past " \
+                            f"u* in [{ex.lower!r}, {ex.upper!r}] by more than {window!r}"
+    return "within", ""
 
 
 def check_step(pair, step: dict, delta: float, res: SetResult) -> object:
     """Runs one step both ways, adds it to res and returns the exact contact."""
     p0, q0, p1, q1 = poses(step)
-    opt = pair.step(p0, q0, p1, q1, delta, repeats=OPTIMIZED_REPEATS)
+    opt = pair.step(p0, q0, p1, q1, delta, time_tolerance=TIME_TOLERANCE, repeats=OPTIMIZED_REPEATS)
     ex = pair.exact_first_contact(p0, q0, p1, q1)
     res.steps += 1
     res.optimized_seconds += opt["seconds"]
@@ -130,6 +174,14 @@ def check_step(pair, step: dict, delta: float, res: SetResult) -> object:
         res.failures.append(f"{sid}: late hit u_hit = {opt['u_hit']!r} > u* in [{ex.lower!r}, {ex.upper!r}]")
     if opt["hit"] and ex.hit:
         res.gaps.append(max(ex.lower - opt["u_hit"], 0.0) if ex.compare(opt["u_hit"]) <= 0 else 0.0)
+        if opt["pair_ids"] is not None:
+            verdict, why = classify_stop_pair(pair, step, opt, ex)
+            res.pair_steps += 1
+            res.pair_matches += int(verdict == "match")
+            res.pair_within_tolerance += int(verdict == "within")
+            if verdict == "violation":
+                res.pair_violations += 1
+                res.failures.append(f"{sid}: {why}")
     # The pose the god-object takes: the stop pose on a hit, X1 otherwise. Exactly free?
     sp, sq = np.asarray(opt["stop_p"]), np.asarray(opt["stop_q"])
     n_int = pair.count_intersecting_pairs(sp, sq)
@@ -267,22 +319,26 @@ def crosscheck(names: list[str] | None = None, with_peers: bool = True, show_pro
         results.append(res)
         failures += [f"{name}/{f}" for f in res.failures]
     sets = [r.as_json() for r in results]
-    ok = all(s["false_negatives"] == 0 and s["late_hits"] == 0 and s["intersecting_stop_poses"] == 0 for s in sets)
+    ok = all(s["false_negatives"] == 0 and s["late_hits"] == 0 and s["intersecting_stop_poses"] == 0
+             and s["pair_violations"] == 0 for s in sets)
     ours = {r.name: r for r in results}
     return {"ok": ok, "sets": sets}, failures, (list(peers.values()) if peer else None), ours
 
 
 def format_table(result: dict, ours: dict[str, SetResult], peers: list[PeerResult] | None) -> str:
     lines = [f"{'set':<18}{'steps':>6}{'hits*':>6}{'FN':>4}{'late':>5}{'max gap u':>11}{'p99 gap u':>11}"
-             f"{'isect':>6}{'max stop sep':>14}{'opt us/step':>13}{'ref s/step':>11}"]
+             f"{'isect':>6}{'max stop sep':>14}{'opt us/step':>13}{'ref s/step':>11}{'pairs =/~/x':>14}"]
     for s in result["sets"]:
         r = ours[s["name"]]
+        pairs = f"{s['pair_matches']}/{s['pair_within_tolerance']}/{s['pair_violations']}"
         lines.append(f"{s['name']:<18}{s['steps']:>6}{r.exact_hits:>6}{s['false_negatives']:>4}{s['late_hits']:>5}"
                      f"{s['max_gap_u']:>11.2e}{s['p99_gap_u']:>11.2e}{s['intersecting_stop_poses']:>6}"
                      f"{s['max_stop_separation']:>14.3e}{s['optimized_us_per_step']:>13.1f}"
-                     f"{s['reference_s_per_step']:>11.3f}")
+                     f"{s['reference_s_per_step']:>11.3f}{pairs:>14}")
     lines.append("hits*: exact contacts; FN: false negatives; late: u_hit > u* (exact); isect: stop poses "
                  "that intersect (exact); stop sep in scene units")
+    lines.append("pairs =/~/x: hit steps stopped on a pair touching at u* / on another pair within the window / "
+                 "on a wrong pair (violation)")
     if peers is None:
         lines.append("FCL: python-fcl not installed (pip install -r requirements.txt): peers skipped")
     else:

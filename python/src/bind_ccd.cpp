@@ -20,6 +20,7 @@
 #include "gauss6/bvh.h"
 #include "gauss6/ccd.h"
 #include "gauss6/ccd_queries.h"
+#include "gauss6/feature_ids.h"
 #include "gauss6/reference/ccd.h"
 #include "module.h"
 
@@ -101,6 +102,38 @@ py::dict run_query_file(const std::string& path, const std::string& kind, const 
   return d;
 }
 
+// Canonical feature ids (feature_ids.h) to and from Python: a pair is the tuple
+// (kind, (feature, a, b) of the god-object, (feature, a, b) of the obstacle), kind
+// as to_string(PairKind), feature "vertex", "edge" or "face"; the same tuple for
+// the optimized step's pair and the reference's, so Python compares them with ==.
+const char* to_string(Feature f) {
+  switch (f) {
+    case Feature::kVertex: return "vertex";
+    case Feature::kEdge: return "edge";
+    case Feature::kFace: return "face";
+  }
+  return "unknown";
+}
+py::tuple to_python(const FeaturePairIds& p) {
+  auto id = [](const FeatureId& f) { return py::make_tuple(to_string(f.feature), f.a, f.b); };
+  return py::make_tuple(to_string(p.kind), id(p.god), id(p.obstacle));
+}
+FeaturePairIds from_python(const py::tuple& t) {
+  auto kind = [](const std::string& s) {
+    for (const PairKindInfo& k : kPairKinds)
+      if (s == to_string(k.kind)) return k.kind;
+    throw py::value_error("unknown pair kind '" + s + "'");
+  };
+  auto id = [](const py::tuple& f) {
+    const std::string name = f[0].cast<std::string>();
+    for (const Feature x : {Feature::kVertex, Feature::kEdge, Feature::kFace})
+      if (name == to_string(x)) return FeatureId{x, f[1].cast<int32_t>(), f[2].cast<int32_t>()};
+    throw py::value_error("unknown feature '" + name + "'");
+  };
+  if (t.size() != 3) throw py::value_error("a feature pair is (kind, god feature, obstacle feature)");
+  return {kind(t[0].cast<std::string>()), id(t[1].cast<py::tuple>()), id(t[2].cast<py::tuple>())};
+}
+
 // The exact first contact of a mesh step, kept whole so that the optimized u_hit
 // can be compared with u* exactly (compare_toi), never through a rounded double.
 struct ExactContact {
@@ -157,6 +190,9 @@ class CcdMeshPair {
     d["hit"] = r.hit;
     d["u_hit"] = r.u_hit;
     d["pair"] = to_string(r.pair.kind);
+    // The pair that stopped the step, in canonical ids (None without a hit on a pair).
+    const bool on_pair = r.hit && r.pair.god_face >= 0 && r.pair.obstacle_face >= 0;
+    d["pair_ids"] = on_pair ? py::object(to_python(feature_ids(r.pair, god_.F, obstacle_.F))) : py::none();
     d["stop_p"] = Eigen::Vector3d(stop.p);
     d["stop_q"] = quat_to(stop.q);
     d["deviation"] = deviation;
@@ -172,6 +208,24 @@ class CcdMeshPair {
     const reference::ExactMeshPair& m = exact();
     const auto t0 = Clock::now();
     ExactContact c{reference::mesh_first_contact(m, pose_from(p0, q0), pose_from(p1, q1)), 0};
+    c.seconds = seconds_since(t0);
+    return c;
+  }
+
+  // Exact first contact over [0, 1] of one feature pair (canonical ids) alone.
+  ExactContact pair_first_contact(const py::tuple& pair, const Eigen::Vector3d& p0, const Eigen::Vector4d& q0,
+                                  const Eigen::Vector3d& p1, const Eigen::Vector4d& q1) {
+    const FeaturePairIds ids = from_python(pair);
+    const reference::ExactMeshPair& m = exact();
+    const auto t0 = Clock::now();
+    ExactContact c;
+    try {
+      c.contact.toi = reference::feature_pair_first_contact(
+          m, reference::make_exact_cayley_motion(pose_from(p0, q0), pose_from(p1, q1)), ids);
+    } catch (const std::invalid_argument& e) {
+      throw py::value_error(e.what());
+    }
+    if (c.contact.toi.hit) c.contact.pairs = {ids};
     c.seconds = seconds_since(t0);
     return c;
   }
@@ -227,6 +281,13 @@ void bind_ccd(py::module_& m) {
                              "double bracket lower <= u* <= upper (adjacent doubles or equal)")
       .def_property_readonly("upper", [](const ExactContact& c) { return c.contact.toi.upper; })
       .def_property_readonly("num_pairs", [](const ExactContact& c) { return c.contact.pairs.size(); })
+      .def_property_readonly("pairs",
+                             [](const ExactContact& c) {
+                               py::list out;
+                               for (const FeaturePairIds& p : c.contact.pairs) out.append(to_python(p));
+                               return out;
+                             },
+                             "every feature pair touching exactly at u*, as (kind, god feature, obstacle feature)")
       .def_property_readonly("num_candidate_pairs", [](const ExactContact& c) { return c.contact.num_candidate_pairs; })
       .def_readonly("seconds", &ExactContact::seconds)
       .def("compare", [](const ExactContact& c, double u) { return reference::compare_toi(c.contact.toi, u); },
@@ -239,9 +300,14 @@ void bind_ccd(py::module_& m) {
       .def_property_readonly("god_radius", &CcdMeshPair::god_radius, "max |r_B| over the god-object's vertices")
       .def("step", &CcdMeshPair::step, py::arg("p0"), py::arg("q0"), py::arg("p1"), py::arg("q1"),
            py::arg("min_separation"), py::arg("time_tolerance") = 1e-6, py::arg("repeats") = 1,
-           "Optimized ccd_step: dict with status, hit, u_hit, stop_p, stop_q, deviation, seconds (fastest run).")
+           "Optimized ccd_step: dict with status, hit, u_hit, pair (its kind), pair_ids (the pair in canonical ids, "
+           "as ExactContact.pairs), stop_p, stop_q, deviation, seconds (fastest run).")
       .def("exact_first_contact", &CcdMeshPair::exact_first_contact, py::arg("p0"), py::arg("q0"), py::arg("p1"),
            py::arg("q1"), "Exact mesh_first_contact of the Cayley motion X0 -> X1: an ExactContact.")
+      .def("pair_first_contact", &CcdMeshPair::pair_first_contact, py::arg("pair"), py::arg("p0"), py::arg("q0"),
+           py::arg("p1"), py::arg("q1"),
+           "Exact first contact over [0, 1] of one feature pair (kind, god feature, obstacle feature) alone under "
+           "the Cayley motion X0 -> X1: an ExactContact (ValueError on ids that do not fit the kind or the meshes).")
       .def("count_intersecting_pairs", &CcdMeshPair::count_intersecting_pairs, py::arg("p"), py::arg("q"),
            "Exact number of intersecting (god, obstacle) triangle pairs at pose (p, q).")
       .def("separation", &CcdMeshPair::separation, py::arg("p"), py::arg("q"), py::arg("max_distance"),

@@ -98,6 +98,8 @@ def test_first_steps_pass_the_crosscheck(name):
     out = res.as_json()
     assert out["steps"] == count and out["false_negatives"] == out["late_hits"] == out["intersecting_stop_poses"] == 0
     assert out["max_gap_u"] >= out["p99_gap_u"] >= 0
+    # Which pair stopped each step: compared on every step where both hit, none wrong.
+    assert out["pair_steps"] == out["pair_matches"] + out["pair_within_tolerance"] and out["pair_violations"] == 0
 
 
 class _Tampered:
@@ -146,13 +148,64 @@ def test_a_late_hit_is_a_violation():
     assert res.late_hits == 0
 
 
+def test_a_stop_on_a_wrong_pair_is_a_violation():
+    pair, s, delta = _first_hit_step()
+    poses = cc.poses(s)
+    opt = pair.step(*poses, delta)
+    ex = pair.exact_first_contact(*poses)
+    assert opt["hit"] and opt["pair_ids"] is not None and ex.pairs
+    # The reference's own touching pair is a match, and solved alone it touches at u*.
+    assert cc.classify_stop_pair(pair, s, {**opt, "pair_ids": ex.pairs[0]}, ex) == ("match", "")
+    own = pair.pair_first_contact(ex.pairs[0], *poses)
+    assert own.hit and own.lower == ex.lower and own.upper == ex.upper
+    # A pair that never touches (a god-object vertex against an obstacle face), fed as the
+    # step's stop pair: flagged, and check_step counts it as a violation.
+    wrong = None
+    for v in range(8):
+        for f in range(8):
+            ids = ("god_vertex/obstacle_face", ("vertex", v, -1), ("face", f, -1))
+            if not pair.pair_first_contact(ids, *poses).hit:
+                wrong = ids
+                break
+        if wrong:
+            break
+    assert wrong is not None
+    verdict, why = cc.classify_stop_pair(pair, s, {**opt, "pair_ids": wrong}, ex)
+    assert verdict == "violation" and "never touches" in why
+    res = cc.SetResult("tampered")
+    cc.check_step(_Tampered(pair, pair_ids=wrong), s, delta, res)
+    assert res.pair_violations == 1 and res.pair_steps == 1 and res.late_hits == 0
+    assert res.as_json()["pair_violations"] == 1
+    # A stop after the pair's own contact (impossible for a sound step) is flagged, when the
+    # pair is solved alone (the reference listing no touching pair).
+    verdict, why = cc.classify_stop_pair(pair, s, {**opt, "pair_ids": ex.pairs[0], "u_hit": 1.0}, _NoPairs(ex))
+    assert verdict == "violation" and "after its own contact" in why
+    # The same pair at the exact u* bracket's lower end, not listed: within tolerance.
+    assert cc.classify_stop_pair(pair, s, {**opt, "pair_ids": ex.pairs[0], "u_hit": ex.lower}, _NoPairs(ex))[0] \
+        == "within"
+    # Ids that do not fit the kind are refused.
+    with pytest.raises(ValueError):
+        pair.pair_first_contact(("edge/edge", ("vertex", 0, -1), ("face", 0, -1)), *poses)
+
+
+class _NoPairs:
+    """An exact contact that lists no touching pair (so the stop pair is solved alone)."""
+
+    def __init__(self, ex):
+        self.ex, self.pairs = ex, []
+
+    def __getattr__(self, name):
+        return getattr(self.ex, name)
+
+
 def test_cli_json_schema(capsys):
     rc = cli.main(["crosscheck", "ccd", "--set", "parallel", "--json"])
     out = json.loads(capsys.readouterr().out)
     assert rc == 0 and list(out) == ["ok", "sets"] and out["ok"] is True
     assert list(out["sets"][0]) == ["name", "steps", "false_negatives", "late_hits", "max_gap_u", "p99_gap_u",
                                     "intersecting_stop_poses", "max_stop_separation", "optimized_us_per_step",
-                                    "reference_s_per_step"]
+                                    "reference_s_per_step", "pair_steps", "pair_matches", "pair_within_tolerance",
+                                    "pair_violations"]
     # Stop poses keep about delta: the exact separation is at most the window and above 0.
     assert 0 < out["sets"][0]["max_stop_separation"] <= cc.STOP_SEPARATION_WINDOW * cc.load_set("parallel")["delta"]
 
