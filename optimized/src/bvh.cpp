@@ -8,8 +8,6 @@
 // earliest hit kept.
 #include "gauss6/bvh.h"
 
-#include "gauss6/contacts.h"
-
 #include <algorithm>
 #include <chrono>
 #include <Eigen/Eigenvalues>

@@ -8,6 +8,7 @@
 #include <random>
 
 #include "gauss6/contacts.h"
+#include "gauss6/distance.h"
 #include "mesh_shapes.h"
 
 using namespace gauss6;
