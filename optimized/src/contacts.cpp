@@ -7,6 +7,7 @@
 #include <cmath>
 
 #include "gauss6/distance.h"
+#include "gauss6/motion_bounds.h"
 
 namespace gauss6 {
 

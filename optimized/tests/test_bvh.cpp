@@ -12,6 +12,9 @@
 #include <set>
 
 #include "gauss6/bvh.h"
+#include "gauss6/ccd_step.h"
+#include "gauss6/distance.h"
+#include "gauss6/motion_bounds.h"
 #include "mesh_shapes.h"
 
 using namespace gauss6;

@@ -7,6 +7,7 @@
 #include <cmath>
 #include <random>
 
+#include "gauss6/ccd_step.h"
 #include "gauss6/contacts.h"
 #include "gauss6/distance.h"
 #include "mesh_shapes.h"

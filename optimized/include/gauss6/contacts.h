@@ -27,6 +27,8 @@
 #include <Eigen/Core>
 
 #include "gauss6/bvh.h"
+#include "gauss6/ccd_step.h"
+#include "gauss6/motion_bounds.h"
 
 namespace gauss6 {
 
