@@ -15,6 +15,7 @@
 
 #include "bench_data.h"
 #include "gauss6/bvh.h"
+#include "gauss6/ccd_step.h"
 #include "gauss6/mesh_io.h"
 #include "latency.h"
 

@@ -30,6 +30,7 @@
 
 #include "bench_data.h"
 #include "gauss6/bvh.h"
+#include "gauss6/ccd_step.h"
 #include "gauss6/contacts.h"
 #include "gauss6/runtime.h"
 #include "latency.h"

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "bench_data.h"
+#include "gauss6/ccd_step.h"
 #include "gauss6/contacts.h"
 #include "gauss6/runtime.h"
 #include "latency.h"

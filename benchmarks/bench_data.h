@@ -23,6 +23,7 @@
 #include <nlohmann/json.hpp>
 
 #include "gauss6/bvh.h"
+#include "gauss6/ccd_step.h"
 #include "gauss6/mesh_io.h"
 #include "gauss6/pose.h"
 #include "gauss6/runtime.h"

@@ -6,7 +6,7 @@
 
 #include <cmath>
 
-#include "gauss6/contacts.h"  // closest points: the separating axes of the u-filter
+#include "gauss6/distance.h"  // closest points: the separating axes of the u-filter
 
 namespace gauss6 {
 

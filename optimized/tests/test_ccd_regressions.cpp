@@ -18,8 +18,10 @@
 #include <vector>
 
 #include "gauss6/bvh.h"
+#include "gauss6/ccd_step.h"
 #include "gauss6/ccd.h"
 #include "gauss6/contacts.h"
+#include "gauss6/distance.h"
 #include "gauss6/runtime.h"
 #include "gauss6/scene.h"
 

@@ -1,12 +1,12 @@
 // Tests of contacts.h: a box resting on a box (four corner contacts, normals +z,
 // the Jacobian rows), duplicates merged, the edge/edge normal's sign, and the
-// closest-point primitives against dense sampling, and the contact sets
-// found from the CCD's near pairs against those of a full descent.
+// contact sets found from the CCD's near pairs against those of a full descent.
 #include <catch2/catch.hpp>
 
 #include <cmath>
 #include <random>
 
+#include "gauss6/ccd_step.h"
 #include "gauss6/contacts.h"
 #include "mesh_shapes.h"
 
@@ -104,28 +104,6 @@ TEST_CASE("contacts: edge/edge normal points from the obstacle to the god-object
     CHECK(std::abs(c.separation - 0.5 * kDelta) < 1e-12);
     // J row: I - G = (0, 0, -side h) is parallel to n: no torque part.
     CHECK(set.J.row(0).tail<3>().norm() < 1e-12);
-  }
-}
-
-TEST_CASE("contacts: closest points agree with dense sampling", "[contacts]") {
-  std::mt19937 rng(8);
-  std::normal_distribution<double> n(0, 1);
-  for (int i = 0; i < 200; ++i) {
-    const Vec3 p(n(rng), n(rng), n(rng)), a(n(rng), n(rng), n(rng)), b(n(rng), n(rng), n(rng)), c(n(rng), n(rng), n(rng));
-    const double d = (p - closest_point_on_triangle(p, a, b, c)).norm();
-    double best = INFINITY;
-    for (int s = 0; s <= 100; ++s)
-      for (int t = 0; s + t <= 100; ++t) best = std::min(best, (p - (a + (s / 100.0) * (b - a) + (t / 100.0) * (c - a))).norm());
-    CHECK(d <= best + 1e-12);
-    CHECK(d >= best - 0.03 * ((b - a).norm() + (c - a).norm()));  // grid spacing bound
-    const Vec3 q0(n(rng), n(rng), n(rng)), q1(n(rng), n(rng), n(rng));
-    double s, t;
-    closest_segment_parameters(a, b, q0, q1, &s, &t);
-    const double ds = ((a + s * (b - a)) - (q0 + t * (q1 - q0))).norm();
-    double bs = INFINITY;
-    for (int k = 0; k <= 200; ++k)
-      for (int j = 0; j <= 200; ++j) bs = std::min(bs, ((a + (k / 200.0) * (b - a)) - (q0 + (j / 200.0) * (q1 - q0))).norm());
-    CHECK(ds <= bs + 1e-12);
   }
 }
 

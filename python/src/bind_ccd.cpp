@@ -18,6 +18,7 @@
 #include <vector>
 
 #include "gauss6/bvh.h"
+#include "gauss6/ccd_step.h"
 #include "gauss6/ccd.h"
 #include "gauss6/ccd_queries.h"
 #include "gauss6/feature_ids.h"

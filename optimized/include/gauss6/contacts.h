@@ -27,6 +27,8 @@
 #include <Eigen/Core>
 
 #include "gauss6/bvh.h"
+#include "gauss6/ccd_step.h"
+#include "gauss6/motion_bounds.h"
 
 namespace gauss6 {
 
@@ -80,12 +82,5 @@ struct ContactWorkspace {
 ContactStatus generate_contacts(const CcdBody* obstacles, int num_obstacles, const CcdBody& god, const Pose& X_WB,
                                 const ContactSettings& settings, ContactWorkspace* ws, ContactSet* set,
                                 const CcdStepWorkspace::Candidate* pairs = nullptr, int num_pairs = -1);
-
-// Closest points, exposed for tests. Point/triangle: the closest point of
-// triangle (a, b, c) to p. Segment/segment: parameters s on [p0, p1] and t on
-// [q0, q1] of a pair of closest points.
-Vec3 closest_point_on_triangle(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c);
-void closest_segment_parameters(const Vec3& p0, const Vec3& p1, const Vec3& q0, const Vec3& q1, double* s,
-                                double* t);
 
 }  // namespace gauss6

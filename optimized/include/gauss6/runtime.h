@@ -50,6 +50,7 @@
 #include <vector>
 
 #include "gauss6/bvh.h"
+#include "gauss6/ccd_step.h"
 #include "gauss6/contacts.h"
 #include "gauss6/coupling.h"
 #include "gauss6/device.h"

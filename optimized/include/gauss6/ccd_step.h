@@ -1,0 +1,199 @@
+// The mesh-level CCD step ccd_step() (METHOD.md section 4): the first contact
+// between the moving god-object and the static obstacles along the in-between
+// motion, over all their feature pairs, with its settings (CcdStepSettings),
+// its result (CcdStepResult, the near pairs for the contact generation
+// included) and its workspace (CcdStepWorkspace: the narrow phase's boxes,
+// the descent's stack, the candidate list, the god-object's swept boxes and
+// the proximity cache), each allocated once.
+//
+// Frames: obstacles in the world frame W, the god-object in its body frame B
+// (origin at G); swept boxes of god nodes come from the interval enclosure of
+// the motion (ccd.h, motion_bounds.h): for every u in the range and every body
+// point in the node's box, the world point lies in the swept box, rounding
+// included.
+//
+// Real time: no allocation, no locks, no exceptions; fixed-capacity stacks and
+// lists in the workspace, a full one reported as a status.
+#pragma once
+
+#include <algorithm>
+#include <cstdint>
+#include <vector>
+
+#include "gauss6/bvh.h"
+#include "gauss6/ccd.h"
+#include "gauss6/feature_pair.h"
+#include "gauss6/mesh.h"
+#include "gauss6/motion_bounds.h"
+#include "gauss6/pose.h"
+
+namespace gauss6 {
+
+// A mesh and its BVH (built from that mesh). Obstacles: world frame; god-object:
+// body frame.
+struct CcdBody {
+  const TriangleMesh* mesh = nullptr;
+  const Bvh* bvh = nullptr;
+};
+
+struct CcdStepSettings {
+  CcdSettings narrow;                      // tolerances and min_separation of every pair test
+  int max_sub_intervals = 16;              // u-ranges whose swept boxes are computed separately
+  double sub_interval_angle = 0.1;         // radians of rotation per sub-interval (at most)
+  double sub_interval_travel = 0.25;       // travel of G per sub-interval, in god-object radii (at most)
+  long cache_fill_budget = 0;              // node pairs per step that refill the cache in the background
+                                           // (0: no background fill)
+  double cache_margin = 0;                 // coherence between steps: keep the pairs within the reach plus this
+                                           // (scene units) at a pose in contact, and take a later step's candidates
+                                           // from them while no point has moved farther than this from that pose
+                                           // (CcdStepWorkspace::ProximityCache; 0: off; the runtime uses 64 delta)
+  double cache_margin_max = 0;             // a list's margin grows up to this (>= cache_margin) to span about six
+                                           // steps like the last one (0: every list's margin is cache_margin)
+  double near_distance = 0;                // also list the triangle pairs that may come within this (>=
+                                           // min_separation) by the stop pose: the near pairs (CcdStepResult)
+};
+
+struct CcdStepResult {
+  CcdStatus status = CcdStatus::kOk;       // kOk, kHalfTurn (split the step: split_step()),
+                                           // kInvalidInput, or a pair test's give-up (hit kept conservative)
+  bool hit = false;
+  double u_hit = 1;                        // first possible contact over all pairs (<= u*); 1 when none
+  FeaturePair pair;                        // the pair that gave u_hit (when hit)
+  double time_tolerance_reached = 0, distance_reached = 0;  // of that pair's test
+  CcdMotion motion;                        // the enclosed motion used (for make_stop_pose)
+  int num_sub_intervals = 0, num_node_pairs = 0, num_triangle_pairs = 0, num_pair_tests = 0;
+  int num_axis_culls = 0;                  // triangle pairs dropped whole by a separating-axis time bound (no pair test)
+  int num_feature_culls = 0;               // feature pairs dropped by their own time bound (no pair test)
+  long num_box_iterations = 0;             // narrow-phase boxes, all tests together
+  // Near pairs (settings.near_distance > 0): when num_near_pairs >= 0, ws->candidates[0 .. num_near_pairs)
+  // hold every triangle pair that can come within near_reach (= max(min_separation, near_distance)) of
+  // each other under the exact motion at any u in [near_u0, u_hit] (the last sub-interval searched), so
+  // the contact generation at the stop pose can test those instead of descending the trees again (with
+  // the stop pose's deviation taken off near_reach). -1: no such list (the step stopped before any
+  // descent, or the candidate buffer overflowed).
+  int num_near_pairs = -1;
+  double near_u0 = 0, near_reach = 0;
+  bool cache_filled = false;               // the proximity cache was (re)filled at X0 (CcdStepWorkspace)
+  bool cache_refilled = false;             // a background fill of the cache was completed and put in use
+  int num_fill_node_pairs = 0;             // node pairs that the cache's fills (at once or in the background) tested
+  double u_cached = 0;                     // [0, u_cached] searched from the proximity cache (0: not used)
+};
+
+// Everything ccd_step needs, allocated once.
+struct CcdStepWorkspace {
+  explicit CcdStepWorkspace(int box_capacity = 1 << 14, int stack_capacity = 1024, int candidate_capacity = 1 << 14)
+      : narrow(box_capacity),
+        stack(stack_capacity),
+        candidates(static_cast<size_t>(std::max(candidate_capacity, 0))),
+        cache(std::max(candidate_capacity, 0), stack_capacity) {}
+  // A candidate triangle pair of one sub-interval and a lower bound of its first contact parameter.
+  struct Candidate {
+    double earliest;
+    int32_t god_face, obstacle_face, obstacle;
+  };
+  // Coherence between steps (CcdStepSettings::cache_margin). pairs[0 ..
+  // num_pairs) hold every triangle pair not proven farther than reach + margin
+  // apart with the god-object at the exact pose ref: so at any god pose whose
+  // every point lies within `margin` of its place at ref, every pair that may
+  // lie within `reach` is among them. A pose of the god-object in contact
+  // hardly moves from one step to the next (resting, or pressed into an edge
+  // and stopped at once): while a step's motion keeps within the margin of ref,
+  // ccd_step takes its candidates from here instead of descending the trees.
+  // ccd_step refills it (at the step's start) when it cannot serve the step
+  // and a fresh one could (see ccd_step). It is keyed by the god-object's and the obstacles' meshes and
+  // BVHs (pointers), the reach and the settings' margins; clear() it when a
+  // mesh behind the same pointers changes. Each list has its own margin
+  // (CcdStepSettings::cache_margin_max).
+  struct ProximityCache {
+    ProximityCache(int capacity, int stack_capacity)
+        : pairs(static_cast<size_t>(capacity)), fill(capacity, stack_capacity) {}
+    // gap: a lower bound of the pair's distance at ref; radius: the largest
+    // |r_B| of the god triangle's corners. A step whose points move at most
+    // shift + turn |r_B| from ref keeps the pair farther apart than
+    // gap - shift - turn radius.
+    struct Pair {
+      double gap, radius;
+      int32_t god_face, obstacle_face, obstacle;
+    };
+    std::vector<Pair> pairs;
+    int num_pairs = -1;            // -1: empty (never filled, or the pairs did not fit)
+    Pose ref;
+    double reach = 0, margin = 0;  // margin: this list's
+    double margin_min = 0, margin_max = 0;  // the settings it was filled under (keys)
+    int uses = 0;  // later steps served since the fill
+    int rest = 0;  // chances to refill still to pass over (see ccd_step)
+    CcdBody god;
+    std::vector<CcdBody> obstacles;  // grows (allocates) only when a fill sees more obstacles than ever before
+    // A fill in progress (CcdStepSettings::cache_fill_budget): the same kind
+    // of list for the pose `ref` (where the god-object is heading: ccd_step)
+    // and its own margin, built a budget of node pairs per step in the
+    // background while the list above still serves, then swapped in;
+    // finished at once when a step needs it first. Same keys as the list above.
+    struct Fill {
+      Fill(int capacity, int stack_capacity) : pairs(static_cast<size_t>(capacity)), stack(stack_capacity) {}
+      std::vector<Pair> pairs;
+      int num_pairs = 0;
+      Pose ref;
+      double margin = 0;
+      CcdMotion motion;  // still at ref (or the step it started in, when ref is that step's start)
+      BvhStack stack;    // the descent's pending node pairs: stack.items[0 .. pending)
+      int pending = 0;
+      int obstacle = 0;  // the obstacle being descended
+      long cost = 0;     // node pairs tested so far
+      bool active = false, complete = false;
+    } fill;
+    long fill_cost = 0;  // node pairs of the last fill completed
+    Pose last_x0;        // the start of the last step (for the background fill's pose)
+    bool has_last = false;
+    void clear() {
+      num_pairs = -1;
+      fill.active = false;
+    }
+  };
+  // The triangle pair that stopped the last step run in this workspace
+  // (coherence): when it is among a step's hints it is searched first. A
+  // god-object pressed into a corner is stopped by the same pair step after
+  // step, at once; found first, its hit ends the searches of the sliding
+  // contacts there, where each would otherwise search the whole step (a
+  // hundred narrow-phase boxes or more each).
+  FeaturePair last_hit;
+  CcdWorkspace narrow;
+  BvhStack stack;
+  std::vector<Candidate> candidates;  // tested earliest-first; overflow is tested in traversal order
+  SweptBoxCache swept;                // god boxes of the current sub-interval
+  ProximityCache cache;
+};
+
+// The first contact of the god-object moving from X0 to X1 (the Cayley motion)
+// with any obstacle: u_hit <= u* over all feature pairs. Per sub-interval, the
+// candidate triangle pairs get a rigorous lower bound of their first contact
+// from a separating-axis bound of their distance at the sub-interval's start
+// (triangle_gap_lower_bound) and a bound on the god-object's speed; pairs
+// that cannot touch in time are dropped, the rest are tested earliest-first,
+// each only up to (best u so far) - time_tolerance, and the step reports the
+// best u less time_tolerance (so u* - u_hit grows by at most that tolerance).
+// Inputs: obstacles[0 .. num_obstacles) (world frame), god (body frame), X0, X1
+// (poses of G). Stop pose: make_stop_pose(result.motion, result.u_hit,
+// god.bvh->radius) when hit (u = 1 otherwise); with narrow.min_separation = d
+// its exact separation is >= d - deviation.
+//
+// hints[0 .. num_hints): feature pairs likely to touch first (the runtime
+// passes the contacts at X0); their triangle pairs are tested over the whole
+// step before the descent (and not again after it). A pair pressed against an
+// obstacle then gives a hit near u = 0 at once, and the descent searches only
+// up to it, with boxes swept over that short range: the peg pressed into the
+// hole's rim, commanded a millimetre into it, no longer sweeps that millimetre
+// through the hole. Any hint is a real pair, so the answer's guarantee is the
+// same with or without them; out-of-range hints are ignored.
+//
+// With settings.cache_margin > 0, ws->cache carries candidates from one step
+// to the next (CcdStepWorkspace::ProximityCache): the same answer as a fresh
+// descent, for a fraction of its cost while the god-object stays near a pose.
+// With settings.cache_fill_budget > 0 as well, the next list is filled that
+// many node pairs per step, at the pose the god-object is heading for, while
+// the list in use serves.
+void ccd_step(const CcdBody* obstacles, int num_obstacles, const CcdBody& god, const Pose& X0, const Pose& X1,
+              const CcdStepSettings& settings, CcdStepWorkspace* ws, CcdStepResult* result,
+              const FeaturePair* hints = nullptr, int num_hints = 0);
+
+}  // namespace gauss6

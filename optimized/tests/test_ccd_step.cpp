@@ -1,0 +1,679 @@
+// Tests of ccd_step.h: no truly colliding triangle pair culled (against a
+// brute-force all-pairs run of the narrow phase), hints, the proximity cache
+// and its background fill, and ccd_step on steps with a known first contact.
+#include <catch2/catch.hpp>
+
+#include <gmpxx.h>
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <random>
+#include <set>
+
+#include "gauss6/bvh.h"
+#include "gauss6/ccd.h"
+#include "gauss6/ccd_step.h"
+#include "mesh_shapes.h"
+
+using namespace gauss6;
+using gauss6::test::concatenate;
+using gauss6::test::make_box;
+using gauss6::test::make_icosphere;
+
+namespace {
+
+// Brute force: every owned feature pair of every triangle pair over [0, 1]; the
+// earliest hit and the set of triangle pairs with a hit.
+struct BruteForce {
+  bool hit = false;
+  double u_hit = 1;
+  std::set<std::pair<int, int>> hitting_pairs;
+};
+BruteForce brute_force(const TriangleMesh& god, const Bvh& gb, const TriangleMesh& obs, const Bvh& ob,
+                       const CcdMotion& m, const CcdSettings& s) {
+  BruteForce out;
+  CcdWorkspace ws;
+  CcdResult r;
+  const auto V = [](const TriangleMesh& mesh, int f, int k) -> Vec3 { return mesh.V.row(mesh.F(f, k)).transpose(); };
+  for (int gf = 0; gf < god.F.rows(); ++gf)
+    for (int of = 0; of < obs.F.rows(); ++of) {
+      const std::array<Vec3, 3> G = {V(god, gf, 0), V(god, gf, 1), V(god, gf, 2)};
+      const std::array<Vec3, 3> O = {V(obs, of, 0), V(obs, of, 1), V(obs, of, 2)};
+      bool any = false;
+      double first = 2;
+      const auto take = [&] {
+        if (r.hit) { any = true; first = std::min(first, r.u_hit); }
+      };
+      for (int k = 0; k < 3; ++k) {
+        if (gb.owned[gf] & (1u << k)) {
+          ccd_rigid_vertex_face({&m, true, G[k], O, 0, 1}, s, &ws, &r);
+          take();
+        }
+        if (ob.owned[of] & (1u << k)) {
+          ccd_rigid_vertex_face({&m, false, O[k], G, 0, 1}, s, &ws, &r);
+          take();
+        }
+        for (int j = 0; j < 3; ++j)
+          if ((gb.owned[gf] & (8u << k)) && (ob.owned[of] & (8u << j))) {
+            ccd_rigid_edge_edge({&m, {G[k], G[(k + 1) % 3]}, {O[j], O[(j + 1) % 3]}, 0, 1}, s, &ws, &r);
+            take();
+          }
+      }
+      if (any) {
+        out.hitting_pairs.insert({gf, of});
+        if (first < out.u_hit || !out.hit) out.u_hit = first;
+        out.hit = true;
+      }
+    }
+  return out;
+}
+
+}  // namespace
+
+TEST_CASE("BVH: every truly colliding triangle pair is a candidate; ccd_step agrees with brute force", "[ccd_step]") {
+  const TriangleMesh god = make_icosphere(1, 0.5);    // 80 triangles, body frame about G
+  const TriangleMesh obs = make_box(2, 2, 1, Vec3(0, 0, -0.5));  // world frame, top at z = 0
+  const TriangleMesh obs2 = make_icosphere(1, 0.4);
+  const Bvh gb = build_bvh(god, 2), ob = build_bvh(obs, 2), ob2 = build_bvh(obs2, 2);
+  std::mt19937 rng(17);
+  std::uniform_real_distribution<double> U(-1, 1);
+  CcdStepSettings settings;
+  CcdStepWorkspace ws, ws_unordered(1 << 14, 1024, /*candidate_capacity=*/0);
+  int hits = 0;
+  for (int i = 0; i < 40; ++i) {
+    const bool sphere = i % 2;
+    const TriangleMesh& om = sphere ? obs2 : obs;
+    const Bvh& obvh = sphere ? ob2 : ob;
+    // Start above (or beside) the obstacle, end near or through it.
+    const Vec3 start = sphere ? Vec3(1.2 * U(rng), 1.2 * U(rng), 1.2) : Vec3(U(rng), U(rng), 0.6 + 0.3 * std::abs(U(rng)));
+    const Vec3 end = sphere ? Vec3(0.3 * U(rng), 0.3 * U(rng), 0.3 * U(rng)) : Vec3(U(rng), U(rng), 0.3 * U(rng));
+    const Pose x0{start, normalized(Quat{1 + U(rng), U(rng), U(rng), U(rng)})};
+    const Pose x1{end, normalized(quat_exp(Vec3(U(rng), U(rng), U(rng))) * x0.q)};
+    CcdMotion m;
+    REQUIRE(make_ccd_motion(x0, x1, &m) == MotionStatus::kOk);
+    const BruteForce bf = brute_force(god, gb, om, obvh, m, settings.narrow);
+    // Candidates over the whole step.
+    MotionEnclosure e;
+    enclose_motion(m, {0, 1}, &e);
+    std::set<std::pair<int, int>> candidates;
+    BvhStack stack;
+    int node_pairs = 0;
+    const auto ts = for_each_candidate_pair(
+        god, gb, om, obvh, [&](const Aabb& b) { return swept_box(e, b); }, 0.0, &stack,
+        [&](int gf, int of) {
+          candidates.insert({gf, of});
+          return true;
+        },
+        &node_pairs);
+    REQUIRE(ts == TraversalStatus::kDone);
+    for (const auto& p : bf.hitting_pairs) CHECK(candidates.count(p) == 1);
+    // The mesh-level step finds the same first contact (both are lower bounds of
+    // u*, each within its tolerance; 1e-5 bounds their difference).
+    CcdBody ob_body{&om, &obvh};
+    CcdStepResult r;
+    ccd_step(&ob_body, 1, {&god, &gb}, x0, x1, settings, &ws, &r);
+    REQUIRE(r.status == CcdStatus::kOk);
+    CHECK(r.hit == bf.hit);
+    if (r.hit && bf.hit) {
+      ++hits;
+      CHECK(std::abs(r.u_hit - bf.u_hit) <= 1e-5);
+    }
+    // Without a candidate buffer the pairs are tested in traversal order, not
+    // earliest-first: the same first contact (same 1e-5 bound).
+    CcdStepResult r_unordered;
+    ccd_step(&ob_body, 1, {&god, &gb}, x0, x1, settings, &ws_unordered, &r_unordered);
+    CHECK(r_unordered.hit == r.hit);
+    if (r.hit && r_unordered.hit) CHECK(std::abs(r.u_hit - r_unordered.u_hit) <= 1e-5);
+    // With hints (a hitting pair when there is one, a random pair, invalid
+    // ones) and with a probe first: the same first contact (same 1e-5 bound).
+    std::vector<FeaturePair> hints;
+    FeaturePair h;
+    h.obstacle = 0;
+    h.god_face = static_cast<int>(rng() % god.F.rows());
+    h.obstacle_face = static_cast<int>(rng() % om.F.rows());
+    hints.push_back(h);
+    if (!bf.hitting_pairs.empty() && i % 4 < 2) {
+      h.god_face = bf.hitting_pairs.begin()->first;
+      h.obstacle_face = bf.hitting_pairs.begin()->second;
+      hints.push_back(h);
+    }
+    h.obstacle = 3;  // out of range: ignored
+    hints.push_back(h);
+    h.obstacle = 0;
+    h.god_face = -1;
+    hints.push_back(h);
+    CcdStepSettings probing = settings;
+    probing.cache_margin = i % 3 == 0 ? 0.0 : 0.01;
+    CcdStepResult r_hinted;
+    ccd_step(&ob_body, 1, {&god, &gb}, x0, x1, probing, &ws, &r_hinted, hints.data(), static_cast<int>(hints.size()));
+    REQUIRE(r_hinted.status == CcdStatus::kOk);
+    CHECK(r_hinted.hit == bf.hit);
+    if (r_hinted.hit && bf.hit) CHECK(std::abs(r_hinted.u_hit - bf.u_hit) <= 1e-5);
+  }
+  CHECK(hits >= 10);
+}
+
+TEST_CASE("ccd_step: a hint's pair is not searched twice, and a pair sharing one face with a hint is", "[ccd_step]") {
+  // Hints that do not hit, each sharing one face with a pair that does (the
+  // god face with another obstacle face, or the obstacle face with another
+  // god face): the step searches the hints over the whole step first, then
+  // skips exactly those pairs later. Skipping by one face alone would drop the
+  // hitting pairs and stop late or not at all: the brute force's first contact
+  // (the 1e-5 bound of the tests above) must still be found. Also on a
+  // workspace whose last step was stopped by one of the hints (first, in the
+  // middle, or last of them), which is then searched first
+  // (CcdStepWorkspace::last_hit) and the rest in their order.
+  const TriangleMesh god = make_icosphere(1, 0.5);
+  const TriangleMesh obs = make_icosphere(1, 0.4);
+  const Bvh gb = build_bvh(god, 2), ob = build_bvh(obs, 2);
+  std::mt19937 rng(23);
+  std::uniform_real_distribution<double> U(-1, 1);
+  CcdStepSettings settings;
+  CcdStepWorkspace ws;
+  const CcdBody ob_body{&obs, &ob};
+  int checked = 0;
+  for (int i = 0; i < 30; ++i) {
+    const Pose x0{Vec3(1.2 * U(rng), 1.2 * U(rng), 1.2), normalized(Quat{1 + U(rng), U(rng), U(rng), U(rng)})};
+    const Pose x1{Vec3(0.3 * U(rng), 0.3 * U(rng), 0.3 * U(rng)),
+                  normalized(quat_exp(Vec3(U(rng), U(rng), U(rng))) * x0.q)};
+    CcdMotion m;
+    REQUIRE(make_ccd_motion(x0, x1, &m) == MotionStatus::kOk);
+    const BruteForce bf = brute_force(god, gb, obs, ob, m, settings.narrow);
+    if (!bf.hit) continue;
+    std::vector<FeaturePair> hints;
+    // The first pair pair_of(k), k = 1, 2, ..., that never comes within d.
+    const auto add_free = [&](int n, const auto& pair_of) {
+      for (int k = 1; k < n; ++k) {
+        const auto [g, o] = pair_of(k);
+        if (bf.hitting_pairs.count({g, o})) continue;
+        hints.push_back({PairKind::kEdgeEdge, 0, g, 0, o, 0});
+        return;
+      }
+    };
+    const int num_god = static_cast<int>(god.F.rows()), num_obs = static_cast<int>(obs.F.rows());
+    for (const auto& [gf, of] : bf.hitting_pairs) {
+      add_free(num_obs, [&](int k) { return std::pair<int, int>{gf, (of + k) % num_obs}; });  // the god face's
+      add_free(num_god, [&](int k) { return std::pair<int, int>{(gf + k) % num_god, of}; });  // the obstacle face's
+    }
+    // Every other step, a hitting pair among them too (so the lead may hit).
+    if (i % 2 == 0) {
+      const auto [gf, of] = *bf.hitting_pairs.begin();
+      hints.insert(hints.begin() + static_cast<long>(hints.size() / 2), FeaturePair{PairKind::kEdgeEdge, 0, gf, 0, of, 0});
+    }
+    CcdStepResult r;
+    ws.last_hit = FeaturePair{};
+    ccd_step(&ob_body, 1, {&god, &gb}, x0, x1, settings, &ws, &r, hints.data(), static_cast<int>(hints.size()));
+    INFO("step " << i << ", " << hints.size() << " hints");
+    REQUIRE(r.status == CcdStatus::kOk);
+    CHECK(r.hit);
+    CHECK(std::abs(r.u_hit - bf.u_hit) <= 1e-5);
+    for (const size_t lead : {size_t{0}, hints.size() / 2, hints.size() - 1}) {
+      ws.last_hit = hints[lead];
+      ccd_step(&ob_body, 1, {&god, &gb}, x0, x1, settings, &ws, &r, hints.data(), static_cast<int>(hints.size()));
+      INFO("last hit: hint " << lead);
+      REQUIRE(r.status == CcdStatus::kOk);
+      CHECK(r.hit);
+      CHECK(std::abs(r.u_hit - bf.u_hit) <= 1e-5);
+    }
+    ++checked;
+  }
+  CHECK(checked >= 10);
+}
+
+TEST_CASE("ccd_step: steps served by the proximity cache find the first contact of a fresh search", "[ccd_step]") {
+  // A ball kept near a slab with a block standing on it, by a chain of steps
+  // each from the last one's stop pose, as the runtime's are: small jitters
+  // (within the margin: served from the cache), presses into the slab or the
+  // block (hits), and every tenth step a long move (the cache is refilled
+  // where the next step starts in contact). Each step must agree with the
+  // brute force (the same 1e-5 bound as above) and with a step on a workspace
+  // without the cache. Run with the cache refilled at once, refilled in the
+  // background a few node pairs per step (cache_fill_budget: the served steps
+  // then take their pairs from a list that was completed steps after the pose
+  // it holds), and with margins that follow the speed (cache_margin_max).
+  const TriangleMesh god = make_icosphere(1, 0.5);
+  const TriangleMesh slab = concatenate(make_box(3, 3, 1, Vec3(0, 0, -0.5)), make_box(0.4, 0.4, 0.6, Vec3(0.6, 0, 0.3)));
+  const Bvh gb = build_bvh(god, 2), sb = build_bvh(slab, 2);
+  for (const auto [budget, margin_max] : {std::pair{0L, 0.0}, std::pair{12L, 0.0}, std::pair{12L, 0.06}}) {
+  INFO("cache_fill_budget " << budget << ", cache_margin_max " << margin_max);
+  std::mt19937 rng(29);
+  std::uniform_real_distribution<double> U(-1, 1);
+  CcdStepSettings settings, plain;
+  settings.narrow.min_separation = plain.narrow.min_separation = 1e-4;
+  settings.cache_margin = 0.02;
+  settings.cache_fill_budget = budget;
+  settings.cache_margin_max = margin_max;
+  CcdStepWorkspace ws, ws_plain;
+  const CcdBody obstacle{&slab, &sb};
+  Pose x{Vec3(0.1, 0, 0.5 + 0.01), Quat{}};  // 1 cm above the slab
+  std::vector<FeaturePair> hints;
+  int served = 0, fills = 0, refills = 0, hits = 0, gave_up = 0;
+  for (int k = 0; k < 120; ++k) {
+    Vec3 dp = 0.003 * Vec3(U(rng), U(rng), U(rng));
+    Vec3 turn = 0.004 * Vec3(U(rng), U(rng), U(rng));
+    if (k % 3 == 2) dp += Vec3(0.01 * U(rng), 0.01 * U(rng), -0.02);  // press down
+    if (k % 10 == 9) dp += Vec3(0.15 * U(rng), 0.15 * U(rng), 0.05), turn *= 20;  // a long move
+    Pose target{x.p + dp, normalized(quat_exp(turn) * x.q)};
+    // Keep the ball over the slab, away from its far edges.
+    target.p.x() = std::clamp(target.p.x(), -0.3, 0.3);
+    target.p.y() = std::clamp(target.p.y(), -1.0, 1.0);
+    CcdStepResult r, r_plain;
+    ccd_step(&obstacle, 1, {&god, &gb}, x, target, settings, &ws, &r, hints.data(), static_cast<int>(hints.size()));
+    ccd_step(&obstacle, 1, {&god, &gb}, x, target, plain, &ws_plain, &r_plain);
+    INFO("step " << k);
+    CcdMotion m;
+    REQUIRE(make_ccd_motion(x, target, &m) == MotionStatus::kOk);
+    const BruteForce bf = brute_force(god, gb, slab, sb, m, settings.narrow);
+    if (r.status == CcdStatus::kMaxIterations || r_plain.status == CcdStatus::kMaxIterations) {
+      // A pair sliding at about d exhausts the bisection: a conservative hit,
+      // never later than the brute force's (which then gives up too).
+      ++gave_up;
+      CHECK(r.hit);
+      CHECK(r.u_hit <= bf.u_hit + 1e-5);
+    } else {
+      REQUIRE(r.status == CcdStatus::kOk);
+      REQUIRE(r_plain.status == CcdStatus::kOk);
+      CHECK(r.hit == bf.hit);
+      CHECK(r_plain.hit == bf.hit);
+      if (r.hit && bf.hit) CHECK(std::abs(r.u_hit - bf.u_hit) <= 1e-5);
+      if (r.hit && r_plain.hit) CHECK(std::abs(r.u_hit - r_plain.u_hit) <= 1e-5);
+    }
+    served += r.u_cached > 0;
+    fills += r.cache_filled;
+    refills += r.cache_refilled;
+    hits += r.hit;
+    // The next step starts at this one's stop pose, lifted by 3 d (a motion
+    // sliding at exactly d is undecidable at the default distance tolerance);
+    // the pair that stopped it is its hint (the runtime passes the contacts there).
+    x = make_stop_pose(r.motion, r.u_hit, gb.radius).pose;
+    x.p.z() += 3e-4;
+    hints.clear();
+    if (r.hit) hints.push_back(r.pair);
+  }
+  std::printf("proximity cache (fill budget %ld, margins up to %g): %d of 120 steps served from it, %d fills, %d "
+              "background refills, %d hits, %d give-ups\n", budget, std::max(margin_max, settings.cache_margin), served,
+              fills, refills, hits, gave_up);
+  CHECK(gave_up <= 6);
+  CHECK(served >= 30);
+  CHECK(fills >= 3);
+  CHECK(hits >= 20);
+  if (budget == 0) CHECK(refills == 0);
+  }
+}
+
+// The settings of the background-fill tests below: the cache's margin, the
+// widest a list's may grow to, and the fill's node pairs per step.
+static CcdStepSettings background_fill_settings(double margin, double margin_max, long fill_budget) {
+  CcdStepSettings settings;
+  settings.narrow.min_separation = 1e-4;
+  settings.cache_margin = margin;
+  settings.cache_margin_max = margin_max;
+  settings.cache_fill_budget = fill_budget;
+  return settings;
+}
+
+// A hint that only tells ccd_step the step starts in contact (the cache
+// serves only such steps).
+static FeaturePair in_contact_hint() {
+  FeaturePair hint;
+  hint.obstacle = 0;
+  hint.god_face = hint.obstacle_face = 0;
+  return hint;
+}
+
+TEST_CASE("ccd_step: a ball sliding on a slab into a wall, its cache refilled in the background", "[ccd_step]") {
+  // The ball slides 2e-4 above a slab (a hint given, as in contact) towards a
+  // wall, 4 mm a step, with the cache refilled in the background a few node
+  // pairs per step: each list is filled at a pose ahead of the ball and put
+  // in use steps later. The wall comes within reach of pairs that were not in
+  // the lists before; every step must still agree with the brute force, and
+  // the step that meets the wall must stop where it does. (The test below,
+  // with the ball wandering, also checks what each list holds.)
+  // Run with every list's margin 3 cm, and with margins up to 8 cm sized to
+  // the ball's speed (cache_margin_max; the ball then slides 8 mm a step).
+  const TriangleMesh god = make_icosphere(1, 0.5);
+  double z_min = 1e300, x_max = -1e300;
+  for (Eigen::Index v = 0; v < god.V.rows(); ++v) {
+    z_min = std::min(z_min, god.V(v, 2));
+    x_max = std::max(x_max, god.V(v, 0));
+  }
+  const double wall_x = x_max + 0.25;
+  const TriangleMesh scene = concatenate(make_box(3, 3, 1, Vec3(0, 0, -0.5)), make_box(0.2, 2, 1, Vec3(wall_x + 0.1, 0, 0.5)));
+  const Bvh gb = build_bvh(god, 2), sb = build_bvh(scene, 2);
+  for (const double margin_max : {0.0, 0.08}) {
+  INFO("cache_margin_max " << margin_max);
+  const CcdStepSettings settings = background_fill_settings(0.03, margin_max, 6);
+  CcdStepWorkspace ws;
+  const CcdBody obstacle{&scene, &sb};
+  const FeaturePair hint = in_contact_hint();
+  Pose x{Vec3(0, 0, 2e-4 - z_min), Quat{}};
+  int served = 0, refills = 0, steps = 0;
+  bool met_wall = false;
+  for (; steps < 100 && !met_wall; ++steps) {
+    const Pose target{x.p + Vec3(margin_max > 0 ? 0.008 : 0.004, 0, 0), x.q};
+    CcdStepResult r;
+    ccd_step(&obstacle, 1, {&god, &gb}, x, target, settings, &ws, &r, &hint, 1);
+    INFO("step " << steps);
+    REQUIRE(r.status == CcdStatus::kOk);
+    CcdMotion m;
+    REQUIRE(make_ccd_motion(x, target, &m) == MotionStatus::kOk);
+    const BruteForce bf = brute_force(god, gb, scene, sb, m, settings.narrow);
+    REQUIRE(r.hit == bf.hit);
+    if (r.hit) CHECK(std::abs(r.u_hit - bf.u_hit) <= 1e-5);
+    served += r.u_cached > 0;
+    refills += r.cache_refilled;
+    met_wall = r.hit;
+    x = target;
+  }
+  std::printf("sliding into a wall (margins up to %g): %d steps, %d served from the cache, %d background refills\n",
+              std::max(margin_max, settings.cache_margin), steps, served, refills);
+  CHECK(met_wall);
+  CHECK(served >= steps / 2);
+  CHECK(refills >= 3);
+  }
+}
+
+TEST_CASE("ccd_step: a ball wandering among blocks, lists filled ahead of it in the background", "[ccd_step]") {
+  // The ball wanders 2e-4 above a slab studded with blocks (a hint given, as
+  // in contact), its velocity turning a little each step and its speed
+  // between 1 and 12 mm a step, now and then reversing: the lists filled ahead
+  // of it (cache_fill_budget) are sometimes where it goes and sometimes not,
+  // and their margins follow its speed (cache_margin_max). A step that meets
+  // a block stops there, and the next starts from the stop pose. Every step
+  // must agree with the brute force, and every tenth step the list in use
+  // must hold the pairs its margin promises.
+  const TriangleMesh god = make_icosphere(1, 0.25);
+  double z_min = 1e300;
+  for (Eigen::Index v = 0; v < god.V.rows(); ++v) z_min = std::min(z_min, god.V(v, 2));
+  TriangleMesh scene = make_box(4, 4, 1, Vec3(0, 0, -0.5));
+  for (int i = -2; i <= 2; ++i)
+    for (int j = -2; j <= 2; ++j)
+      if (i != 0 || j != 0) scene = concatenate(scene, make_box(0.12, 0.12, 0.1, Vec3(0.55 * i, 0.55 * j, 0.05)));
+  const Bvh gb = build_bvh(god, 2), sb = build_bvh(scene, 2);
+  const CcdStepSettings settings = background_fill_settings(0.02, 0.06, 30);
+  CcdStepWorkspace ws;
+  const CcdBody obstacle{&scene, &sb};
+  const FeaturePair hint = in_contact_hint();
+  std::mt19937 rng(41);
+  std::uniform_real_distribution<double> U(-1, 1);
+  const double z = 2e-4 - z_min;
+  Pose x{Vec3(0.15, 0.1, z), Quat{}};
+  double heading = 0.8;
+  int served = 0, refills = 0, hits = 0;
+  double widest = 0;  // the widest margin of a list checked
+  for (int k = 0; k < 250; ++k) {
+    heading += 0.15 * U(rng);
+    if (k % 80 == 79) heading += 3.0;  // turn back
+    const double speed = 0.001 + 0.011 * (0.5 + 0.5 * std::sin(k / 15.0));
+    Vec3 p = x.p + speed * Vec3(std::cos(heading), std::sin(heading), 0);
+    p.z() = z;
+    if (std::abs(p.x()) > 1.5 || std::abs(p.y()) > 1.5) heading += 3.0, p = x.p;  // keep over the slab
+    const Pose target{p, normalized(quat_exp(Vec3(0, 0, 0.02 * U(rng))) * x.q)};
+    CcdStepResult r;
+    ccd_step(&obstacle, 1, {&god, &gb}, x, target, settings, &ws, &r, &hint, 1);
+    INFO("step " << k);
+    CcdMotion m;
+    REQUIRE(make_ccd_motion(x, target, &m) == MotionStatus::kOk);
+    const BruteForce bf = brute_force(god, gb, scene, sb, m, settings.narrow);
+    if (r.status == CcdStatus::kMaxIterations) {
+      CHECK(r.hit);
+      CHECK(r.u_hit <= bf.u_hit + 1e-5);
+    } else {
+      REQUIRE(r.status == CcdStatus::kOk);
+      REQUIRE(r.hit == bf.hit);
+      if (r.hit) CHECK(std::abs(r.u_hit - bf.u_hit) <= 1e-5);
+    }
+    served += r.u_cached > 0;
+    refills += r.cache_refilled;
+    hits += r.hit;
+    if (k % 10 == 0 && ws.cache.num_pairs >= 0) {
+      // The list in use holds every pair within its reach plus its margin at
+      // its pose: here, every pair with two corners that close.
+      const CcdStepWorkspace::ProximityCache& pc = ws.cache;
+      std::set<std::pair<int, int>> listed;
+      for (int i = 0; i < pc.num_pairs; ++i) listed.insert({pc.pairs[i].god_face, pc.pairs[i].obstacle_face});
+      const double within = (pc.reach + pc.margin) * (1 - 1e-9);
+      widest = std::max(widest, pc.margin);
+      for (Eigen::Index gf = 0; gf < god.F.rows(); ++gf)
+        for (Eigen::Index of = 0; of < scene.F.rows(); ++of) {
+          double d = 1e300;
+          for (int a = 0; a < 3; ++a)
+            for (int b = 0; b < 3; ++b)
+              d = std::min(d, (transform_point(pc.ref, god.V.row(god.F(gf, a)).transpose()) -
+                               scene.V.row(scene.F(of, b)).transpose()).norm());
+          if (d <= within) CHECK(listed.count({static_cast<int>(gf), static_cast<int>(of)}) == 1);
+        }
+    }
+    if (r.hit) {
+      x = make_stop_pose(r.motion, r.u_hit, gb.radius).pose;
+      x.p.z() = z;
+      heading += 3.0;  // bounce back
+    } else {
+      x = target;
+    }
+  }
+  std::printf("wandering among blocks: %d of 250 steps served from the cache, %d background refills, %d hits, "
+              "margins up to %g\n", served, refills, hits, widest);
+  CHECK(widest > 1.5 * settings.cache_margin);
+  CHECK(served >= 125);
+  CHECK(refills >= 8);
+  CHECK(hits >= 5);
+}
+
+TEST_CASE("ccd_step: a workspace without room to descend is never served an empty cache", "[ccd_step]") {
+  // A ball pressed into a slab, in contact (a hint given), on a workspace whose
+  // traversal stack holds nothing: every descent, the cache's fill included,
+  // must report the workspace full and stop at the start, as a step without
+  // the cache does, rather than serve the step from a list it never filled.
+  const TriangleMesh god = make_icosphere(1, 0.5), slab = make_box(3, 3, 1, Vec3(0, 0, -0.5));
+  const Bvh gb = build_bvh(god, 2), sb = build_bvh(slab, 2);
+  double z_min = 1e300;
+  for (Eigen::Index v = 0; v < god.V.rows(); ++v) z_min = std::min(z_min, god.V(v, 2));
+  const Pose x0{Vec3(0, 0, 2e-4 - z_min), Quat{}}, x1{x0.p + Vec3(0, 0, -0.01), x0.q};
+  const FeaturePair hint = in_contact_hint();
+  const CcdBody obstacle{&slab, &sb};
+  for (const double margin : {0.0, 0.02}) {
+    INFO("cache_margin " << margin);
+    CcdStepWorkspace ws(1 << 14, /*stack_capacity=*/0);
+    CcdStepResult r;
+    ccd_step(&obstacle, 1, {&god, &gb}, x0, x1, background_fill_settings(margin, 0, 0), &ws, &r, &hint, 1);
+    CHECK(r.status == CcdStatus::kWorkspaceFull);
+    CHECK(r.hit);
+    CHECK(r.u_hit == 0);
+    CHECK_FALSE(r.cache_filled);
+  }
+}
+
+TEST_CASE("ccd_step: the proximity cache is not served for another mesh behind the same CcdBody", "[ccd_step]") {
+  // A ball 2 d above a slab, in contact (a hint given): a first small step
+  // fills the cache. The obstacle's CcdBody, the same variable, then points to
+  // a new mesh: the slab plus a cube 5 mm beside the ball, which the next step
+  // pushes the ball into (1.5 cm, within the 2 cm margin). That step must find
+  // the cube, as the brute force does; on the old mesh the same step is served
+  // from the cache (the control).
+  const TriangleMesh god = make_icosphere(1, 0.5), slab = make_box(3, 3, 1, Vec3(0, 0, -0.5));
+  const Bvh gb = build_bvh(god, 2), sb = build_bvh(slab, 2);
+  CcdStepSettings settings;
+  settings.narrow.min_separation = 1e-4;
+  settings.cache_margin = 0.02;
+  double z_min = 1e300, y_max = -1e300;
+  for (Eigen::Index v = 0; v < god.V.rows(); ++v) {
+    z_min = std::min(z_min, god.V(v, 2));
+    y_max = std::max(y_max, god.V(v, 1));
+  }
+  const Pose x0{Vec3(0, 0, 2e-4 - z_min), Quat{}};
+  const Pose x1{x0.p + Vec3(1e-3, 0, 0), x0.q}, x2{x1.p + Vec3(0, 0.015, 0), x1.q};
+  const TriangleMesh slab_cube = concatenate(slab, make_box(0.1, 0.1, 0.1, Vec3(x1.p.x(), y_max + 0.005 + 0.05, x1.p.z())));
+  const Bvh scb = build_bvh(slab_cube, 2);
+  FeaturePair hint;
+  hint.obstacle = 0;
+  hint.god_face = hint.obstacle_face = 0;
+  for (const bool swap : {false, true}) {
+    CcdStepWorkspace ws;
+    CcdBody obstacle{&slab, &sb};
+    CcdStepResult r;
+    ccd_step(&obstacle, 1, {&god, &gb}, x0, x1, settings, &ws, &r, &hint, 1);
+    REQUIRE(r.status == CcdStatus::kOk);
+    CHECK(r.cache_filled);
+    CHECK_FALSE(r.hit);
+    if (swap) obstacle = {&slab_cube, &scb};
+    ccd_step(&obstacle, 1, {&god, &gb}, x1, x2, settings, &ws, &r, &hint, 1);
+    REQUIRE(r.status == CcdStatus::kOk);
+    CcdMotion m;
+    REQUIRE(make_ccd_motion(x1, x2, &m) == MotionStatus::kOk);
+    const BruteForce bf = brute_force(god, gb, swap ? slab_cube : slab, swap ? scb : sb, m, settings.narrow);
+    CHECK(bf.hit == swap);
+    CHECK(r.hit == bf.hit);
+    if (r.hit && bf.hit) CHECK(std::abs(r.u_hit - bf.u_hit) <= 1e-5);
+    if (!swap) CHECK((r.u_cached == 1.0 && !r.cache_filled));  // served whole from the cache
+  }
+}
+
+TEST_CASE("ccd_step: a box falling flat onto a slab, and one tipping onto it", "[ccd_step]") {
+  const TriangleMesh god = make_box(1, 1, 1);
+  const TriangleMesh slab = make_box(4, 4, 1, Vec3(0, 0, -0.5));  // top face z = 0
+  const Bvh gb = build_bvh(god), sb = build_bvh(slab);
+  const CcdBody obstacle{&slab, &sb};
+  const CcdBody body{&god, &gb};
+  CcdStepSettings settings;
+  CcdStepWorkspace ws;
+  CcdStepResult r;
+
+  SECTION("falling: the bottom face (z = G - 1/2) reaches z = 0 at u = 1/3") {
+    ccd_step(&obstacle, 1, body, {Vec3(0.1, 0.2, 1.5), Quat{}}, {Vec3(0.1, 0.2, -1.5), Quat{}}, settings, &ws, &r);
+    REQUIRE(r.status == CcdStatus::kOk);
+    REQUIRE(r.hit);
+    CHECK(mpq_class(r.u_hit) <= mpq_class(1, 3));
+    CHECK(1.0 / 3 - r.u_hit <= 1e-5);  // time tolerance 1e-6, distance tolerance 1e-9 at speed 3
+    // Stop pose with min separation: the exact separation stays >= d - deviation > 0.
+    CcdStepSettings sep = settings;
+    sep.narrow.min_separation = 1e-5;
+    ccd_step(&obstacle, 1, body, {Vec3(0.1, 0.2, 1.5), Quat{}}, {Vec3(0.1, 0.2, -1.5), Quat{}}, sep, &ws, &r);
+    REQUIRE(r.hit);
+    const StopPose sp = make_stop_pose(r.motion, r.u_hit, gb.radius);
+    CHECK(sp.deviation < 1e-12);
+    const double bottom = sp.pose.p.z() - 0.5;
+    CHECK(bottom >= 1e-5 - 1e-12);
+    CHECK(bottom <= 1e-5 + 1e-4);  // no stop far from contact (3 u-tolerance + distance tolerances)
+    std::printf("falling box: u_hit %.12f, gap at stop %.3e, %d triangle pairs, %d pair tests, %ld boxes\n", r.u_hit,
+                bottom, r.num_triangle_pairs, r.num_pair_tests, r.num_box_iterations);
+  }
+  SECTION("tipping: a quarter turn about x lowers the box's edge onto the slab") {
+    // G at height 0.6; turning by theta about x, the lowest edge is at
+    // 0.6 - (cos theta + sin theta) / 2: zero at theta* = asin(1.2 / sqrt 2) - 45 deg.
+    // With a 90 degree step, u* = tan(theta* / 2) / tan(45 deg).
+    const double theta = std::asin(1.2 / std::sqrt(2.0)) - M_PI / 4;
+    const double u_star = std::tan(theta / 2);
+    ccd_step(&obstacle, 1, body, {Vec3(0, 0, 0.6), Quat{}}, {Vec3(0, 0, 0.6), quat_exp(Vec3(M_PI / 2, 0, 0))},
+             settings, &ws, &r);
+    REQUIRE(r.status == CcdStatus::kOk);
+    REQUIRE(r.hit);
+    CHECK(r.u_hit <= u_star + 1e-12);  // 1e-12: u_star's own rounding
+    CHECK(u_star - r.u_hit <= 1e-5);
+    std::printf("tipping box: u_hit %.12f (u* %.12f), %d sub-intervals, %d triangle pairs, %d pair tests\n", r.u_hit,
+                u_star, r.num_sub_intervals, r.num_triangle_pairs, r.num_pair_tests);
+  }
+  SECTION("moving away: no hit; bad poses and half turns are statuses") {
+    ccd_step(&obstacle, 1, body, {Vec3(0, 0, 0.6), Quat{}}, {Vec3(0.3, 0, 2), quat_exp(Vec3(0, 0, 1))}, settings, &ws,
+             &r);
+    CHECK(r.status == CcdStatus::kOk);
+    CHECK_FALSE(r.hit);
+    CHECK(r.u_hit == 1.0);
+    ccd_step(&obstacle, 1, body, {Vec3(0, 0, NAN), Quat{}}, {Vec3(0, 0, 2), Quat{}}, settings, &ws, &r);
+    CHECK(r.status == CcdStatus::kInvalidInput);
+    ccd_step(&obstacle, 1, body, {Vec3(0, 0, 2), Quat{}}, {Vec3(0, 0, 2), quat_exp(Vec3(0, 0, 3.1))}, settings, &ws,
+             &r);
+    CHECK(r.status == CcdStatus::kHalfTurn);
+  }
+}
+
+TEST_CASE("ccd_step: a bar pivoting about its lowest corner over a slab agrees with the brute force", "[ccd_step]") {
+  // A 10 x 2 x 2 bar tilted over a slab, its lowest corner a small gap above
+  // it, turned about that corner (G moving by the turn of its offset from the
+  // corner), plus a small translation that sometimes presses the corner in:
+  // the motion whose translation and turn cancel near the contact, which the
+  // swept oriented boxes and time bounds take as such (bvh.h: SweptObbFrame,
+  // TriangleMotion::lag). Each step must agree with the brute force (the 1e-5
+  // bound of the tests above), with and without hints and the cache.
+  const TriangleMesh god = make_box(0.1, 0.02, 0.02);
+  const TriangleMesh slab = concatenate(make_box(1, 1, 0.1, Vec3(0, 0, -0.05)), make_box(0.02, 0.4, 0.1, Vec3(0.12, 0, 0.05)));
+  const Bvh gb = build_bvh(god, 2), sb = build_bvh(slab, 2);
+  const CcdBody obstacle{&slab, &sb};
+  std::mt19937 rng(53);
+  std::uniform_real_distribution<double> U(-1, 1);
+  CcdStepSettings settings, cached;
+  settings.narrow.min_separation = cached.narrow.min_separation = 1e-5;
+  cached.cache_margin = 1e-3;
+  CcdStepWorkspace ws, ws_cached;
+  int hits = 0;
+  for (int i = 0; i < 40; ++i) {
+    const Quat q0 = normalized(quat_exp(Vec3(0.3 * U(rng), 0.3 + 0.2 * U(rng), 0.3 * U(rng))));
+    const Mat3 R0 = rotation_matrix(q0);
+    Vec3 lowest(0, 0, 1e300);
+    for (int k = 0; k < god.V.rows(); ++k) {
+      const Vec3 x = R0 * god.V.row(k).transpose();
+      if (x.z() < lowest.z()) lowest = x;
+    }
+    const double gap = std::pow(10.0, -2 - 2 * std::abs(U(rng)));
+    const Vec3 G0 = Vec3(0.02 * U(rng), 0.02 * U(rng), gap - lowest.z());
+    const Vec3 pivot = G0 + lowest;
+    const Vec3 turn = (i % 4 == 0 ? 0.01 : 0.2) * Vec3(U(rng), U(rng), U(rng));
+    const Mat3 Q = rotation_matrix(normalized(quat_exp(turn)));
+    const Vec3 press = (i % 3 == 0 ? 2 * gap : 0.0) * Vec3(0.3 * U(rng), 0.3 * U(rng), -1);
+    const Pose x0{G0, q0}, x1{pivot + Q * (G0 - pivot) + press, normalized(quat_exp(turn) * q0)};
+    CcdMotion m;
+    REQUIRE(make_ccd_motion(x0, x1, &m) == MotionStatus::kOk);
+    const BruteForce bf = brute_force(god, gb, slab, sb, m, settings.narrow);
+    INFO("step " << i << ", gap " << gap);
+    CcdStepResult r;
+    ccd_step(&obstacle, 1, {&god, &gb}, x0, x1, settings, &ws, &r);
+    REQUIRE(r.status == CcdStatus::kOk);
+    CHECK(r.hit == bf.hit);
+    if (r.hit && bf.hit) CHECK(std::abs(r.u_hit - bf.u_hit) <= 1e-5);
+    hits += bf.hit;
+    // Hinted by a pair of faces near the pivot, through the proximity cache.
+    const FeaturePair hint{PairKind::kEdgeEdge, 0, 0, 0, 2, 0};
+    ccd_step(&obstacle, 1, {&god, &gb}, x0, x1, cached, &ws_cached, &r, &hint, 1);
+    REQUIRE(r.status == CcdStatus::kOk);
+    CHECK(r.hit == bf.hit);
+    if (r.hit && bf.hit) CHECK(std::abs(r.u_hit - bf.u_hit) <= 1e-5);
+  }
+  CHECK(hits >= 8);
+  CHECK(hits <= 32);
+}
+
+TEST_CASE("ccd_step timing on spheres", "[ccd_step][timing]") {
+  // Prints per-step times for the report; fails only on a bad status.
+  const TriangleMesh god = make_icosphere(3, 0.5), obs = make_icosphere(4, 1.0);
+  const Bvh gb = build_bvh(god), ob = build_bvh(obs);
+  CcdStepSettings settings;
+  settings.narrow.min_separation = 1e-5;
+  CcdStepWorkspace ws;
+  CcdStepResult r;
+  const CcdBody obstacle{&obs, &ob};
+  std::mt19937 rng(1);
+  std::uniform_real_distribution<double> U(-1, 1);
+  double total = 0, worst = 0;
+  int hits = 0;
+  long pair_tests = 0, boxes = 0, triangle_pairs = 0;
+  const int n = 50;
+  for (int i = 0; i < n; ++i) {
+    const Vec3 dir = Vec3(U(rng), U(rng), U(rng)).normalized();
+    const Pose x0{1.6 * dir, Quat{}};
+    const Pose x1{(1.45 + 0.1 * U(rng)) * dir + 0.02 * Vec3(U(rng), U(rng), U(rng)), quat_exp(0.05 * Vec3(U(rng), U(rng), U(rng)))};
+    const auto t0 = std::chrono::steady_clock::now();
+    ccd_step(&obstacle, 1, {&god, &gb}, x0, x1, settings, &ws, &r);
+    const double dt = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    total += dt;
+    worst = std::max(worst, dt);
+    hits += r.hit;
+    pair_tests += r.num_pair_tests;
+    boxes += r.num_box_iterations;
+    triangle_pairs += r.num_triangle_pairs;
+    REQUIRE(r.status == CcdStatus::kOk);
+  }
+  std::printf("ccd_step, icosphere 1280 tris vs 5120 tris, approach steps: mean %.1f us, worst %.1f us, %d/%d hits; "
+              "per step %ld triangle pairs, %ld pair tests, %ld boxes\n",
+              1e6 * total / n, 1e6 * worst, hits, n, triangle_pairs / n, pair_tests / n, boxes / n);
+}
