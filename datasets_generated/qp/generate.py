@@ -19,15 +19,25 @@ import argparse
 import hashlib
 import json
 import math
+import os
+import platform
 import sys
 import time
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Callable
 
-import numpy as np
-from numpy.random import PCG64, Generator
-from scipy.optimize import linprog
+# numpy's OpenBLAS picks its kernels by CPU, and the last bits of small matrix
+# products differ between its AVX-512 (SkylakeX) and AVX2 (Haswell, Zen) kernels:
+# the files would depend on the machine that wrote them. Pin the AVX2 kernels on
+# x86-64 (which MANIFEST.json was written with); OpenBLAS reads this when numpy
+# loads it, so the generator must run in a process of its own (qp_instances.generate).
+if platform.machine() in ("x86_64", "AMD64"):
+    os.environ.setdefault("OPENBLAS_CORETYPE", "Haswell")
+
+import numpy as np  # noqa: E402
+from numpy.random import PCG64, Generator  # noqa: E402
+from scipy.optimize import linprog  # noqa: E402
 
 FORMAT = "gauss6-qp-instances"
 FORMAT_VERSION = 1

@@ -10,8 +10,8 @@ temporary directory and compares it with MANIFEST.json.
 from __future__ import annotations
 
 import hashlib
-import importlib.util
 import json
+import subprocess
 import sys
 import tempfile
 from dataclasses import dataclass, field
@@ -123,18 +123,16 @@ def _sha256(path: Path) -> str:
 
 def generate(out_dir: Path | None = None) -> None:
     """Run the generator (datasets_generated/qp/generate.py): every family and
-    MANIFEST.json into out_dir (default: in place)."""
+    MANIFEST.json into out_dir (default: in place). It runs in a process of its own, so
+    that it loads numpy's OpenBLAS with the kernels it pins (see the generator's imports):
+    the files are then the same bytes on every x86-64 machine. Raises RuntimeError with
+    the generator's own error output when it fails."""
     gen_path = FAMILIES_DIR / "generate.py"
-    # Load the generator by path (datasets_generated/ is not a package); it must be in
-    # sys.modules while it runs, for its dataclasses.
-    spec = importlib.util.spec_from_file_location("gauss6_qp_generate", gen_path)
-    gen = importlib.util.module_from_spec(spec)
-    sys.modules[spec.name] = gen
-    try:
-        spec.loader.exec_module(gen)
-        gen.main(["--out", str(out_dir if out_dir is not None else FAMILIES_DIR)])
-    finally:
-        sys.modules.pop(spec.name, None)
+    cmd = [sys.executable, str(gen_path), "--out", str(out_dir if out_dir is not None else FAMILIES_DIR)]
+    r = subprocess.run(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
+    if r.returncode != 0:
+        raise RuntimeError(f"{gen_path} failed (exit {r.returncode}):\n{r.stderr}")
+    sys.stderr.write(r.stderr)
 
 
 def check_all() -> list[str]:
