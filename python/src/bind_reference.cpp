@@ -16,10 +16,10 @@ namespace gauss6::python {
 namespace {
 const char* to_string(reference::ProjectionStatus s) {
   switch (s) {
-    case reference::ProjectionStatus::optimal: return "optimal";
-    case reference::ProjectionStatus::infeasible: return "infeasible";
-    case reference::ProjectionStatus::solver_failure: return "solver_failure";
-    case reference::ProjectionStatus::bad_input: return "bad_input";
+    case reference::ProjectionStatus::kOptimal: return "optimal";
+    case reference::ProjectionStatus::kInfeasibleOffsets: return "infeasible";
+    case reference::ProjectionStatus::kSolverFailure: return "solver_failure";
+    case reference::ProjectionStatus::kBadInput: return "bad_input";
   }
   return "unknown";
 }
@@ -42,7 +42,7 @@ void bind_reference(py::module_& m) {
 
   ref.def("project",
           [](const Mat6& M, const Vec6& au, const Eigen::MatrixXd& J, const std::optional<Eigen::VectorXd>& b) {
-            const reference::ExactProjection p = reference::project_exact(M, au, J, rhs_or_zero(b, J.rows()));
+            const reference::ProjectionResult p = reference::project({M, au, J, rhs_or_zero(b, J.rows())});
             py::dict d;
             d["status"] = to_string(p.status);
             d["ac"] = p.ac_double;
@@ -58,7 +58,7 @@ void bind_reference(py::module_& m) {
           [](const Mat6& M, const Vec6& au, const Eigen::MatrixXd& J, const std::optional<Eigen::VectorXd>& b,
              const std::vector<int>& active) {
             const reference::CertificateReport r =
-                reference::check_certificate(M, au, J, rhs_or_zero(b, J.rows()), active);
+                reference::check_certificate({M, au, J, rhs_or_zero(b, J.rows())}, active);
             py::dict d;
             d["pass"] = r.pass;
             d["failure"] = to_string(r.failure);

@@ -384,7 +384,7 @@ Alg to_algebraic(const ExactToi& t) {
 }
 
 ExactToi solve(PairPredicates pr, double u_max = 1.0) {
-  if (!(u_max > 0 && u_max <= 1)) throw std::invalid_argument("exact CCD: u_max must be in (0, 1]");
+  if (!(u_max > 0 && u_max <= 1)) throw std::invalid_argument("exact CCD: u_end must be in (0, 1]");
   const std::optional<Alg> u = first_contact(pr, mpq_class(u_max));
   return u ? make_toi(*u) : ExactToi{};
 }
@@ -564,23 +564,25 @@ int compare_toi(const ExactToi& a, const ExactToi& b) {
 
 ExactPoint to_exact(const RationalPoint& p) { return {exact(p.xyz[0]), exact(p.xyz[1]), exact(p.xyz[2])}; }
 
-ExactToi vertex_face_toi_linear(const std::array<ExactPoint, 4>& x0, const std::array<ExactPoint, 4>& x1) {
-  const auto pts = linear_points(x0, x1);
+ExactToi ccd_linear_vertex_face(const LinearVertexFaceQuery& q) {
+  const auto& [v, f] = q;
+  const auto pts = linear_points({v[0], f[0][0], f[0][1], f[0][2]}, {v[1], f[1][0], f[1][1], f[1][2]});
   return solve(vertex_face_predicates(pts[0], pts[1], pts[2], pts[3], Weight{}));
 }
 
-ExactToi edge_edge_toi_linear(const std::array<ExactPoint, 4>& x0, const std::array<ExactPoint, 4>& x1) {
-  const auto pts = linear_points(x0, x1);
+ExactToi ccd_linear_edge_edge(const LinearEdgeEdgeQuery& q) {
+  const auto& [a, b] = q;
+  const auto pts = linear_points({a[0][0], a[0][1], b[0][0], b[0][1]}, {a[1][0], a[1][1], b[1][0], b[1][1]});
   return solve(edge_edge_predicates(pts[0], pts[1], pts[2], pts[3], Weight{}));
 }
 
 ExactToi query_toi(const CcdQuery& q) {
-  std::array<ExactPoint, 4> x0, x1;
-  for (int i = 0; i < 4; ++i) {
-    x0[i] = to_exact(q.points[i]);
-    x1[i] = to_exact(q.points[4 + i]);
-  }
-  return q.kind == CcdQuery::kVertexFace ? vertex_face_toi_linear(x0, x1) : edge_edge_toi_linear(x0, x1);
+  // Points in the order v, f0, f1, f2 (vertex/face) or a0, a1, b0, b1 (edge/edge).
+  std::array<ExactPoint, 8> x;
+  for (int i = 0; i < 8; ++i) x[i] = to_exact(q.points[i]);
+  if (q.kind == CcdQuery::kVertexFace)
+    return ccd_linear_vertex_face({{x[0], x[4]}, {{{x[1], x[2], x[3]}, {x[5], x[6], x[7]}}}});
+  return ccd_linear_edge_edge({{{{x[0], x[1]}, {x[4], x[5]}}}, {{{x[2], x[3]}, {x[6], x[7]}}}});
 }
 
 ExactCayleyMotion make_exact_cayley_motion(const Pose& X0, const Pose& X1) {
@@ -647,32 +649,28 @@ ExactPoint motion_point_exact(const ExactCayleyMotion& m, const mpq_class& u, co
   return out;
 }
 
-ExactToi moving_vertex_face_toi(const ExactCayleyMotion& m, const Vec3& v_B, const std::array<Vec3, 3>& f_W,
-                                double u_max) {
-  return solve(moving_vertex_face_predicates(m, v_B, f_W), u_max);
+ExactToi ccd_rigid_vertex_face(const RigidVertexFaceQuery& q) {
+  return solve(moving_vertex_face_predicates(*q.motion, q.vertex_B, q.face_W), q.u_end);
 }
 
-ExactToi vertex_moving_face_toi(const ExactCayleyMotion& m, const Vec3& v_W, const std::array<Vec3, 3>& f_B,
-                                double u_max) {
-  return solve(vertex_moving_face_predicates(m, v_W, f_B), u_max);
+ExactToi ccd_rigid_face_vertex(const RigidFaceVertexQuery& q) {
+  return solve(vertex_moving_face_predicates(*q.motion, q.vertex_W, q.face_B), q.u_end);
 }
 
-ExactToi moving_edge_edge_toi(const ExactCayleyMotion& m, const std::array<Vec3, 2>& e_B,
-                              const std::array<Vec3, 2>& e_W, double u_max) {
-  return solve(moving_edge_edge_predicates(m, e_B, e_W), u_max);
+ExactToi ccd_rigid_edge_edge(const RigidEdgeEdgeQuery& q) {
+  return solve(moving_edge_edge_predicates(*q.motion, q.edge_B, q.edge_W), q.u_end);
 }
 
-int moving_vertex_face_degree(const ExactCayleyMotion& m, const Vec3& v_B, const std::array<Vec3, 3>& f_W) {
-  return degree(moving_vertex_face_predicates(m, v_B, f_W).coplanar);
+int coplanarity_degree(const RigidVertexFaceQuery& q) {
+  return degree(moving_vertex_face_predicates(*q.motion, q.vertex_B, q.face_W).coplanar);
 }
 
-int vertex_moving_face_degree(const ExactCayleyMotion& m, const Vec3& v_W, const std::array<Vec3, 3>& f_B) {
-  return degree(vertex_moving_face_predicates(m, v_W, f_B).coplanar);
+int coplanarity_degree(const RigidFaceVertexQuery& q) {
+  return degree(vertex_moving_face_predicates(*q.motion, q.vertex_W, q.face_B).coplanar);
 }
 
-int moving_edge_edge_degree(const ExactCayleyMotion& m, const std::array<Vec3, 2>& e_B,
-                            const std::array<Vec3, 2>& e_W) {
-  return degree(moving_edge_edge_predicates(m, e_B, e_W).coplanar);
+int coplanarity_degree(const RigidEdgeEdgeQuery& q) {
+  return degree(moving_edge_edge_predicates(*q.motion, q.edge_B, q.edge_W).coplanar);
 }
 
 }  // namespace gauss6::reference

@@ -468,15 +468,15 @@ using PairSolver = ExactToi (*)(const ExactCayleyMotion&, const std::array<Vec3,
                                 const std::array<Vec3, 3>& obstacle, double u_max);
 ExactToi solve_vertex_face(const ExactCayleyMotion& m, const std::array<Vec3, 3>& g, const std::array<Vec3, 3>& o,
                            double u_max) {
-  return moving_vertex_face_toi(m, g[0], o, u_max);
+  return ccd_rigid_vertex_face({&m, g[0], o, u_max});
 }
 ExactToi solve_face_vertex(const ExactCayleyMotion& m, const std::array<Vec3, 3>& g, const std::array<Vec3, 3>& o,
                            double u_max) {
-  return vertex_moving_face_toi(m, o[0], g, u_max);
+  return ccd_rigid_face_vertex({&m, o[0], g, u_max});
 }
 ExactToi solve_edge_edge(const ExactCayleyMotion& m, const std::array<Vec3, 3>& g, const std::array<Vec3, 3>& o,
                          double u_max) {
-  return moving_edge_edge_toi(m, {g[0], g[1]}, {o[0], o[1]}, u_max);
+  return ccd_rigid_edge_edge({&m, {g[0], g[1]}, {o[0], o[1]}, u_max});
 }
 constexpr PairSolver kPairSolvers[kNumPairKinds] = {solve_vertex_face, solve_face_vertex, solve_edge_edge};
 static_assert(kPairKinds[0].kind == PairKind::kGodVertexObstacleFace &&

@@ -46,7 +46,7 @@ Row6 exact_row(const Eigen::Ref<const Eigen::MatrixXd>& J, int k);
 // whichever solver produced it: J ac >= b, lambda >= 0, lambda_k (J_k ac - b_k)
 // = 0 for every row, and sym(M) (ac - au) = J^T lambda. These KKT conditions
 // are sufficient for a strictly convex problem, so true means ac is the exact
-// optimum. ac has size 6, lambda size m (else false); b as in project_exact.
+// optimum. ac has size 6, lambda size m (else false); b as in project.
 bool verify_optimum(const Mat6& M, const Vec6& au,
                     const Eigen::Ref<const Eigen::MatrixXd>& J,
                     const Eigen::VectorXd& b, const std::vector<Rational>& ac,
@@ -54,7 +54,7 @@ bool verify_optimum(const Mat6& M, const Vec6& au,
 
 // Exact verification of a Farkas certificate of infeasibility of J a >= b:
 // y >= 0 (size m), J^T y = 0 and b^T y > 0 (so 0 = y^T J a >= y^T b > 0 would
-// follow for any feasible a). b as in project_exact (size 0 means 0: never
+// follow for any feasible a). b as in project (size 0 means 0: never
 // infeasible).
 bool verify_infeasibility(const Eigen::Ref<const Eigen::MatrixXd>& J,
                           const Eigen::VectorXd& b, const std::vector<Rational>& y);

@@ -183,10 +183,11 @@ std::vector<std::string> to_strings(const std::vector<Rational>& values) {
   return out;
 }
 
-CertificateReport check_certificate(const Mat6& M, const Vec6& au,
-                                    const Eigen::Ref<const Eigen::MatrixXd>& J,
-                                    const Eigen::VectorXd& b,
-                                    const std::vector<int>& active_set) {
+CertificateReport check_certificate(const ProjectionProblem& problem, const std::vector<int>& active_set) {
+  const Mat6& M = problem.M;
+  const Vec6& au = problem.au;
+  const Eigen::MatrixXd& J = problem.J;
+  const Eigen::VectorXd& b = problem.b;
   CertificateReport rep;  // failure = bad_input until the inputs are checked
   if (!internal::valid_inputs(M, au, J, b)) return rep;
   const int m = static_cast<int>(J.rows());

@@ -39,10 +39,12 @@ Rational to_rational(const CGAL::Quotient<ET>& x) {
 
 }  // namespace
 
-ExactProjection project_exact(const Mat6& M, const Vec6& au,
-                              const Eigen::Ref<const Eigen::MatrixXd>& J,
-                              const Eigen::VectorXd& b) {
-  ExactProjection out;  // status = bad_input until the inputs are checked
+ProjectionResult project(const ProjectionProblem& problem) {
+  const Mat6& M = problem.M;
+  const Vec6& au = problem.au;
+  const Eigen::MatrixXd& J = problem.J;
+  const Eigen::VectorXd& b = problem.b;
+  ProjectionResult out;  // status = kBadInput until the inputs are checked
   if (!internal::valid_inputs(M, au, J, b)) return out;
   if (!internal::positive_definite(internal::symmetric_part(M))) return out;
   const int m = static_cast<int>(J.rows());
@@ -74,7 +76,7 @@ ExactProjection project_exact(const Mat6& M, const Vec6& au,
   // Every answer is verified here in exact rational arithmetic, independently
   // of CGAL's own claim: a Farkas certificate for infeasible, the KKT
   // conditions for optimal. Anything unverified is a solver failure.
-  out.status = ProjectionStatus::solver_failure;
+  out.status = ProjectionStatus::kSolverFailure;
   if (sol.status() == CGAL::QP_INFEASIBLE) {
     // CGAL's certificate l has l <= 0 on >= rows, l^T A = 0, l^T b < 0: y = -l.
     std::vector<Rational> y;
@@ -82,7 +84,7 @@ ExactProjection project_exact(const Mat6& M, const Vec6& au,
     for (auto it = sol.infeasibility_certificate_begin();
          it != sol.infeasibility_certificate_end(); ++it)
       y.push_back(-to_rational(*it));
-    if (internal::verify_infeasibility(J, b, y)) out.status = ProjectionStatus::infeasible;
+    if (internal::verify_infeasibility(J, b, y)) out.status = ProjectionStatus::kInfeasibleOffsets;
     return out;
   }
   // sym(M) is positive definite (checked exactly above), so "unbounded" is
@@ -101,7 +103,7 @@ ExactProjection project_exact(const Mat6& M, const Vec6& au,
     lambda.push_back(-to_rational(*it));
   if (!internal::verify_optimum(M, au, J, b, ac, lambda)) return out;
 
-  out.status = ProjectionStatus::optimal;
+  out.status = ProjectionStatus::kOptimal;
   out.ac = std::move(ac);
   out.lambda = std::move(lambda);
   for (int i = 0; i < 6; ++i) out.ac_double[i] = to_double_nearest(out.ac[i]);

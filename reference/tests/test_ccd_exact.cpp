@@ -35,6 +35,15 @@ mpq_class Q(long n, long d = 1) {
   return q;
 }
 
+// The linear queries from the points at t = 0 and t = 1 in the order v, f0, f1,
+// f2 (vertex/face) or a0, a1, b0, b1 (edge/edge).
+ExactToi vertex_face_linear(const std::array<ExactPoint, 4>& x0, const std::array<ExactPoint, 4>& x1) {
+  return ccd_linear_vertex_face({{x0[0], x1[0]}, {{{x0[1], x0[2], x0[3]}, {x1[1], x1[2], x1[3]}}}});
+}
+ExactToi edge_edge_linear(const std::array<ExactPoint, 4>& x0, const std::array<ExactPoint, 4>& x1) {
+  return ccd_linear_edge_edge({{{{x0[0], x0[1]}, {x1[0], x1[1]}}}, {{{x0[2], x0[3]}, {x1[2], x1[3]}}}});
+}
+
 mpq_class eval(const std::vector<mpz_class>& poly, const mpq_class& u) {
   mpq_class acc = 0;
   for (auto it = poly.rbegin(); it != poly.rend(); ++it) acc = acc * u + mpq_class(*it);
@@ -136,27 +145,27 @@ TEST_CASE("to_double rounds to nearest and reports exactness", "[refccd]") {
 TEST_CASE("linear vertex/face: known exact times", "[refccd]") {
   const ExactPoint a = P(0, 0, 0), b = P(3, 0, 0), c = P(0, 3, 0);
   SECTION("vertex falls onto the face at t = 1/3") {
-    require_hit_at(vertex_face_toi_linear({P(1, 1, 1), a, b, c}, {P(1, 1, -2), a, b, c}), Q(1, 3));
+    require_hit_at(vertex_face_linear({P(1, 1, 1), a, b, c}, {P(1, 1, -2), a, b, c}), Q(1, 3));
   }
   SECTION("contact at t = 0") {
-    require_hit_at(vertex_face_toi_linear({P(Q(1, 4), Q(1, 4), 0), a, b, c}, {P(1, 1, -1), a, b, c}), Q(0));
+    require_hit_at(vertex_face_linear({P(Q(1, 4), Q(1, 4), 0), a, b, c}, {P(1, 1, -1), a, b, c}), Q(0));
   }
   SECTION("vertex crosses an edge of the face at t = 1/2") {
-    require_hit_at(vertex_face_toi_linear({P(1, 0, 1), a, b, c}, {P(1, 0, -1), a, b, c}), Q(1, 2));
+    require_hit_at(vertex_face_linear({P(1, 0, 1), a, b, c}, {P(1, 0, -1), a, b, c}), Q(1, 2));
   }
   SECTION("grazing a corner: hit; passing 2^-20 beside it: miss") {
-    require_hit_at(vertex_face_toi_linear({P(-1, -1, 1), a, b, c}, {P(1, 1, -1), a, b, c}), Q(1, 2));
+    require_hit_at(vertex_face_linear({P(-1, -1, 1), a, b, c}, {P(1, 1, -1), a, b, c}), Q(1, 2));
     const mpq_class e = Q(1, 1 << 20);
-    CHECK_FALSE(vertex_face_toi_linear({P(-1 - e, -1, 1), a, b, c}, {P(1 - e, 1, -1), a, b, c}).hit);
+    CHECK_FALSE(vertex_face_linear({P(-1 - e, -1, 1), a, b, c}, {P(1 - e, 1, -1), a, b, c}).hit);
   }
   SECTION("coplanar motion: the vertex slides into the face at t = 1/3") {
-    require_hit_at(vertex_face_toi_linear({P(-1, Q(1, 4), 0), a, b, c}, {P(2, Q(1, 4), 0), a, b, c}), Q(1, 3));
+    require_hit_at(vertex_face_linear({P(-1, Q(1, 4), 0), a, b, c}, {P(2, Q(1, 4), 0), a, b, c}), Q(1, 3));
     // Same plane, passing beside the face: no contact.
-    CHECK_FALSE(vertex_face_toi_linear({P(-1, 4, 0), a, b, c}, {P(2, 4, 0), a, b, c}).hit);
+    CHECK_FALSE(vertex_face_linear({P(-1, 4, 0), a, b, c}, {P(2, 4, 0), a, b, c}).hit);
   }
   SECTION("the face moves onto a static vertex; the face itself moves") {
     const ExactPoint v = P(1, 1, 0);
-    require_hit_at(vertex_face_toi_linear({v, P(0, 0, 2), P(3, 0, 2), P(0, 3, 2)},
+    require_hit_at(vertex_face_linear({v, P(0, 0, 2), P(3, 0, 2), P(0, 3, 2)},
                                           {v, P(0, 0, -4), P(3, 0, -4), P(0, 3, -4)}),
                    Q(1, 3));
   }
@@ -166,55 +175,55 @@ TEST_CASE("linear vertex/face: known exact times", "[refccd]") {
     // coordinates (x, w) along those two directions the triangle is (0,0),
     // (3,0), (0, 1 - 2t). The vertex (1, 1, 1/3), i.e. (x, w) = (1, 1/3), is
     // inside at t = 0 (1/3 + (1/3) / 1 <= 1).
-    require_hit_at(vertex_face_toi_linear({P(1, 1, Q(1, 3)), a, b, P(0, 3, 1)},
+    require_hit_at(vertex_face_linear({P(1, 1, Q(1, 3)), a, b, P(0, 3, 1)},
                                           {P(1, 1, Q(1, 3)), a, b, P(0, -3, -1)}),
                    Q(0));
     // The vertex (1, -1, -1/3), (x, w) = (1, -1/3), is reached by the flipped
     // triangle (2t - 1 = k > 0) when 1/3 + 1 / (3k) <= 1, i.e. k >= 1/2: t = 3/4.
-    require_hit_at(vertex_face_toi_linear({P(1, -1, Q(-1, 3)), a, b, P(0, 3, 1)},
+    require_hit_at(vertex_face_linear({P(1, -1, Q(-1, 3)), a, b, P(0, 3, 1)},
                                           {P(1, -1, Q(-1, 3)), a, b, P(0, -3, -1)}),
                    Q(3, 4));
     // A vertex on the line of [a, b] beyond b: on the collapsed triangle's line
     // but never in the triangle.
-    CHECK_FALSE(vertex_face_toi_linear({P(4, 0, 0), a, b, P(0, 3, 1)}, {P(4, 0, 0), a, b, P(0, -3, -1)}).hit);
+    CHECK_FALSE(vertex_face_linear({P(4, 0, 0), a, b, P(0, 3, 1)}, {P(4, 0, 0), a, b, P(0, -3, -1)}).hit);
     // The vertex (1, 0, 0) on edge [a, b]: contact from t = 0.
-    require_hit_at(vertex_face_toi_linear({P(1, 0, 0), a, b, P(0, 3, 1)}, {P(1, 0, 0), a, b, P(0, -3, -1)}), Q(0));
+    require_hit_at(vertex_face_linear({P(1, 0, 0), a, b, P(0, 3, 1)}, {P(1, 0, 0), a, b, P(0, -3, -1)}), Q(0));
   }
 }
 
 TEST_CASE("linear edge/edge: known exact times", "[refccd]") {
   SECTION("crossing edges at t = 1/2") {
-    const auto toi = edge_edge_toi_linear({P(-1, 0, 1), P(1, 0, 1), P(0, -1, 0), P(0, 1, 0)},
+    const auto toi = edge_edge_linear({P(-1, 0, 1), P(1, 0, 1), P(0, -1, 0), P(0, 1, 0)},
                                           {P(-1, 0, -1), P(1, 0, -1), P(0, -1, 0), P(0, 1, 0)});
     require_hit_at(toi, Q(1, 2));
     CHECK(compare_toi(toi, 0.5) == 0);
     CHECK(compare_toi(toi, std::nextafter(0.5, 0.0)) == -1);
   }
   SECTION("crossing lines whose segments miss") {
-    CHECK_FALSE(edge_edge_toi_linear({P(1, 0, 1), P(3, 0, 1), P(0, -1, 0), P(0, 1, 0)},
+    CHECK_FALSE(edge_edge_linear({P(1, 0, 1), P(3, 0, 1), P(0, -1, 0), P(0, 1, 0)},
                                      {P(1, 0, -1), P(3, 0, -1), P(0, -1, 0), P(0, 1, 0)})
                     .hit);
   }
   SECTION("parallel edges: overlap at t = 1/3, collinear without overlap, never coplanar-touching") {
     // b slides in the plane z = 0 towards a, collinear at y = 0 when t = 1/3.
-    require_hit_at(edge_edge_toi_linear({P(0, 0, 0), P(2, 0, 0), P(1, 1, 0), P(3, 1, 0)},
+    require_hit_at(edge_edge_linear({P(0, 0, 0), P(2, 0, 0), P(1, 1, 0), P(3, 1, 0)},
                                         {P(0, 0, 0), P(2, 0, 0), P(1, -2, 0), P(3, -2, 0)}),
                    Q(1, 3));
-    CHECK_FALSE(edge_edge_toi_linear({P(0, 0, 0), P(2, 0, 0), P(3, 1, 0), P(4, 1, 0)},
+    CHECK_FALSE(edge_edge_linear({P(0, 0, 0), P(2, 0, 0), P(3, 1, 0), P(4, 1, 0)},
                                      {P(0, 0, 0), P(2, 0, 0), P(3, -2, 0), P(4, -2, 0)})
                     .hit);
     // Parallel in z = 1: always coplanar with a (two parallel lines), never touching.
-    CHECK_FALSE(edge_edge_toi_linear({P(0, 0, 0), P(2, 0, 0), P(1, 1, 1), P(3, 1, 1)},
+    CHECK_FALSE(edge_edge_linear({P(0, 0, 0), P(2, 0, 0), P(1, 1, 1), P(3, 1, 1)},
                                      {P(0, 0, 0), P(2, 0, 0), P(1, -2, 1), P(3, -2, 1)})
                     .hit);
   }
   SECTION("endpoint touching an edge, and a zero-length edge") {
     // b0 reaches the interior of a at t = 1/3 (b is perpendicular, coming down).
-    require_hit_at(edge_edge_toi_linear({P(0, 0, 0), P(2, 0, 0), P(1, 0, 1), P(1, 0, 2)},
+    require_hit_at(edge_edge_linear({P(0, 0, 0), P(2, 0, 0), P(1, 0, 1), P(1, 0, 2)},
                                         {P(0, 0, 0), P(2, 0, 0), P(1, 0, -2), P(1, 0, -1)}),
                    Q(1, 3));
     // Degenerate a (a point) crossing b at t = 1/4.
-    require_hit_at(edge_edge_toi_linear({P(1, 1, 0), P(1, 1, 0), P(0, 0, 0), P(2, 0, 0)},
+    require_hit_at(edge_edge_linear({P(1, 1, 0), P(1, 1, 0), P(0, 0, 0), P(2, 0, 0)},
                                         {P(1, -3, 0), P(1, -3, 0), P(0, 0, 0), P(2, 0, 0)}),
                    Q(1, 4));
   }
@@ -290,16 +299,16 @@ TEST_CASE("Cayley pure rotation sweeps features into each other at the exact Cay
   SECTION("moving vertex into a static face") {
     // Face in the half-plane of direction (3, 4): (rho, z) = (0, -1), (5, -1), (0, 2);
     // the vertex (1, 0, 0) arrives at rho = 1, z = 0, inside.
-    require_hit_at(moving_vertex_face_toi(m, Vec3(1, 0, 0), {Vec3(0, 0, -1), Vec3(3, 4, -1), Vec3(0, 0, 2)}),
+    require_hit_at(ccd_rigid_vertex_face({&m, Vec3(1, 0, 0), {Vec3(0, 0, -1), Vec3(3, 4, -1), Vec3(0, 0, 2)}}),
                    u_star);
   }
   SECTION("static vertex hit by a moving face") {
     // Body face in the half-plane of direction (1, 0), scaled by 5; static vertex (3, 4, 0).
-    require_hit_at(vertex_moving_face_toi(m, Vec3(3, 4, 0), {Vec3(0, 0, -5), Vec3(25, 0, -5), Vec3(0, 0, 10)}),
+    require_hit_at(ccd_rigid_face_vertex({&m, Vec3(3, 4, 0), {Vec3(0, 0, -5), Vec3(25, 0, -5), Vec3(0, 0, 10)}}),
                    u_star);
   }
   SECTION("moving edge against a static edge") {
-    require_hit_at(moving_edge_edge_toi(m, {Vec3(1, 0, -1), Vec3(1, 0, 1)}, {Vec3(0, 0, 0), Vec3(6, 8, 0)}),
+    require_hit_at(ccd_rigid_edge_edge({&m, {Vec3(1, 0, -1), Vec3(1, 0, 1)}, {Vec3(0, 0, 0), Vec3(6, 8, 0)}}),
                    u_star);
   }
   SECTION("the exact positions agree: at u*, the vertex is on the ray of direction (3, 4)") {
@@ -317,9 +326,9 @@ TEST_CASE("Cayley motion without rotation equals the linear motion", "[refccd]")
   const Vec3 v_B(0.125, 0.375, 0.0);
   const std::array<Vec3, 3> f_W = {Vec3(-1, -1, 0), Vec3(2, -1, 0.5), Vec3(-1, 2, -0.25)};
   auto ex = [](const Vec3& x) { return P(mpq_class(x[0]), mpq_class(x[1]), mpq_class(x[2])); };
-  const ExactToi cayley = moving_vertex_face_toi(m, v_B, f_W);
-  const ExactToi linear = vertex_face_toi_linear({ex(p0 + v_B), ex(f_W[0]), ex(f_W[1]), ex(f_W[2])},
-                                                 {ex(p1 + v_B), ex(f_W[0]), ex(f_W[1]), ex(f_W[2])});
+  const ExactToi cayley = ccd_rigid_vertex_face({&m, v_B, f_W});
+  const ExactToi linear = vertex_face_linear({ex(p0 + v_B), ex(f_W[0]), ex(f_W[1]), ex(f_W[2])},
+                                             {ex(p1 + v_B), ex(f_W[0]), ex(f_W[1]), ex(f_W[2])});
   REQUIRE(cayley.hit);
   REQUIRE(linear.hit);
   CHECK(compare_toi(cayley, linear) == 0);
@@ -349,14 +358,15 @@ TEST_CASE("Cayley contact polynomials have degree <= 3 and exact brackets", "[re
     const Vec3 v_B = 0.5 * rand_vec();
     const std::array<Vec3, 3> f = {0.5 * rand_vec(), 0.5 * rand_vec(), 0.5 * rand_vec()};
     const std::array<Vec3, 2> e_B = {0.5 * rand_vec(), 0.5 * rand_vec()}, e_W = {0.5 * rand_vec(), 0.5 * rand_vec()};
-    const int d1 = moving_vertex_face_degree(m, v_B, f), d2 = vertex_moving_face_degree(m, v_B, f),
-              d3 = moving_edge_edge_degree(m, e_B, e_W);
+    const int d1 = coplanarity_degree(RigidVertexFaceQuery{&m, v_B, f}),
+              d2 = coplanarity_degree(RigidFaceVertexQuery{&m, v_B, f}),
+              d3 = coplanarity_degree(RigidEdgeEdgeQuery{&m, e_B, e_W});
     CHECK(d1 <= 3);
     CHECK(d2 <= 3);
     CHECK(d3 <= 3);
     num_deg3 += (d1 == 3) + (d2 == 3) + (d3 == 3);
 
-    const ExactToi toi = moving_vertex_face_toi(m, v_B, f);
+    const ExactToi toi = ccd_rigid_vertex_face({&m, v_B, f});
     if (!toi.hit) continue;
     ++num_hits;
     auto volume = [&](double u) {
@@ -502,12 +512,12 @@ TEST_CASE("mesh first contact: culling keeps the brute-force minimum (turning st
     return std::array<Vec3, 3>{V(mesh, mesh.F(f, 0)), V(mesh, mesh.F(f, 1)), V(mesh, mesh.F(f, 2))};
   };
   for (int v = 0; v < stick.V.rows(); ++v)
-    for (int f = 0; f < post.F.rows(); ++f) consider(moving_vertex_face_toi(m, V(stick, v), F(post, f)));
+    for (int f = 0; f < post.F.rows(); ++f) consider(ccd_rigid_vertex_face({&m, V(stick, v), F(post, f)}));
   for (int v = 0; v < post.V.rows(); ++v)
-    for (int f = 0; f < stick.F.rows(); ++f) consider(vertex_moving_face_toi(m, V(post, v), F(stick, f)));
+    for (int f = 0; f < stick.F.rows(); ++f) consider(ccd_rigid_face_vertex({&m, V(post, v), F(stick, f)}));
   for (const auto& a : mp.god_edges)
     for (const auto& b : mp.obstacle_edges)
-      consider(moving_edge_edge_toi(m, {V(stick, a[0]), V(stick, a[1])}, {V(post, b[0]), V(post, b[1])}));
+      consider(ccd_rigid_edge_edge({&m, {V(stick, a[0]), V(stick, a[1])}, {V(post, b[0]), V(post, b[1])}}));
   REQUIRE(best.hit);
   CHECK(compare_toi(c.toi, best) == 0);
   CHECK(c.num_candidate_pairs < int64_t(stick.V.rows() * post.F.rows() + post.V.rows() * stick.F.rows() +

@@ -131,8 +131,8 @@ TEST_CASE("one contact through G: the normal component is removed exactly", "[re
   au << 0.3, -0.7, -1.0 / 3.0, 0.2, 0.1, -0.9;
   JMat J(1, 6);
   J << 0, 0, 1, 0, 0, 0;
-  const auto p = ref::project_exact(M, au, J);
-  REQUIRE(p.status == ProjectionStatus::optimal);
+  const auto p = ref::project({M, au, J, {}});
+  REQUIRE(p.status == ProjectionStatus::kOptimal);
   std::vector<Rational> expect = exact(au);
   expect[2] = 0;
   CHECK(p.ac == expect);
@@ -150,8 +150,8 @@ TEST_CASE("one contact with a lever arm matches the closed form", "[refqp]") {
   Vec6 au;
   au << 0.1, 0.2, -0.6, 0.3, 0.25, -0.4;
   JMat J = contact_row({1.0 / 3.0, 0, 0}, {0, 0, 1});  // [0 0 1 0 -1/3 0]
-  const auto p = ref::project_exact(M, au, J);
-  REQUIRE(p.status == ProjectionStatus::optimal);
+  const auto p = ref::project({M, au, J, {}});
+  REQUIRE(p.status == ProjectionStatus::kOptimal);
   Rational jau = 0, jmj = 0;
   for (int j = 0; j < 6; ++j) {
     jau += Rational(J(0, j)) * Rational(au[j]);
@@ -172,8 +172,8 @@ TEST_CASE("two orthogonal contacts zero both normal components", "[refqp]") {
   JMat J(2, 6);
   J << 0, 0, 1, 0, 0, 0,  //
       1, 0, 0, 0, 0, 0;
-  const auto p = ref::project_exact(M, au, J);
-  REQUIRE(p.status == ProjectionStatus::optimal);
+  const auto p = ref::project({M, au, J, {}});
+  REQUIRE(p.status == ProjectionStatus::kOptimal);
   std::vector<Rational> expect = exact(au);
   expect[0] = expect[2] = 0;
   CHECK(p.ac == expect);
@@ -189,13 +189,13 @@ TEST_CASE("moving away from the contacts: ac == au exactly, lambda == 0", "[refq
   JMat J(2, 6);
   J << 0, 0, 1, 0, 0, 0,  //
       1, 0, 0, 0, 0, 0;
-  const auto p = ref::project_exact(M, au, J);
-  REQUIRE(p.status == ProjectionStatus::optimal);
+  const auto p = ref::project({M, au, J, {}});
+  REQUIRE(p.status == ProjectionStatus::kOptimal);
   CHECK(p.ac == exact(au));
   CHECK(p.lambda == std::vector<Rational>{0, 0});
   CHECK(p.active_set.empty());
   CHECK(p.ac_double == au);
-  const auto c = ref::check_certificate(M, au, J, Eigen::VectorXd(), {});
+  const auto c = ref::check_certificate({M, au, J, {}}, {});
   CHECK(c.pass);
   CHECK(c.ac_exact == exact(au));
 }
@@ -209,20 +209,20 @@ TEST_CASE("offsets: b > 0 pushes out, b < 0 lets the device in, both exactly", "
   for (double b0 : {0.25, -0.2}) {
     Eigen::VectorXd b(1);
     b << b0;
-    const auto p = ref::project_exact(M, au, J, b);
-    REQUIRE(p.status == ProjectionStatus::optimal);
+    const auto p = ref::project({M, au, J, b});
+    REQUIRE(p.status == ProjectionStatus::kOptimal);
     CHECK(p.ac[2] == Rational(b0));
     CHECK(p.lambda[0] == Rational(0.9) * (Rational(b0) - Rational(au[2])));
     require_exact_kkt(M, au, J, b, p.ac, p.lambda);
-    const auto c = ref::check_certificate(M, au, J, b, p.active_set);
+    const auto c = ref::check_certificate({M, au, J, b}, p.active_set);
     CHECK(c.pass);
     CHECK(c.ac_exact == p.ac);
   }
   // An offset the device already satisfies is inactive.
   Eigen::VectorXd b(1);
   b << -0.5;
-  const auto p = ref::project_exact(M, au, J, b);
-  REQUIRE(p.status == ProjectionStatus::optimal);
+  const auto p = ref::project({M, au, J, b});
+  REQUIRE(p.status == ProjectionStatus::kOptimal);
   CHECK(p.ac == exact(au));
   CHECK(p.active_set.empty());
 }
@@ -235,21 +235,21 @@ TEST_CASE("contradictory offsets are infeasible", "[refqp]") {
       0, 0, -1, 0, 0, 0;  // z <= 0
   Eigen::VectorXd b(2);
   b << 1e-3, 0;
-  CHECK(ref::project_exact(M, au, J, b).status == ProjectionStatus::infeasible);
+  CHECK(ref::project({M, au, J, b}).status == ProjectionStatus::kInfeasibleOffsets);
   b << 0, 0;  // touching: z == 0 is feasible
-  CHECK(ref::project_exact(M, au, J, b).status == ProjectionStatus::optimal);
+  CHECK(ref::project({M, au, J, b}).status == ProjectionStatus::kOptimal);
 }
 
 TEST_CASE("the exact verification behind every answer rejects each broken condition", "[refqp]") {
-  // project_exact returns optimal / infeasible only after these checks pass;
+  // project returns kOptimal / kInfeasibleOffsets only after these checks pass;
   // here they must reject answers that are wrong by the smallest amounts.
   Rng rng(99);
   int corrupted = 0;
   for (int trial = 0; trial < 20; ++trial) {
     const Instance in = random_instance(rng, 2 + trial % 6);
     const Eigen::VectorXd b = Eigen::VectorXd::Zero(in.J.rows());
-    const auto p = ref::project_exact(in.M, in.au, in.J, b);
-    REQUIRE(p.status == ProjectionStatus::optimal);
+    const auto p = ref::project({in.M, in.au, in.J, b});
+    REQUIRE(p.status == ProjectionStatus::kOptimal);
     CHECK(ref::internal::verify_optimum(in.M, in.au, in.J, b, p.ac, p.lambda));
     const Rational tiny(1, mpz_class(1) << 200);
     for (int i = 0; i < 6; ++i) {  // any ac off by 2^-200 in one entry
@@ -290,19 +290,19 @@ TEST_CASE("bad inputs are reported, not solved", "[refqp]") {
   J << 0, 0, 1, 0, 0, 0;
   SECTION("non-finite") {
     au[3] = std::nan("");
-    CHECK(ref::project_exact(M, au, J).status == ProjectionStatus::bad_input);
-    CHECK(ref::check_certificate(M, au, J, {}, {0}).failure == CertificateFailure::bad_input);
+    CHECK(ref::project({M, au, J, {}}).status == ProjectionStatus::kBadInput);
+    CHECK(ref::check_certificate({M, au, J, {}}, {0}).failure == CertificateFailure::bad_input);
   }
   SECTION("M not positive definite") {
     M(5, 5) = 0;
-    CHECK(ref::project_exact(M, au, J).status == ProjectionStatus::bad_input);
-    CHECK(ref::check_certificate(M, au, J, {}, {0}).failure == CertificateFailure::bad_input);
+    CHECK(ref::project({M, au, J, {}}).status == ProjectionStatus::kBadInput);
+    CHECK(ref::check_certificate({M, au, J, {}}, {0}).failure == CertificateFailure::bad_input);
   }
   SECTION("sizes and indices") {
-    CHECK(ref::project_exact(M, au, J, Eigen::VectorXd::Zero(2)).status ==
-          ProjectionStatus::bad_input);
-    CHECK(ref::check_certificate(M, au, J, {}, {1}).failure == CertificateFailure::bad_input);
-    CHECK(ref::check_certificate(M, au, J, {}, {-1}).failure == CertificateFailure::bad_input);
+    CHECK(ref::project({M, au, J, Eigen::VectorXd::Zero(2)}).status ==
+          ProjectionStatus::kBadInput);
+    CHECK(ref::check_certificate({M, au, J, {}}, {1}).failure == CertificateFailure::bad_input);
+    CHECK(ref::check_certificate({M, au, J, {}}, {-1}).failure == CertificateFailure::bad_input);
   }
 }
 
@@ -311,8 +311,8 @@ TEST_CASE("random instances: exact KKT, orthogonality, dissipativity", "[refqp]"
   int num_active = 0;
   for (int trial = 0; trial < 60; ++trial) {
     const Instance in = random_instance(rng, 1 + trial % 12);
-    const auto p = ref::project_exact(in.M, in.au, in.J);
-    REQUIRE(p.status == ProjectionStatus::optimal);
+    const auto p = ref::project({in.M, in.au, in.J, {}});
+    REQUIRE(p.status == ProjectionStatus::kOptimal);
     require_exact_kkt(in.M, in.au, in.J, Eigen::VectorXd(), p.ac, p.lambda);
     // METHOD.md 5.1: (ac - au)^T M ac == 0, and 5.4: Fu^T ac <= Fu^T au, exactly.
     Rational orth = 0, fu_ac = 0, fu_au = 0;
@@ -334,9 +334,9 @@ TEST_CASE("the certificate accepts the exact active set and reproduces ac exactl
   Rng rng(1234567);
   for (int trial = 0; trial < 60; ++trial) {
     const Instance in = random_instance(rng, 1 + trial % 12);
-    const auto p = ref::project_exact(in.M, in.au, in.J);
-    REQUIRE(p.status == ProjectionStatus::optimal);
-    const auto c = ref::check_certificate(in.M, in.au, in.J, {}, p.active_set);
+    const auto p = ref::project({in.M, in.au, in.J, {}});
+    REQUIRE(p.status == ProjectionStatus::kOptimal);
+    const auto c = ref::check_certificate({in.M, in.au, in.J, {}}, p.active_set);
     INFO("trial " << trial << " failure " << name(c.failure) << " row " << c.row);
     REQUIRE(c.pass);
     CHECK(c.ac_exact == p.ac);
@@ -354,21 +354,21 @@ TEST_CASE("the certificate rejects a wrong active set, naming the row", "[refqp]
   J << 0, 0, 1, 0, 0, 0,  // moving away from it: inactive
       1, 0, 0, 0, 0, 0;   // pushed into: active
   SECTION("a missing active row is violated by exactly its penetration") {
-    const auto c = ref::check_certificate(M, au, J, {}, {});
+    const auto c = ref::check_certificate({M, au, J, {}}, {});
     CHECK_FALSE(c.pass);
     CHECK(c.failure == CertificateFailure::violated_constraint);
     CHECK(c.row == 1);
     CHECK(c.amount == 0.5);
   }
   SECTION("an inactive row held active needs a pulling multiplier") {
-    const auto c = ref::check_certificate(M, au, J, {}, {0, 1});
+    const auto c = ref::check_certificate({M, au, J, {}}, {0, 1});
     CHECK_FALSE(c.pass);
     CHECK(c.failure == CertificateFailure::negative_multiplier);
     CHECK(c.row == 0);
     CHECK(c.amount == 1.5);  // m au_z = 2 * 0.75
   }
   SECTION("the right set passes") {
-    const auto c = ref::check_certificate(M, au, J, {}, {1});
+    const auto c = ref::check_certificate({M, au, J, {}}, {1});
     CHECK(c.pass);
     CHECK(c.lambda_exact == std::vector<Rational>{0, 1});  // 2 * 0.5
   }
@@ -384,16 +384,16 @@ TEST_CASE("random wrong active sets never pass", "[refqp]") {
   int rejected_drops = 0, rejected_adds = 0;
   for (int trial = 0; trial < 80; ++trial) {
     const Instance in = random_instance(rng, 2 + trial % 11);
-    const auto p = ref::project_exact(in.M, in.au, in.J);
-    REQUIRE(p.status == ProjectionStatus::optimal);
-    const auto full = ref::check_certificate(in.M, in.au, in.J, {}, p.active_set);
+    const auto p = ref::project({in.M, in.au, in.J, {}});
+    REQUIRE(p.status == ProjectionStatus::kOptimal);
+    const auto full = ref::check_certificate({in.M, in.au, in.J, {}}, p.active_set);
     REQUIRE(full.pass);
     const bool independent = full.rank == static_cast<int>(p.active_set.size());
     for (size_t drop = 0; drop < p.active_set.size(); ++drop) {
       if (sgn(p.lambda[p.active_set[drop]]) <= 0) continue;
       std::vector<int> w = p.active_set;
       w.erase(w.begin() + static_cast<long>(drop));
-      const auto c = ref::check_certificate(in.M, in.au, in.J, {}, w);
+      const auto c = ref::check_certificate({in.M, in.au, in.J, {}}, w);
       if (c.pass) CHECK(c.ac_exact == p.ac);
       if (independent) {
         CHECK_FALSE(c.pass);
@@ -404,7 +404,7 @@ TEST_CASE("random wrong active sets never pass", "[refqp]") {
       if (std::find(p.active_set.begin(), p.active_set.end(), k) != p.active_set.end()) continue;
       std::vector<int> w = p.active_set;
       w.push_back(k);
-      const auto c = ref::check_certificate(in.M, in.au, in.J, {}, w);
+      const auto c = ref::check_certificate({in.M, in.au, in.J, {}}, w);
       CHECK_FALSE(c.pass);
       rejected_adds += !c.pass;
     }
@@ -422,20 +422,20 @@ TEST_CASE("duplicated contacts: dependent rows are dropped and the answer is kep
   J << 0, 0, 1, 0, 0, 0,  //
       0, 0, 1, 0, 0, 0,   // the same contact twice
       0, 0, 2, 0, 0, 0;   // and scaled
-  const auto p = ref::project_exact(M, au, J);
-  REQUIRE(p.status == ProjectionStatus::optimal);
+  const auto p = ref::project({M, au, J, {}});
+  REQUIRE(p.status == ProjectionStatus::kOptimal);
   CHECK(p.active_set == std::vector<int>{0, 1, 2});
   CHECK(p.ac[2] == 0);
   require_exact_kkt(M, au, J, Eigen::VectorXd(), p.ac, p.lambda);
   for (const std::vector<int>& w : {std::vector<int>{0, 1, 2}, std::vector<int>{2, 0},
                                     std::vector<int>{1}, std::vector<int>{0, 0, 0}}) {
-    const auto c = ref::check_certificate(M, au, J, {}, w);
+    const auto c = ref::check_certificate({M, au, J, {}}, w);
     CHECK(c.pass);
     CHECK(c.ac_exact == p.ac);
     CHECK(c.rank == 1);
     require_exact_kkt(M, au, J, Eigen::VectorXd(), c.ac_exact, c.lambda_exact);
   }
-  CHECK(ref::check_certificate(M, au, J, {}, {0, 1, 2}).num_dependent_rows == 2);
+  CHECK(ref::check_certificate({M, au, J, {}}, {0, 1, 2}).num_dependent_rows == 2);
 }
 
 TEST_CASE("dependent rows whose first basis needs a negative multiplier", "[refqp]") {
@@ -450,10 +450,10 @@ TEST_CASE("dependent rows whose first basis needs a negative multiplier", "[refq
   J << 1, 0, 0, 0, 0, 0,  //
       0, 1, 0, 0, 0, 0,   //
       1, -1, 0, 0, 0, 0;
-  const auto p = ref::project_exact(M, au, J);
-  REQUIRE(p.status == ProjectionStatus::optimal);
+  const auto p = ref::project({M, au, J, {}});
+  REQUIRE(p.status == ProjectionStatus::kOptimal);
   CHECK(p.active_set == std::vector<int>{0, 1, 2});
-  const auto c = ref::check_certificate(M, au, J, {}, {0, 1, 2});
+  const auto c = ref::check_certificate({M, au, J, {}}, {0, 1, 2});
   INFO(name(c.failure));
   CHECK(c.pass);
   CHECK(c.used_lp);
@@ -465,12 +465,12 @@ TEST_CASE("dependent rows whose first basis needs a negative multiplier", "[refq
   // tight needs lambda_x + lambda_{x-y} = -1/2, impossible with lambda >= 0.
   au[0] = 0.5;
   au[1] = -1;
-  const auto bad = ref::check_certificate(M, au, J, {}, {0, 1, 2});
+  const auto bad = ref::check_certificate({M, au, J, {}}, {0, 1, 2});
   CHECK_FALSE(bad.pass);
   CHECK(bad.failure == CertificateFailure::negative_multiplier);
   CHECK(bad.row == 0);
   CHECK(bad.amount == 0.5);
-  const auto good = ref::check_certificate(M, au, J, {}, ref::project_exact(M, au, J).active_set);
+  const auto good = ref::check_certificate({M, au, J, {}}, ref::project({M, au, J, {}}).active_set);
   CHECK(good.pass);
 }
 
@@ -490,14 +490,14 @@ TEST_CASE("box face on a plane: four coplanar corners, rank 3", "[refqp]") {
     Vec6 au;
     for (int i = 0; i < 6; ++i) au[i] = rng.uniform(-1, 1);
     au[2] = -std::abs(au[2]) - 0.5;
-    const auto p = ref::project_exact(M, au, J);
-    REQUIRE(p.status == ProjectionStatus::optimal);
+    const auto p = ref::project({M, au, J, {}});
+    REQUIRE(p.status == ProjectionStatus::kOptimal);
     require_exact_kkt(M, au, J, Eigen::VectorXd(), p.ac, p.lambda);
     // Every order of the tight rows is a valid claim.
     std::vector<int> w = p.active_set;
     std::reverse(w.begin(), w.end());
     for (const auto& claim : {p.active_set, w}) {
-      const auto c = ref::check_certificate(M, au, J, {}, claim);
+      const auto c = ref::check_certificate({M, au, J, {}}, claim);
       INFO("trial " << trial << " failure " << name(c.failure));
       CHECK(c.pass);
       CHECK(c.ac_exact == p.ac);
@@ -536,11 +536,11 @@ TEST_CASE("timing of the exact solve and the certificate", "[.][refqp-timing]") 
     for (int trial = 0; trial < n; ++trial) {
       const Instance in = random_instance(rng, m);
       const double t0 = cpu_seconds();
-      const auto p = ref::project_exact(in.M, in.au, in.J);
+      const auto p = ref::project({in.M, in.au, in.J, {}});
       const double t1 = cpu_seconds();
-      const auto c = ref::check_certificate(in.M, in.au, in.J, {}, p.active_set);
+      const auto c = ref::check_certificate({in.M, in.au, in.J, {}}, p.active_set);
       const double t2 = cpu_seconds();
-      REQUIRE(p.status == ProjectionStatus::optimal);
+      REQUIRE(p.status == ProjectionStatus::kOptimal);
       REQUIRE(c.pass);
       REQUIRE(c.ac_exact == p.ac);
       t_solve += t1 - t0;
@@ -668,8 +668,8 @@ TEST_CASE("jammed instances of the families: the exact optimum is verified; the 
     const Eigen::VectorXd b = Eigen::Map<const Eigen::VectorXd>(s.b.data(), m);
 
     // 1. The exact answer: KKT verified here, independently of the solver.
-    const auto p = ref::project_exact(M, au, J, b);
-    REQUIRE(p.status == ProjectionStatus::optimal);
+    const auto p = ref::project({M, au, J, b});
+    REQUIRE(p.status == ProjectionStatus::kOptimal);
     require_exact_kkt(M, au, J, b, p.ac, p.lambda);
     // Ill-conditioning shows in the multipliers: a well-posed instance has
     // |lambda| about |M au| / sigma_min(J_W), here within 1e3 of |M au|; these
@@ -682,7 +682,7 @@ TEST_CASE("jammed instances of the families: the exact optimum is verified; the 
     // active set violates a row, by about 1e-19 of the rows' scale (1e-15: any
     // rounding-level amount), while its objective is lower: it is not a
     // feasible point of the problem as given, so it cannot beat the optimum.
-    const auto c = ref::check_certificate(M, au, J, b, s.float_active);
+    const auto c = ref::check_certificate({M, au, J, b}, s.float_active);
     REQUIRE(c.failure == CertificateFailure::violated_constraint);
     const double row_scale = J.rowwise().lpNorm<1>().maxCoeff() * au.cwiseAbs().maxCoeff();
     CHECK(c.amount > 0);
@@ -706,12 +706,12 @@ TEST_CASE("jammed instances of the families: the exact optimum is verified; the 
     }
     CHECK(change > 0);
     CHECK(change < 1e-15 * row_scale);
-    const auto c2 = ref::check_certificate(M, au, J, b_relaxed, s.float_active);
+    const auto c2 = ref::check_certificate({M, au, J, b_relaxed}, s.float_active);
     INFO("relaxed certificate: " << name(c2.failure) << " row " << c2.row);
     CHECK(c2.pass);
     CHECK(c2.ac_exact == c.ac_exact);
-    const auto p2 = ref::project_exact(M, au, J, b_relaxed);
-    REQUIRE(p2.status == ProjectionStatus::optimal);
+    const auto p2 = ref::project({M, au, J, b_relaxed});
+    REQUIRE(p2.status == ProjectionStatus::kOptimal);
     require_exact_kkt(M, au, J, b_relaxed, p2.ac, p2.lambda);
     CHECK(p2.ac == c.ac_exact);
   }
@@ -761,17 +761,17 @@ TEST_CASE("every instance of every family: the exact answer is verified and its 
       const bool declared_infeasible = inst.contains("tags") && inst["tags"].contains("feasible") &&
                                        !inst["tags"]["feasible"].get<bool>();
       const double t0 = cpu_seconds();
-      const auto p = ref::project_exact(M, au, J, b);
+      const auto p = ref::project({M, au, J, b});
       t_solve += cpu_seconds() - t0;
       ++count;
       if (declared_infeasible) {
-        REQUIRE(p.status == ProjectionStatus::infeasible);  // Farkas-verified inside
+        REQUIRE(p.status == ProjectionStatus::kInfeasibleOffsets);  // Farkas-verified inside
         ++infeasible;
         continue;
       }
-      REQUIRE(p.status == ProjectionStatus::optimal);
+      REQUIRE(p.status == ProjectionStatus::kOptimal);
       require_exact_kkt(M, au, J, b, p.ac, p.lambda);
-      const auto c = ref::check_certificate(M, au, J, b, p.active_set);
+      const auto c = ref::check_certificate({M, au, J, b}, p.active_set);
       INFO("certificate failure " << name(c.failure) << " row " << c.row);
       REQUIRE(c.pass);
       REQUIRE(c.ac_exact == p.ac);

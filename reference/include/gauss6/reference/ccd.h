@@ -66,10 +66,19 @@ int compare_toi(const ExactToi& a, const ExactToi& b);
 
 using ExactPoint = std::array<mpq_class, 3>;
 
-// Vertex/face: points in the order v, f0, f1, f2; x0 at t = 0, x1 at t = 1.
-ExactToi vertex_face_toi_linear(const std::array<ExactPoint, 4>& x0, const std::array<ExactPoint, 4>& x1);
-// Edge/edge: points in the order a0, a1, b0, b1.
-ExactToi edge_edge_toi_linear(const std::array<ExactPoint, 4>& x0, const std::array<ExactPoint, 4>& x1);
+// The optimized linear queries (gauss6/ccd.h) with exact points and no window:
+// index [0] is the position at t = 0, [1] at t = 1.
+// Vertex/face: contact when the vertex lies on the closed triangle face[.][0..2].
+struct LinearVertexFaceQuery {
+  std::array<ExactPoint, 2> vertex;
+  std::array<std::array<ExactPoint, 3>, 2> face;
+};
+// Edge/edge: edge_a[time][endpoint], edge_b[time][endpoint].
+struct LinearEdgeEdgeQuery {
+  std::array<std::array<ExactPoint, 2>, 2> edge_a, edge_b;
+};
+ExactToi ccd_linear_vertex_face(const LinearVertexFaceQuery& q);
+ExactToi ccd_linear_edge_edge(const LinearEdgeEdgeQuery& q);
 // A query of the shared file format (gauss6/ccd_queries.h), by its kind.
 ExactToi query_toi(const CcdQuery& query);
 ExactPoint to_exact(const RationalPoint& p);
@@ -96,23 +105,42 @@ ExactPoint motion_point_exact(const ExactCayleyMotion& m, const mpq_class& u, co
 // Exact world position under the static pose X (METHOD.md section 1).
 ExactPoint transform_point_exact(const Pose& X, const Vec3& r_B);
 
-// The body (the god-object) moves, the obstacle is static. Body features in the body frame (B),
-// obstacle features in the world frame (W). Only contacts at u <= u_max are
-// looked for (u_max in (0, 1], a double taken exactly; std::invalid_argument
-// otherwise): a miss then means no contact in [0, u_max].
-ExactToi moving_vertex_face_toi(const ExactCayleyMotion& m, const Vec3& v_B, const std::array<Vec3, 3>& f_W,
-                                double u_max = 1.0);
-ExactToi vertex_moving_face_toi(const ExactCayleyMotion& m, const Vec3& v_W, const std::array<Vec3, 3>& f_B,
-                                double u_max = 1.0);
-ExactToi moving_edge_edge_toi(const ExactCayleyMotion& m, const std::array<Vec3, 2>& e_B,
-                              const std::array<Vec3, 2>& e_W, double u_max = 1.0);
+// The optimized rigid queries (gauss6/ccd.h), exactly: the body (the god-object)
+// moves, the obstacle is static; body features in the body frame (B), obstacle
+// features in the world frame (W). Only contacts at u <= u_end are looked for
+// (u_end in (0, 1], a double taken exactly; std::invalid_argument otherwise): a
+// miss then means no contact in [0, u_end]. The window always starts at u = 0.
 
-// Degree of the coplanarity polynomial after removing the positive factors W,
-// -1 when it is identically zero (for tests and documentation).
-int moving_vertex_face_degree(const ExactCayleyMotion& m, const Vec3& v_B, const std::array<Vec3, 3>& f_W);
-int vertex_moving_face_degree(const ExactCayleyMotion& m, const Vec3& v_W, const std::array<Vec3, 3>& f_B);
-int moving_edge_edge_degree(const ExactCayleyMotion& m, const std::array<Vec3, 2>& e_B,
-                            const std::array<Vec3, 2>& e_W);
+// The god-object's vertex moving, the obstacle face static.
+struct RigidVertexFaceQuery {
+  const ExactCayleyMotion* motion = nullptr;
+  Vec3 vertex_B;
+  std::array<Vec3, 3> face_W;
+  double u_end = 1;
+};
+// The obstacle's vertex static, the god-object's face moving.
+struct RigidFaceVertexQuery {
+  const ExactCayleyMotion* motion = nullptr;
+  Vec3 vertex_W;
+  std::array<Vec3, 3> face_B;
+  double u_end = 1;
+};
+// The god-object's edge moving, the obstacle edge static.
+struct RigidEdgeEdgeQuery {
+  const ExactCayleyMotion* motion = nullptr;
+  std::array<Vec3, 2> edge_B, edge_W;
+  double u_end = 1;
+};
+ExactToi ccd_rigid_vertex_face(const RigidVertexFaceQuery& q);
+ExactToi ccd_rigid_face_vertex(const RigidFaceVertexQuery& q);
+ExactToi ccd_rigid_edge_edge(const RigidEdgeEdgeQuery& q);
+
+// Degree of the query's coplanarity polynomial after removing the positive
+// factors W, -1 when it is identically zero (u_end plays no part; for tests and
+// documentation).
+int coplanarity_degree(const RigidVertexFaceQuery& q);
+int coplanarity_degree(const RigidFaceVertexQuery& q);
+int coplanarity_degree(const RigidEdgeEdgeQuery& q);
 
 // ---------------------------------------------------------------------------
 // Mesh level: a moving god-object mesh (body frame B) against a static obstacle

@@ -39,23 +39,40 @@ using Rational = mpq_class;
 // sym(M) (ac - au) = J^T lambda exactly (sufficient for this strictly convex
 // problem); infeasible means a Farkas certificate y >= 0 with J^T y = 0 and
 // b^T y > 0 was checked exactly.
+// The names mirror the optimized projection's (gauss6/quasistatics.h) where the
+// meaning is the same; kSolverFailure has no optimized counterpart, and the
+// exact solver has no iteration cap.
 enum class ProjectionStatus {
-  optimal,         // ac, lambda hold the exact optimum and multipliers (verified)
-  infeasible,      // no a satisfies J a >= b (possible only when b != 0; verified)
-  solver_failure,  // the solver's answer did not pass the exact verification
-                   // (or it claimed "unbounded", impossible for sym(M) > 0);
-                   // ac, lambda are empty. Never seen on the test families.
-  bad_input,       // non-finite entry, wrong sizes, or sym(M) not positive definite
+  kOptimal,            // ac, lambda hold the exact optimum and multipliers (verified)
+  kInfeasibleOffsets,  // no a satisfies J a >= b (possible only when b != 0; verified)
+  kSolverFailure,      // the solver's answer did not pass the exact verification
+                       // (or it claimed "unbounded", impossible for sym(M) > 0);
+                       // ac, lambda are empty. Never seen on the test families.
+  kBadInput,           // non-finite entry, wrong sizes, or sym(M) not positive definite
 };
 
-struct ExactProjection {
-  ProjectionStatus status = ProjectionStatus::bad_input;
+// One projection's data, the fields of the optimized ProjectionProblem held by
+// value (no cap on the number of rows m = J.rows()).
+//   M   6 x 6, symmetric part positive definite.
+//   au  6, unconstrained acceleration.
+//   J   m x 6 (m >= 0), one contact per row.
+//   b   size m, or size 0 for b = 0 (no offsets).
+struct ProjectionProblem {
+  Mat6 M = Mat6::Identity();
+  Vec6 au = Vec6::Zero();
+  Eigen::MatrixXd J = Eigen::MatrixXd(0, 6);
+  Eigen::VectorXd b;
+};
+
+struct ProjectionResult {
+  ProjectionStatus status = ProjectionStatus::kBadInput;
   std::vector<Rational> ac;      // size 6 when optimal, else empty
   std::vector<Rational> lambda;  // size m when optimal, else empty; >= 0
   Vec6 ac_double = Vec6::Zero();     // ac, each entry rounded to nearest
   std::vector<double> lambda_double; // lambda, rounded to nearest
   // Rows with J_k ac == b_k exactly, increasing. Contains every row with
-  // lambda_k > 0 (and also the weakly active rows, lambda_k == 0).
+  // lambda_k > 0 (and also the weakly active rows, lambda_k == 0); unlike the
+  // optimized working set, not limited to independent rows.
   std::vector<int> active_set;
 };
 
@@ -68,16 +85,10 @@ struct ExactProjection {
 // (1e12 and more) and can differ by O(|au|) from a floating-point solver's
 // answer, which violates some row exactly by about 1e-20. Both are right: such
 // an instance is ill-conditioned (test "[refqp-illposed]").
-//   M   6 x 6, symmetric part positive definite.
-//   au  6, unconstrained acceleration.
-//   J   m x 6 (m >= 0), one contact per row.
-//   b   size m, or size 0 for b = 0 (no offsets).
 // Not real-time: allocates; about 0.4 ms CPU for m = 3, 1.3 ms for m = 12,
 // 5 ms for m = 50 (test "[refqp-timing]", random contacts), the exact
 // verification included (about a sixth of it).
-ExactProjection project_exact(const Mat6& M, const Vec6& au,
-                              const Eigen::Ref<const Eigen::MatrixXd>& J,
-                              const Eigen::VectorXd& b = Eigen::VectorXd());
+ProjectionResult project(const ProjectionProblem& problem);
 
 // ---------------------------------------------------------------------------
 // Exact certificate check of a claimed active set.
@@ -127,14 +138,11 @@ struct CertificateReport {
   std::vector<double> lambda_rounded;  // lambda_exact rounded to nearest
 };
 
-//   M, au, J, b as in project_exact.
+//   problem     as in project.
 //   active_set  row indices into J (any order; repeated indices count once).
 // Allocates; about 0.14 ms CPU for m = 3, 0.35 ms for m = 12, 1.2 ms for
-// m = 50 (test "[refqp-timing]"), three to four times cheaper than project_exact.
-CertificateReport check_certificate(const Mat6& M, const Vec6& au,
-                                    const Eigen::Ref<const Eigen::MatrixXd>& J,
-                                    const Eigen::VectorXd& b,
-                                    const std::vector<int>& active_set);
+// m = 50 (test "[refqp-timing]"), three to four times cheaper than project.
+CertificateReport check_certificate(const ProjectionProblem& problem, const std::vector<int>& active_set);
 
 // ---------------------------------------------------------------------------
 // Exact helpers, for comparing a floating-point answer with an exact one.
