@@ -36,7 +36,7 @@
 #include <thread>
 #include <vector>
 
-#include "gauss6/device.h"
+#include "gauss6/device_port.h"
 #include "gauss6/pose.h"
 
 namespace gauss6 {

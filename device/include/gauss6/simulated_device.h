@@ -23,7 +23,7 @@
 #include <string>
 #include <vector>
 
-#include "gauss6/device.h"
+#include "gauss6/device_port.h"
 #include "gauss6/pose.h"
 
 namespace gauss6 {

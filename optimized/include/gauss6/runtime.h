@@ -53,7 +53,7 @@
 #include "gauss6/ccd_step.h"
 #include "gauss6/contacts.h"
 #include "gauss6/coupling.h"
-#include "gauss6/device.h"
+#include "gauss6/device_port.h"
 #include "gauss6/quasistatics.h"
 #include "gauss6/scene.h"
 #include "gauss6/shared_state.h"

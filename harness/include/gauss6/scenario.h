@@ -12,11 +12,11 @@
 // The writer's background thread flushes the file every flush_period (<= 1 s),
 // so a crash loses at most that much of the run.
 //
-// It also checks, per coupling step, the two properties of METHOD.md section 5
-// that the trace cannot show exactly (it records the clamped wrench, not ac):
-// orthogonality Fc . ac = 0 and the constraint stage's energy balance
-// au . Fc <= 0 (the constraints only remove energy); and it runs a
-// Hannaford-Ryu passivity observer on the device port.
+// It also feeds the property observers (property_observers.h): per coupling
+// step, orthogonality Fc . ac = 0 and the constraint stage's energy balance
+// au . Fc <= 0, which the trace cannot show exactly (it records the clamped
+// wrench, not ac); per haptic tick, a Hannaford-Ryu passivity observer on the
+// device port. Their totals are in ScenarioResult.
 //
 // Units: the scene's (metres, kilograms, seconds in the shipped scenes); wrenches
 // in N and N m, world frame.
@@ -26,6 +26,7 @@
 #include <functional>
 #include <string>
 
+#include "gauss6/property_observers.h"
 #include "gauss6/runtime.h"
 #include "gauss6/scene.h"
 #include "gauss6/simulated_device.h"

@@ -1,6 +1,6 @@
 // Scripted scenarios: the simulated device, the runtime's loops and a trace of
-// the run, with the per-step property checks and the passivity observer
-// (scenario.h).
+// the run, with the property observers fed by the hooks (scenario.h,
+// property_observers.h).
 #include "gauss6/scenario.h"
 
 #include <atomic>
@@ -17,9 +17,6 @@ namespace gauss6 {
 namespace {
 
 using Clock = std::chrono::steady_clock;
-
-// Orthogonality is measured only where |ac| > this |au| (see on_coupling_step).
-constexpr double kMinRelativeAc = 1e-6;
 
 constexpr uint32_t bit(RuntimeEventKind k) { return 1u << static_cast<int>(k); }
 constexpr uint32_t kWatchdogEvents = bit(RuntimeEventKind::kDeviceTimeout) | bit(RuntimeEventKind::kSimStalled) |
@@ -50,27 +47,11 @@ struct Recorder {
   bool let_go_reported = false;
   uint64_t last_sequence = 0;
   long num_ticks = 0;
-  bool has_previous = false;
-  Pose previous_xh;
-  Vec6 previous_F = Vec6::Zero();
-  double port_work = 0, port_energy_max = 0, port_energy = 0;
+  PassivityObserver port;
 
   // Coupling thread.
-  double max_rel_dot = 0;
-  long num_orthogonality_checks = 0, num_offset_steps = 0;
-  double energy_injected = 0, energy_removed = 0;
+  CouplingPropertyObserver constraints;
 };
-
-// V = F^T M^-1 F / (2 kh ks): the energy stored in the coupling spring
-// (stiffness kh ks M) that produces F. M at the orientation q.
-double coupling_energy(const RuntimeModel& model, const Quat& q, const Vec6& F) {
-  const double k = model.gains.kh * model.gains.ks;
-  if (!(k > 0)) return 0;
-  const Mat3 R = rotation_matrix(normalized(q));
-  const Vec3 tau_B = R.transpose() * F.tail<3>();
-  const double e = F.head<3>().squaredNorm() / model.mass + tau_B.dot(model.inertia_G_B.llt().solve(tau_B));
-  return e / (2 * k);
-}
 
 void on_coupling_step(void* user, const CouplingStepInfo& info) {
   auto* r = static_cast<Recorder*>(user);
@@ -81,23 +62,7 @@ void on_coupling_step(void* user, const CouplingStepInfo& info) {
   c.god_sequence = info.god_sequence;
   c.force_seconds = info.force_seconds;
   r->coupling.write(c);
-  if (!info.has_god_object) return;
-  // Constraint stage's work on the command: au . Fc = -kh |ac - au|_M^2 (<= 0).
-  const double w = info.au.dot(info.Fc);
-  if (w > 0) r->energy_injected += w;
-  else r->energy_removed -= w;
-  // Orthogonality Fc . ac = 0 (not with running offsets: their b != 0).
-  if (info.num_offset_rows > 0) {
-    ++r->num_offset_steps;
-    return;
-  }
-  // With ac at rounding level (pressing straight into a face: ac = 0 exactly),
-  // the ratio measures rounding noise, not the solver: skip |ac| <= 1e-6 |au|.
-  const double nf = info.Fc.norm(), na = info.ac.norm();
-  if (nf > 0 && na > kMinRelativeAc * info.au.norm()) {
-    r->max_rel_dot = std::max(r->max_rel_dot, std::abs(info.Fc.dot(info.ac)) / (nf * na));
-    ++r->num_orthogonality_checks;
-  }
+  r->constraints.add(info);
 }
 
 void on_sim_step(void* user, const SimStepInfo& info) {
@@ -150,14 +115,8 @@ void on_haptic_tick(void* user, const HapticTickRecord& rec) {
   if (has_coupling) r->last_sequence = c.god_sequence;
   r->writer->append(row);
 
-  // Passivity observer: the work of the wrench held since the last tick on the
-  // handle's motion, plus the energy stored in the coupling now.
-  if (r->has_previous) r->port_work += r->previous_F.dot(pose_difference(rec.xh, r->previous_xh));
-  r->port_energy = r->port_work + coupling_energy(*r->model, row.X_WS.q, rec.F_sent);
-  r->port_energy_max = std::max(r->port_energy_max, r->port_energy);
-  r->previous_xh = rec.xh;
-  r->previous_F = rec.F_sent;
-  r->has_previous = true;
+  // Passivity observer on the device port.
+  r->port.add(*r->model, rec.xh, rec.F_sent, row.X_WS.q);
 
   ++r->num_ticks;
   r->time.store(rec.time, std::memory_order_relaxed);
@@ -285,13 +244,13 @@ ScenarioResult run_scenario(const Scene& scene, const HandScript& script, const 
   out.num_ticks = rec.num_ticks;
   out.num_sim_steps = rec.num_sim_steps.load();
   out.run_time = data->stats.run_seconds;
-  out.max_rel_force_dot_ac = rec.max_rel_dot;
-  out.num_orthogonality_checks = rec.num_orthogonality_checks;
-  out.num_offset_steps = rec.num_offset_steps;
-  out.constraint_energy_injected = rec.energy_injected;
-  out.constraint_energy_removed = rec.energy_removed;
-  out.port_energy_max = rec.port_energy_max;
-  out.port_energy_final = rec.port_energy;
+  out.max_rel_force_dot_ac = rec.constraints.max_rel_force_dot_ac;
+  out.num_orthogonality_checks = rec.constraints.num_orthogonality_checks;
+  out.num_offset_steps = rec.constraints.num_offset_steps;
+  out.constraint_energy_injected = rec.constraints.energy_injected;
+  out.constraint_energy_removed = rec.constraints.energy_removed;
+  out.port_energy_max = rec.port.energy_max;
+  out.port_energy_final = rec.port.energy;
   out.wall_seconds = std::chrono::duration<double>(Clock::now() - wall_start).count();
   return out;
 }

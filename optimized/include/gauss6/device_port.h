@@ -1,7 +1,9 @@
-// The one Device interface of gauss6: a haptic handle that reports its pose and
-// buttons and takes a wrench. Virtual dispatch lives here, at the device
-// boundary, and nowhere else. Implementations: simulated (device/src/simulated),
-// replay of a recorded trace (device/src/replay), HID through hidapi (device/src/hid).
+// The device port of the runtime: the one Device interface of gauss6, a haptic
+// handle that reports its pose and buttons and takes a wrench. It belongs to the
+// core, which consumes it (the haptic loop, runtime.h); the drivers in device/
+// implement it. Virtual dispatch lives here, at the device boundary, and nowhere
+// else. Implementations: simulated (device/src/simulated_device.cpp), replay of a
+// recorded trace (device/src/replay_device.cpp), HID through hidapi (device/src/hid_device.cpp).
 //
 // Real-time contract: read() and write() are called from the haptic loop at the
 // device's rate; they allocate nothing, take no lock that a non-real-time thread

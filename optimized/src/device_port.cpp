@@ -1,5 +1,5 @@
-// Names of the device statuses (device.h).
-#include "gauss6/device.h"
+// Names of the device statuses (device_port.h).
+#include "gauss6/device_port.h"
 
 namespace gauss6 {
 

@@ -1,0 +1,62 @@
+// Property observers of a run: the checks of METHOD.md section 5 that a trace
+// cannot show exactly (it records the clamped wrench, not ac), fed one step at
+// a time by the scenario's hooks (scenario.h):
+//   - per coupling step: orthogonality Fc . ac = 0 (5.1) and the constraint
+//     stage's energy balance au . Fc <= 0 (5.4: the constraints only remove energy);
+//   - per haptic tick: a Hannaford-Ryu passivity observer on the device port.
+// Each observer is written by one thread only (the loop that feeds it).
+//
+// Units: the scene's (metres, kilograms, seconds in the shipped scenes); wrenches
+// in N and N m, world frame; energies in J.
+#pragma once
+
+#include "gauss6/runtime.h"
+
+namespace gauss6 {
+
+// Orthogonality is measured only where |ac| > this |au| (see CouplingPropertyObserver).
+inline constexpr double kMinRelativeAc = 1e-6;
+
+// Orthogonality and constraint energy over the coupling steps.
+struct CouplingPropertyObserver {
+  // Orthogonality (METHOD.md 5.1), over coupling steps with |Fc| > 0, |ac| > 1e-6 |au|
+  // (below, ac is rounding noise: pressing straight into a face gives ac = 0) and
+  // no running offset (an offset row's right-hand side is not 0, so the identity
+  // does not hold there): max |Fc . ac| / (|Fc| |ac|).
+  double max_rel_force_dot_ac = 0;
+  long num_orthogonality_checks = 0;
+  long num_offset_steps = 0;           // coupling steps skipped because an offset ran
+  // The constraint stage's work on the user's command (METHOD.md 5.4 with Fu = kh M au):
+  // per coupling step au . Fc = -kh |ac - au|_M^2 <= 0 (J). Sums of its positive and
+  // negative parts; the positive sum must be 0 up to rounding.
+  double energy_injected = 0;
+  double energy_removed = 0;
+
+  // Adds one coupling step (steps without a god-object are skipped).
+  void add(const CouplingStepInfo& info) noexcept;
+};
+
+// V = F^T M^-1 F / (2 kh ks): the energy stored in the coupling spring
+// (stiffness kh ks M) that produces F. M at the orientation q. 0 when kh ks <= 0.
+double coupling_energy(const RuntimeModel& model, const Quat& q, const Vec6& F);
+
+// Passivity observer on the device port (Hannaford and Ryu 2002): W(n) =
+// sum_k F_k . (xh_{k+1} (-) xh_k), the work of the sent wrench on the handle,
+// plus the energy stored in the coupling at tick n, V = F^T M^-1 F / (2 kh ks).
+// A passive environment keeps W(n) + V(n) <= 0 for every n. Zero-order hold of
+// a stiff coupling makes it slightly positive (about k/2 sum |dx|^2), which is
+// why the constraint-stage balance (CouplingPropertyObserver) is kept apart.
+struct PassivityObserver {
+  double work = 0;                     // W(n), J
+  double energy = 0;                   // W(n) + V(n) at the last tick, J
+  double energy_max = 0;               // max(0, max_n W(n) + V(n)), J
+  bool has_previous = false;
+  Pose previous_xh;
+  Vec6 previous_F = Vec6::Zero();
+
+  // Adds one haptic tick: the handle pose xh, the wrench sent F, and the
+  // orientation q of the god-object the force was computed at.
+  void add(const RuntimeModel& model, const Pose& xh, const Vec6& F, const Quat& q);
+};
+
+}  // namespace gauss6
