@@ -407,105 +407,6 @@ bool receive_god_object(const RuntimeChannels& ch, CouplingState* s) {
   return true;
 }
 
-// Constraint offsetting of a new set (coupling.h). A row that is the same
-// constraint as a cached one (same body-frame point within match_distance, same
-// normal) keeps its offset. A new row k is measured against what the user felt
-// just before it arrived: d_k = J_k ac_old, with ac_old the projection of au on
-// the previous set's rows with their right-hand sides at t (ac_old = au when
-// there were none: METHOD.md's d_k = J_k au). A new row with d_k < eps starts an
-// offset at f_k(0) = d_k: ac_old stays feasible and optimal, so the force does
-// not jump. Measured against au instead, a contact that slides across triangles
-// (its rows change identity at every set) would be offset again and again and
-// the force would keep dropping to zero; so would a row that the old rows
-// already enforce (an edge crossing a face the god-object slides on). Returns
-// the number of offsets started.
-int start_offsets(const RuntimeModel& model, double t, const Vec6& au, CouplingState* s) {
-  const int m = s->god.num_contacts;
-  const Mat3 Rt = rotation_matrix(s->xs.q).transpose();
-  // The previous set's rows and their right-hand sides now: the "before" problem.
-  // After an empty set, the last non-empty one (arrived or emptied less than
-  // offset_time ago) stands in for it, without offsets.
-  const int num_old = s->num_cached_rows;
-  const bool use_last = num_old == 0 && s->num_last_rows > 0 && t - s->last_rows_time < model.offsets.T;
-  const int num_before = use_last ? s->num_last_rows : num_old;
-  for (int j = 0; j < num_before; ++j) {
-    std::memcpy(&s->kept_J[6 * j], &s->cached_J[6 * j], 6 * sizeof(double));
-    const double dt = t - s->offset_t0[j];
-    s->kept_b[j] = !use_last && s->offset_start[j] < 0 && dt < model.offsets.T
-                       ? offset_rhs(s->offset_start[j], dt, model.offsets)
-                       : 0.0;
-  }
-  int num_new = 0;
-  for (int k = 0; k < m; ++k) {
-    const Vec3 point_W(s->god.point[k][0], s->god.point[k][1], s->god.point[k][2]);
-    const Vec3 normal_W(s->god.normal[k][0], s->god.normal[k][1], s->god.normal[k][2]);
-    s->new_point_B[k] = Rt * (point_W - s->xs.p);
-    s->new_normal_W[k] = normal_W;
-    int match = -1;
-    for (int j = 0; j < num_old && match < 0; ++j)
-      if ((s->point_B[j] - s->new_point_B[k]).norm() <= model.match_distance &&
-          s->normal_W[j].dot(normal_W) >= model.settings.match_cosine)
-        match = j;
-    s->matched[k] = match >= 0;
-    if (match < 0) {
-      ++num_new;
-      continue;
-    }
-    // Kept: its offset (if any) runs on.
-    s->new_start[k] = s->offset_start[match];
-    s->new_t0[k] = s->offset_t0[match];
-  }
-  int started = 0;
-  if (num_new > 0) {
-    Vec6 ac_old = au;
-    if (num_before > 0) {
-      ProjectionProblem before;
-      before.M = &s->M;
-      before.au = au;
-      before.J = s->kept_J.data();
-      before.b = s->kept_b.data();
-      before.num_rows = num_before;
-      const ProjectionStatus status = project(before, model.settings.projection, &s->arrival_ws, &s->arrival);
-      if (status == ProjectionStatus::kOptimal) ac_old = s->arrival.ac;
-    }
-    for (int k = 0; k < m; ++k) {
-      if (s->matched[k]) continue;
-      const double d_k = Eigen::Map<const Vec6>(s->god.J + 6 * k).dot(ac_old);
-      const bool offset = needs_offset(d_k, model.offsets);
-      s->new_start[k] = offset ? d_k : 0.0;
-      s->new_t0[k] = t;
-      started += offset ? 1 : 0;
-    }
-  }
-  for (int k = 0; k < m; ++k) {
-    s->offset_start[k] = s->new_start[k];
-    s->offset_t0[k] = s->new_t0[k];
-    s->point_B[k] = s->new_point_B[k];
-    s->normal_W[k] = s->new_normal_W[k];
-  }
-  if (m > 0) {
-    std::memcpy(s->cached_J.data(), s->god.J, sizeof(double) * 6 * static_cast<size_t>(m));
-    s->num_last_rows = m;
-    s->last_rows_time = t;
-  } else if (num_old > 0) {
-    s->last_rows_time = t;  // the set just emptied: the stand-in's clock starts now
-  }
-  s->num_cached_rows = m;
-  return started;
-}
-
-// b_k = f_k(t - t0_k) for the rows whose offset runs; returns their number.
-int fill_rhs(const RuntimeModel& model, double t, CouplingState* s) {
-  int running = 0;
-  for (int k = 0; k < s->num_cached_rows; ++k) {
-    const double dt = t - s->offset_t0[k];
-    const bool runs = s->offset_start[k] < 0 && dt < model.offsets.T;
-    s->rhs[k] = runs ? offset_rhs(s->offset_start[k], dt, model.offsets) : 0.0;
-    running += runs ? 1 : 0;
-  }
-  return running;
-}
-
 void publish_wrench(double t, const CouplingStepInfo& info, RuntimeChannels* ch) {
   WrenchSample w;
   w.time = t;
@@ -534,14 +435,19 @@ const CouplingStepInfo& coupling_step(const RuntimeModel& model, double t, Runti
     info.num_rows = m;
     // 2. au = ks (xh (-) xs); offsets for the new rows of a new set.
     info.au = model.gains.ks * pose_difference(to_pose(s->handle.p, s->handle.q), s->xs);
-    if (info.new_set) info.num_new_offsets = start_offsets(model, t, info.au, s);
+    if (info.new_set) {
+      const OffsetRule rule{model.offsets, model.match_distance, model.settings.match_cosine,
+                            model.settings.projection};
+      const OffsetRows rows{m, s->god.J, s->god.point, s->god.normal};
+      info.num_new_offsets = start_offsets(rule, t, info.au, s->M, s->xs, rows, &s->offsets);
+    }
     // 3. ac = projection (warm-started), b(t) while offsets run; Fc = kh M (ac - au).
-    info.num_offset_rows = fill_rhs(model, t, s);
+    info.num_offset_rows = fill_offsets(model.offsets, t, &s->offsets);
     ProjectionProblem problem;
     problem.M = &s->M;
     problem.au = info.au;
     problem.J = m > 0 ? s->god.J : nullptr;
-    problem.b = info.num_offset_rows > 0 ? s->rhs.data() : nullptr;
+    problem.b = info.num_offset_rows > 0 ? s->offsets.rhs.data() : nullptr;
     problem.num_rows = m;
     info.projection = project(problem, model.settings.projection, &s->projection_ws, &s->projection);
     info.ac = s->projection.ac;

@@ -54,6 +54,7 @@
 #include "gauss6/contacts.h"
 #include "gauss6/coupling.h"
 #include "gauss6/device_port.h"
+#include "gauss6/offsetting.h"
 #include "gauss6/quasistatics.h"
 #include "gauss6/scene.h"
 #include "gauss6/shared_state.h"
@@ -317,29 +318,9 @@ struct CouplingState {
   GodObjectSnapshot god;               // cached snapshot (xs, M, J)
   bool has_god = false;
   uint64_t god_writes = 0;             // channel writes seen (detects a new snapshot)
-  int num_cached_rows = 0;             // rows whose identities are in point_B / normal_W
   Pose xs;
   Mat6 M = Mat6::Identity();
-  // Offsets (coupling.h), one per cached row: start value d_k (0: none), start
-  // time, and the row's identity for matching across snapshots.
-  std::array<double, kMaxContacts> offset_start{};
-  std::array<double, kMaxContacts> offset_t0{};
-  std::array<double, kMaxContacts> rhs{};
-  std::array<Vec3, kMaxContacts> point_B{};   // I_k in the god-object's frame
-  std::array<Vec3, kMaxContacts> normal_W{};
-  std::array<double, kMaxContacts * 6> cached_J{};  // the last non-empty set's rows (m x 6 row-major)
-  int num_last_rows = 0;               // rows in cached_J (kept through empty sets)
-  double last_rows_time = -1;          // s, when that set arrived or was last replaced by an empty one
-  // Scratch for the matching of a new snapshot's rows.
-  std::array<double, kMaxContacts> new_start{}, new_t0{};
-  std::array<Vec3, kMaxContacts> new_point_B{}, new_normal_W{};
-  std::array<unsigned char, kMaxContacts> matched{};
-  // The previous set's rows and their right-hand sides at the new set's arrival,
-  // projected once per new set to measure the new rows (see start_offsets in runtime.cpp).
-  std::array<double, kMaxContacts * 6> kept_J{};
-  std::array<double, kMaxContacts> kept_b{};
-  ProjectionWorkspace arrival_ws;
-  ProjectionResult arrival;
+  OffsetState offsets;                 // offsets and identities of the cached rows (offsetting.h)
   ProjectionWorkspace projection_ws;
   ProjectionResult projection;
   uint32_t active_events = 0;          // conditions of the last step (coupling thread's events)

@@ -1,0 +1,102 @@
+// Constraint offsetting of new contacts (METHOD.md section 3), the rule the
+// coupling loop runs: which rows of a new set are the same constraints as
+// cached ones (their offsets run on), what a new row's offset starts from (d_k
+// against the previous set's projection), and the stand-in set after an empty
+// one; then the right-hand sides b(t) of each coupling step.
+//
+// Units: accelerations a are the quasi-static per-step displacements of
+// METHOD.md section 1 (metres, radians); J rows are [n^T, (G I_k x n)^T];
+// points in scene units (metres); time t in seconds.
+//
+// Real-time contract: start_offsets() and fill_offsets() allocate nothing and
+// throw nothing; OffsetState holds every buffer, sized at compile time.
+#pragma once
+
+#include <array>
+
+#include "gauss6/pose.h"
+#include "gauss6/quasistatics.h"
+
+namespace gauss6 {
+
+// Constraint offsetting after Mark et al.: a new row J_k with d_k below eps
+// (< 0) starts at J_k a >= d_k and relaxes to J_k a >= 0 in T seconds.
+struct OffsetSettings {
+  double eps = -1e-4;  // threshold on d_k (< 0, metres): deeper rows are offset
+  double T = 0.1;      // duration of an offset (> 0, seconds)
+};
+
+// True when eps < 0 and T > 0 are finite.
+bool valid_offset_settings(const OffsetSettings& settings) noexcept;
+
+// True when a new row with start value d_k gets an offset: d_k < eps.
+bool needs_offset(double d_k, const OffsetSettings& settings) noexcept;
+
+// The offset profile f_k(t) = d_k (1 - s(t / T)), s(u) = 3u^2 - 2u^3 (cubic
+// smoothstep), clamped to u in [0, 1]: f_k(0) = d_k, f_k(T) = 0, increasing for
+// d_k < 0, with zero slope at both ends, so the felt force has neither a jump
+// nor a kink in its rate when an offset starts or ends. t < 0 gives d_k.
+// Requires valid_offset_settings(settings).
+double offset_rhs(double d_k, double t, const OffsetSettings& settings) noexcept;
+
+// The rule: the offset settings, when a row of a new set is "the same
+// constraint" as a cached one, and the settings of the projection that
+// measures the new rows.
+struct OffsetRule {
+  OffsetSettings offsets;
+  double match_distance = 0;       // same body-frame point: |I_B - I_B'| <= this (> 0, scene units)
+  double match_cosine = 1 - 1e-9;  // ... and same normal: n . n' >= this
+  ProjectionSettings projection;
+};
+
+// A newly published contact set (a view; world frame): m rows J (m x 6
+// row-major), their contact points I_k and normals n_k.
+struct OffsetRows {
+  int num_rows = 0;                    // m <= kMaxContacts
+  const double* J = nullptr;
+  const double (*point)[3] = nullptr;
+  const double (*normal)[3] = nullptr;
+};
+
+// Per-row offsets and identities of the cached set, the stand-in set, and the
+// scratch of the matching. Construct once; the members are internal.
+struct OffsetState {
+  // One per cached row: start value d_k (0: none), start time, right-hand side
+  // of the current step, and the row's identity for matching across sets.
+  int num_rows = 0;                    // rows whose identities are in point_B / normal_W
+  std::array<double, kMaxContacts> start{};
+  std::array<double, kMaxContacts> t0{};
+  std::array<double, kMaxContacts> rhs{};
+  std::array<Vec3, kMaxContacts> point_B{};   // I_k in the god-object's frame
+  std::array<Vec3, kMaxContacts> normal_W{};
+  std::array<double, kMaxContacts * 6> cached_J{};  // the last non-empty set's rows (m x 6 row-major)
+  int num_last_rows = 0;               // rows in cached_J (kept through empty sets)
+  double last_rows_time = -1;          // s, when that set arrived or was last replaced by an empty one
+  // Scratch for the matching of a new set's rows.
+  std::array<double, kMaxContacts> new_start{}, new_t0{};
+  std::array<Vec3, kMaxContacts> new_point_B{}, new_normal_W{};
+  std::array<unsigned char, kMaxContacts> matched{};
+  // The previous set's rows and their right-hand sides at the new set's
+  // arrival, projected once per new set to measure the new rows.
+  std::array<double, kMaxContacts * 6> kept_J{};
+  std::array<double, kMaxContacts> kept_b{};
+  ProjectionWorkspace arrival_ws;
+  ProjectionResult arrival;
+};
+
+// A new set `rows` arrives at time t, with the god-object at xs (mass matrix M)
+// and au the unconstrained acceleration. A row that is the same constraint as
+// a cached one keeps its offset; a new row k with d_k = J_k ac_old < eps starts
+// one, ac_old the projection of au on the previous set's rows (au when there
+// were none); after an empty set, the last non-empty one (arrived or emptied
+// less than T ago) stands in for the previous set, without offsets. The new
+// set becomes the cached one. Invalid offset settings start no offset.
+// Returns the number of offsets started.
+int start_offsets(const OffsetRule& rule, double t, const Vec6& au, const Mat6& M, const Pose& xs,
+                  const OffsetRows& rows, OffsetState* s) noexcept;
+
+// s->rhs[k] = f_k(t - t0_k) for the cached rows whose offset runs (0 for the
+// others); returns their number (0: the projection may take b = nullptr).
+int fill_offsets(const OffsetSettings& settings, double t, OffsetState* s) noexcept;
+
+}  // namespace gauss6
