@@ -5,7 +5,7 @@
 //
 // with multipliers lambda >= 0, M (ac - au) = J^T lambda and complementarity
 // lambda_k (J_k ac - b_k) = 0. b = 0 (the contact cone) unless constraint
-// offsetting (coupling.h) is running, in which case the feasible set is a
+// offsetting (offsetting.h) is running, in which case the feasible set is a
 // polyhedron that may be empty.
 //
 // Method: with M = L L^T (cached per M) and y = L^T a, the problem is the

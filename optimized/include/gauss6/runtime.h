@@ -16,7 +16,7 @@
 // seconds. Poses are of G (pose.h). Accelerations a are the quasi-static per-step
 // displacements (coupling.h); wrenches F = (force, torque about G), world frame.
 //
-// Choices the method leaves open (see runtime.cpp for the reasons):
+// Choices the method leaves open (see runtime.cpp, and offsetting.cpp for the offsets, for the reasons):
 //   - the sim loop regenerates the contact set at every new xs (hit or not), so
 //     a god-object sliding off an edge drops that edge's rows; when the step's
 //     motion (projected on the previous contacts' tangent cone) ends free and
