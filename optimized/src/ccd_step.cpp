@@ -274,10 +274,10 @@ void ccd_step(const CcdBody* obstacles, int num_obstacles, const CcdBody& god, c
     std::sort(cand, cand + num_cand, [](const auto& a, const auto& b) { return a.earliest < b.earliest; });
     for (int c = 0; c < num_cand; ++c) {
       if (cand[c].earliest > tester.end() || tester.done()) break;
-      if (searched(cand[c].god_face, cand[c].obstacle_face, cand[c].obstacle)) continue;
-      const CcdBody& ob = obstacles[cand[c].obstacle];
-      tester.test(*god.mesh, *god.bvh, cand[c].god_face, *ob.mesh, *ob.bvh, cand[c].obstacle_face,
-                  cand[c].obstacle);
+      const TrianglePair& p = cand[c].pair;
+      if (searched(p.god_face, p.obstacle_face, p.obstacle)) continue;
+      const CcdBody& ob = obstacles[p.obstacle];
+      tester.test(*god.mesh, *god.bvh, p.god_face, *ob.mesh, *ob.bvh, p.obstacle_face, p.obstacle);
     }
   };
   // Whatever the testing finds, u_hit stays <= the end of the window the near
@@ -502,7 +502,7 @@ void ccd_step(const CcdBody* obstacles, int num_obstacles, const CcdBody& god, c
           ++result->num_axis_culls;
           continue;
         }
-        cand[num_cand++] = {t, c.god_face, c.obstacle_face, c.obstacle};  // fits: the cache has cand's capacity
+        cand[num_cand++] = {{c.god_face, c.obstacle_face, c.obstacle}, t};  // fits: the cache has cand's capacity
       }
       set_near_pairs(num_cand, 0.0);
       test_candidates(num_cand);
@@ -534,7 +534,7 @@ void ccd_step(const CcdBody* obstacles, int num_obstacles, const CcdBody& god, c
         return true;
       }
       if (num_cand < cand_capacity) {
-        cand[num_cand++] = {t, gf, of, o};
+        cand[num_cand++] = {{gf, of, o}, t};
         return true;
       }
       listed = false;
