@@ -11,139 +11,13 @@
 #include <limits>
 
 #include "gauss6/distance.h"
+#include "pair_tester.h"
 
 namespace gauss6 {
 
 using detail::Displacement;
+using detail::PairTester;
 using detail::StartFrame;
-
-namespace {
-
-Vec3 vertex(const TriangleMesh& m, int f, int k) { return m.V.row(m.F(f, k)).transpose(); }
-
-// Runs the owned feature pairs of one (god triangle, obstacle triangle) pair on
-// the window [u0, *u_best]; lowers *u_best and records the pair on a hit.
-struct PairTester {
-  const CcdMotion* motion;
-  const MotionEnclosure* sub;  // the motion over the sub-interval [u0, u1]
-  const CcdStepSettings* settings;
-  CcdWorkspace* ws;
-  CcdStepResult* result;
-  double u0, u1;  // the sub-interval; tests search [u0, min(u1, best u so far)]
-  SweptBoxCache* swept = nullptr;  // god vertex boxes over *sub, shared by the pairs of the sub-interval
-  const StartFrame* start = nullptr;  // the god-object at u0 and its motion bounds
-  double reach = 0;                   // the narrow phase's min_separation
-
-  // Once a pair hit at u_b, later pairs search only up to u_b - time_tolerance:
-  // a contact in (u_b - tol, u_b] cannot lower the step's answer by more than
-  // the tolerance, and the step reports u_b - tol (see ccd_step), which is then
-  // <= u* for those pairs too.
-  double end() const { return result->hit ? std::min(u1, result->u_hit - settings->narrow.time_tolerance) : u1; }
-  bool done() const { return result->hit && end() <= u0; }
-
-  void consider(const CcdResult& r, const FeaturePair& p) {
-    ++result->num_pair_tests;
-    result->num_box_iterations += r.iterations;
-    if (!r.hit || (result->hit && r.u_hit >= result->u_hit)) return;
-    result->hit = true;
-    result->u_hit = r.u_hit;
-    result->pair = p;
-    result->time_tolerance_reached = r.time_tolerance_reached;
-    result->distance_reached = r.distance_reached;
-    if (r.status != CcdStatus::kOk) result->status = r.status;  // conservative give-up
-  }
-
-  void test(const TriangleMesh& gm, const Bvh& gb, int gf, const TriangleMesh& om, const Bvh& ob, int of,
-            int obstacle) {
-    const uint8_t go = gb.owned[gf], oo = ob.owned[of];
-    CcdResult r;
-    const std::array<Vec3, 3> obs_face = {vertex(om, of, 0), vertex(om, of, 1), vertex(om, of, 2)};
-    const std::array<Vec3, 3> god_face = {vertex(gm, gf, 0), vertex(gm, gf, 1), vertex(gm, gf, 2)};
-    // Feature-level box filter over the sub-interval (conservative: swept boxes
-    // enclose the motion, static boxes are grown by min_separation).
-    const double margin = settings->narrow.min_separation;
-    const auto box_of = [](const Vec3& a, const Vec3& b) { return Aabb{a.cwiseMin(b), a.cwiseMax(b)}; };
-    const Aabb obs_face_box = inflate(triangle_box(om, of), margin);
-    // Vertex boxes over the sub-interval (cached per mesh vertex). At each u the
-    // motion maps body points affinely, so an edge or the face lies in the hull
-    // of its vertices' world points, hence in the hull of their swept boxes.
-    Aabb god_swept[3], god_edge_swept[3];
-    for (int k = 0; k < 3; ++k)
-      god_swept[k] = swept->get(swept->vertices, gm.F(gf, k),
-                                [&] { return swept_box(*sub, box_of(god_face[k], god_face[k])); });
-    const auto hull_of = [](const Aabb& a, const Aabb& b) { return Aabb{a.lo.cwiseMin(b.lo), a.hi.cwiseMax(b.hi)}; };
-    for (int k = 0; k < 3; ++k) god_edge_swept[k] = hull_of(god_swept[k], god_swept[(k + 1) % 3]);
-    const Aabb god_face_swept = hull_of(god_edge_swept[0], god_swept[2]);
-    // Each feature pair's own time bound (StartFrame::earliest on the features
-    // as degenerate triangles, the axis between their closest points at u0
-    // tried first): a pair sliding along at its gap, or turning across it,
-    // needs no test.
-    Vec3 X[3];
-    double rad[3];
-    bool posed = false;
-    const auto pose_god_face = [&] {  // once, for the first feature past the box filter
-      if (posed) return;
-      posed = true;
-      for (int k = 0; k < 3; ++k) {
-        X[k] = start->pose(god_face[k]);
-        rad[k] = start->radius(god_face[k].squaredNorm());
-      }
-    };
-    const Vec3* Y = obs_face.data();
-    // The bound also starts the feature pair's search: nothing comes within
-    // reach before it, so the narrow phase searches [from, end()] only (a
-    // contact sliding along at its gap is then searched from where the
-    // motion can first close it, not across the whole step).
-    double from = u0;
-    const auto apart = [&](const Vec3 A[3], const Vec3 B[3], double radius, const Vec3& axis) {
-      from = std::max(u0, start->earliest(A, B, radius, reach, end(), &axis));
-      if (from <= end()) return false;
-      ++result->num_feature_culls;
-      return true;
-    };
-    for (int k = 0; k < 3; ++k) {
-      if (!(go & (1u << k)) || !(u0 <= end()) || !overlap(god_swept[k], obs_face_box)) continue;
-      pose_god_face();
-      const Vec3 A[3] = {X[k], X[k], X[k]};
-      if (apart(A, Y, rad[k], X[k] - closest_point_on_triangle(X[k], Y[0], Y[1], Y[2]))) continue;
-      RigidVertexFaceQuery q{motion, /*vertex_on_body=*/true, god_face[k], obs_face, from, end()};
-      ccd_rigid_vertex_face(q, settings->narrow, ws, &r);
-      consider(r, {PairKind::kGodVertexObstacleFace, obstacle, gf, k, of, -1});
-    }
-    for (int k = 0; k < 3; ++k) {
-      if (!(oo & (1u << k)) || !(u0 <= end()) ||
-          !overlap(god_face_swept, inflate(box_of(obs_face[k], obs_face[k]), margin)))
-        continue;
-      pose_god_face();
-      const Vec3 B[3] = {Y[k], Y[k], Y[k]};
-      if (apart(X, B, std::max({rad[0], rad[1], rad[2]}), closest_point_on_triangle(Y[k], X[0], X[1], X[2]) - Y[k]))
-        continue;
-      RigidVertexFaceQuery q{motion, /*vertex_on_body=*/false, obs_face[k], god_face, from, end()};
-      ccd_rigid_vertex_face(q, settings->narrow, ws, &r);
-      consider(r, {PairKind::kObstacleVertexGodFace, obstacle, gf, -1, of, k});
-    }
-    for (int k = 0; k < 3; ++k) {
-      if (!(go & (8u << k))) continue;
-      for (int j = 0; j < 3; ++j) {
-        if (!(oo & (8u << j)) || !(u0 <= end()) ||
-            !overlap(god_edge_swept[k], inflate(box_of(obs_face[j], obs_face[(j + 1) % 3]), margin)))
-          continue;
-        pose_god_face();
-        const int k1 = (k + 1) % 3, j1 = (j + 1) % 3;
-        const Vec3 A[3] = {X[k], X[k1], X[k1]}, B[3] = {Y[j], Y[j1], Y[j1]};
-        double s = 0, t = 0;
-        closest_segment_parameters(X[k], X[k1], Y[j], Y[j1], &s, &t);
-        if (apart(A, B, std::max(rad[k], rad[k1]), (X[k] + s * (X[k1] - X[k])) - (Y[j] + t * (Y[j1] - Y[j])))) continue;
-        RigidEdgeEdgeQuery q{motion, {god_face[k], god_face[(k + 1) % 3]}, {obs_face[j], obs_face[(j + 1) % 3]},
-                             from, end()};
-        ccd_rigid_edge_edge(q, settings->narrow, ws, &r);
-        consider(r, {PairKind::kEdgeEdge, obstacle, gf, k, of, j});
-      }
-    }
-  }
-};
-
-}  // namespace
 
 void ccd_step(const CcdBody* obstacles, int num_obstacles, const CcdBody& god, const Pose& X0, const Pose& X1,
               const CcdStepSettings& settings, CcdStepWorkspace* ws, CcdStepResult* result, const FeaturePair* hints,
@@ -274,10 +148,10 @@ void ccd_step(const CcdBody* obstacles, int num_obstacles, const CcdBody& god, c
     std::sort(cand, cand + num_cand, [](const auto& a, const auto& b) { return a.earliest < b.earliest; });
     for (int c = 0; c < num_cand; ++c) {
       if (cand[c].earliest > tester.end() || tester.done()) break;
-      if (searched(cand[c].god_face, cand[c].obstacle_face, cand[c].obstacle)) continue;
-      const CcdBody& ob = obstacles[cand[c].obstacle];
-      tester.test(*god.mesh, *god.bvh, cand[c].god_face, *ob.mesh, *ob.bvh, cand[c].obstacle_face,
-                  cand[c].obstacle);
+      const TrianglePair& p = cand[c].pair;
+      if (searched(p.god_face, p.obstacle_face, p.obstacle)) continue;
+      const CcdBody& ob = obstacles[p.obstacle];
+      tester.test(*god.mesh, *god.bvh, p.god_face, *ob.mesh, *ob.bvh, p.obstacle_face, p.obstacle);
     }
   };
   // Whatever the testing finds, u_hit stays <= the end of the window the near
@@ -502,7 +376,7 @@ void ccd_step(const CcdBody* obstacles, int num_obstacles, const CcdBody& god, c
           ++result->num_axis_culls;
           continue;
         }
-        cand[num_cand++] = {t, c.god_face, c.obstacle_face, c.obstacle};  // fits: the cache has cand's capacity
+        cand[num_cand++] = {{c.god_face, c.obstacle_face, c.obstacle}, t};  // fits: the cache has cand's capacity
       }
       set_near_pairs(num_cand, 0.0);
       test_candidates(num_cand);
@@ -534,7 +408,7 @@ void ccd_step(const CcdBody* obstacles, int num_obstacles, const CcdBody& god, c
         return true;
       }
       if (num_cand < cand_capacity) {
-        cand[num_cand++] = {t, gf, of, o};
+        cand[num_cand++] = {{gf, of, o}, t};
         return true;
       }
       listed = false;

@@ -56,12 +56,12 @@ struct Collector {
 
 ContactStatus generate_contacts(const CcdBody* obstacles, int num_obstacles, const CcdBody& god, const Pose& X_WB,
                                 const ContactSettings& settings, ContactWorkspace* ws, ContactSet* set,
-                                const CcdStepWorkspace::Candidate* pairs, int num_pairs) {
+                                const NearPairs& near) {
   set->num_contacts = 0;
   set->num_pairs_within = 0;
   if (!god.mesh || !god.bvh || !ws || !is_valid_pose(X_WB) || !(settings.distance > 0) ||
       !std::isfinite(settings.distance) || ws->god_world.size() != static_cast<size_t>(god.mesh->V.rows()) ||
-      (num_obstacles > 0 && !obstacles) || (num_pairs > 0 && !pairs))
+      (num_obstacles > 0 && !obstacles) || (near.num_pairs > 0 && !near.pairs))
     return ContactStatus::kInvalidInput;
   const TriangleMesh& gm = *god.mesh;
   const Mat3 R = rotation_matrix(X_WB.q);
@@ -162,10 +162,12 @@ ContactStatus generate_contacts(const CcdBody* obstacles, int num_obstacles, con
       }
       return true;
     };
-    if (num_pairs >= 0) {  // the listed pairs of this obstacle (in range: ccd_step made them)
-      for (int k = 0; k < num_pairs; ++k)
-        if (pairs[k].obstacle == o && pairs[k].god_face < gm.F.rows() && pairs[k].obstacle_face < om.F.rows())
-          visit(pairs[k].god_face, pairs[k].obstacle_face);
+    if (near.listed()) {  // the listed pairs of this obstacle (in range: ccd_step made them)
+      for (int k = 0; k < near.num_pairs; ++k) {
+        const TrianglePair& p = near[k];
+        if (p.obstacle == o && p.god_face < gm.F.rows() && p.obstacle_face < om.F.rows())
+          visit(p.god_face, p.obstacle_face);
+      }
       continue;
     }
     int node_pairs = 0;

@@ -280,7 +280,7 @@ void update_contacts(const RuntimeModel& model, SimState* s) {
   const bool near = r.num_near_pairs >= 0 && (r.hit ? r.u_hit : 1.0) >= r.near_u0 && cs.distance + slack <= r.near_reach;
   const ContactStatus status =
       generate_contacts(model.obstacles.data(), static_cast<int>(model.obstacles.size()), model.god, s->xs, cs,
-                        &s->contact_ws, &s->contacts, s->ccd_ws.candidates.data(), near ? r.num_near_pairs : -1);
+                        &s->contact_ws, &s->contacts, s->ccd_ws.near_pairs(near ? r.num_near_pairs : -1));
   if (status == ContactStatus::kInvalidInput) s->contacts.num_contacts = 0;
   if (status == ContactStatus::kOverflow || status == ContactStatus::kStackFull)
     s->step_events |= bit(RuntimeEventKind::kContactOverflow);

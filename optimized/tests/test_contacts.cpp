@@ -155,8 +155,8 @@ TEST_CASE("contacts: the CCD's near pairs give the same set as the descent", "[c
     REQUIRE(generate_contacts(&obstacle, 1, god, stop.pose, cs, &ws, &descended) == ContactStatus::kOk);
     if (!(r.num_near_pairs >= 0 && u >= r.near_u0 && cs.distance + slack <= r.near_reach)) continue;
     ++used;
-    REQUIRE(generate_contacts(&obstacle, 1, god, stop.pose, cs, &ws, &listed, ccd_ws.candidates.data(),
-                              r.num_near_pairs) == ContactStatus::kOk);
+    REQUIRE(generate_contacts(&obstacle, 1, god, stop.pose, cs, &ws, &listed, ccd_ws.near_pairs(r.num_near_pairs)) ==
+            ContactStatus::kOk);
     with_contacts += descended.num_contacts > 0;
     REQUIRE(listed.num_contacts == descended.num_contacts);
     for (int k = 0; k < descended.num_contacts; ++k) {

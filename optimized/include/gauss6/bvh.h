@@ -59,6 +59,13 @@ struct Bvh {
   size_t memory_bytes() const;
 };
 
+// A mesh and its BVH (built from that mesh): what the CCD step and the contact
+// generation take of each body. Obstacles: world frame; god-object: body frame.
+struct CcdBody {
+  const TriangleMesh* mesh = nullptr;
+  const Bvh* bvh = nullptr;
+};
+
 // Top-down build: each node's triangles split where the surface-area
 // heuristic puts the split of their centroids sorted along an axis (the least
 // area(left) n_left + area(right) n_right over the three axes), leaves of at

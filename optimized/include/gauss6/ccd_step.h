@@ -25,16 +25,10 @@
 #include "gauss6/feature_pair.h"
 #include "gauss6/mesh.h"
 #include "gauss6/motion_bounds.h"
+#include "gauss6/near_pairs.h"
 #include "gauss6/pose.h"
 
 namespace gauss6 {
-
-// A mesh and its BVH (built from that mesh). Obstacles: world frame; god-object:
-// body frame.
-struct CcdBody {
-  const TriangleMesh* mesh = nullptr;
-  const Bvh* bvh = nullptr;
-};
 
 struct CcdStepSettings {
   CcdSettings narrow;                      // tolerances and min_separation of every pair test
@@ -65,8 +59,8 @@ struct CcdStepResult {
   int num_axis_culls = 0;                  // triangle pairs dropped whole by a separating-axis time bound (no pair test)
   int num_feature_culls = 0;               // feature pairs dropped by their own time bound (no pair test)
   long num_box_iterations = 0;             // narrow-phase boxes, all tests together
-  // Near pairs (settings.near_distance > 0): when num_near_pairs >= 0, ws->candidates[0 .. num_near_pairs)
-  // hold every triangle pair that can come within near_reach (= max(min_separation, near_distance)) of
+  // Near pairs (settings.near_distance > 0): when num_near_pairs >= 0, ws->near_pairs(num_near_pairs)
+  // holds every triangle pair that can come within near_reach (= max(min_separation, near_distance)) of
   // each other under the exact motion at any u in [near_u0, u_hit] (the last sub-interval searched), so
   // the contact generation at the stop pose can test those instead of descending the trees again (with
   // the stop pose's deviation taken off near_reach). -1: no such list (the step stopped before any
@@ -88,8 +82,8 @@ struct CcdStepWorkspace {
         cache(std::max(candidate_capacity, 0), stack_capacity) {}
   // A candidate triangle pair of one sub-interval and a lower bound of its first contact parameter.
   struct Candidate {
+    TrianglePair pair;
     double earliest;
-    int32_t god_face, obstacle_face, obstacle;
   };
   // Coherence between steps (CcdStepSettings::cache_margin). pairs[0 ..
   // num_pairs) hold every triangle pair not proven farther than reach + margin
@@ -160,6 +154,10 @@ struct CcdStepWorkspace {
   CcdWorkspace narrow;
   BvhStack stack;
   std::vector<Candidate> candidates;  // tested earliest-first; overflow is tested in traversal order
+  // The first num candidates' triangle pairs as near pairs (CcdStepResult::num_near_pairs; -1: no list).
+  NearPairs near_pairs(int num) const {
+    return {candidates.empty() ? nullptr : &candidates[0].pair, num, sizeof(Candidate)};
+  }
   SweptBoxCache swept;                // god boxes of the current sub-interval
   ProximityCache cache;
 };

@@ -27,8 +27,8 @@
 #include <Eigen/Core>
 
 #include "gauss6/bvh.h"
-#include "gauss6/ccd_step.h"
 #include "gauss6/motion_bounds.h"
+#include "gauss6/near_pairs.h"
 
 namespace gauss6 {
 
@@ -75,12 +75,13 @@ struct ContactWorkspace {
 };
 
 // The contact set of the god-object at pose X_WB (G = X_WB.p) against the
-// obstacles (world frame). With num_pairs >= 0, the triangle pairs
-// pairs[0 .. num_pairs) are tested instead of a descent of the trees: a list
-// that holds every pair within settings.distance at X_WB (ccd_step's near
-// pairs: CcdStepResult::num_near_pairs), which gives the same set.
+// obstacles (world frame). With near.listed(), the triangle pairs near[0 ..
+// near.num_pairs) are tested instead of a descent of the trees: a list that
+// holds every pair within settings.distance at X_WB (ccd_step's near pairs:
+// CcdStepWorkspace::near_pairs(CcdStepResult::num_near_pairs)), which gives
+// the same set.
 ContactStatus generate_contacts(const CcdBody* obstacles, int num_obstacles, const CcdBody& god, const Pose& X_WB,
                                 const ContactSettings& settings, ContactWorkspace* ws, ContactSet* set,
-                                const CcdStepWorkspace::Candidate* pairs = nullptr, int num_pairs = -1);
+                                const NearPairs& near = {});
 
 }  // namespace gauss6
