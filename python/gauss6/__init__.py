@@ -7,6 +7,7 @@ from __future__ import annotations
 
 from . import _gauss6  # noqa: F401  (the C++ core; built by CMake)
 from ._gauss6 import (  # noqa: F401
+    LoadError,
     MeshFileError,
     ProjectionSettings,
     Projector,

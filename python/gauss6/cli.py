@@ -36,12 +36,12 @@ def _error(message: str) -> int:
 
 
 def cmd_scene_info(args: argparse.Namespace) -> int:
-    from . import SceneError
+    from . import LoadError
     from .scene import format_scene_info, scene_info
 
     try:
         info = scene_info(args.scene, self_intersections=not args.no_self_intersections)
-    except SceneError as e:
+    except LoadError as e:
         return _error(str(e))
     print(json.dumps(info, indent=2) if args.json else format_scene_info(info))
     return 0

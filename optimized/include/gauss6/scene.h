@@ -1,14 +1,14 @@
 // The scene: an immutable model built once from a TOML file (docs/scene-format.md)
 // and shared read-only by every loop (MuJoCo's mjModel). Loading validates every
 // key and value, reads and validates the meshes, and computes the god-object's
-// mass properties once. Errors are SceneError exceptions (load time only) whose
-// message names the file, line, column and key.
+// mass properties once. Errors are SceneError exceptions (load_error.h; load time
+// only) whose message names the file, line, column and key.
 #pragma once
 
-#include <stdexcept>
 #include <string>
 #include <vector>
 
+#include "gauss6/load_error.h"
 #include "gauss6/mass_properties.h"
 #include "gauss6/mesh.h"
 #include "gauss6/pose.h"
@@ -16,11 +16,6 @@
 namespace gauss6 {
 
 inline constexpr int kSceneFormatVersion = 1;
-
-class SceneError : public std::runtime_error {
- public:
-  using std::runtime_error::runtime_error;
-};
 
 enum class BodyRole { kObstacle, kGodObject };
 enum class SurfaceKind { kNone, kForceShading, kTexture };

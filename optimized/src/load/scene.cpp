@@ -6,7 +6,6 @@
 #include <filesystem>
 #include <initializer_list>
 #include <set>
-#include <sstream>
 
 #include <Eigen/Eigenvalues>
 #include <toml++/toml.h>
@@ -45,10 +44,8 @@ class TableReader {
 
   [[noreturn]] void fail(const toml::source_region& where, const std::string& key,
                          const std::string& message) const {
-    std::ostringstream os;
-    os << file_ << ":" << where.begin.line << ":" << where.begin.column << ": " << prefix_ << key
-       << ": " << message;
-    throw SceneError(os.str());
+    throw SceneError(file_, static_cast<int>(where.begin.line), prefix_ + key, message,
+                     static_cast<int>(where.begin.column));
   }
   [[noreturn]] void fail_missing(const std::string& key, const std::string& what) const {
     fail(table_.source(), key, "missing (" + what + ")");
@@ -201,11 +198,10 @@ Scene load_scene(const std::string& path) {
   try {
     root = toml::parse_file(path);
   } catch (const toml::parse_error& e) {
-    std::ostringstream os;
-    os << path << ":" << e.source().begin.line << ":" << e.source().begin.column << ": " << e.description();
-    throw SceneError(os.str());
+    throw SceneError(path, static_cast<int>(e.source().begin.line), /*key=*/"", std::string(e.description()),
+                     static_cast<int>(e.source().begin.column));
   } catch (const std::exception& e) {
-    throw SceneError(path + ": " + e.what());
+    throw SceneError(path, e.what());
   }
   const toml::table empty;
   TableReader top(path, root, "");
