@@ -20,3 +20,10 @@ from ._gauss6 import (  # noqa: F401
 )
 
 __version__ = "0.1.0"
+
+
+def defaults() -> dict:
+    """Every documented default, read from the C++ structs that hold it:
+    {"contact", "surface", "device", "ccd", "projection"} (contact.offset_eps_per_delta:
+    a scene's offset_eps defaults to that multiple of its delta)."""
+    return {**_gauss6.defaults(), "projection": _gauss6.projection_defaults()}
