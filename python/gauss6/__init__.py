@@ -7,6 +7,7 @@ from __future__ import annotations
 
 from . import _gauss6  # noqa: F401  (the C++ core; built by CMake)
 from ._gauss6 import (  # noqa: F401
+    LoadError,
     MeshFileError,
     ProjectionSettings,
     Projector,
@@ -19,3 +20,10 @@ from ._gauss6 import (  # noqa: F401
 )
 
 __version__ = "0.1.0"
+
+
+def defaults() -> dict:
+    """Every documented default, read from the C++ structs that hold it:
+    {"contact", "surface", "device", "ccd", "projection"} (contact.offset_eps_per_delta:
+    a scene's offset_eps defaults to that multiple of its delta)."""
+    return {**_gauss6.defaults(), "projection": _gauss6.projection_defaults()}

@@ -36,12 +36,12 @@ def _error(message: str) -> int:
 
 
 def cmd_scene_info(args: argparse.Namespace) -> int:
-    from . import SceneError
+    from . import LoadError
     from .scene import format_scene_info, scene_info
 
     try:
         info = scene_info(args.scene, self_intersections=not args.no_self_intersections)
-    except SceneError as e:
+    except LoadError as e:
         return _error(str(e))
     print(json.dumps(info, indent=2) if args.json else format_scene_info(info))
     return 0
@@ -113,6 +113,8 @@ def cmd_device_list(args: argparse.Namespace) -> int:
 
 
 def build_parser() -> argparse.ArgumentParser:
+    from . import defaults  # the C++ settings' defaults, for the options that share them
+
     p = argparse.ArgumentParser(prog="gauss6", description=__doc__.splitlines()[0])
     sub = p.add_subparsers(dest="command", required=True)
 
@@ -148,7 +150,9 @@ def build_parser() -> argparse.ArgumentParser:
     cq.add_argument("target", help="query CSV file, or a directory (every CSV under vertex-face/ or edge-edge/)")
     cq.add_argument("--kind", choices=["vf", "ee"], help="vertex/face or edge/edge (default: from the folder name)")
     cq.add_argument("--impl", choices=["optimized", "reference"], default="optimized", help="default: optimized")
-    cq.add_argument("--time-tolerance", type=float, default=1e-6, help="optimized CCD time tolerance (default 1e-6)")
+    time_tolerance = defaults()["ccd"]["time_tolerance"]
+    cq.add_argument("--time-tolerance", type=float, default=time_tolerance,
+                    help=f"optimized CCD time tolerance (default {time_tolerance:g})")
     cq.add_argument("--json", action="store_true", help="machine-readable output")
     cq.set_defaults(func=cmd_ccd_queries)
 

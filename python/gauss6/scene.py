@@ -19,7 +19,7 @@ def _vector(v) -> list[float | None]:
 def scene_info(path: str, self_intersections: bool = True) -> dict[str, Any]:
     """{"scene": PATH, "bodies": [...]} with exactly the keys of the documented form.
 
-    Raises gauss6.SceneError (naming file, line and key) for a bad scene.
+    Raises gauss6.LoadError (a ValueError naming file, line and key) for a bad scene or mesh.
     """
     raw = _gauss6.scene_summary(str(path), self_intersections)
     bodies = []

@@ -3,6 +3,8 @@
 #include <pybind11/eigen.h>
 #include <pybind11/stl.h>
 
+#include "gauss6/ccd.h"
+#include "gauss6/load_error.h"
 #include "gauss6/mass_properties.h"
 #include "gauss6/mesh.h"
 #include "gauss6/mesh_io.h"
@@ -36,9 +38,34 @@ py::dict summary_dict(const BodySummary& s) {
 }  // namespace
 
 void bind_core(py::module_& m) {
-  // Errors at the edges become Python exceptions naming the problem.
-  py::register_exception<MeshFileError>(m, "MeshFileError", PyExc_ValueError);
-  py::register_exception<SceneError>(m, "SceneError", PyExc_ValueError);
+  // Every load-time error (load_error.h: scenes, meshes, CCD query and projection-
+  // instance files) becomes gauss6.LoadError, a ValueError with the same message
+  // ("FILE:LINE: KEY: problem"). SceneError and MeshFileError are its old names.
+  const auto& load_error = py::register_exception<LoadError>(m, "LoadError", PyExc_ValueError);
+  m.attr("SceneError") = load_error;
+  m.attr("MeshFileError") = load_error;
+
+  // The defaults of the scene file's optional keys and of the CCD settings, read
+  // from default-constructed C++ structs: the one place they are stated.
+  m.def("defaults",
+        [] {
+          const ContactParameters contact;
+          const SurfaceSettings surface;
+          const DeviceSettings device;
+          const CcdSettings ccd;
+          py::dict d;
+          d["contact"] = py::dict(py::arg("offset_eps_per_delta") = kDefaultOffsetEpsPerDelta,
+                                  py::arg("offset_time") = contact.offset_time);
+          d["surface"] = py::dict(py::arg("kind") = to_string(surface.kind));
+          d["device"] = py::dict(py::arg("rate_hz") = device.rate_hz, py::arg("max_force") = device.max_force,
+                                 py::arg("max_torque") = device.max_torque);
+          d["ccd"] = py::dict(py::arg("time_tolerance") = ccd.time_tolerance,
+                              py::arg("distance_tolerance") = ccd.distance_tolerance,
+                              py::arg("max_iterations") = ccd.max_iterations);
+          return d;
+        },
+        "Defaults of the scene file's optional keys (contact: offset_eps as a multiple of delta) and of "
+        "CcdSettings, from the C++ structs.");
 
   // Poses: p (3,), q (4,) as (w, x, y, z).
   m.def("rotation_matrix", [](const Eigen::Vector4d& q) { return rotation_matrix(quat_from(q)); }, py::arg("q"),
@@ -136,7 +163,7 @@ void bind_core(py::module_& m) {
           return d;
         },
         py::arg("path"), py::arg("self_intersections") = true,
-        "Loads a scene (raises SceneError naming file, line and key) and summarises its bodies.");
+        "Loads a scene (raises LoadError naming file, line and key) and summarises its bodies.");
 }
 
 }  // namespace gauss6::python

@@ -99,6 +99,16 @@ void bind_quasistatics(py::module_& m) {
       .def_readwrite("warm_start", &ProjectionSettings::warm_start)
       .def_readwrite("compute_residuals", &ProjectionSettings::compute_residuals);
 
+  // ProjectionSettings' defaults (quasistatics.h), from a default-constructed struct.
+  m.def("projection_defaults",
+        [] {
+          const ProjectionSettings s;
+          return py::dict(py::arg("dependence_tol") = s.dependence_tol, py::arg("feasibility_tol") = s.feasibility_tol,
+                          py::arg("max_iterations") = s.max_iterations, py::arg("warm_start") = s.warm_start,
+                          py::arg("compute_residuals") = s.compute_residuals);
+        },
+        "Defaults of ProjectionSettings (quasistatics.h).");
+
   py::class_<PyProjection>(m, "Projection")
       .def_readonly("ac", &PyProjection::ac)
       .def_readonly("lam", &PyProjection::lam)

@@ -19,6 +19,8 @@
 #include <string>
 #include <vector>
 
+#include "gauss6/load_error.h"
+
 namespace gauss6 {
 
 // The exact rational num/den, both decimal integers without leading '+', with
@@ -42,7 +44,7 @@ struct CcdQuery {
   int line = 0;           // 1-based line number of the query's first row in its file
 };
 
-// Reads one query file. Throws std::runtime_error naming the file and line on:
+// Reads one query file. Throws CcdQueryFileError (load_error.h) naming the file and line on:
 // a file that cannot be opened, a row without exactly 7 integer columns, a zero
 // denominator, a ground truth other than 0/1 or differing within a query, or a
 // number of rows that is not a multiple of 8. Empty lines are skipped.
@@ -54,7 +56,7 @@ struct CcdQueryFile {
   CcdQuery::Kind kind;
 };
 // Every *.csv file under root in a directory named "vertex-face" or "edge-edge"
-// (recursively), sorted by path. Throws std::runtime_error if root is not a directory.
+// (recursively), sorted by path. Throws CcdQueryFileError if root is not a directory.
 std::vector<CcdQueryFile> list_ccd_query_files(const std::string& root);
 
 // Nearest double to the rational (round to nearest, ties to even); *exact (if

@@ -3,19 +3,16 @@
 // never called from a real-time loop.
 #pragma once
 
-#include <stdexcept>
 #include <string>
 
+#include "gauss6/load_error.h"
 #include "gauss6/mesh.h"
 
 namespace gauss6 {
 
-// Raised for a missing, unreadable or malformed mesh file; what() names the file
-// and the problem ("bunny.obj: face 12 has 4 corners; only triangles are supported").
-class MeshFileError : public std::runtime_error {
- public:
-  using std::runtime_error::runtime_error;
-};
+// Errors are MeshFileError (load_error.h) for a missing, unreadable or malformed
+// mesh file; what() names the file and the problem ("bunny.obj: face 12 has 4
+// corners; only triangles are supported").
 
 // Reads a triangle mesh by extension (.obj .off .ply .stl, case-insensitive).
 // OBJ, OFF and PLY keep the file's vertex numbering; STL corners with exactly equal

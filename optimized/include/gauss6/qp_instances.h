@@ -11,6 +11,7 @@
 
 #include <Eigen/Core>
 
+#include "gauss6/load_error.h"
 #include "gauss6/pose.h"
 
 namespace gauss6 {
@@ -30,10 +31,11 @@ struct QpInstance {
 };
 
 // Every instance of one family file, in file order. Numbers are read bit-exactly
-// (the files hold shortest round-trip decimal forms). Throws std::runtime_error whose
-// message starts with the path and names the problem (unreadable file, not JSON, wrong
-// "format" or "version", a missing key, a wrong size, a non-number or non-finite value,
-// an unknown push label).
+// (the files hold shortest round-trip decimal forms). Throws QpInstanceError
+// (load_error.h) whose message starts with the path, then the line of a JSON syntax
+// error or the key ("instances[3].J[1]"), and names the problem (unreadable file, not
+// JSON, wrong "format" or "version", a missing key, a wrong size, a non-number or
+// non-finite value, an unknown push label).
 std::vector<QpInstance> read_qp_instances(const std::string& path);
 
 }  // namespace gauss6

@@ -1,14 +1,14 @@
 // The scene: an immutable model built once from a TOML file (docs/scene-format.md)
 // and shared read-only by every loop (MuJoCo's mjModel). Loading validates every
 // key and value, reads and validates the meshes, and computes the god-object's
-// mass properties once. Errors are SceneError exceptions (load time only) whose
-// message names the file, line, column and key.
+// mass properties once. Errors are SceneError exceptions (load_error.h; load time
+// only) whose message names the file, line, column and key.
 #pragma once
 
-#include <stdexcept>
 #include <string>
 #include <vector>
 
+#include "gauss6/load_error.h"
 #include "gauss6/mass_properties.h"
 #include "gauss6/mesh.h"
 #include "gauss6/pose.h"
@@ -16,11 +16,6 @@
 namespace gauss6 {
 
 inline constexpr int kSceneFormatVersion = 1;
-
-class SceneError : public std::runtime_error {
- public:
-  using std::runtime_error::runtime_error;
-};
 
 enum class BodyRole { kObstacle, kGodObject };
 enum class SurfaceKind { kNone, kForceShading, kTexture };
@@ -51,10 +46,17 @@ struct Gains {
   double kh = 0;     // Fc = kh M (ac - au)
 };
 
+// The defaults of the scene file's optional keys are stated once, here: as the
+// default values of the settings structs below (a default-constructed struct holds
+// them), and for offset_eps, which is relative to delta, as a factor. The loader
+// takes them from here and so do the Python bindings (gauss6.defaults()).
+inline constexpr double kDefaultOffsetEpsPerDelta = -10;  // contact.offset_eps = -10 delta
+
 struct ContactParameters {
-  double delta = 0;        // separation kept before contact (scene units)
-  double offset_eps = 0;   // new rows with J_k au < offset_eps are offset (< 0)
-  double offset_time = 0;  // time T of an offset's return to 0 (s)
+  double delta = 0;           // separation kept before contact (scene units); required
+  double offset_eps = 0;      // new rows with J_k au < offset_eps are offset (< 0);
+                              // the loader's default is kDefaultOffsetEpsPerDelta * delta
+  double offset_time = 0.05;  // time T of an offset's return to 0 (s)
 };
 
 struct SurfaceSettings {
@@ -65,10 +67,10 @@ struct SurfaceSettings {
 };
 
 struct DeviceSettings {
-  DeviceKind kind = DeviceKind::kSimulated;
-  double rate_hz = 1000;
-  double max_force = 20;   // N
-  double max_torque = 1;   // N m
+  DeviceKind kind = DeviceKind::kSimulated;  // required in a scene file
+  double rate_hz = 1000;   // Hz
+  double max_force = 20;   // N: force clamp
+  double max_torque = 1;   // N m: torque clamp
   std::string script;      // simulated: scripted hand trajectory's name
   std::string trace;       // replay: trace file (resolved)
   int vendor_id = -1, product_id = -1;  // hid: -1 = any

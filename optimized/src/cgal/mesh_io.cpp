@@ -29,7 +29,7 @@ using Polygon = std::vector<std::size_t>;
 enum class Format { kObj, kOff, kPly, kStl };
 
 [[noreturn]] void fail(const std::string& path, const std::string& what) {
-  throw MeshFileError(path + ": " + what);
+  throw MeshFileError(path, what);
 }
 
 // The format named by the file's extension (case-insensitive).

@@ -42,7 +42,7 @@ std::string negate(const std::string& canonical) {
 }
 
 [[noreturn]] void fail(const std::string& path, int line, const std::string& what) {
-  throw std::runtime_error(path + ":" + std::to_string(line) + ": " + what);
+  throw CcdQueryFileError(path, line, /*key=*/"", what);
 }
 
 // |value| of a canonical decimal integer as u128; throws beyond 127 bits.
@@ -80,7 +80,7 @@ int bit_length(u128 v) {
 
 std::vector<CcdQuery> read_ccd_queries(const std::string& path, CcdQuery::Kind kind) {
   std::ifstream in(path);
-  if (!in) throw std::runtime_error(path + ": cannot open");
+  if (!in) throw CcdQueryFileError(path, "cannot open");
   std::vector<CcdQuery> queries;
   CcdQuery current;
   current.kind = kind;
@@ -139,7 +139,7 @@ std::vector<CcdQuery> read_ccd_queries(const std::string& path, CcdQuery::Kind k
 
 std::vector<CcdQueryFile> list_ccd_query_files(const std::string& root) {
   namespace fs = std::filesystem;
-  if (!fs::is_directory(root)) throw std::runtime_error(root + ": not a directory");
+  if (!fs::is_directory(root)) throw CcdQueryFileError(root, "not a directory");
   std::vector<CcdQueryFile> files;
   for (const auto& entry : fs::recursive_directory_iterator(root)) {
     if (!entry.is_regular_file() || entry.path().extension() != ".csv") continue;

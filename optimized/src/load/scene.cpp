@@ -6,7 +6,6 @@
 #include <filesystem>
 #include <initializer_list>
 #include <set>
-#include <sstream>
 
 #include <Eigen/Eigenvalues>
 #include <toml++/toml.h>
@@ -45,10 +44,8 @@ class TableReader {
 
   [[noreturn]] void fail(const toml::source_region& where, const std::string& key,
                          const std::string& message) const {
-    std::ostringstream os;
-    os << file_ << ":" << where.begin.line << ":" << where.begin.column << ": " << prefix_ << key
-       << ": " << message;
-    throw SceneError(os.str());
+    throw SceneError(file_, static_cast<int>(where.begin.line), prefix_ + key, message,
+                     static_cast<int>(where.begin.column));
   }
   [[noreturn]] void fail_missing(const std::string& key, const std::string& what) const {
     fail(table_.source(), key, "missing (" + what + ")");
@@ -201,11 +198,10 @@ Scene load_scene(const std::string& path) {
   try {
     root = toml::parse_file(path);
   } catch (const toml::parse_error& e) {
-    std::ostringstream os;
-    os << path << ":" << e.source().begin.line << ":" << e.source().begin.column << ": " << e.description();
-    throw SceneError(os.str());
+    throw SceneError(path, static_cast<int>(e.source().begin.line), /*key=*/"", std::string(e.description()),
+                     static_cast<int>(e.source().begin.column));
   } catch (const std::exception& e) {
-    throw SceneError(path + ": " + e.what());
+    throw SceneError(path, e.what());
   }
   const toml::table empty;
   TableReader top(path, root, "");
@@ -230,10 +226,11 @@ Scene load_scene(const std::string& path) {
   contact.allow_only({"delta", "offset_eps", "offset_time"});
   scene.contact.delta = contact.number("delta");
   require(scene.contact.delta > 0, contact, "delta", "must be > 0");
-  const double default_eps = -10.0 * scene.contact.delta, default_T = 0.05;
+  const ContactParameters defaults;
+  const double default_eps = kDefaultOffsetEpsPerDelta * scene.contact.delta;
   scene.contact.offset_eps = contact.number("offset_eps", &default_eps);
   require(scene.contact.offset_eps < 0, contact, "offset_eps", "must be < 0");
-  scene.contact.offset_time = contact.number("offset_time", &default_T);
+  scene.contact.offset_time = contact.number("offset_time", &defaults.offset_time);
   require(scene.contact.offset_time > 0, contact, "offset_time", "must be > 0");
 
   std::set<std::string> names;
@@ -367,12 +364,12 @@ Scene load_scene(const std::string& path) {
       for (const std::string& o : own) mine |= o == k;
       if (!mine && r.has(k)) r.fail(r.node(k)->source(), k, "not a key of a \"" + kind + "\" device");
     }
-    const double rate = 1000, fmax = 20, tmax = 1;
-    d.rate_hz = r.number("rate_hz", &rate);
+    const DeviceSettings defaults;
+    d.rate_hz = r.number("rate_hz", &defaults.rate_hz);
     require(d.rate_hz >= 100 && d.rate_hz <= 10000, r, "rate_hz", "must be in [100, 10000]");
-    d.max_force = r.number("max_force", &fmax);
+    d.max_force = r.number("max_force", &defaults.max_force);
     require(d.max_force > 0, r, "max_force", "must be > 0");
-    d.max_torque = r.number("max_torque", &tmax);
+    d.max_torque = r.number("max_torque", &defaults.max_torque);
     require(d.max_torque > 0, r, "max_torque", "must be > 0");
   }
   return scene;
