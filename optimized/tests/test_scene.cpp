@@ -3,6 +3,7 @@
 // names the file, the line and the key.
 #include <catch2/catch.hpp>
 
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <string>
@@ -174,4 +175,31 @@ TEST_CASE("given mass properties are validated", "[scene]") {
   CHECK_FALSE(s.god_mass.from_density);
   CHECK(s.god_mass.mass.mass == 1.0);
   CHECK(s.god_mass.mass.inertia(2, 2) == 3.0);
+}
+
+TEST_CASE("the settings rules are one function per table and the loader uses them", "[scene]") {
+  using Catch::Matchers::Contains;
+  CHECK_FALSE(check_gains(Gains{0.5, 100.0}));
+  CHECK(check_gains(Gains{0.5, 0.0}).message() == "gains.kh: must be > 0");
+  CHECK(check_gains(Gains{1.5, 100.0}).message() == "gains.ks: must be in (0, 1]");
+  CHECK(check_gains(Gains{0.5, std::nan("")}).key == "kh");
+  ContactParameters c;
+  c.delta = 1e-5;
+  c.offset_eps = -1e-4;
+  CHECK_FALSE(check_contact_parameters(c));
+  c.offset_eps = 0;
+  CHECK(check_contact_parameters(c).message() == "contact.offset_eps: must be < 0");
+  CHECK_FALSE(check_device_settings(DeviceSettings{}));  // the defaults meet the rules
+  DeviceSettings d;
+  d.rate_hz = 50;
+  CHECK(check_device_settings(d).message() == "device.rate_hz: must be in [100, 10000]");
+  SurfaceSettings s;
+  s.kind = SurfaceKind::kTexture;
+  s.amplitude = 0.2;
+  s.wavelength = 0;
+  CHECK(check_surface_settings(s).message() == "surface.wavelength: must be > 0");
+  // The loader reports a broken rule at its key's line.
+  CHECK_THAT(load_error(edited("kh = 100.0", "kh = 0.0")), Contains("scene.toml:7:6: gains.kh: must be > 0"));
+  CHECK_THAT(load_error(edited("script = \"none\"", "script = \"none\"\nrate_hz = 50.0")),
+             Contains("device.rate_hz: must be in [100, 10000]"));
 }

@@ -90,6 +90,25 @@ struct Scene {
   DeviceSettings device;
 };
 
+// The rules a scene's settings must meet (docs/scene-format.md, "Rules"), stated
+// once: the loader applies them and names the file, line and key; code that builds
+// a Scene itself applies them too. Each check returns the first broken rule, or an
+// empty problem when every rule holds. NaN and infinities break every rule.
+struct SettingsProblem {
+  std::string table;    // the scene file's table ("gains"); empty when the rules hold
+  std::string key;      // the key in that table ("kh")
+  std::string problem;  // "must be > 0"
+  explicit operator bool() const { return !key.empty(); }
+  std::string message() const { return table + "." + key + ": " + problem; }  // "gains.kh: must be > 0"
+};
+SettingsProblem check_gains(const Gains& gains);                         // 0 < ks <= 1, kh > 0
+SettingsProblem check_contact_parameters(const ContactParameters& contact);  // delta > 0, offset_eps < 0,
+                                                                         // offset_time > 0
+SettingsProblem check_surface_settings(const SurfaceSettings& surface);  // texture: 0 < amplitude <= 1,
+                                                                         // wavelength > 0, axis 0, 1 or 2
+SettingsProblem check_device_settings(const DeviceSettings& device);     // 100 <= rate_hz <= 10000,
+                                                                         // max_force > 0, max_torque > 0
+
 // Loads and validates a scene file. Throws SceneError.
 Scene load_scene(const std::string& path);
 

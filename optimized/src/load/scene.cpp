@@ -1,4 +1,5 @@
-// The TOML scene loader (docs/scene-format.md, version 1), with toml++. Every
+// The TOML scene loader (docs/scene-format.md, version 1), with toml++, and the
+// rules of the scene's settings (check_gains() and the others), stated once. Every
 // error names the file, the line and column, and the key.
 #include "gauss6/scene.h"
 
@@ -30,6 +31,43 @@ const char* to_string(DeviceKind k) {
     case DeviceKind::kHid: return "hid";
   }
   return "unknown";
+}
+
+namespace {
+
+// x is finite and above lo (below hi): NaN and infinities break every settings rule.
+bool finite_above(double x, double lo) { return std::isfinite(x) && x > lo; }
+bool finite_below(double x, double hi) { return std::isfinite(x) && x < hi; }
+
+}  // namespace
+
+SettingsProblem check_gains(const Gains& g) {
+  if (!(finite_above(g.ks, 0) && g.ks <= 1)) return {"gains", "ks", "must be in (0, 1]"};
+  if (!finite_above(g.kh, 0)) return {"gains", "kh", "must be > 0"};
+  return {};
+}
+
+SettingsProblem check_contact_parameters(const ContactParameters& c) {
+  if (!finite_above(c.delta, 0)) return {"contact", "delta", "must be > 0"};
+  if (!finite_below(c.offset_eps, 0)) return {"contact", "offset_eps", "must be < 0"};
+  if (!finite_above(c.offset_time, 0)) return {"contact", "offset_time", "must be > 0"};
+  return {};
+}
+
+SettingsProblem check_surface_settings(const SurfaceSettings& s) {
+  if (s.kind != SurfaceKind::kTexture) return {};
+  if (!(finite_above(s.amplitude, 0) && s.amplitude <= 1)) return {"surface", "amplitude", "must be in (0, 1]"};
+  if (!finite_above(s.wavelength, 0)) return {"surface", "wavelength", "must be > 0"};
+  if (s.axis < 0 || s.axis > 2) return {"surface", "axis", "must be x, y or z"};
+  return {};
+}
+
+SettingsProblem check_device_settings(const DeviceSettings& d) {
+  if (!(std::isfinite(d.rate_hz) && d.rate_hz >= 100 && d.rate_hz <= 10000))
+    return {"device", "rate_hz", "must be in [100, 10000]"};
+  if (!finite_above(d.max_force, 0)) return {"device", "max_force", "must be > 0"};
+  if (!finite_above(d.max_torque, 0)) return {"device", "max_torque", "must be > 0"};
+  return {};
 }
 
 namespace {
@@ -159,6 +197,11 @@ void require(bool ok, const TableReader& r, const char* key, const std::string& 
   if (!ok) r.fail(r.node(key) ? r.node(key)->source() : r.table().source(), key, message);
 }
 
+// A broken settings rule (check_gains() and the others) as an error at its key's line.
+void require(const SettingsProblem& p, const TableReader& r) {
+  if (p) require(false, r, p.key.c_str(), p.problem);
+}
+
 // Pose of the mesh's own frame in the world: position and (w, x, y, z) orientation.
 Pose read_pose(const TableReader& r) {
   const Vec3 zero = Vec3::Zero();
@@ -217,21 +260,18 @@ Scene load_scene(const std::string& path) {
   TableReader gains(path, sub_table(top, "gains", true, empty), "gains.");
   gains.allow_only({"ks", "kh"});
   scene.gains.ks = gains.number("ks");
-  require(scene.gains.ks > 0 && scene.gains.ks <= 1, gains, "ks", "must be in (0, 1]");
   scene.gains.kh = gains.number("kh");
-  require(scene.gains.kh > 0, gains, "kh", "must be > 0");
+  require(check_gains(scene.gains), gains);
 
   // [contact]
   TableReader contact(path, sub_table(top, "contact", true, empty), "contact.");
   contact.allow_only({"delta", "offset_eps", "offset_time"});
   scene.contact.delta = contact.number("delta");
-  require(scene.contact.delta > 0, contact, "delta", "must be > 0");
   const ContactParameters defaults;
   const double default_eps = kDefaultOffsetEpsPerDelta * scene.contact.delta;
   scene.contact.offset_eps = contact.number("offset_eps", &default_eps);
-  require(scene.contact.offset_eps < 0, contact, "offset_eps", "must be < 0");
   scene.contact.offset_time = contact.number("offset_time", &defaults.offset_time);
-  require(scene.contact.offset_time > 0, contact, "offset_time", "must be > 0");
+  require(check_contact_parameters(scene.contact), contact);
 
   std::set<std::string> names;
   auto claim_name = [&](const TableReader& r, const std::string& name) {
@@ -317,13 +357,12 @@ Scene load_scene(const std::string& path) {
     else r.fail(r.node("kind")->source(), "kind", "must be \"none\", \"force_shading\" or \"texture\"");
     if (scene.surface.kind == SurfaceKind::kTexture) {
       scene.surface.amplitude = r.number("amplitude");
-      require(scene.surface.amplitude > 0 && scene.surface.amplitude <= 1, r, "amplitude", "must be in (0, 1]");
       scene.surface.wavelength = r.number("wavelength");
-      require(scene.surface.wavelength > 0, r, "wavelength", "must be > 0");
       const std::string x = "x";
       const std::string axis = r.string("axis", &x);
       if (axis != "x" && axis != "y" && axis != "z") r.fail(r.node("axis")->source(), "axis", "must be x, y or z");
       scene.surface.axis = axis[0] - 'x';
+      require(check_surface_settings(scene.surface), r);
     } else {
       for (const char* k : {"amplitude", "wavelength", "axis"})
         if (r.has(k)) r.fail(r.node(k)->source(), k, "only for kind = \"texture\"");
@@ -366,11 +405,9 @@ Scene load_scene(const std::string& path) {
     }
     const DeviceSettings defaults;
     d.rate_hz = r.number("rate_hz", &defaults.rate_hz);
-    require(d.rate_hz >= 100 && d.rate_hz <= 10000, r, "rate_hz", "must be in [100, 10000]");
     d.max_force = r.number("max_force", &defaults.max_force);
-    require(d.max_force > 0, r, "max_force", "must be > 0");
     d.max_torque = r.number("max_torque", &defaults.max_torque);
-    require(d.max_torque > 0, r, "max_torque", "must be > 0");
+    require(check_device_settings(d), r);
   }
   return scene;
 }
