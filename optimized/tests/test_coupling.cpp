@@ -6,6 +6,7 @@
 #include <limits>
 
 #include "gauss6/coupling.h"
+#include "mass_matrices.h"
 
 namespace {
 
@@ -14,12 +15,7 @@ using gauss6::Vec6;
 
 constexpr double kEps = std::numeric_limits<double>::epsilon();
 
-Mat6 box_mass_matrix() {
-  Mat6 M = Mat6::Zero();
-  M.diagonal() << 2.0, 2.0, 2.0, 0.01, 0.02, 0.03;
-  M(3, 4) = M(4, 3) = 0.001;
-  return M;
-}
+using gauss6::test::box_mass_matrix;
 
 }  // namespace
 

@@ -13,6 +13,7 @@
 
 #include "gauss6/coupling.h"
 #include "gauss6/offsetting.h"
+#include "mass_matrices.h"
 
 namespace {
 
@@ -27,12 +28,7 @@ using gauss6::Vec6;
 
 constexpr double kEps = std::numeric_limits<double>::epsilon();
 
-Mat6 box_mass_matrix() {
-  Mat6 M = Mat6::Zero();
-  M.diagonal() << 2.0, 2.0, 2.0, 0.01, 0.02, 0.03;
-  M(3, 4) = M(4, 3) = 0.001;
-  return M;
-}
+using gauss6::test::box_mass_matrix;
 
 // A contact set of up to 4 rows at points I_k with normals n_k, for a god-object
 // at G = 0 (identity pose): J_k = [n_k, I_k x n_k].
