@@ -69,7 +69,7 @@ struct Scales { double u, a, b, coordinate; };
 // beyond d |n| on one side: |F|_2 >= |n.F| / |n| > d. For fixed u, F is affine
 // in the feature parameters, so n.F over P lies between its values at P's
 // corners (vertex/face, rigid: at the points whose hull holds P cut by the
-// triangle, see ccd_rigid_vertex_face()), and each corner's value over U lies
+// triangle, see rigid_vertex_face()), and each corner's value over U lies
 // in n . (the corner's enclosure): the hull of those scalar intervals encloses
 // n.F on U x P. (The
 // axis-aligned hull of F loses up to a factor sqrt(3) on a diagonal n: a pair
@@ -137,7 +137,7 @@ GAUSS6_ALWAYS_INLINE Interval along(const Vec3& n, const IVec3& x) {
 }
 
 // Enclosures of F at the corners of a parameter box (up to 5: see
-// ccd_rigid_vertex_face()), each over the box's whole u-range; F over the box
+// rigid_vertex_face()), each over the box's whole u-range; F over the box
 // lies in their hull (see bisect()).
 struct Corners {
   IVec3 c[5];
@@ -972,10 +972,21 @@ void filtered_bisect(const Enclose& enclose, bool triangle, const Scales& sc, UF
   no_hit();
 }
 
-}  // namespace
+// Which side of a rigid vertex/face pair moves with the god-object.
+enum class Moving { kVertex, kFace };
 
-void ccd_rigid_vertex_face(const RigidVertexFaceQuery& q, const CcdSettings& s, CcdWorkspace* ws,
-                           CcdResult* r) {
+// The one vertex/face search under RigidVertexFaceQuery and RigidFaceVertexQuery:
+// the moving feature in the body frame (B), the static one in the world frame (W).
+struct VertexFacePair {
+  const CcdMotion* motion;
+  const Vec3& vertex;
+  const std::array<Vec3, 3>& face;
+  double u_begin, u_end;
+};
+
+void rigid_vertex_face(Moving moving, const VertexFacePair& q, const CcdSettings& s, CcdWorkspace* ws,
+                       CcdResult* r) {
+  const bool vertex_moves = moving == Moving::kVertex;
   bool ok = valid_settings(s) && valid_window(q.u_begin, q.u_end) && ws != nullptr && q.motion != nullptr &&
             bounded(q.vertex);
   for (const Vec3& f : q.face) ok = ok && bounded(f);
@@ -985,8 +996,8 @@ void ccd_rigid_vertex_face(const RigidVertexFaceQuery& q, const CcdSettings& s, 
   const IVec3 e1 = to_interval(q.face[1]) - f0, e2 = to_interval(q.face[2]) - f0;
   const IVec3 v = to_interval(q.vertex);
   Scales sc{0, max_abs(q.face[1] - q.face[0]), max_abs(q.face[2] - q.face[0]), 0};
-  const double rho = q.vertex_on_body ? q.vertex.norm()
-                                      : std::max({q.face[0].norm(), q.face[1].norm(), q.face[2].norm()});
+  const double rho = vertex_moves ? q.vertex.norm()
+                                    : std::max({q.face[0].norm(), q.face[1].norm(), q.face[2].norm()});
   sc.u = rigid_speed(*q.motion, rho);
   sc.coordinate = std::max({max_abs(q.vertex), max_abs(q.face[0]), max_abs(q.face[1]), max_abs(q.face[2]),
                             max_abs(q.motion->nominal.p0), max_abs(q.motion->nominal.p0 + q.motion->nominal.dp)});
@@ -1010,7 +1021,7 @@ void ccd_rigid_vertex_face(const RigidVertexFaceQuery& q, const CcdSettings& s, 
       pa[4] = std::clamp(next_up(1 - b1), a0, a1);
       K->n = 5;
     }
-    if (q.vertex_on_body) {
+    if (vertex_moves) {
       // F = M(u, v) - (f0 + a e1 + b e2)
       const IVec3 mv = enclose_point(e, v) - f0;
       for (int k = 0; k < K->n; ++k) K->c[k] = mv - pa[k] * e1 - pb[k] * e2;
@@ -1028,7 +1039,7 @@ void ccd_rigid_vertex_face(const RigidVertexFaceQuery& q, const CcdSettings& s, 
   filter.motion = &m;
   const IVec3 corner[3] = {f0, to_interval(q.face[1]), to_interval(q.face[2])};
   const IVec3 n = cross(e1, e2);
-  if (q.vertex_on_body) {
+  if (vertex_moves) {
     const Vec3 x_begin = motion_point(m.nominal, q.u_begin, q.vertex);  // heuristic only (the axis)
     const IVec3 w = mul(m.R0, v);
     const Vec3 axis = x_begin - closest_point_on_triangle(x_begin, q.face[0], q.face[1], q.face[2]);
@@ -1119,17 +1130,29 @@ void ccd_rigid_vertex_face(const RigidVertexFaceQuery& q, const CcdSettings& s, 
   }, Guides<decltype(guide_at), decltype(separated)>{guide_at, separated}, q.u_begin, q.u_end, s, ws, r);
 }
 
+}  // namespace
+
+void ccd_rigid_vertex_face(const RigidVertexFaceQuery& q, const CcdSettings& s, CcdWorkspace* ws,
+                           CcdResult* r) {
+  rigid_vertex_face(Moving::kVertex, {q.motion, q.vertex_B, q.face_W, q.u_begin, q.u_end}, s, ws, r);
+}
+
+void ccd_rigid_face_vertex(const RigidFaceVertexQuery& q, const CcdSettings& s, CcdWorkspace* ws,
+                           CcdResult* r) {
+  rigid_vertex_face(Moving::kFace, {q.motion, q.vertex_W, q.face_B, q.u_begin, q.u_end}, s, ws, r);
+}
+
 void ccd_rigid_edge_edge(const RigidEdgeEdgeQuery& q, const CcdSettings& s, CcdWorkspace* ws, CcdResult* r) {
   bool ok = valid_settings(s) && valid_window(q.u_begin, q.u_end) && ws != nullptr && q.motion != nullptr;
-  for (int k = 0; k < 2; ++k) ok = ok && bounded(q.edge_body[k]) && bounded(q.edge_world[k]);
+  for (int k = 0; k < 2; ++k) ok = ok && bounded(q.edge_B[k]) && bounded(q.edge_W[k]);
   if (!ok) return refuse(q.u_end, r);
   const CachedEnclosure cache{q.motion, {}, -1, -1};
-  const IVec3 a0 = to_interval(q.edge_body[0]), ea = to_interval(q.edge_body[1]) - a0;
-  const IVec3 b0 = to_interval(q.edge_world[0]), eb = to_interval(q.edge_world[1]) - b0;
-  Scales sc{0, max_abs(q.edge_body[1] - q.edge_body[0]), max_abs(q.edge_world[1] - q.edge_world[0]), 0};
-  sc.u = rigid_speed(*q.motion, std::max(q.edge_body[0].norm(), q.edge_body[1].norm()));
-  sc.coordinate = std::max({max_abs(q.edge_body[0]), max_abs(q.edge_body[1]), max_abs(q.edge_world[0]),
-                            max_abs(q.edge_world[1]), max_abs(q.motion->nominal.p0),
+  const IVec3 a0 = to_interval(q.edge_B[0]), ea = to_interval(q.edge_B[1]) - a0;
+  const IVec3 b0 = to_interval(q.edge_W[0]), eb = to_interval(q.edge_W[1]) - b0;
+  Scales sc{0, max_abs(q.edge_B[1] - q.edge_B[0]), max_abs(q.edge_W[1] - q.edge_W[0]), 0};
+  sc.u = rigid_speed(*q.motion, std::max(q.edge_B[0].norm(), q.edge_B[1].norm()));
+  sc.coordinate = std::max({max_abs(q.edge_B[0]), max_abs(q.edge_B[1]), max_abs(q.edge_W[0]),
+                            max_abs(q.edge_W[1]), max_abs(q.motion->nominal.p0),
                             max_abs(q.motion->nominal.p0 + q.motion->nominal.dp)});
   auto enclose = [&](const Box& box, Corners* K) {
     const MotionEnclosure& e = cache.at(box);
@@ -1151,11 +1174,11 @@ void ccd_rigid_edge_edge(const RigidEdgeEdgeQuery& q, const CcdSettings& s, CcdW
   filter.motion = &m;
   const IVec3 a0W = mul(m.R0, a0), eaW = mul(m.R0, ea), Q = m.p0 - b0;
   const IVec3 a1W = mul(m.R0, a0 + ea);
-  const Vec3 A0 = motion_point(m.nominal, q.u_begin, q.edge_body[0]);
-  const Vec3 A1 = motion_point(m.nominal, q.u_begin, q.edge_body[1]);
+  const Vec3 A0 = motion_point(m.nominal, q.u_begin, q.edge_B[0]);
+  const Vec3 A1 = motion_point(m.nominal, q.u_begin, q.edge_B[1]);
   double sa = 0, tb = 0;
-  closest_segment_parameters(A0, A1, q.edge_world[0], q.edge_world[1], &sa, &tb);
-  const Vec3 axis = (A0 + sa * (A1 - A0)) - (q.edge_world[0] + tb * (q.edge_world[1] - q.edge_world[0]));
+  closest_segment_parameters(A0, A1, q.edge_W[0], q.edge_W[1], &sa, &tb);
+  const Vec3 axis = (A0 + sa * (A1 - A0)) - (q.edge_W[0] + tb * (q.edge_W[1] - q.edge_W[0]));
   if (axis != Vec3::Zero() && std::isfinite(axis.squaredNorm())) {
     const IVec3 na = to_interval(axis);
     filter.add_corner(a0W, axis);
@@ -1181,10 +1204,10 @@ void ccd_rigid_edge_edge(const RigidEdgeEdgeQuery& q, const CcdSettings& s, CcdW
   // Guide: the closest points of the nominally moved edge and the static one.
   const auto guide_at = [&](double u) {
     Guide g;
-    const Vec3 P0 = motion_point(m.nominal, u, q.edge_body[0]), P1 = motion_point(m.nominal, u, q.edge_body[1]);
-    closest_segment_parameters(P0, P1, q.edge_world[0], q.edge_world[1], &g.a, &g.b);
+    const Vec3 P0 = motion_point(m.nominal, u, q.edge_B[0]), P1 = motion_point(m.nominal, u, q.edge_B[1]);
+    closest_segment_parameters(P0, P1, q.edge_W[0], q.edge_W[1], &g.a, &g.b);
     g.valid = g.a >= 0 && g.a <= 1 && g.b >= 0 && g.b <= 1;  // false for NaN or out of range
-    g.axis = (P0 + g.a * (P1 - P0)) - (q.edge_world[0] + g.b * (q.edge_world[1] - q.edge_world[0]));
+    g.axis = (P0 + g.a * (P1 - P0)) - (q.edge_W[0] + g.b * (q.edge_W[1] - q.edge_W[0]));
     return g;
   };
   const IVec3 ea_gxw[2] = {cross(m.g, a0W), cross(m.g, a1W)};

@@ -87,7 +87,7 @@ void PairTester::test(const TriangleMesh& gm, const Bvh& gb, int gf, const Trian
         pose_god_face();
         const Vec3 A[3] = {X[k], X[k], X[k]};
         if (apart(A, Y, rad[k], X[k] - closest_point_on_triangle(X[k], Y[0], Y[1], Y[2]))) return true;
-        RigidVertexFaceQuery q{motion, /*vertex_on_body=*/true, god_face[k], obs_face, from, end()};
+        RigidVertexFaceQuery q{motion, god_face[k], obs_face, from, end()};
         ccd_rigid_vertex_face(q, settings->narrow, ws, &r);
         break;
       }
@@ -97,8 +97,8 @@ void PairTester::test(const TriangleMesh& gm, const Bvh& gb, int gf, const Trian
         const Vec3 B[3] = {Y[j], Y[j], Y[j]};
         if (apart(X, B, std::max({rad[0], rad[1], rad[2]}), closest_point_on_triangle(Y[j], X[0], X[1], X[2]) - Y[j]))
           return true;
-        RigidVertexFaceQuery q{motion, /*vertex_on_body=*/false, obs_face[j], god_face, from, end()};
-        ccd_rigid_vertex_face(q, settings->narrow, ws, &r);
+        RigidFaceVertexQuery q{motion, obs_face[j], god_face, from, end()};
+        ccd_rigid_face_vertex(q, settings->narrow, ws, &r);
         break;
       }
       case PairKind::kEdgeEdge: {

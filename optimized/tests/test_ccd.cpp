@@ -319,8 +319,8 @@ TEST_CASE("rigid CCD: pure rotation about G sweeps a vertex into a face at a kno
   REQUIRE(make_ccd_motion(x0, x1, &m) == MotionStatus::kOk);
   RigidVertexFaceQuery q;
   q.motion = &m;
-  q.vertex = Vec3(1, 0, 0);
-  q.face = {Vec3(0, 0.5, -1), Vec3(2, 0.5, -1), Vec3(0, 0.5, 1)};
+  q.vertex_B = Vec3(1, 0, 0);
+  q.face_W = {Vec3(0, 0.5, -1), Vec3(2, 0.5, -1), Vec3(0, 0.5, 1)};
   CcdWorkspace ws;
   CcdSettings s;
   CcdResult r;
@@ -343,12 +343,11 @@ TEST_CASE("rigid CCD: pure rotation about G sweeps a vertex into a face at a kno
   // turns by +2 atan(u) and meets the wall at the same u* = 2 - sqrt(3).
   CcdMotion m2;
   REQUIRE(make_ccd_motion(x0, Pose{Vec3::Zero(), quat_exp(Vec3(0, 0, -M_PI / 2))}, &m2) == MotionStatus::kOk);
-  RigidVertexFaceQuery q2;
+  RigidFaceVertexQuery q2;
   q2.motion = &m2;
-  q2.vertex_on_body = false;
-  q2.vertex = Vec3(1, 0, 0);
-  q2.face = q.face;
-  ccd_rigid_vertex_face(q2, s, &ws, &r);
+  q2.vertex_W = Vec3(1, 0, 0);
+  q2.face_B = q.face_W;
+  ccd_rigid_face_vertex(q2, s, &ws, &r);
   REQUIRE(r.status == CcdStatus::kOk);
   REQUIRE(r.hit);
   const mpq_class two_minus2 = 2 - Q(r.u_hit - 1e-15);
@@ -359,8 +358,8 @@ TEST_CASE("rigid CCD: pure rotation about G sweeps a vertex into a face at a kno
   // edge on the wall y = 1/2 (along z... a horizontal edge x in [0, 2] at z = 0).
   RigidEdgeEdgeQuery qe;
   qe.motion = &m;
-  qe.edge_body = {Vec3(1, 0, -1), Vec3(1, 0, 1)};
-  qe.edge_world = {Vec3(0, 0.5, 0), Vec3(2, 0.5, 0)};
+  qe.edge_B = {Vec3(1, 0, -1), Vec3(1, 0, 1)};
+  qe.edge_W = {Vec3(0, 0.5, 0), Vec3(2, 0.5, 0)};
   ccd_rigid_edge_edge(qe, s, &ws, &r);
   REQUIRE(r.status == CcdStatus::kOk);
   REQUIRE(r.hit);
@@ -387,8 +386,8 @@ TEST_CASE("rigid CCD with a pure translation agrees with the linear CCD", "[ccd]
     const Vec3 r_B = (i % 2) ? Vec3(target - 0.5 * (x0.p + x1.p)) : Vec3(U(rng), U(rng), U(rng));
     RigidVertexFaceQuery q;
     q.motion = &m;
-    q.vertex = r_B;
-    q.face = f;
+    q.vertex_B = r_B;
+    q.face_W = f;
     CcdResult rr, rl;
     ccd_rigid_vertex_face(q, s, &ws, &rr);
     // The same trajectory as a linear query (p + r_B rounded: compare loosely).
@@ -439,16 +438,16 @@ TEST_CASE("rigid CCD never misses a contact built into a random motion", "[ccd]"
     const Vec3 e1 = Vec3(n(rng), n(rng), n(rng)), e2 = Vec3(n(rng), n(rng), n(rng));
     RigidVertexFaceQuery q;
     q.motion = &m;
-    q.vertex = r_B;
-    q.face = {p - (e1 + e2) / 3, p + 2 * e1 / 3 - e2 / 3, p - e1 / 3 + 2 * e2 / 3};
+    q.vertex_B = r_B;
+    q.face_W = {p - (e1 + e2) / 3, p + 2 * e1 / 3 - e2 / 3, p - e1 / 3 + 2 * e2 / 3};
     ccd_rigid_vertex_face(q, s, &ws, &r);
     REQUIRE(r.status == CcdStatus::kOk);
     if (!r.hit || r.u_hit > u_c + 1e-12) ++misses;
     // The claim "within distance_reached at u_hit": check it on the double motion.
     if (r.hit) {
       const Vec3 v = motion_point(m.nominal, r.u_hit, r_B);
-      const Vec3 nrm = (q.face[1] - q.face[0]).cross(q.face[2] - q.face[0]).normalized();
-      if (std::abs(nrm.dot(v - q.face[0])) > r.distance_reached + 1e-12) ++late_distance;
+      const Vec3 nrm = (q.face_W[1] - q.face_W[0]).cross(q.face_W[2] - q.face_W[0]).normalized();
+      if (std::abs(nrm.dot(v - q.face_W[0])) > r.distance_reached + 1e-12) ++late_distance;
     }
   }
   CHECK(misses == 0);

@@ -122,11 +122,12 @@ TEST_CASE("u-filter keeps every exact contact: body vertex against a static face
     const Vec3 P = to_double(x_star) + 0.9 * s.min_separation * H(rng) * nrm;
     RigidVertexFaceQuery q;
     q.motion = &m;
-    q.vertex = r_B;
-    q.face = {P - (e1 + e2) / 3, P + 2 * e1 / 3 - e2 / 3, P - e1 / 3 + 2 * e2 / 3};
+    q.vertex_B = r_B;
+    q.face_W = {P - (e1 + e2) / 3, P + 2 * e1 / 3 - e2 / 3, P - e1 / 3 + 2 * e2 / 3};
     // Tolerance: none. Skip the rare placements whose rounding leaves x* farther
     // than d (only possible with d = 0): the exact check decides.
-    if (!within_of_triangle(x_star, q3(q.face[0]), q3(q.face[1]), q3(q.face[2]), Q(s.min_separation))) return -1.0;
+    if (!within_of_triangle(x_star, q3(q.face_W[0]), q3(q.face_W[1]), q3(q.face_W[2]), Q(s.min_separation)))
+      return -1.0;
     ccd_rigid_vertex_face(q, s, ws, r);
     return u_c;
   });
@@ -144,13 +145,12 @@ TEST_CASE("u-filter keeps every exact contact: static vertex against a body face
     for (int k = 0; k < 3; ++k) X[k] = em.point(Q(u_c), q3(face[k]));
     const Q3 centre = mpq_class(1, 3) * ((X[0] + X[1]) + X[2]);
     const Vec3 nrm = to_double(cross(X[1] - X[0], X[2] - X[0])).normalized();
-    RigidVertexFaceQuery q;
+    RigidFaceVertexQuery q;
     q.motion = &m;
-    q.vertex_on_body = false;
-    q.vertex = to_double(centre) + 0.9 * s.min_separation * H(rng) * nrm;
-    q.face = face;
-    if (!within_of_triangle(q3(q.vertex), X[0], X[1], X[2], Q(s.min_separation))) return -1.0;
-    ccd_rigid_vertex_face(q, s, ws, r);
+    q.vertex_W = to_double(centre) + 0.9 * s.min_separation * H(rng) * nrm;
+    q.face_B = face;
+    if (!within_of_triangle(q3(q.vertex_W), X[0], X[1], X[2], Q(s.min_separation))) return -1.0;
+    ccd_rigid_face_vertex(q, s, ws, r);
     return u_c;
   });
 }
@@ -182,9 +182,9 @@ PlacedEdgeEdge place_edge_edge(int i, std::mt19937& rng, const CcdMotion& m, con
   const Vec3 P = to_double(x_star) + 0.9 * d * H(rng) * nrm;
   const double sb = S(rng);
   out.q.motion = &m;
-  out.q.edge_body = {a0, a1};
-  out.q.edge_world = {P - sb * eb, P + (1 - sb) * eb};
-  out.within = within_of_segment(A0, A1, q3(out.q.edge_world[0]), q3(out.q.edge_world[1]), Q(d));
+  out.q.edge_B = {a0, a1};
+  out.q.edge_W = {P - sb * eb, P + (1 - sb) * eb};
+  out.within = within_of_segment(A0, A1, q3(out.q.edge_W[0]), q3(out.q.edge_W[1]), Q(d));
   return out;
 }
 
@@ -222,8 +222,8 @@ TEST_CASE("u-filter never stops later than a contact certified by the plain bise
     const Vec3 e1 = rnd(rng, 0.005), e2 = rnd(rng, 0.005);
     RigidVertexFaceQuery q;
     q.motion = &m;
-    q.vertex = r_B;
-    q.face = {P - (e1 + e2) / 3, P + 2 * e1 / 3 - e2 / 3, P - e1 / 3 + 2 * e2 / 3};
+    q.vertex_B = r_B;
+    q.face_W = {P - (e1 + e2) / 3, P + 2 * e1 / 3 - e2 / 3, P - e1 / 3 + 2 * e2 / 3};
     CcdSettings sp = s;
     sp.use_u_filter = false;
     sp.min_separation = 0.5 * s.min_separation;

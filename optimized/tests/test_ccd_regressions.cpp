@@ -205,11 +205,10 @@ TEST_CASE("CCD regression: a rim vertex 1.1 delta from a tilted peg face's edge 
   const CapturedStep& step = kPegSteps[2];
   CcdMotion m;
   REQUIRE(make_ccd_motion(pose_of(step.x0), pose_of(step.x1), &m) == MotionStatus::kOk);
-  RigidVertexFaceQuery q;
+  RigidFaceVertexQuery q;
   q.motion = &m;
-  q.vertex_on_body = false;
-  q.vertex = Vec3(-0.0023562683146316726, -0.029999999999999999, -0.0099418777635765735);
-  q.face = {Vec3(0.00087155742747658182, -0.050000000000000003, -0.0099619469809174559),
+  q.vertex_W = Vec3(-0.0023562683146316726, -0.029999999999999999, -0.0099418777635765735);
+  q.face_B = {Vec3(0.00087155742747658182, -0.050000000000000003, -0.0099619469809174559),
             Vec3(0.00087155742747658182, 0.050000000000000003, -0.0099619469809174559),
             Vec3(0.0017364817766693037, 0.050000000000000003, -0.0098480775301220801)};
   CcdSettings s;
@@ -217,7 +216,7 @@ TEST_CASE("CCD regression: a rim vertex 1.1 delta from a tilted peg face's edge 
   s.distance_tolerance = 1e-7;  // the runtime's 0.1 delta
   CcdWorkspace ws;
   CcdResult r;
-  ccd_rigid_vertex_face(q, s, &ws, &r);
+  ccd_rigid_face_vertex(q, s, &ws, &r);
   INFO("hit " << r.hit << " u_hit " << r.u_hit << " boxes " << r.iterations);
   CHECK(r.status == CcdStatus::kOk);
   CHECK(r.iterations < 2000);  // was 200000 (give-up); measured 172
@@ -225,11 +224,12 @@ TEST_CASE("CCD regression: a rim vertex 1.1 delta from a tilted peg face's edge 
   // L = |dp| + 2 |g| max |f_k| (times 1.01), as in certify_step().
   const CayleyMotion& n = m.nominal;
   double rho = 0;
-  for (const Vec3& f : q.face) rho = std::max(rho, f.norm());
+  for (const Vec3& f : q.face_B) rho = std::max(rho, f.norm());
   const double L = 1.01 * (n.dp.norm() + 2 * n.g.norm() * rho);
   const auto dist = [&](double u) {
-    const Vec3 a = motion_point(n, u, q.face[0]), b = motion_point(n, u, q.face[1]), c = motion_point(n, u, q.face[2]);
-    return (q.vertex - closest_point_on_triangle(q.vertex, a, b, c)).norm();
+    const Vec3 a = motion_point(n, u, q.face_B[0]), b = motion_point(n, u, q.face_B[1]);
+    const Vec3 c = motion_point(n, u, q.face_B[2]);
+    return (q.vertex_W - closest_point_on_triangle(q.vertex_W, a, b, c)).norm();
   };
   long evaluations = 0;
   const double u_end = r.hit ? r.u_hit : 1.0;

@@ -47,11 +47,11 @@ BruteForce brute_force(const TriangleMesh& god, const Bvh& gb, const TriangleMes
       };
       for (int k = 0; k < 3; ++k) {
         if (gb.owned[gf] & (1u << k)) {
-          ccd_rigid_vertex_face({&m, true, G[k], O, 0, 1}, s, &ws, &r);
+          ccd_rigid_vertex_face({&m, G[k], O, 0, 1}, s, &ws, &r);
           take();
         }
         if (ob.owned[of] & (1u << k)) {
-          ccd_rigid_vertex_face({&m, false, O[k], G, 0, 1}, s, &ws, &r);
+          ccd_rigid_face_vertex({&m, O[k], G, 0, 1}, s, &ws, &r);
           take();
         }
         for (int j = 0; j < 3; ++j)

@@ -149,26 +149,36 @@ struct LinearEdgeEdgeQuery {
   double u_begin = 0, u_end = 1;
 };
 
-// Rigid motion: one feature on the moving body (body frame B, moved by *motion),
-// the other static (world frame W).
+// Rigid motion: one feature on the moving body (the god-object, body frame B,
+// moved by *motion), the other static (the obstacle, world frame W). The names
+// and fields mirror the exact twins of gauss6/reference/ccd.h.
+
+// The god-object's vertex moving, the obstacle face static.
 struct RigidVertexFaceQuery {
   const CcdMotion* motion = nullptr;
-  bool vertex_on_body = true;         // true: vertex r_B moving, face static (W);
-                                      // false: vertex static (W), face moving (B)
-  Vec3 vertex = Vec3::Zero();
-  std::array<Vec3, 3> face = {Vec3::Zero(), Vec3::Zero(), Vec3::Zero()};
+  Vec3 vertex_B = Vec3::Zero();
+  std::array<Vec3, 3> face_W = {Vec3::Zero(), Vec3::Zero(), Vec3::Zero()};
+  double u_begin = 0, u_end = 1;      // search window, 0 <= u_begin <= u_end <= 1
+};
+// The obstacle's vertex static, the god-object's face moving.
+struct RigidFaceVertexQuery {
+  const CcdMotion* motion = nullptr;
+  Vec3 vertex_W = Vec3::Zero();
+  std::array<Vec3, 3> face_B = {Vec3::Zero(), Vec3::Zero(), Vec3::Zero()};
   double u_begin = 0, u_end = 1;
 };
+// The god-object's edge moving, the obstacle edge static.
 struct RigidEdgeEdgeQuery {
   const CcdMotion* motion = nullptr;
-  std::array<Vec3, 2> edge_body;      // r_B, moving
-  std::array<Vec3, 2> edge_world;     // static
+  std::array<Vec3, 2> edge_B;         // moving
+  std::array<Vec3, 2> edge_W;         // static
   double u_begin = 0, u_end = 1;
 };
 
 void ccd_linear_vertex_face(const LinearVertexFaceQuery& q, const CcdSettings& s, CcdWorkspace* ws, CcdResult* r);
 void ccd_linear_edge_edge(const LinearEdgeEdgeQuery& q, const CcdSettings& s, CcdWorkspace* ws, CcdResult* r);
 void ccd_rigid_vertex_face(const RigidVertexFaceQuery& q, const CcdSettings& s, CcdWorkspace* ws, CcdResult* r);
+void ccd_rigid_face_vertex(const RigidFaceVertexQuery& q, const CcdSettings& s, CcdWorkspace* ws, CcdResult* r);
 void ccd_rigid_edge_edge(const RigidEdgeEdgeQuery& q, const CcdSettings& s, CcdWorkspace* ws, CcdResult* r);
 
 // The mesh-level step (BVH traversal, first hit over all feature pairs) is
