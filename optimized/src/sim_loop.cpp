@@ -167,6 +167,27 @@ void publish_god_object(double t, SimState* s, RuntimeChannels* ch) {
   ch->god_object.write(g);
 }
 
+// Step 2: au = ks (xh (-) xs), the command towards the handle sample just read.
+Vec6 command_motion(const RuntimeModel& model, const SimState& s) {
+  const Pose xh = to_pose(s.handle.p, s.handle.q);
+  return model.gains.ks * pose_difference(xh, s.xs);
+}
+
+// Step 4: xt = xs (+) ac; CCD; xs = xt or the stop pose; the new contact set
+// (and the settling leg by au - ac if the previous contacts' surface fell away).
+void advance_by(const RuntimeModel& model, SimState* s, SimStepInfo* info) {
+  const Vec6 residual = s->contacts.num_contacts > 0 ? Vec6(info->au - info->ac) : Vec6::Zero();
+  const Pose x_start = s->xs;  // a copy: the step overwrites s->xs
+  advance_god_object(model, x_start, pose_update(x_start, info->ac), residual, s, info);
+}
+
+// Without a handle sample the god-object stays put (and is still published).
+void stay_put(const SimState& s, SimStepInfo* info) {
+  info->status = SimStepStatus::kNoHandle;
+  info->x_start = info->x_target = s.xs;
+  info->num_contacts = s.contacts.num_contacts;
+}
+
 }  // namespace
 
 const SimStepInfo& sim_step(const RuntimeModel& model, double t, RuntimeChannels* channels, SimState* s) {
@@ -176,26 +197,15 @@ const SimStepInfo& sim_step(const RuntimeModel& model, double t, RuntimeChannels
   info.step = ++s->step;
   info.time = t;
   s->step_events = 0;
-  // 1. Read xh.
-  if (read_handle(*channels, &s->handle)) {
-    const Pose xh = to_pose(s->handle.p, s->handle.q);
-    // 2. au = ks (xh (-) xs).
-    info.au = model.gains.ks * pose_difference(xh, s->xs);
-    // 3. ac: projection with the previous step's contacts.
-    info.ac = constrain_motion(model, info.au, s);
+  if (read_handle(*channels, &s->handle)) {      // 1. Read xh.
+    info.au = command_motion(model, *s);         // 2. au = ks (xh (-) xs).
+    info.ac = constrain_motion(model, info.au, s);  // 3. ac: projection with the previous step's contacts.
     info.projection = s->projection.status;
-    // 4. xt = xs (+) ac; CCD; xs = xt or the stop pose; the new contact set
-    //    (and the settling leg by au - ac if the previous contacts' surface fell away).
-    const Vec6 residual = s->contacts.num_contacts > 0 ? Vec6(info.au - info.ac) : Vec6::Zero();
-    const Pose x_start = s->xs;  // a copy: the step overwrites s->xs
-    advance_god_object(model, x_start, pose_update(x_start, info.ac), residual, s, &info);
+    advance_by(model, s, &info);                 // 4. CCD from xs towards xs (+) ac; the new contacts.
   } else {
-    info.status = SimStepStatus::kNoHandle;
-    info.x_start = info.x_target = s->xs;
-    info.num_contacts = s->contacts.num_contacts;
+    stay_put(*s, &info);
   }
-  // 5. Publish xs, M, J, the contacts (a new sequence number is the flag).
-  publish_god_object(t, s, channels);
+  publish_god_object(t, s, channels);            // 5. Publish xs, M, J, the contacts (a new sequence number is the flag).
   info.xs = s->xs;
   info.contacts = &s->contacts;
   info.update_seconds = seconds_since(start);
