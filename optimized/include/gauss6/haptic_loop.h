@@ -1,0 +1,47 @@
+// The haptic loop (fixed rate, the device's): its state and its tick.
+//
+//   haptic_tick(): device read -> Fc -> safety -> device write
+//
+// The force comes from the coupling step run inside the tick, or from the
+// coupling loop's wrench channel. The safety stage (watchdogs, finiteness,
+// limits) is make_safe_wrench. Real time: haptic_tick and make_safe_wrench
+// allocate nothing, lock nothing and throw nothing. Frames: world frame W.
+#pragma once
+
+#include <cstdint>
+
+#include "gauss6/coupling_loop.h"
+#include "gauss6/device_port.h"
+#include "gauss6/runtime_channels.h"
+#include "gauss6/runtime_events.h"
+#include "gauss6/runtime_model.h"
+#include "gauss6/runtime_stats.h"
+
+namespace gauss6 {
+
+// Every buffer of the haptic loop.
+struct HapticState {
+  uint64_t tick = 0;
+  DeviceState device;                  // last sample
+  Pose xh;                             // last good handle pose
+  bool has_handle = false;
+  double last_good_time = 0;           // s, time of the last good sample (the run's start at first)
+  uint32_t active_events = 0;          // conditions that held last tick (events fire on onset)
+  bool ended = false;                  // the device ended
+  WrenchSample wrench;                 // kCouplingLoop: last Fc read
+  HapticTickRecord record;
+};
+
+// t is the run's clock (s): virtual in lockstep runs, steady_clock in threads.
+// One haptic tick: device read, force (the coupling step when coupling != null,
+// else the wrench channel), safety (watchdogs, finiteness, limits), device write.
+// Writes stats->haptic (and stats->coupling when coupling != null); event onsets
+// go to the observer. Returns false when the device ended (zero force written).
+bool haptic_tick(const RuntimeModel& model, double t, Device* device, RuntimeChannels* channels,
+                 HapticState* h, CouplingState* coupling, const RuntimeObserver& observer, RuntimeStats* stats);
+
+// The safety stage alone: returns a finite wrench within the limits; sets the
+// bits of *events (1 << RuntimeEventKind) for kNonFiniteForce and kForceClamped.
+Vec6 make_safe_wrench(const Vec6& F, double max_force, double max_torque, uint32_t* events);
+
+}  // namespace gauss6

@@ -1,0 +1,110 @@
+// What the runtime's loops report (runtime.h): the kinds of events (watchdogs,
+// device and solver failures), the per-step records of each loop, and the
+// observer hook that receives both (trace recording, logging).
+//
+// Units and frames: seconds, world frame W; poses are of G (pose.h).
+#pragma once
+
+#include <cstdint>
+
+#include "gauss6/ccd_step.h"
+#include "gauss6/contacts.h"
+#include "gauss6/device_port.h"
+#include "gauss6/quasistatics.h"
+
+namespace gauss6 {
+
+// ---------------------------------------------------------------------------
+// Events and the observer hook (trace recording, logging).
+// ---------------------------------------------------------------------------
+
+enum class RuntimeEventKind {
+  kInvalidHandlePose = 0,  // the device returned a non-finite pose: zero force this tick
+  kDeviceError,            // read() returned a status other than kOk
+  kDeviceTimeout,          // watchdog: no good sample for device_timeout: zero force
+  kSimStalled,             // watchdog: no sim snapshot for sim_timeout: zero force
+  kCouplingStalled,        // watchdog: no Fc for coupling_timeout: zero force
+  kNonFiniteForce,         // the computed wrench was not finite: zero force
+  kForceClamped,           // force or torque above the device's limits: scaled down
+  kDeviceEnded,            // the device's script or replay ended: the run stops
+  kProjectionFailed,       // a projection returned kBadInput or kIterationCap
+  kCcdGaveUp,              // the sim step's CCD gave up (hit kept conservatively) or refused its input
+  kContactOverflow,        // more contacts than kMaxContacts: the set was truncated
+};
+inline constexpr int kNumRuntimeEventKinds = 11;
+const char* to_string(RuntimeEventKind k);
+
+struct RuntimeEvent {
+  RuntimeEventKind kind = RuntimeEventKind::kDeviceError;
+  double time = 0;                     // s
+  uint64_t tick = 0;                   // haptic tick, or sim step for sim events
+  int detail = 0;                      // the status's integer value, when one applies
+};
+
+// Per-step records, handed to the hooks.
+enum class SimStepStatus { kFree = 0, kContact, kNoHandle, kInvalidStep };
+struct SimStepInfo {
+  uint64_t step = 0;
+  double time = 0;
+  SimStepStatus status = SimStepStatus::kNoHandle;
+  Pose xs;                             // after the step
+  Vec6 au = Vec6::Zero(), ac = Vec6::Zero();
+  ProjectionStatus projection = ProjectionStatus::kOptimal;
+  CcdStatus ccd = CcdStatus::kOk;
+  double u_hit = 1;                    // of the last CCD leg
+  int num_contacts = 0;
+  int num_halves = 1;                  // 2 when the first leg was split (half turn)
+  // The CCD's inputs (step 4), so that a run's collision work can be replayed
+  // exactly (advance_god_object): the first leg's motion x_start -> x_target, with
+  // x_start the god-object's pose before the step and x_target = x_start (+) ac.
+  // A leg split in halves (num_halves = 2, near a half turn) is still recorded
+  // whole: its halves are x_start -> split_step(x_start, x_target) -> x_target.
+  // residual = au - ac, the part of the command the previous contacts withheld
+  // (zero when the previous set was empty); settled: the settling leg ran (the
+  // first leg ended free and out of contact: the god-object moved on by
+  // `residual` from where it ended, see advance_god_object). Both poses are the
+  // god-object's, world frame; they equal xs when status is kNoHandle.
+  Pose x_start, x_target;
+  Vec6 residual = Vec6::Zero();
+  bool settled = false;
+  double update_seconds = 0;           // wall time of the whole step (steady_clock)
+  const ContactSet* contacts = nullptr;  // the contact set at xs (valid during the hook call only)
+};
+
+struct CouplingStepInfo {
+  double time = 0;
+  bool has_god_object = false;         // false until the first snapshot arrives (Fc = 0)
+  bool new_set = false;                // a snapshot arrived this step
+  uint64_t god_sequence = 0;
+  double god_time = -1;
+  Pose xs;                             // the god-object pose the step used (the cached snapshot's)
+  Vec6 au = Vec6::Zero(), ac = Vec6::Zero(), Fc = Vec6::Zero();
+  int num_rows = 0, num_offset_rows = 0;  // rows, and rows whose offset still runs
+  int num_new_offsets = 0;             // rows offset when this snapshot arrived
+  ProjectionStatus projection = ProjectionStatus::kOptimal;
+  double force_seconds = 0;            // wall time of the step (steady_clock)
+};
+
+struct HapticTickRecord {
+  uint64_t tick = 0;
+  double time = 0;
+  DeviceStatus device_status = DeviceStatus::kOk;
+  Pose xh;                             // the last good handle pose
+  uint32_t buttons = 0;                // the last sample's buttons
+  bool gripped = true;                 // the last sample's DeviceState::gripped
+  Vec6 F_computed = Vec6::Zero();      // before the safety stage
+  Vec6 F_sent = Vec6::Zero();          // what write() received
+  uint32_t active_events = 0;          // bit k: RuntimeEventKind k holds this tick
+};
+
+// Hooks, called from the loops' threads (concurrently in threaded runs): they
+// must not block, allocate for long or throw. Null members are skipped.
+struct RuntimeObserver {
+  void* user = nullptr;
+  void (*on_event)(void* user, const RuntimeEvent& event) = nullptr;
+  void (*on_sim_step)(void* user, const SimStepInfo& info) = nullptr;
+  void (*on_coupling_step)(void* user, const CouplingStepInfo& info) = nullptr;
+  void (*on_haptic_tick)(void* user, const HapticTickRecord& record) = nullptr;
+};
+
+}  // namespace gauss6

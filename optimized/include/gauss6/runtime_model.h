@@ -1,0 +1,82 @@
+// The runtime's settings and its immutable model (MuJoCo's mjModel): built once
+// from a Scene, shared read-only by the three loops (runtime.h).
+//
+// Units and frames: world frame W, scene units (metres in the shipped scenes),
+// seconds. Mass properties are in the god-object's body frame B (origin at G).
+#pragma once
+
+#include <stdexcept>
+#include <vector>
+
+#include "gauss6/bvh.h"
+#include "gauss6/ccd_step.h"
+#include "gauss6/contacts.h"
+#include "gauss6/offsetting.h"
+#include "gauss6/quasistatics.h"
+#include "gauss6/scene.h"
+
+namespace gauss6 {
+
+class RuntimeError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+// Where the haptic loop takes its force from.
+enum class ForceSource {
+  kHapticTick,    // the coupling step runs inside each haptic tick (lowest latency; default)
+  kCouplingLoop,  // a separate coupling thread publishes Fc (the paper's three loops; threaded runs only)
+};
+
+// Every setting of the runtime, one line each. Defaults suit scenes whose delta
+// is about 1e-4 of their size.
+struct RuntimeSettings {
+  ProjectionSettings projection;       // both loops' projections
+  CcdStepSettings ccd;                 // the sim loop's CCD; narrow.min_separation is set to scene delta
+  double contact_factor = 0.5;         // contacts within delta (1 + contact_factor) of the god-object
+  double gap_factor = 0.25;            // sim loop keeps contact gaps near delta (1 + gap_factor) (< contact_factor)
+  double match_distance = 0;           // coupling: a row is "the same" as a cached one when its body-frame point
+                                       // moved less than this (0: 1e-3 of the god-object's radius) ...
+  double match_cosine = 1 - 1e-9;      // ... and the cosine of the angle between their normals is above this
+  ForceSource force_source = ForceSource::kHapticTick;
+  double device_timeout = 0.005;       // s without a good device sample before the watchdog zeroes the force
+  double sim_timeout = 0.5;            // s without a new sim snapshot (sim stalled) before the force is zeroed
+  double coupling_timeout = 0.005;     // s without a new Fc (kCouplingLoop) before the force is zeroed
+  int lockstep_sim_period = 1;         // lockstep: haptic ticks per sim step (>= 1)
+  double sim_min_period = 0.0005;      // threaded: a sim step starts at most every this many seconds
+  double coupling_min_period = 0;      // threaded, kCouplingLoop: same for coupling steps (0: back to back)
+};
+
+// The immutable model: built once from a Scene, shared read-only by every loop.
+// Not copyable or movable (bodies point into its own meshes and BVHs).
+struct RuntimeModel {
+  RuntimeModel(const Scene& scene, const RuntimeSettings& settings);  // throws RuntimeError
+  RuntimeModel(const RuntimeModel&) = delete;
+  RuntimeModel& operator=(const RuntimeModel&) = delete;
+
+  // Obstacles: meshes moved to the world frame once, their BVHs (world frame).
+  std::vector<TriangleMesh> obstacle_meshes_W;
+  std::vector<Bvh> obstacle_bvhs_W;
+  std::vector<CcdBody> obstacles;      // obstacle k = {&obstacle_meshes_W[k], &obstacle_bvhs_W[k]}
+  // God-object: mesh and BVH in its body frame B (origin at G).
+  TriangleMesh god_mesh_B;
+  Bvh god_bvh_B;
+  CcdBody god;
+  double god_radius = 0;               // max |r_B| over the mesh (scene units)
+  // Mass properties in B: mass and inertia about G (parallel-axis from the centre of mass).
+  double mass = 0;
+  Mat3 inertia_G_B = Mat3::Identity();
+  Pose initial_pose;                   // X_WB of the god-object at start
+  Gains gains;
+  ContactParameters contact;
+  OffsetSettings offsets;              // from the scene's offset_eps and offset_time
+  DeviceSettings device;               // rate and force/torque limits
+  RuntimeSettings settings;            // as given, ccd.narrow.min_separation = delta
+  ContactSettings contact_generation;  // distance = delta (1 + contact_factor)
+  double match_distance = 0;           // resolved (never 0)
+};
+
+// M = diag(m I3, R I_G R^T) at orientation q: world frame, about G.
+Mat6 mass_matrix_at(const RuntimeModel& model, const Quat& q);
+
+}  // namespace gauss6

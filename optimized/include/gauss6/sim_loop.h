@@ -1,0 +1,66 @@
+// The sim loop (METHOD.md section 2, variable rate): its state and its step.
+//
+//   sim_step(): xh -> au -> ac -> CCD -> xs, contacts -> publish
+//
+// The step reads the handle from RuntimeChannels and publishes the god-object
+// and its contact set there (runtime_channels.h). Real time: sim_step and
+// advance_god_object allocate nothing, lock nothing and throw nothing; every
+// buffer lives in SimState, built once. Frames: world frame W; poses are of G.
+#pragma once
+
+#include <array>
+#include <cstdint>
+
+#include "gauss6/ccd_step.h"
+#include "gauss6/contacts.h"
+#include "gauss6/quasistatics.h"
+#include "gauss6/runtime_channels.h"
+#include "gauss6/runtime_events.h"
+#include "gauss6/runtime_model.h"
+
+namespace gauss6 {
+
+// Every buffer of the sim loop, allocated when built.
+struct SimState {
+  explicit SimState(const RuntimeModel& model);
+  Pose xs;                             // god-object pose
+  Mat6 M = Mat6::Identity();           // at xs's orientation
+  ContactSet contacts;                 // the current set (capacity kMaxContacts)
+  std::array<double, kMaxContacts> gap_rhs{};  // b_k = delta (1 + gap_factor) - separation_k
+  ProjectionWorkspace projection_ws;
+  ProjectionResult projection;
+  CcdStepWorkspace ccd_ws;
+  CcdStepResult ccd;
+  std::array<FeaturePair, kMaxContacts> ccd_hints{};  // the contacts at a leg's start, tested first (ccd_step)
+  double stop_deviation = 0;           // of xs from the motion's exact pose (make_stop_pose)
+  ContactWorkspace contact_ws;
+  HandleSample handle;                 // last sample read
+  GodObjectSnapshot snapshot;          // what step 5 publishes
+  uint64_t step = 0;
+  uint32_t step_events = 0;            // conditions found by this step (contact overflow)
+  uint32_t active_events = 0;          // conditions of the last step (events fire on onset)
+  SimStepInfo info;
+};
+
+// t is the run's clock (s): virtual in lockstep runs, steady_clock in threads.
+// One sim step (METHOD.md section 2). Fills and returns s->info. Without a
+// handle sample yet, the god-object stays put (and is still published).
+const SimStepInfo& sim_step(const RuntimeModel& model, double t, RuntimeChannels* channels, SimState* s);
+
+// Step 4 of a sim step alone, from its recorded inputs (SimStepInfo::x_start,
+// x_target, residual): the CCD along the Cayley motion x_start -> x_target (split
+// in halves on a half turn), s->xs = its end or its stop pose (delta before the
+// first contact), s->M at s->xs, and s->contacts, the contact set at s->xs. If
+// that leg ends free with an empty contact set while residual != 0 (the previous
+// contacts withheld part of the command, and their surface fell away under the
+// linearised constraints: a convex crease or a curved surface), a settling leg
+// moves on from s->xs by residual, with its own CCD and contact set, so that a
+// god-object pressed against a surface follows it instead of floating off it
+// for a step (which the force would show as a dropout). Each leg's motion is
+// free of contact (the CCD's guarantee). Sets info's x_start, x_target,
+// residual, settled, ccd (the first status other than kOk over the legs),
+// u_hit, num_halves, status and num_contacts. Real time: no allocation.
+void advance_god_object(const RuntimeModel& model, const Pose& x_start, const Pose& x_target, const Vec6& residual,
+                        SimState* s, SimStepInfo* info);
+
+}  // namespace gauss6

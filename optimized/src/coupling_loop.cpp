@@ -1,0 +1,83 @@
+// The coupling loop (METHOD.md section 3): the cached god-object snapshot,
+// offsets for new rows, projection and the force Fc (coupling_loop.h).
+#include "gauss6/coupling_loop.h"
+
+#include "gauss6/coupling.h"
+#include "runtime_detail.h"
+
+namespace gauss6 {
+
+using namespace detail;  // the loops' shared machinery (runtime_detail.h)
+
+// ---------------------------------------------------------------------------
+// Coupling loop.
+// ---------------------------------------------------------------------------
+
+namespace {
+
+// Copies a new snapshot, if one was published since the last call. True when it did.
+bool receive_god_object(const RuntimeChannels& ch, CouplingState* s) {
+  const uint64_t writes = ch.god_object.num_writes();
+  if (writes == s->god_writes) return false;
+  if (!ch.god_object.try_read(&s->god)) return false;  // raced: keep the cached one
+  s->god_writes = writes;
+  s->has_god = true;
+  s->xs = to_pose(s->god.p, s->god.q);
+  for (int i = 0; i < 6; ++i)
+    for (int j = 0; j < 6; ++j) s->M(i, j) = s->god.M[6 * i + j];
+  return true;
+}
+
+void publish_wrench(double t, const CouplingStepInfo& info, RuntimeChannels* ch) {
+  WrenchSample w;
+  w.time = t;
+  for (int i = 0; i < 6; ++i) w.F[i] = info.Fc[i];
+  w.god_time = info.god_time;
+  ch->wrench.write(w);
+}
+
+}  // namespace
+
+const CouplingStepInfo& coupling_step(const RuntimeModel& model, double t, RuntimeChannels* channels,
+                                      CouplingState* s) {
+  const Clock::time_point start = Clock::now();
+  CouplingStepInfo& info = s->info;
+  info = CouplingStepInfo{};
+  info.time = t;
+  // 1. Read xh; read xs, M, J when a new set has arrived.
+  if (read_handle(*channels, &s->handle)) s->has_handle = true;
+  info.new_set = receive_god_object(*channels, s);
+  info.has_god_object = s->has_god;
+  if (s->has_handle && s->has_god) {
+    info.god_sequence = s->god.sequence;
+    info.god_time = s->god.time;
+    info.xs = s->xs;
+    const int m = s->god.num_contacts;
+    info.num_rows = m;
+    // 2. au = ks (xh (-) xs); offsets for the new rows of a new set.
+    info.au = model.gains.ks * pose_difference(to_pose(s->handle.p, s->handle.q), s->xs);
+    if (info.new_set) {
+      const OffsetRule rule{model.offsets, model.match_distance, model.settings.match_cosine,
+                            model.settings.projection};
+      const OffsetRows rows{m, s->god.J, s->god.point, s->god.normal};
+      info.num_new_offsets = start_offsets(rule, t, info.au, s->M, s->xs, rows, &s->offsets);
+    }
+    // 3. ac = projection (warm-started), b(t) while offsets run; Fc = kh M (ac - au).
+    info.num_offset_rows = fill_offsets(model.offsets, t, &s->offsets);
+    ProjectionProblem problem;
+    problem.M = &s->M;
+    problem.au = info.au;
+    problem.J = m > 0 ? s->god.J : nullptr;
+    problem.b = info.num_offset_rows > 0 ? s->offsets.rhs.data() : nullptr;
+    problem.num_rows = m;
+    info.projection = project(problem, model.settings.projection, &s->projection_ws, &s->projection);
+    info.ac = s->projection.ac;
+    info.Fc = coupling_force(s->M, info.au, info.ac, model.gains.kh);
+  }
+  // 4. Publish Fc (zero until both xh and a snapshot are known).
+  publish_wrench(t, info, channels);
+  info.force_seconds = seconds_since(start);
+  return info;
+}
+
+}  // namespace gauss6

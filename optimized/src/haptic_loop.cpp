@@ -1,0 +1,123 @@
+// The haptic loop: device read, force, safety stage, device write
+// (haptic_loop.h).
+#include "gauss6/haptic_loop.h"
+
+#include "runtime_detail.h"
+
+namespace gauss6 {
+
+using namespace detail;  // the loops' shared machinery (runtime_detail.h)
+
+// ---------------------------------------------------------------------------
+// Haptic loop.
+// ---------------------------------------------------------------------------
+
+namespace {
+
+bool all_finite(const Vec6& v) { return v.allFinite(); }
+
+}  // namespace
+
+Vec6 make_safe_wrench(const Vec6& F, double max_force, double max_torque, uint32_t* events) {
+  if (!all_finite(F)) {
+    *events |= bit(RuntimeEventKind::kNonFiniteForce);
+    return Vec6::Zero();
+  }
+  // Scale each part down to its limit (direction kept).
+  Vec6 out = F;
+  const double f = F.head<3>().norm(), tau = F.tail<3>().norm();
+  if (f > max_force) out.head<3>() *= max_force / f, *events |= bit(RuntimeEventKind::kForceClamped);
+  if (tau > max_torque) out.tail<3>() *= max_torque / tau, *events |= bit(RuntimeEventKind::kForceClamped);
+  if (!all_finite(out)) {  // only when a limit itself is not finite
+    *events |= bit(RuntimeEventKind::kNonFiniteForce);
+    return Vec6::Zero();
+  }
+  return out;
+}
+
+namespace {
+
+constexpr uint32_t kZeroForceEvents =
+    bit(RuntimeEventKind::kInvalidHandlePose) | bit(RuntimeEventKind::kDeviceTimeout) |
+    bit(RuntimeEventKind::kSimStalled) | bit(RuntimeEventKind::kCouplingStalled) |
+    bit(RuntimeEventKind::kDeviceEnded);
+
+}  // namespace
+
+bool haptic_tick(const RuntimeModel& model, double t, Device* device, RuntimeChannels* channels, HapticState* h,
+                 CouplingState* coupling, const RuntimeObserver& observer, RuntimeStats* stats) {
+  const Clock::time_point start = Clock::now();
+  const RuntimeSettings& settings = model.settings;
+  uint32_t events = 0;
+  ++h->tick;
+
+  // 1. Read the device; publish a good xh.
+  const DeviceStatus status = device->read(t, &h->device);
+  if (status == DeviceStatus::kOk) {
+    if (is_valid_pose(h->device.X_WH)) {
+      h->xh = h->device.X_WH;
+      h->has_handle = true;
+      h->last_good_time = t;
+      HandleSample sample;
+      sample.time = t;
+      sample.tick = h->tick;
+      store_pose(h->xh, sample.p, sample.q);
+      channels->handle.write(sample);
+    } else {
+      events |= bit(RuntimeEventKind::kInvalidHandlePose);
+    }
+  } else if (status == DeviceStatus::kEnded) {
+    events |= bit(RuntimeEventKind::kDeviceEnded);
+    h->ended = true;
+  } else {
+    events |= bit(RuntimeEventKind::kDeviceError);
+  }
+
+  // 2. The force: the coupling step in this tick, or the coupling loop's Fc.
+  Vec6 F = Vec6::Zero();
+  double god_time = -1, force_time = t;
+  if (coupling) {
+    const CouplingStepInfo& info = coupling_step(model, t, channels, coupling);
+    stats->coupling.add_start(t);
+    stats->coupling.work.add(info.force_seconds);
+    if (projection_failed(info.projection)) events |= bit(RuntimeEventKind::kProjectionFailed);
+    if (observer.on_coupling_step) observer.on_coupling_step(observer.user, info);
+    F = info.Fc;
+    god_time = info.god_time;
+  } else if (channels->wrench.try_read(&h->wrench)) {
+    F = Eigen::Map<const Vec6>(h->wrench.F);
+    god_time = h->wrench.god_time;
+    force_time = h->wrench.time;
+  } else {
+    force_time = 0;  // nothing published yet (the run started at 0)
+  }
+
+  // 3. Safety: watchdogs, then finiteness and limits.
+  if (t - h->last_good_time > settings.device_timeout) events |= bit(RuntimeEventKind::kDeviceTimeout);
+  if (t - (god_time >= 0 ? god_time : 0.0) > settings.sim_timeout) events |= bit(RuntimeEventKind::kSimStalled);
+  if (!coupling && t - force_time > settings.coupling_timeout) events |= bit(RuntimeEventKind::kCouplingStalled);
+  const Vec6 F_computed = F;
+  if (events & kZeroForceEvents) F.setZero();
+  F = make_safe_wrench(F, model.device.max_force, model.device.max_torque, &events);
+
+  // 4. Write the device.
+  device->write(t, F);
+
+  // Events (onsets), statistics, record.
+  report_onsets(events, &h->active_events, t, h->tick, observer, &stats->haptic, static_cast<int>(status));
+  stats->haptic.work.add(seconds_since(start));
+  HapticTickRecord& rec = h->record;
+  rec.tick = h->tick;
+  rec.time = t;
+  rec.device_status = status;
+  rec.xh = h->xh;
+  rec.buttons = h->device.buttons;
+  rec.gripped = h->device.gripped;
+  rec.F_computed = F_computed;
+  rec.F_sent = F;
+  rec.active_events = events;
+  if (observer.on_haptic_tick) observer.on_haptic_tick(observer.user, rec);
+  return !h->ended;
+}
+
+}  // namespace gauss6

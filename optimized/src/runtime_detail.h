@@ -1,0 +1,57 @@
+// Machinery the runtime's loops share (sim_loop.cpp, coupling_loop.cpp,
+// haptic_loop.cpp, runtime.cpp): the clock, event bits and their onsets, and
+// the copy of a pose into a channel payload. Not part of the public headers.
+#pragma once
+
+#include <chrono>
+#include <cstdint>
+
+#include "gauss6/runtime_channels.h"
+#include "gauss6/runtime_events.h"
+#include "gauss6/runtime_stats.h"
+
+namespace gauss6::detail {
+
+using Clock = std::chrono::steady_clock;
+
+inline double seconds_since(Clock::time_point start) {
+  return std::chrono::duration<double>(Clock::now() - start).count();
+}
+
+constexpr uint32_t bit(RuntimeEventKind k) { return 1u << static_cast<int>(k); }
+static_assert(kNumRuntimeEventKinds <= 32, "event kinds are bits of a uint32_t");
+
+// Reports the conditions of `events` that did not hold last time (*active), and
+// counts them in stats.
+inline void report_onsets(uint32_t events, uint32_t* active, double t, uint64_t tick,
+                          const RuntimeObserver& observer, LoopStats* stats, int detail = 0) {
+  const uint32_t onset = events & ~*active;
+  *active = events;
+  for (int k = 0; k < kNumRuntimeEventKinds; ++k) {
+    if (!(onset & (1u << k))) continue;
+    ++stats->event_counts[k];
+    if (observer.on_event) {
+      RuntimeEvent e;
+      e.kind = static_cast<RuntimeEventKind>(k);
+      e.time = t;
+      e.tick = tick;
+      e.detail = detail;
+      observer.on_event(observer.user, e);
+    }
+  }
+}
+
+inline void store_pose(const Pose& x, double p[3], double q[4]) {
+  for (int i = 0; i < 3; ++i) p[i] = x.p[i];
+  q[0] = x.q.w, q[1] = x.q.x, q[2] = x.q.y, q[3] = x.q.z;
+}
+
+// Step 1 of the sim and coupling loops: the latest handle sample (false when
+// none was published yet).
+inline bool read_handle(const RuntimeChannels& ch, HandleSample* sample) { return ch.handle.try_read(sample); }
+
+inline bool projection_failed(ProjectionStatus s) {
+  return s == ProjectionStatus::kBadInput || s == ProjectionStatus::kIterationCap;
+}
+
+}  // namespace gauss6::detail

@@ -1,0 +1,108 @@
+// The runtime model: the scene's meshes, BVHs, mass properties and settings,
+// checked and prepared once (runtime_model.h).
+#include "gauss6/runtime_model.h"
+
+#include <cmath>
+#include <string>
+
+namespace gauss6 {
+
+RuntimeModel::RuntimeModel(const Scene& scene, const RuntimeSettings& s) : settings(s) {
+  auto fail = [&](const std::string& what) {
+    throw RuntimeError("scene '" + scene.path + "': " + what);
+  };
+  // Surface properties are not rendered by this runtime: refuse rather than
+  // silently render a plain surface.
+  if (scene.surface.kind == SurfaceKind::kForceShading)
+    fail("surface.kind = force_shading is not supported by the runtime (two-pass scheme not implemented)");
+  if (scene.surface.kind == SurfaceKind::kTexture)
+    fail("surface.kind = texture is not supported by the runtime");
+  if (num_triangles(scene.god_object.mesh) == 0) fail("the god-object's mesh is empty");
+  if (!(scene.contact.delta > 0) || !std::isfinite(scene.contact.delta)) fail("contact.delta must be > 0");
+  if (!(scene.gains.ks > 0 && scene.gains.ks <= 1)) fail("gains.ks must be in (0, 1]");
+  if (!(scene.gains.kh >= 0) || !std::isfinite(scene.gains.kh)) fail("gains.kh must be >= 0 and finite");
+  if (!(scene.device.rate_hz > 0 && scene.device.rate_hz <= 10000)) fail("device.rate_hz must be in (0, 10000]");
+  if (!(scene.device.max_force > 0) || !(scene.device.max_torque > 0)) fail("device limits must be > 0");
+  if (!(s.contact_factor > 0) || !(s.gap_factor > 0 && s.gap_factor < s.contact_factor))
+    fail("settings: need 0 < gap_factor < contact_factor");
+  if (!(s.device_timeout > 0) || !(s.sim_timeout > 0) || !(s.coupling_timeout > 0))
+    fail("settings: timeouts must be > 0");
+  if (s.lockstep_sim_period < 1) fail("settings: lockstep_sim_period must be >= 1");
+  if (!(s.sim_min_period >= 0) || !(s.coupling_min_period >= 0)) fail("settings: min periods must be >= 0");
+
+  // Obstacles: vertices and normals moved to the world frame once; BVHs built once.
+  obstacle_meshes_W.reserve(scene.obstacles.size());
+  obstacle_bvhs_W.reserve(scene.obstacles.size());
+  for (const Body& b : scene.obstacles) {
+    TriangleMesh m = b.mesh;
+    const Mat3 R = rotation_matrix(b.pose.q);
+    for (Eigen::Index v = 0; v < m.V.rows(); ++v) m.V.row(v) = (b.pose.p + R * m.V.row(v).transpose()).transpose();
+    if (m.N.rows() == m.V.rows()) {
+      // R(q) is a rotation times |q|^0 (rational form): normals only rotate.
+      for (Eigen::Index v = 0; v < m.N.rows(); ++v) m.N.row(v) = (R * m.N.row(v).transpose()).transpose();
+    }
+    obstacle_meshes_W.push_back(std::move(m));
+  }
+  for (const TriangleMesh& m : obstacle_meshes_W) obstacle_bvhs_W.push_back(build_bvh(m));
+  for (size_t k = 0; k < obstacle_meshes_W.size(); ++k) obstacles.push_back({&obstacle_meshes_W[k], &obstacle_bvhs_W[k]});
+
+  // God-object: body frame B, origin at G.
+  god_mesh_B = scene.god_object.mesh;
+  god_bvh_B = build_bvh(god_mesh_B);
+  god = {&god_mesh_B, &god_bvh_B};
+  god_radius = god_bvh_B.radius;
+
+  // Inertia about G from the inertia about the centre of mass c (parallel axes).
+  const MassProperties& mp = scene.god_mass.mass;
+  mass = mp.mass;
+  const Vec3 c = mp.center_of_mass;
+  inertia_G_B = mp.inertia + mp.mass * (c.squaredNorm() * Mat3::Identity() - c * c.transpose());
+  if (!(mass > 0) || !std::isfinite(mass) || !inertia_G_B.allFinite() || inertia_G_B.llt().info() != Eigen::Success)
+    fail("the god-object's mass properties are not positive definite");
+
+  initial_pose = scene.god_object.pose;
+  gains = scene.gains;
+  contact = scene.contact;
+  offsets.eps = scene.contact.offset_eps;
+  offsets.T = scene.contact.offset_time;
+  if (!valid_offset_settings(offsets)) fail("contact.offset_eps must be < 0 and contact.offset_time > 0");
+  device = scene.device;
+
+  // The CCD stops the god-object delta before contact; contacts are the pairs
+  // within delta (1 + contact_factor).
+  settings.ccd.narrow.min_separation = contact.delta;
+  // A hit is accepted once the features are proven within 1.1 delta: the stop pose keeps
+  // at least delta (the guarantee) and the search ends well before rounding-level widths
+  // (the default 1e-9 is meant for unit-size queries; docs/benchmarks.md, the delta sweep).
+  settings.ccd.narrow.distance_tolerance = 0.1 * contact.delta;
+  // Coherence: a leg that starts in contact keeps the pairs within 64 delta
+  // more than the reach, and the legs after it take their candidates from them
+  // while no point has moved 64 delta from there (ccd_step's proximity cache;
+  // docs/benchmarks.md has the sweep of this margin).
+  settings.ccd.cache_margin = 64 * contact.delta;
+  // A list's margin grows with the god-object's speed up to 256 delta (about
+  // six steps like the last one), and the next list is filled 300 node pairs
+  // a step (about 60 us on the peg) while the one in use serves, at the pose
+  // the god-object is heading for: a sliding god-object seldom waits for a
+  // whole fill, and a resting one scans a short list.
+  settings.ccd.cache_margin_max = 256 * contact.delta;
+  settings.ccd.cache_fill_budget = 300;
+  contact_generation.distance = contact.delta * (1 + settings.contact_factor);
+  // The CCD lists the pairs that may come within the contact distance (and the
+  // distance a hit may be accepted at, 0.1 delta more: update_contacts) of each
+  // other by the stop pose, so the contact set needs no descent of its own.
+  settings.ccd.near_distance = contact_generation.distance + 0.2 * contact.delta;
+  match_distance = settings.match_distance > 0 ? settings.match_distance : 1e-3 * god_radius;
+}
+
+Mat6 mass_matrix_at(const RuntimeModel& model, const Quat& q) {
+  const Mat3 R = rotation_matrix(normalized(q));
+  Mat6 M = Mat6::Zero();
+  M.topLeftCorner<3, 3>() = model.mass * Mat3::Identity();
+  M.bottomRightCorner<3, 3>() = R * model.inertia_G_B * R.transpose();
+  // Symmetric to the last bit (the projection caches M by its bytes).
+  M.bottomRightCorner<3, 3>() = (0.5 * (M.bottomRightCorner<3, 3>() + M.bottomRightCorner<3, 3>().transpose())).eval();
+  return M;
+}
+
+}  // namespace gauss6

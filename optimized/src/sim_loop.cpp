@@ -1,0 +1,215 @@
+// The sim loop (METHOD.md section 2): projection with the previous contacts,
+// CCD along the in-between motion, the new contact set, publish (sim_loop.h).
+#include "gauss6/sim_loop.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+
+#include "gauss6/motion.h"
+#include "runtime_detail.h"
+
+namespace gauss6 {
+
+using namespace detail;  // the loops' shared machinery (runtime_detail.h)
+
+SimState::SimState(const RuntimeModel& model)
+    : contacts(kMaxContacts), contact_ws(model.god_mesh_B) {
+  xs = model.initial_pose;
+  M = mass_matrix_at(model, xs.q);
+  contacts.num_contacts = 0;
+}
+
+// ---------------------------------------------------------------------------
+// Sim loop.
+// ---------------------------------------------------------------------------
+
+namespace {
+
+// Step 3: ac, the M-projection of au with the current contacts. The sim loop
+// also keeps each contact's gap near delta (1 + gap_factor): J_k a >= b_k with
+// b_k = delta (1 + gap_factor) - separation_k (a few delta at most), so that a
+// god-object sliding along a face stays clear of the CCD's stopping distance
+// delta instead of grazing it. If these rows conflict (empty polyhedron), the
+// plain cone J a >= 0 is used. The force (coupling loop) never sees b.
+Vec6 constrain_motion(const RuntimeModel& model, const Vec6& au, SimState* s) {
+  const int m = s->contacts.num_contacts;
+  const double target = model.contact.delta * (1 + model.settings.gap_factor);
+  for (int k = 0; k < m; ++k) s->gap_rhs[k] = target - s->contacts.contacts[k].separation;
+  ProjectionProblem problem;
+  problem.M = &s->M;
+  problem.au = au;
+  problem.J = m > 0 ? s->contacts.J.data() : nullptr;
+  problem.b = m > 0 ? s->gap_rhs.data() : nullptr;
+  problem.num_rows = m;
+  project(problem, model.settings.projection, &s->projection_ws, &s->projection);
+  if (s->projection.status == ProjectionStatus::kInfeasibleOffsets) {
+    problem.b = nullptr;
+    project(problem, model.settings.projection, &s->projection_ws, &s->projection);
+  }
+  return s->projection.ac;
+}
+
+// One CCD leg along the Cayley motion x0 -> x1, split in halves on a half turn
+// (each half turns by at most 90 degrees), with s->ccd_hints[0 .. num_hints)
+// tested first; s->ccd holds the result of the last call. When the leg can
+// run, s->xs becomes the motion's own pose at u_hit (its end when no hit: the
+// CCD's guarantee holds for it, up to make_stop_pose's deviation bound) and the
+// function returns true; on invalid input or a half turn left after splitting,
+// s->xs is left as it was and it returns false.
+bool ccd_leg(const RuntimeModel& model, const Pose& x0, const Pose& x1, int num_hints, SimState* s,
+             int* num_halves) {
+  const int num_obstacles = static_cast<int>(model.obstacles.size());
+  const CcdBody* obstacles = model.obstacles.data();
+  CcdStepResult& r = s->ccd;
+  ccd_step(obstacles, num_obstacles, model.god, x0, x1, model.settings.ccd, &s->ccd_ws, &r, s->ccd_hints.data(),
+           num_hints);
+  if (r.status == CcdStatus::kHalfTurn) {
+    const Pose mid = split_step(x0, x1);
+    *num_halves = 2;
+    ccd_step(obstacles, num_obstacles, model.god, x0, mid, model.settings.ccd, &s->ccd_ws, &r, s->ccd_hints.data(),
+             num_hints);
+    if (r.status != CcdStatus::kInvalidInput && r.status != CcdStatus::kHalfTurn && !r.hit)
+      ccd_step(obstacles, num_obstacles, model.god, mid, x1, model.settings.ccd, &s->ccd_ws, &r);
+  }
+  if (r.status == CcdStatus::kInvalidInput || r.status == CcdStatus::kHalfTurn) return false;
+  const StopPose stop = make_stop_pose(r.motion, r.hit ? r.u_hit : 1.0, model.god_radius);
+  s->xs = stop.pose;
+  s->stop_deviation = stop.deviation;
+  return true;
+}
+
+// The contact set at s->xs: every pair within delta (1 + contact_factor), and
+// at least the pair that stopped the last leg (s->ccd). Sets the overflow event.
+void update_contacts(const RuntimeModel& model, SimState* s) {
+  const CcdStepResult& r = s->ccd;
+  ContactSettings cs = model.contact_generation;
+  if (r.hit && std::isfinite(r.distance_reached))
+    cs.distance = std::max(cs.distance, r.distance_reached + model.contact.delta * model.settings.contact_factor);
+  // The CCD's near pairs hold every pair within its near reach at xs, less how
+  // far the double pose xs may lie from the motion's (its deviation, and the
+  // rounding of posing the vertices in doubles): when the contact distance is
+  // within that, they are the only pairs to test.
+  const double slack = next_up(s->stop_deviation + 1e-13 * (s->xs.p.cwiseAbs().maxCoeff() + model.god_radius));
+  const bool near = r.num_near_pairs >= 0 && (r.hit ? r.u_hit : 1.0) >= r.near_u0 && cs.distance + slack <= r.near_reach;
+  const ContactStatus status =
+      generate_contacts(model.obstacles.data(), static_cast<int>(model.obstacles.size()), model.god, s->xs, cs,
+                        &s->contact_ws, &s->contacts, s->ccd_ws.near_pairs(near ? r.num_near_pairs : -1));
+  if (status == ContactStatus::kInvalidInput) s->contacts.num_contacts = 0;
+  if (status == ContactStatus::kOverflow || status == ContactStatus::kStackFull)
+    s->step_events |= bit(RuntimeEventKind::kContactOverflow);
+}
+
+}  // namespace
+
+// Step 4: CCD along x_start -> x_target, then xs = its end or the stop pose and
+// the contact set at xs; then, when that leg ended free and out of contact while
+// the previous contacts withheld part of the command, the settling leg by the
+// withheld part (sim_loop.h).
+void advance_god_object(const RuntimeModel& model, const Pose& x_start, const Pose& x_target, const Vec6& residual,
+                        SimState* s, SimStepInfo* info) {
+  info->x_start = x_start;
+  info->x_target = x_target;
+  info->residual = residual;
+  info->settled = false;
+  info->num_halves = 1;
+  s->xs = x_start;
+  // The contacts at x_start (the set of the last step, at s->xs) are the pairs
+  // most likely to stop either leg: ccd_step tests them first.
+  const int num_hints = std::min(s->contacts.num_contacts, kMaxContacts);
+  for (int k = 0; k < num_hints; ++k) s->ccd_hints[k] = s->contacts.contacts[k].features;
+  const bool moved = ccd_leg(model, x_start, x_target, num_hints, s, &info->num_halves);
+  info->ccd = s->ccd.status;
+  info->u_hit = s->ccd.u_hit;
+  info->status = !moved ? SimStepStatus::kInvalidStep
+                        : (s->ccd.hit ? SimStepStatus::kContact : SimStepStatus::kFree);
+  update_contacts(model, s);
+
+  // Settling leg: the linearised constraints J a >= 0 hold to first order only,
+  // so a motion along a contact's tangent plane lifts off a surface that curves
+  // or creases away under it. The god-object then moves on by what the previous
+  // contacts withheld, au - ac, from where it ended (the total command is at
+  // most au, as without contacts), and stops delta before the surface again.
+  const bool lifted_off = moved && !s->ccd.hit && s->contacts.num_contacts == 0;
+  if (lifted_off && residual.allFinite() && residual != Vec6::Zero()) {
+    info->settled = true;
+    const Pose from = s->xs;
+    int halves = 1;
+    if (ccd_leg(model, from, pose_update(from, residual), num_hints, s, &halves)) {
+      if (s->ccd.hit) info->status = SimStepStatus::kContact;
+      update_contacts(model, s);
+    }
+    if (info->ccd == CcdStatus::kOk) info->ccd = s->ccd.status;
+    info->u_hit = s->ccd.u_hit;
+  }
+  s->M = mass_matrix_at(model, s->xs.q);
+  info->num_contacts = s->contacts.num_contacts;
+}
+
+namespace {
+
+// Step 5: publish xs, M, J and the contacts.
+void publish_god_object(double t, SimState* s, RuntimeChannels* ch) {
+  GodObjectSnapshot& g = s->snapshot;
+  g.sequence = s->step;
+  g.time = t;
+  store_pose(s->xs, g.p, g.q);
+  for (int i = 0; i < 6; ++i)
+    for (int j = 0; j < 6; ++j) g.M[6 * i + j] = s->M(i, j);
+  const int m = std::min(s->contacts.num_contacts, kMaxContacts);
+  g.num_contacts = m;
+  std::memcpy(g.J, s->contacts.J.data(), sizeof(double) * 6 * static_cast<size_t>(m));
+  for (int k = 0; k < m; ++k) {
+    const Contact& c = s->contacts.contacts[k];
+    for (int i = 0; i < 3; ++i) g.point[k][i] = c.point[i], g.normal[k][i] = c.normal[i];
+    g.separation[k] = c.separation;
+  }
+  ch->god_object.write(g);
+}
+
+// Step 2: au = ks (xh (-) xs), the command towards the handle sample just read.
+Vec6 command_motion(const RuntimeModel& model, const SimState& s) {
+  const Pose xh = to_pose(s.handle.p, s.handle.q);
+  return model.gains.ks * pose_difference(xh, s.xs);
+}
+
+// Step 4: xt = xs (+) ac; CCD; xs = xt or the stop pose; the new contact set
+// (and the settling leg by au - ac if the previous contacts' surface fell away).
+void advance_by(const RuntimeModel& model, SimState* s, SimStepInfo* info) {
+  const Vec6 residual = s->contacts.num_contacts > 0 ? Vec6(info->au - info->ac) : Vec6::Zero();
+  const Pose x_start = s->xs;  // a copy: the step overwrites s->xs
+  advance_god_object(model, x_start, pose_update(x_start, info->ac), residual, s, info);
+}
+
+// Without a handle sample the god-object stays put (and is still published).
+void stay_put(const SimState& s, SimStepInfo* info) {
+  info->status = SimStepStatus::kNoHandle;
+  info->x_start = info->x_target = s.xs;
+  info->num_contacts = s.contacts.num_contacts;
+}
+
+}  // namespace
+
+const SimStepInfo& sim_step(const RuntimeModel& model, double t, RuntimeChannels* channels, SimState* s) {
+  const Clock::time_point start = Clock::now();
+  SimStepInfo& info = s->info;
+  info = SimStepInfo{};
+  info.step = ++s->step;
+  info.time = t;
+  s->step_events = 0;
+  if (read_handle(*channels, &s->handle)) {      // 1. Read xh.
+    info.au = command_motion(model, *s);         // 2. au = ks (xh (-) xs).
+    info.ac = constrain_motion(model, info.au, s);  // 3. ac: projection with the previous step's contacts.
+    info.projection = s->projection.status;
+    advance_by(model, s, &info);                 // 4. CCD from xs towards xs (+) ac; the new contacts.
+  } else {
+    stay_put(*s, &info);
+  }
+  publish_god_object(t, s, channels);            // 5. Publish xs, M, J, the contacts (a new sequence number is the flag).
+  info.xs = s->xs;
+  info.contacts = &s->contacts;
+  info.update_seconds = seconds_since(start);
+  return info;
+}
+
+}  // namespace gauss6
