@@ -19,7 +19,7 @@ from ._gauss6 import (  # noqa: F401
     validate_mesh,
 )
 
-__version__ = "0.1.0"
+__version__ = "0.2.0"
 
 
 def defaults() -> dict:
