@@ -5,7 +5,7 @@ SHELL := /bin/bash
 VENV := .venv/bin
 JOBS ?= $(shell nproc)
 
-.PHONY: setup test reproduce bench ctest pytest proofs checks datasets clean
+.PHONY: setup test reproduce bench ctest pytest proofs checks datasets clean wheel-test
 
 setup:
 	@tools/setup.sh
@@ -55,3 +55,8 @@ reproduce: setup
 
 clean:
 	rm -rf build out
+
+# The wheel built from the checkout, installed into a fresh venv (python/tests/test_packaging.py;
+# slow: a CMake build of the extension). Not part of `make test`.
+wheel-test: setup
+	GAUSS6_TEST_WHEEL=1 $(VENV)/python -m pytest -q python/tests/test_packaging.py

@@ -19,7 +19,7 @@ from ._gauss6 import (  # noqa: F401
     validate_mesh,
 )
 
-__version__ = "0.1.0"
+from ._version import __version__  # noqa: F401  (written by CMake from project())
 
 
 def defaults() -> dict:

@@ -1,5 +1,6 @@
 """The `gauss6` command: one entry point for scenes, datasets, cross-checks and reproduction.
 
+    gauss6 --version
     gauss6 scene info SCENE [--json]
     gauss6 datasets generate | check
     gauss6 crosscheck qp [--family NAME] [--json]
@@ -113,9 +114,10 @@ def cmd_device_list(args: argparse.Namespace) -> int:
 
 
 def build_parser() -> argparse.ArgumentParser:
-    from . import defaults  # the C++ settings' defaults, for the options that share them
+    from . import __version__, defaults  # the C++ settings' defaults, for the options that share them
 
     p = argparse.ArgumentParser(prog="gauss6", description=__doc__.splitlines()[0])
+    p.add_argument("--version", action="version", version=f"gauss6 {__version__}")
     sub = p.add_subparsers(dest="command", required=True)
 
     scene = sub.add_parser("scene", help="scene files").add_subparsers(dest="action", required=True)
