@@ -7,6 +7,7 @@
 #include <cmath>
 
 #include "gauss6/distance.h"
+#include "gauss6/feature_pair.h"
 #include "gauss6/motion_bounds.h"
 
 namespace gauss6 {
@@ -112,54 +113,53 @@ ContactStatus generate_contacts(const CcdBody* obstacles, int num_obstacles, con
       // Pairs proven farther apart than d by a separating axis have no pair within d.
       const Vec3 X[3] = {gv(gf, 0), gv(gf, 1), gv(gf, 2)}, Y[3] = {oa, obb, oc};
       if (triangle_gap_lower_bound(X, Y, d) > d) return true;
-      // God vertices against the obstacle face: the face normal.
-      for (int k = 0; k < 3; ++k) {
-        if (!(go & (1u << k))) continue;
-        const Vec3& x = gv(gf, k);
-        const double sep = (x - closest_point_on_triangle(x, oa, obb, oc)).norm();
-        const Vec3 n = unit_normal(oa, obb, oc);
-        if (sep <= d && n != Vec3::Zero())
-          col.add({x, n, sep, {PairKind::kGodVertexObstacleFace, o, gf, k, of, -1}});
-      }
-      // Obstacle vertices against the god face: minus the god face's normal.
-      for (int k = 0; k < 3; ++k) {
-        if (!(oo & (1u << k))) continue;
-        const Vec3 y = ov(of, k);
-        const Vec3 c = closest_point_on_triangle(y, gv(gf, 0), gv(gf, 1), gv(gf, 2));
-        const double sep = (y - c).norm();
-        const Vec3 n = -unit_normal(gv(gf, 0), gv(gf, 1), gv(gf, 2));
-        if (sep <= d && n != Vec3::Zero())
-          col.add({c, n, sep, {PairKind::kObstacleVertexGodFace, o, gf, -1, of, k}});
-      }
-      // Edge/edge with closest points inside both edges, edges not parallel.
-      for (int k = 0; k < 3; ++k) {
-        if (!(go & (8u << k))) continue;
-        const Vec3 &g0 = gv(gf, k), &g1 = gv(gf, (k + 1) % 3);
-        for (int j = 0; j < 3; ++j) {
-          if (!(oo & (8u << j))) continue;
-          const Vec3 o0 = ov(of, j), o1 = ov(of, (j + 1) % 3);
-          double s, t;
-          closest_segment_parameters(g0, g1, o0, o1, &s, &t);
-          if (!(s > 0 && s < 1 && t > 0 && t < 1)) continue;
-          const Vec3 pg = g0 + s * (g1 - g0), po = o0 + t * (o1 - o0);
-          const double sep = (pg - po).norm();
-          if (!(sep <= d)) continue;
-          Vec3 n = (g1 - g0).cross(o1 - o0);
-          if (n.squaredNorm() <= par2 * (g1 - g0).squaredNorm() * (o1 - o0).squaredNorm()) continue;
-          n.normalize();
-          // Sign: from the obstacle's point to the god-object's; if they coincide,
-          // along the obstacle edge's outward direction (sum of its faces' normals).
-          double side = n.dot(pg - po);
-          if (side == 0) {
-            Vec3 out = unit_normal(oa, obb, oc);
-            const int nb = ob.neighbor[3 * of + j];
-            if (nb >= 0) out += unit_normal(ov(nb, 0), ov(nb, 1), ov(nb, 2));
-            side = n.dot(out);
+      // One pass over the table of feature-pair kinds (feature_pair.h); k: the
+      // god-object's corner (vertex k, or edge k -> k + 1), j: the obstacle's.
+      for_each_feature_pair(go, oo, [&](PairKind kind, int k, int j) {
+        switch (kind) {
+          case PairKind::kGodVertexObstacleFace: {  // the obstacle face's normal
+            const Vec3& x = gv(gf, k);
+            const double sep = (x - closest_point_on_triangle(x, oa, obb, oc)).norm();
+            const Vec3 n = unit_normal(oa, obb, oc);
+            if (sep <= d && n != Vec3::Zero()) col.add({x, n, sep, {kind, o, gf, k, of, -1}});
+            break;
           }
-          if (side < 0) n = -n;
-          col.add({pg, n, sep, {PairKind::kEdgeEdge, o, gf, k, of, j}});
+          case PairKind::kObstacleVertexGodFace: {  // minus the god face's normal
+            const Vec3 y = ov(of, j);
+            const Vec3 c = closest_point_on_triangle(y, gv(gf, 0), gv(gf, 1), gv(gf, 2));
+            const double sep = (y - c).norm();
+            const Vec3 n = -unit_normal(gv(gf, 0), gv(gf, 1), gv(gf, 2));
+            if (sep <= d && n != Vec3::Zero()) col.add({c, n, sep, {kind, o, gf, -1, of, j}});
+            break;
+          }
+          case PairKind::kEdgeEdge: {  // closest points inside both edges, edges not parallel
+            const Vec3 &g0 = gv(gf, k), &g1 = gv(gf, (k + 1) % 3);
+            const Vec3 o0 = ov(of, j), o1 = ov(of, (j + 1) % 3);
+            double s, t;
+            closest_segment_parameters(g0, g1, o0, o1, &s, &t);
+            if (!(s > 0 && s < 1 && t > 0 && t < 1)) break;
+            const Vec3 pg = g0 + s * (g1 - g0), po = o0 + t * (o1 - o0);
+            const double sep = (pg - po).norm();
+            if (!(sep <= d)) break;
+            Vec3 n = (g1 - g0).cross(o1 - o0);
+            if (n.squaredNorm() <= par2 * (g1 - g0).squaredNorm() * (o1 - o0).squaredNorm()) break;
+            n.normalize();
+            // Sign: from the obstacle's point to the god-object's; if they coincide,
+            // along the obstacle edge's outward direction (sum of its faces' normals).
+            double side = n.dot(pg - po);
+            if (side == 0) {
+              Vec3 out = unit_normal(oa, obb, oc);
+              const int nb = ob.neighbor[3 * of + j];
+              if (nb >= 0) out += unit_normal(ov(nb, 0), ov(nb, 1), ov(nb, 2));
+              side = n.dot(out);
+            }
+            if (side < 0) n = -n;
+            col.add({pg, n, sep, {kind, o, gf, k, of, j}});
+            break;
+          }
         }
-      }
+        return true;
+      });
       return true;
     };
     if (near.listed()) {  // the listed pairs of this obstacle (in range: ccd_step made them)
