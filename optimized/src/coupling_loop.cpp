@@ -39,7 +39,7 @@ void publish_wrench(double t, const CouplingStepInfo& info, RuntimeChannels* ch)
 }  // namespace
 
 const CouplingStepInfo& coupling_step(const RuntimeModel& model, double t, RuntimeChannels* channels,
-                                      CouplingState* s) {
+                                      CouplingState* s) noexcept {
   const Clock::time_point start = Clock::now();
   CouplingStepInfo& info = s->info;
   info = CouplingStepInfo{};

@@ -18,7 +18,7 @@ bool all_finite(const Vec6& v) { return v.allFinite(); }
 
 }  // namespace
 
-Vec6 make_safe_wrench(const Vec6& F, double max_force, double max_torque, uint32_t* events) {
+Vec6 make_safe_wrench(const Vec6& F, double max_force, double max_torque, uint32_t* events) noexcept {
   if (!all_finite(F)) {
     *events |= bit(RuntimeEventKind::kNonFiniteForce);
     return Vec6::Zero();
@@ -42,10 +42,16 @@ constexpr uint32_t kZeroForceEvents =
     bit(RuntimeEventKind::kSimStalled) | bit(RuntimeEventKind::kCouplingStalled) |
     bit(RuntimeEventKind::kDeviceEnded);
 
+// The smaller of the scene's limit and the device's; a device limit that is not a
+// positive number (unset, NaN) leaves the scene's, which the model checked is > 0.
+double lower_limit(double scene_limit, double device_limit) {
+  return device_limit > 0 && device_limit < scene_limit ? device_limit : scene_limit;
+}
+
 }  // namespace
 
 bool haptic_tick(const RuntimeModel& model, double t, Device* device, RuntimeChannels* channels, HapticState* h,
-                 CouplingState* coupling, const RuntimeObserver& observer, RuntimeStats* stats) {
+                 CouplingState* coupling, const RuntimeObserver& observer, RuntimeStats* stats) noexcept {
   const Clock::time_point start = Clock::now();
   const RuntimeSettings& settings = model.settings;
   uint32_t events = 0;
@@ -98,7 +104,10 @@ bool haptic_tick(const RuntimeModel& model, double t, Device* device, RuntimeCha
   if (!coupling && t - force_time > settings.coupling_timeout) events |= bit(RuntimeEventKind::kCouplingStalled);
   const Vec6 F_computed = F;
   if (events & kZeroForceEvents) F.setZero();
-  F = make_safe_wrench(F, model.device.max_force, model.device.max_torque, &events);
+  // The device's info() is the one source of what it can render; a scene may only lower it.
+  const DeviceInfo& limits = device->info();
+  F = make_safe_wrench(F, lower_limit(model.device.max_force, limits.max_force),
+                       lower_limit(model.device.max_torque, limits.max_torque), &events);
 
   // 4. Write the device.
   device->write(t, F);

@@ -107,7 +107,7 @@ void update_contacts(const RuntimeModel& model, SimState* s) {
 // the previous contacts withheld part of the command, the settling leg by the
 // withheld part (sim_loop.h).
 void advance_god_object(const RuntimeModel& model, const Pose& x_start, const Pose& x_target, const Vec6& residual,
-                        SimState* s, SimStepInfo* info) {
+                        SimState* s, SimStepInfo* info) noexcept {
   info->x_start = x_start;
   info->x_target = x_target;
   info->residual = residual;
@@ -190,7 +190,7 @@ void stay_put(const SimState& s, SimStepInfo* info) {
 
 }  // namespace
 
-const SimStepInfo& sim_step(const RuntimeModel& model, double t, RuntimeChannels* channels, SimState* s) {
+const SimStepInfo& sim_step(const RuntimeModel& model, double t, RuntimeChannels* channels, SimState* s) noexcept {
   const Clock::time_point start = Clock::now();
   SimStepInfo& info = s->info;
   info = SimStepInfo{};

@@ -80,6 +80,7 @@ class ScriptedDevice : public Device {
     writes.reserve(100000);
   }
   const DeviceInfo& info() const override { return info_; }
+  void set_limits(double max_force, double max_torque) { info_.max_force = max_force, info_.max_torque = max_torque; }
   DeviceStatus read(double t, DeviceState* state) override {
     state->time = t;
     if (t >= end_time) return state->status = DeviceStatus::kEnded;
@@ -443,6 +444,30 @@ TEST_CASE("runtime: safety: NaN from the device, device timeout, sim stall, forc
     for (const HapticTickRecord& t : r.rec.ticks) {
       const double since_sim = std::fmod(t.time + 1e-9, 0.2);
       if (since_sim > 0.0505) CHECK(t.F_sent.norm() == 0.0);
+    }
+  }
+  SECTION("the device's info() limits the force; the scene's limits only lower them") {
+    // Pressing 1 cm gives 5 N (the NaN section above); a device that renders at
+    // most 3 N gets at most 3 N (and one clamp event), while the scene says 20 N.
+    ScriptedDevice device(press_script(0.2, 0.04, 0.4));
+    device.set_limits(3, 1);
+    Run r;
+    run(&r, sc, RuntimeSettings{}, &device, 700);
+    CHECK(r.rec.count(RuntimeEventKind::kForceClamped) == 1);
+    double max_sent = 0;
+    for (const HapticTickRecord& t : r.rec.ticks) max_sent = std::max(max_sent, t.F_sent.head<3>().norm());
+    // Clamping scales the force to exactly the limit, up to rounding (1e-12 N).
+    CHECK(max_sent <= 3 + 1e-12);
+    CHECK(max_sent >= 3 - 1e-12);
+    // A device limit above the scene's leaves the scene's (20 N: no clamp at 5 N);
+    // one that is not a positive number (unset, NaN) is ignored.
+    for (double device_limit : {1000.0, 0.0, std::nan("")}) {
+      ScriptedDevice roomy(press_script(0.2, 0.04, 0.4));
+      roomy.set_limits(device_limit, device_limit);
+      Run q;
+      run(&q, sc, RuntimeSettings{}, &roomy, 700);
+      CHECK(q.rec.count(RuntimeEventKind::kForceClamped) == 0);
+      CHECK(q.rec.ticks.back().F_sent[2] > 4.9);
     }
   }
   SECTION("the safety stage: limits keep the direction, non-finite becomes zero") {

@@ -39,6 +39,6 @@ struct CouplingState {
 // t is the run's clock (s): virtual in lockstep runs, steady_clock in threads.
 // One coupling step (METHOD.md section 3). Fills and returns s->info.
 const CouplingStepInfo& coupling_step(const RuntimeModel& model, double t, RuntimeChannels* channels,
-                                      CouplingState* s);
+                                      CouplingState* s) noexcept;
 
 }  // namespace gauss6

@@ -35,13 +35,14 @@ struct HapticState {
 // t is the run's clock (s): virtual in lockstep runs, steady_clock in threads.
 // One haptic tick: device read, force (the coupling step when coupling != null,
 // else the wrench channel), safety (watchdogs, finiteness, limits), device write.
+// The limits are the device's (device->info()) lowered by the scene's (model.device).
 // Writes stats->haptic (and stats->coupling when coupling != null); event onsets
 // go to the observer. Returns false when the device ended (zero force written).
 bool haptic_tick(const RuntimeModel& model, double t, Device* device, RuntimeChannels* channels,
-                 HapticState* h, CouplingState* coupling, const RuntimeObserver& observer, RuntimeStats* stats);
+                 HapticState* h, CouplingState* coupling, const RuntimeObserver& observer, RuntimeStats* stats) noexcept;
 
 // The safety stage alone: returns a finite wrench within the limits; sets the
 // bits of *events (1 << RuntimeEventKind) for kNonFiniteForce and kForceClamped.
-Vec6 make_safe_wrench(const Vec6& F, double max_force, double max_torque, uint32_t* events);
+Vec6 make_safe_wrench(const Vec6& F, double max_force, double max_torque, uint32_t* events) noexcept;
 
 }  // namespace gauss6

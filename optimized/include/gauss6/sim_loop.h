@@ -45,7 +45,7 @@ struct SimState {
 // t is the run's clock (s): virtual in lockstep runs, steady_clock in threads.
 // One sim step (METHOD.md section 2). Fills and returns s->info. Without a
 // handle sample yet, the god-object stays put (and is still published).
-const SimStepInfo& sim_step(const RuntimeModel& model, double t, RuntimeChannels* channels, SimState* s);
+const SimStepInfo& sim_step(const RuntimeModel& model, double t, RuntimeChannels* channels, SimState* s) noexcept;
 
 // Step 4 of a sim step alone, from its recorded inputs (SimStepInfo::x_start,
 // x_target, residual): the CCD along the Cayley motion x_start -> x_target (split
@@ -61,6 +61,6 @@ const SimStepInfo& sim_step(const RuntimeModel& model, double t, RuntimeChannels
 // residual, settled, ccd (the first status other than kOk over the legs),
 // u_hit, num_halves, status and num_contacts. Real time: no allocation.
 void advance_god_object(const RuntimeModel& model, const Pose& x_start, const Pose& x_target, const Vec6& residual,
-                        SimState* s, SimStepInfo* info);
+                        SimState* s, SimStepInfo* info) noexcept;
 
 }  // namespace gauss6
