@@ -44,7 +44,9 @@ class QueryStats:
         return {"queries": self.queries, "positives": self.positives, "false_negatives": self.false_negatives,
                 "false_positives": self.false_positives, "seconds": self.seconds}
 
-    def add_file(self, path: str, kind: str, impl: str, time_tolerance: float = 1e-6) -> None:
+    def add_file(self, path: str, kind: str, impl: str, time_tolerance: float | None = None) -> None:
+        if time_tolerance is None:  # the narrow phase's default (CcdSettings, ccd.h)
+            time_tolerance = _gauss6.defaults()["ccd"]["time_tolerance"]
         r = _gauss6.ccd.run_query_file(str(path), kind, impl, time_tolerance)
         for hit, expected, line in zip(r["hit"], r["expected"], r["line"]):
             self.queries += 1
@@ -76,7 +78,7 @@ def query_files(target: Path, kind: str | None) -> list[tuple[str, str]]:
     return [(str(target), kind)]
 
 
-def run_queries(target: Path, kind: str | None, impl: str, time_tolerance: float = 1e-6) -> QueryStats:
+def run_queries(target: Path, kind: str | None, impl: str, time_tolerance: float | None = None) -> QueryStats:
     """Runs every query of target (a file or a directory) through impl."""
     if impl not in IMPLS:
         raise ValueError(f"impl must be one of {IMPLS}")

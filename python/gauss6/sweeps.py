@@ -37,6 +37,8 @@ from pathlib import Path
 
 import numpy as np
 
+import gauss6
+
 from . import bench, paths
 
 CCD_SETS = ["peg_script", "grazing", "zero_rotation", "random", "bunny_script"]
@@ -46,7 +48,12 @@ CCD_TOLERANCES = [1e-9, 1e-8, 1e-7, 1e-6, 1e-5, 1e-4, 1e-3, 1e-2]
 DELTA_FACTORS = [0.25, 0.5, 1.0, 2.0, 4.0, 8.0]
 FEASIBILITY_TOLS = ["1e-15", "1e-14", "1e-13", "1e-12", "1e-10", "1e-08", "1e-06"]
 DEPENDENCE_TOLS = ["1e-14", "1e-12", "1e-10", "1e-08", "1e-06"]
-DEFAULTS = {"projection_feasibility_tol": 1e-13, "projection_dependence_tol": 1e-10, "ccd_time_tolerance": 1e-6,
+# The shipped value of each knob: the settings' defaults come from the C++ core
+# (gauss6.defaults()); the separation is delta itself, the leaf size the BVH build's.
+_SHIPPED = gauss6.defaults()
+DEFAULTS = {"projection_feasibility_tol": _SHIPPED["projection"]["feasibility_tol"],
+            "projection_dependence_tol": _SHIPPED["projection"]["dependence_tol"],
+            "ccd_time_tolerance": _SHIPPED["ccd"]["time_tolerance"],
             "separation_delta": 1.0, "bvh_leaf_size": 4}
 KNOBS = list(DEFAULTS)
 ERROR_FLOOR = 1e-17  # zero errors are drawn here on log axes
