@@ -7,6 +7,38 @@
 
 namespace gauss6 {
 
+EffectiveSettings resolve_runtime_settings(const Scene& scene, const RuntimeSettings& s) {
+  EffectiveSettings effective{s, ContactSettings{}};
+  RuntimeSettings& settings = effective.runtime;
+  ContactSettings& contact_generation = effective.contact_generation;
+  const ContactParameters& contact = scene.contact;
+  // The CCD stops the god-object delta before contact; contacts are the pairs
+  // within delta (1 + contact_factor).
+  settings.ccd.narrow.min_separation = contact.delta;
+  // A hit is accepted once the features are proven within 1.1 delta: the stop pose keeps
+  // at least delta (the guarantee) and the search ends well before rounding-level widths
+  // (the default 1e-9 is meant for unit-size queries; docs/benchmarks.md, the delta sweep).
+  settings.ccd.narrow.distance_tolerance = 0.1 * contact.delta;
+  // Coherence: a leg that starts in contact keeps the pairs within 64 delta
+  // more than the reach, and the legs after it take their candidates from them
+  // while no point has moved 64 delta from there (ccd_step's proximity cache;
+  // docs/benchmarks.md has the sweep of this margin).
+  settings.ccd.cache_margin = 64 * contact.delta;
+  // A list's margin grows with the god-object's speed up to 256 delta (about
+  // six steps like the last one), and the next list is filled 300 node pairs
+  // a step (about 60 us on the peg) while the one in use serves, at the pose
+  // the god-object is heading for: a sliding god-object seldom waits for a
+  // whole fill, and a resting one scans a short list.
+  settings.ccd.cache_margin_max = 256 * contact.delta;
+  settings.ccd.cache_fill_budget = 300;
+  contact_generation.distance = contact.delta * (1 + settings.contact_factor);
+  // The CCD lists the pairs that may come within the contact distance (and the
+  // distance a hit may be accepted at, 0.1 delta more: update_contacts) of each
+  // other by the stop pose, so the contact set needs no descent of its own.
+  settings.ccd.near_distance = contact_generation.distance + 0.2 * contact.delta;
+  return effective;
+}
+
 RuntimeModel::RuntimeModel(const Scene& scene, const RuntimeSettings& s) : settings(s) {
   auto fail = [&](const std::string& what) {
     throw RuntimeError("scene '" + scene.path + "': " + what);
@@ -68,30 +100,9 @@ RuntimeModel::RuntimeModel(const Scene& scene, const RuntimeSettings& s) : setti
   if (!valid_offset_settings(offsets)) fail("contact.offset_eps must be < 0 and contact.offset_time > 0");
   device = scene.device;
 
-  // The CCD stops the god-object delta before contact; contacts are the pairs
-  // within delta (1 + contact_factor).
-  settings.ccd.narrow.min_separation = contact.delta;
-  // A hit is accepted once the features are proven within 1.1 delta: the stop pose keeps
-  // at least delta (the guarantee) and the search ends well before rounding-level widths
-  // (the default 1e-9 is meant for unit-size queries; docs/benchmarks.md, the delta sweep).
-  settings.ccd.narrow.distance_tolerance = 0.1 * contact.delta;
-  // Coherence: a leg that starts in contact keeps the pairs within 64 delta
-  // more than the reach, and the legs after it take their candidates from them
-  // while no point has moved 64 delta from there (ccd_step's proximity cache;
-  // docs/benchmarks.md has the sweep of this margin).
-  settings.ccd.cache_margin = 64 * contact.delta;
-  // A list's margin grows with the god-object's speed up to 256 delta (about
-  // six steps like the last one), and the next list is filled 300 node pairs
-  // a step (about 60 us on the peg) while the one in use serves, at the pose
-  // the god-object is heading for: a sliding god-object seldom waits for a
-  // whole fill, and a resting one scans a short list.
-  settings.ccd.cache_margin_max = 256 * contact.delta;
-  settings.ccd.cache_fill_budget = 300;
-  contact_generation.distance = contact.delta * (1 + settings.contact_factor);
-  // The CCD lists the pairs that may come within the contact distance (and the
-  // distance a hit may be accepted at, 0.1 delta more: update_contacts) of each
-  // other by the stop pose, so the contact set needs no descent of its own.
-  settings.ccd.near_distance = contact_generation.distance + 0.2 * contact.delta;
+  const EffectiveSettings effective = resolve_runtime_settings(scene, s);
+  settings = effective.runtime;
+  contact_generation = effective.contact_generation;
   match_distance = settings.match_distance > 0 ? settings.match_distance : 1e-3 * god_radius;
 }
 

@@ -38,13 +38,17 @@ def _error(message: str) -> int:
 
 def cmd_scene_info(args: argparse.Namespace) -> int:
     from . import LoadError
-    from .scene import format_scene_info, scene_info
+    from .scene import effective_settings, format_effective_settings, format_scene_info, scene_info
 
     try:
         info = scene_info(args.scene, self_intersections=not args.no_self_intersections)
+        settings = effective_settings(args.scene)
     except LoadError as e:
         return _error(str(e))
-    print(json.dumps(info, indent=2) if args.json else format_scene_info(info))
+    if args.json:  # the documented form; the effective settings only on request
+        print(json.dumps({**info, "effective_settings": settings} if args.settings else info, indent=2))
+    else:
+        print(format_scene_info(info) + "\n" + format_effective_settings(settings))
     return 0
 
 
@@ -121,9 +125,11 @@ def build_parser() -> argparse.ArgumentParser:
     sub = p.add_subparsers(dest="command", required=True)
 
     scene = sub.add_parser("scene", help="scene files").add_subparsers(dest="action", required=True)
-    info = scene.add_parser("info", help="per body: triangles, closed, manifold, mass, inertia, bbox")
+    info = scene.add_parser("info", help="per body: triangles, closed, manifold, mass, inertia, bbox; the effective settings")
     info.add_argument("scene", help="scene TOML file")
     info.add_argument("--json", action="store_true", help="machine-readable output")
+    info.add_argument("--settings", action="store_true",
+                      help="with --json: add the effective settings (always in the text output)")
     info.add_argument("--no-self-intersections", action="store_true",
                       help="skip the exact self-intersection test (reported as -1)")
     info.set_defaults(func=cmd_scene_info)

@@ -61,3 +61,21 @@ def format_scene_info(info: dict[str, Any]) -> str:
         lines.append("    bbox [" + ", ".join(f"{x:.6g}" for x in lo) + "] .. ["
                      + ", ".join(f"{x:.6g}" for x in hi) + "]")
     return "\n".join(lines)
+
+
+def effective_settings(path: str) -> dict[str, Any]:
+    """The settings a run of the scene uses: the scene's values and the C++ defaults,
+    with the CCD and contact distances derived from delta (resolve_runtime_settings).
+
+    Raises gauss6.LoadError for a bad scene."""
+    return _gauss6.runtime.effective_settings(str(path))
+
+
+def format_effective_settings(settings: dict[str, Any]) -> str:
+    """Human-readable list of effective_settings(), one group a line."""
+    lines = [f"effective settings (delta = {settings['delta']:.6g})"]
+    for group, values in settings.items():
+        if isinstance(values, dict):
+            lines.append(f"  {group:<11}" + ", ".join(f"{k} {v:.6g}" for k, v in values.items()))
+    return "\n".join(lines)
+

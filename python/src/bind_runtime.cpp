@@ -25,12 +25,37 @@ namespace {
 using MatrixX3d = Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor>;
 using MatrixX3i = Eigen::Matrix<int32_t, Eigen::Dynamic, 3, Eigen::RowMajor>;
 
-Scene load(const std::string& path) {
-  try {
-    return load_scene(path);
-  } catch (const SceneError& e) {
-    throw py::value_error(e.what());
-  }
+// A scene's errors reach Python as gauss6.LoadError (bind_core registers it).
+Scene load(const std::string& path) { return load_scene(path); }
+
+// The settings a run of the scene uses (resolve_runtime_settings on the default
+// RuntimeSettings): what `gauss6 scene info` prints.
+py::dict effective_settings(const std::string& path) {
+  const Scene scene = load(path);
+  const EffectiveSettings e = resolve_runtime_settings(scene, RuntimeSettings{});
+  const RuntimeSettings& r = e.runtime;
+  const CcdStepSettings& c = r.ccd;
+  py::dict d;
+  d["delta"] = scene.contact.delta;
+  d["ccd"] = py::dict(py::arg("min_separation") = c.narrow.min_separation,
+                      py::arg("distance_tolerance") = c.narrow.distance_tolerance,
+                      py::arg("time_tolerance") = c.narrow.time_tolerance,
+                      py::arg("max_iterations") = c.narrow.max_iterations,
+                      py::arg("cache_margin") = c.cache_margin, py::arg("cache_margin_max") = c.cache_margin_max,
+                      py::arg("cache_fill_budget") = c.cache_fill_budget, py::arg("near_distance") = c.near_distance,
+                      py::arg("max_sub_intervals") = c.max_sub_intervals,
+                      py::arg("sub_interval_angle") = c.sub_interval_angle,
+                      py::arg("sub_interval_travel") = c.sub_interval_travel);
+  d["contacts"] = py::dict(py::arg("distance") = e.contact_generation.distance,
+                           py::arg("contact_factor") = r.contact_factor, py::arg("gap_factor") = r.gap_factor);
+  d["projection"] = py::dict(py::arg("feasibility_tol") = r.projection.feasibility_tol,
+                             py::arg("dependence_tol") = r.projection.dependence_tol,
+                             py::arg("max_iterations") = r.projection.max_iterations);
+  d["offsets"] = py::dict(py::arg("eps") = scene.contact.offset_eps, py::arg("time") = scene.contact.offset_time);
+  d["gains"] = py::dict(py::arg("ks") = scene.gains.ks, py::arg("kh") = scene.gains.kh);
+  d["device"] = py::dict(py::arg("rate_hz") = scene.device.rate_hz, py::arg("max_force") = scene.device.max_force,
+                         py::arg("max_torque") = scene.device.max_torque);
+  return d;
 }
 
 py::dict loop_dict(const LoopStats& s) {
@@ -205,6 +230,9 @@ void bind_runtime(py::module_& parent) {
         "Runs the scene with its hand script (lockstep by default, or threaded) and writes the trace. Returns a dict "
         "of run statistics and property checks (orthogonality, constraint energy, passivity observer). "
         "progress(run_time_s) is called about every 0.2 s of wall time.");
+  m.def("effective_settings", &effective_settings, py::arg("scene"),
+        "The settings a run of the scene uses: the scene's values and the defaults, with the CCD and contact "
+        "distances derived from delta (resolve_runtime_settings, runtime_model.h). Raises LoadError.");
   m.def("scene_geometry", &geometry, py::arg("scene"),
         "Obstacles (world frame: list of (name, V, F)), god_V/god_F (body frame, origin at G), p0, q0, mass, "
         "inertia_G_B, ks, kh, delta, rate_hz, max_force.");

@@ -91,3 +91,31 @@ def test_python_mesh_api_matches_closed_forms():
     # An open mesh is reported, not accepted.
     rep = validate_mesh(V, F[:-1])
     assert not rep.closed and rep.num_boundary_edges == 3 and not rep.ok()
+
+
+@pytest.mark.parametrize("scene", ["peg", "bunny"])
+def test_scene_info_effective_settings(scene):
+    """The settings a run uses, derived from the scene's delta as runtime_model.h states.
+    Exact equality: each is one product of delta by a constant, computed the same way
+    (doubles) on both sides; 0.2 delta is added after delta (1 + contact_factor)."""
+    r = run_cli("scene", "info", str(cli.SCENES[scene]), "--json", "--settings", "--no-self-intersections")
+    assert r.returncode == 0, r.stderr
+    info = json.loads(r.stdout)
+    assert list(info) == ["scene", "bodies", "effective_settings"]
+    s = info["effective_settings"]
+    d = s["delta"]
+    assert d > 0
+    assert s["ccd"]["min_separation"] == d
+    assert s["ccd"]["distance_tolerance"] == 0.1 * d
+    assert s["ccd"]["cache_margin"] == 64 * d and s["ccd"]["cache_margin_max"] == 256 * d
+    contact_distance = d * (1 + s["contacts"]["contact_factor"])
+    assert s["contacts"]["distance"] == contact_distance
+    assert s["ccd"]["near_distance"] == contact_distance + 0.2 * d
+    # Not derived from delta: the C++ defaults (gauss6.defaults()).
+    import gauss6
+    shipped = gauss6.defaults()
+    assert s["ccd"]["time_tolerance"] == shipped["ccd"]["time_tolerance"]
+    assert s["projection"]["feasibility_tol"] == shipped["projection"]["feasibility_tol"]
+    # The text form lists them too.
+    text = run_cli("scene", "info", str(cli.SCENES[scene]), "--no-self-intersections")
+    assert text.returncode == 0 and "effective settings (delta = " in text.stdout

@@ -32,7 +32,8 @@ enum class ForceSource {
 // is about 1e-4 of their size.
 struct RuntimeSettings {
   ProjectionSettings projection;       // both loops' projections
-  CcdStepSettings ccd;                 // the sim loop's CCD; narrow.min_separation is set to scene delta
+  CcdStepSettings ccd;                 // the sim loop's CCD; six fields are derived from the scene's delta
+                                       // (resolve_runtime_settings): what is given there is not used
   double contact_factor = 0.5;         // contacts within delta (1 + contact_factor) of the god-object
   double gap_factor = 0.25;            // sim loop keeps contact gaps near delta (1 + gap_factor) (< contact_factor)
   double match_distance = 0;           // coupling: a row is "the same" as a cached one when its body-frame point
@@ -71,10 +72,27 @@ struct RuntimeModel {
   ContactParameters contact;
   OffsetSettings offsets;              // from the scene's offset_eps and offset_time
   DeviceSettings device;               // rate and force/torque limits
-  RuntimeSettings settings;            // as given, ccd.narrow.min_separation = delta
+  RuntimeSettings settings;            // the effective settings (resolve_runtime_settings)
   ContactSettings contact_generation;  // distance = delta (1 + contact_factor)
   double match_distance = 0;           // resolved (never 0)
 };
+
+// The settings a model runs with: `settings` as given, except the CCD fields
+// derived from the scene's delta, which are overwritten (the value given is not
+// used):
+//   ccd.narrow.min_separation   = delta             (the stop distance)
+//   ccd.narrow.distance_tolerance = 0.1 delta       (a hit is accepted within 1.1 delta)
+//   ccd.cache_margin            = 64 delta          (proximity cache, at rest)
+//   ccd.cache_margin_max        = 256 delta         (proximity cache, at speed)
+//   ccd.cache_fill_budget       = 300               (node pairs a step; not scaled)
+//   ccd.near_distance           = delta (1 + contact_factor) + 0.2 delta
+// and contact_generation.distance = delta (1 + contact_factor). No validation:
+// RuntimeModel's constructor checks the scene and the settings.
+struct EffectiveSettings {
+  RuntimeSettings runtime;
+  ContactSettings contact_generation;  // the contact set's distance
+};
+EffectiveSettings resolve_runtime_settings(const Scene& scene, const RuntimeSettings& settings);
 
 // M = diag(m I3, R I_G R^T) at orientation q: world frame, about G.
 Mat6 mass_matrix_at(const RuntimeModel& model, const Quat& q);
