@@ -20,6 +20,8 @@ from pathlib import Path
 
 import numpy as np
 
+from ._gauss6 import LoadError
+
 MAGIC = b"G6TRACE\0"
 VERSION = 1
 HEADER = struct.Struct("<8sIIQ")  # magic, version, flags, metadata length
@@ -42,8 +44,9 @@ TICK_FLAGS = {"gripped": 1, "new_contact_set": 2, "force_clamped": 4, "watchdog"
 DEVICE_STATUS = {0: "ok", 1: "not_connected", 2: "timeout", 3: "ended", 4: "error"}
 
 
-class TraceFormatError(ValueError):
-    """A malformed trace: the message names the file and the problem."""
+class TraceFormatError(LoadError):
+    """A malformed trace: the message names the file and the problem. A gauss6.LoadError
+    (so a ValueError), as the C++ reader's TraceError is."""
 
 
 class TraceWarning(UserWarning):

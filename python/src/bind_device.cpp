@@ -32,7 +32,8 @@ py::dict entry_dict(const HidDeviceEntry& e) {
 
 void bind_device(py::module_& parent) {
   py::module_ m = parent.def_submodule("device", "Devices (simulated, HID) and the trace writer");
-  py::register_exception<TraceError>(m, "TraceError", PyExc_ValueError);
+  // A trace file's errors are load-time errors: gauss6.device.TraceError is a gauss6.LoadError.
+  py::register_exception<TraceError>(m, "TraceError", parent.attr("LoadError"));
 
   m.def("list_hid_devices", [] {
     py::list out;

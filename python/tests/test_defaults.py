@@ -5,6 +5,8 @@ from __future__ import annotations
 
 import re
 
+import pytest
+
 import gauss6
 from gauss6 import paths
 
@@ -71,3 +73,15 @@ def test_scene_format_defaults_are_the_code_s():
     assert num("device.max_force", "N") == d["device"]["max_force"]
     assert num("device.max_torque", "N m") == d["device"]["max_torque"]
     assert _value(doc["surface.kind"]) == d["surface"]["kind"]
+
+
+def test_trace_errors_are_load_errors(tmp_path):
+    """Both trace readers' errors belong to the one load-error hierarchy (load_error.h)."""
+    import gauss6
+    from gauss6.trace import TraceFormatError, read_trace
+    assert issubclass(gauss6._gauss6.device.TraceError, gauss6.LoadError)
+    assert issubclass(TraceFormatError, gauss6.LoadError) and issubclass(TraceFormatError, ValueError)
+    bad = tmp_path / "bad.g6trace"
+    bad.write_bytes(b"not a trace")
+    with pytest.raises(gauss6.LoadError, match="bad.g6trace"):
+        read_trace(bad)

@@ -212,7 +212,7 @@ struct TraceWriter::Impl {
   }
 
   void write_bytes(const void* p, size_t n) {
-    if (std::fwrite(p, 1, n, file) != n) throw TraceError(path + ": write failed");
+    if (std::fwrite(p, 1, n, file) != n) throw TraceError(path, "write failed");
   }
 
   void write_chunk(TraceChunk type, size_t num_cols, const double* rows, uint64_t num_rows) {
@@ -239,7 +239,7 @@ struct TraceWriter::Impl {
         if (n < settings.rows_per_chunk) break;
       }
     }
-    if (std::fflush(file) != 0) throw TraceError(path + ": flush failed");
+    if (std::fflush(file) != 0) throw TraceError(path, "flush failed");
     ++num_flushes;
   }
 
@@ -267,8 +267,8 @@ TraceWriter::TraceWriter(const std::string& path, const TraceMeta& meta, const T
   m.path = path;
   m.settings = settings;
   if (!(settings.flush_period > 0 && settings.flush_period <= 1.0))
-    throw TraceError(path + ": flush_period must be in (0, 1] s, got " + std::to_string(settings.flush_period));
-  if (settings.rows_per_chunk == 0) throw TraceError(path + ": rows_per_chunk must be > 0");
+    throw TraceError(path, "flush_period must be in (0, 1] s, got " + std::to_string(settings.flush_period));
+  if (settings.rows_per_chunk == 0) throw TraceError(path, "rows_per_chunk must be > 0");
 
   // Metadata first, so that a bad extra_json fails before the file exists.
   nlohmann::json j;
@@ -287,7 +287,7 @@ TraceWriter::TraceWriter(const std::string& path, const TraceMeta& meta, const T
   try {
     j["extra"] = nlohmann::json::parse(meta.extra_json.empty() ? "{}" : meta.extra_json);
   } catch (const nlohmann::json::parse_error& e) {
-    throw TraceError(path + ": TraceMeta::extra_json is not JSON: " + e.what());
+    throw TraceError(path, std::string("TraceMeta::extra_json is not JSON: ") + e.what());
   }
   const std::string meta_text = j.dump();
 
@@ -298,7 +298,7 @@ TraceWriter::TraceWriter(const std::string& path, const TraceMeta& meta, const T
   m.staging.assign(settings.rows_per_chunk * kTickCols, 0.0);
 
   m.file = std::fopen(path.c_str(), "wb");
-  if (!m.file) throw TraceError(path + ": cannot create the file: " + std::strerror(errno));
+  if (!m.file) throw TraceError(path, std::string("cannot create the file: ") + std::strerror(errno));
   // Header: magic, version, flags (0), metadata length, metadata.
   const uint32_t version_flags[2] = {kTraceVersion, 0};
   const uint64_t meta_len = meta_text.size();
@@ -306,7 +306,7 @@ TraceWriter::TraceWriter(const std::string& path, const TraceMeta& meta, const T
   m.write_bytes(version_flags, sizeof version_flags);
   m.write_bytes(&meta_len, sizeof meta_len);
   m.write_bytes(meta_text.data(), meta_text.size());
-  if (std::fflush(m.file) != 0) throw TraceError(path + ": flush failed");
+  if (std::fflush(m.file) != 0) throw TraceError(path, "flush failed");
 
   if (settings.background_thread) m.thread = std::thread([this] { impl_->run(); });
 }
@@ -389,7 +389,7 @@ void TraceWriter::close() {
     throw;
   }
   m.file = nullptr;
-  if (std::fclose(f) != 0) throw TraceError(m.path + ": close failed");
+  if (std::fclose(f) != 0) throw TraceError(m.path, "close failed");
 }
 
 TraceWriterStats TraceWriter::stats() const {
@@ -411,10 +411,10 @@ const std::string& TraceWriter::path() const { return impl_->path; }
 
 Trace read_trace(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
-  if (!in) throw TraceError(path + ": cannot open the file");
+  if (!in) throw TraceError(path, "cannot open the file");
   const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
   const size_t size = bytes.size();
-  auto fail = [&](const std::string& problem) { return TraceError(path + ": " + problem); };
+  auto fail = [&](const std::string& problem) { return TraceError(path, problem); };
 
   // Header: magic (8), version (4), flags (4), metadata length (8), metadata.
   constexpr size_t kHeader = 24;

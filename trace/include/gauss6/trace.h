@@ -21,6 +21,7 @@
 #include <vector>
 
 #include "gauss6/device_port.h"
+#include "gauss6/load_error.h"
 #include "gauss6/pose.h"
 
 namespace gauss6 {
@@ -110,9 +111,11 @@ struct TraceMeta {
   std::string extra_json = "{}";    // a JSON object merged under "extra"
 };
 
-class TraceError : public std::runtime_error {
+// A trace file that cannot be read, written or made: "FILE: problem". One of the
+// load-time errors (load_error.h), so a caller catches every file's error alike.
+class TraceError : public LoadError {
  public:
-  using std::runtime_error::runtime_error;
+  TraceError(std::string file, std::string problem) : LoadError(std::move(file), std::move(problem)) {}
 };
 
 struct TraceWriterSettings {
