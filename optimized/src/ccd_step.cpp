@@ -23,7 +23,8 @@ namespace {
 bool inputs_valid(const CcdBody* obstacles, int num_obstacles, const CcdBody& god, const CcdStepSettings& settings,
                   const CcdStepWorkspace* ws) {
   bool ok = god.mesh && god.bvh && ws && (num_obstacles == 0 || obstacles) && settings.max_sub_intervals >= 1 &&
-            settings.sub_interval_angle > 0 && settings.sub_interval_travel > 0;
+            settings.sub_interval_angle > 0 && settings.sub_interval_travel > 0 &&
+            valid_proximity_cache_settings(settings.cache);
   for (int o = 0; ok && o < num_obstacles; ++o) ok = obstacles[o].mesh && obstacles[o].bvh;
   return ok;
 }
@@ -203,7 +204,7 @@ void set_near_pairs(StepState* s, int num_cand, double u0) {
 
 void ccd_step(const CcdBody* obstacles, int num_obstacles, const CcdBody& god, const Pose& X0, const Pose& X1,
               const CcdStepSettings& settings, CcdStepWorkspace* ws, CcdStepResult* result, const FeaturePair* hints,
-              int num_hints) {
+              int num_hints) noexcept {
   using namespace detail;
   *result = CcdStepResult{};
   // Validate the input; make the motion and its enclosure (METHOD.md section 4).
@@ -221,7 +222,7 @@ void ccd_step(const CcdBody* obstacles, int num_obstacles, const CcdBody& god, c
   s.n = plan_sub_intervals(s.motion, god, settings);
   result->num_sub_intervals = s.n;
   // The hints and the proximity cache both start from the god-object at u = 0.
-  const bool cached = settings.cache_margin > 0;
+  const bool cached = settings.cache.margin > 0;
   if ((hints && num_hints > 0) || cached) s.start.set(s.motion, 0.0, god.bvh->radius);
   // Search the hints over the whole step.
   search_hints(&s);

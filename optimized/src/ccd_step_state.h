@@ -116,7 +116,7 @@ TraversalStatus traverse(const StepState& s, const StartFrame& frame, const Moti
                                 num_node_pairs, separated);
 }
 
-// The stages of the proximity cache (proximity_cache.cpp; settings.cache_margin > 0):
+// The stages of the proximity cache (proximity_cache.cpp; settings.cache.margin > 0):
 // serve this step from the cache's list, or refill it at X0 first, searching
 // [0, u_cached] from it (sets s->u_cached).
 void serve_proximity_cache(StepState* s);

@@ -57,7 +57,7 @@ struct Collector {
 
 ContactStatus generate_contacts(const CcdBody* obstacles, int num_obstacles, const CcdBody& god, const Pose& X_WB,
                                 const ContactSettings& settings, ContactWorkspace* ws, ContactSet* set,
-                                const NearPairs& near) {
+                                const NearPairs& near) noexcept {
   set->num_contacts = 0;
   set->num_pairs_within = 0;
   if (!god.mesh || !god.bvh || !ws || !is_valid_pose(X_WB) || !(settings.distance > 0) ||

@@ -50,6 +50,11 @@ double lower_limit(double scene_limit, double device_limit) {
 
 }  // namespace
 
+WrenchLimits resolve_wrench_limits(const RuntimeModel& model, const DeviceInfo& device) {
+  return {lower_limit(model.device.max_force, device.max_force), lower_limit(model.device.max_torque, device.max_torque),
+          /*resolved=*/true};
+}
+
 bool haptic_tick(const RuntimeModel& model, double t, Device* device, RuntimeChannels* channels, HapticState* h,
                  CouplingState* coupling, const RuntimeObserver& observer, RuntimeStats* stats) noexcept {
   const Clock::time_point start = Clock::now();
@@ -105,9 +110,8 @@ bool haptic_tick(const RuntimeModel& model, double t, Device* device, RuntimeCha
   const Vec6 F_computed = F;
   if (events & kZeroForceEvents) F.setZero();
   // The device's info() is the one source of what it can render; a scene may only lower it.
-  const DeviceInfo& limits = device->info();
-  F = make_safe_wrench(F, lower_limit(model.device.max_force, limits.max_force),
-                       lower_limit(model.device.max_torque, limits.max_torque), &events);
+  if (!h->limits.resolved) h->limits = resolve_wrench_limits(model, device->info());
+  F = make_safe_wrench(F, h->limits.max_force, h->limits.max_torque, &events);
 
   // 4. Write the device.
   device->write(t, F);

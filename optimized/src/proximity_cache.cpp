@@ -1,8 +1,9 @@
-// The proximity cache's stages of the CCD step (CcdStepWorkspace::ProximityCache,
-// coherence between steps): serve the step's start from the list in use, put a
+// The proximity cache's stages of the CCD step (proximity_cache.h, coherence
+// between steps): serve the step's start from the list in use, put a
 // background fill in use or refill the list at X0 when that pays, search the
 // cached range from the list's pairs, and fill the next list in the background
-// at the pose the god-object is heading for.
+// at the pose the god-object is heading for. Where each policy constant of
+// ProximityCacheSettings acts is said at its use.
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -10,27 +11,40 @@
 #include "ccd_step_state.h"
 #include "gauss6/distance.h"
 
-namespace gauss6::detail {
+namespace gauss6 {
+
+bool valid_proximity_cache_settings(const ProximityCacheSettings& s) {
+  const auto in_unit = [](double x) { return x > 0 && x <= 1; };  // false for NaN
+  return s.margin >= 0 && std::isfinite(s.margin) && s.margin_max >= 0 && std::isfinite(s.margin_max) &&
+         s.fill_budget >= 0 && s.steps_per_list > 0 && std::isfinite(s.steps_per_list) &&
+         in_unit(s.slow_fraction) && in_unit(s.max_probe_sub_intervals) && in_unit(s.fill_lead) &&
+         s.min_uses >= 1 && s.skip_after_poor_fill >= 0;
+}
+
+namespace detail {
 
 namespace {
 
-using ProximityCache = CcdStepWorkspace::ProximityCache;
+// The policy constants (ProximityCacheSettings).
+const ProximityCacheSettings& policy(const StepState& s) { return s.settings.cache; }
 
-// The margin of a list filled now: about six steps like the last one (v),
-// within [margin, margin_max]: a wide one while the god-object slides
+// The margin of a list filled now: about steps_per_list steps like the last
+// one (v), within [margin, margin_max]: a wide one while the god-object slides
 // steadily (fewer fills), the narrow one at rest (a shorter list to scan).
-double list_margin(double v, double margin, double margin_max) { return std::clamp(6 * v, margin, margin_max); }
+double list_margin(const StepState& s, double v, double margin, double margin_max) {
+  return std::clamp(policy(s).steps_per_list * v, margin, margin_max);
+}
 
 bool same_body(const CcdBody& a, const CcdBody& b) { return a.mesh == b.mesh && a.bvh == b.bvh; }
 
 // The settings' margins, the larger one at least the smaller.
-double step_margin(const StepState& s) { return s.settings.cache_margin; }
-double step_margin_max(const StepState& s) { return std::max(s.settings.cache_margin_max, step_margin(s)); }
+double step_margin(const StepState& s) { return s.settings.cache.margin; }
+double step_margin_max(const StepState& s) { return std::max(s.settings.cache.margin_max, step_margin(s)); }
 
 // The list in use was filled for these meshes, trees, reach and margins.
 bool is_keyed(const StepState& s) {
   const ProximityCache& pc = s.ws->cache;
-  bool k = pc.num_pairs >= 0 && same_body(pc.god, s.god) && pc.reach == s.reach && pc.margin_min == step_margin(s) &&
+  bool k = pc.num_pairs >= 0 && s.num_obstacles <= pc.obstacle_capacity && same_body(pc.god, s.god) && pc.reach == s.reach && pc.margin_min == step_margin(s) &&
            pc.margin_max == step_margin_max(s) && static_cast<int>(pc.obstacles.size()) == s.num_obstacles;
   for (int o = 0; k && o < s.num_obstacles; ++o) k = same_body(pc.obstacles[static_cast<size_t>(o)], s.obstacles[o]);
   return k;
@@ -140,6 +154,7 @@ struct CacheRanges {
   bool probing;    // hints given and none hit: a short first search may pay
   double u_probe;  // over [0, u_probe] no point moves a quarter of the margin
   int n;           // sub-intervals
+  double max_probe;  // a first search is shorter than this many sub-intervals (max_probe_sub_intervals)
   // [0, u] keeps every point within m of a list's pose, the points `moved`
   // from there by X0 (0: none).
   double range(double moved, double m) const {
@@ -148,13 +163,13 @@ struct CacheRanges {
   }
   // The part of a cache range [0, u] to search from the cache (0: none): all
   // of it when it covers the rest of the step; as a first search, at most
-  // the range over which no point moves a quarter of the margin, and only
-  // when that is under half a sub-interval (a longer one saves no descent).
+  // the range over which no point moves slow_fraction of the margin, and only
+  // when that is under max_probe sub-intervals (a longer one saves no descent).
   double window(double u) const {
     if (!(u > 0)) return 0.0;  // also NaN
     if (u >= u_rest) return u;
     const double w = std::min(u, u_probe);
-    return probing && w > 0 && w < 0.5 / n ? w : 0.0;
+    return probing && w > 0 && w < max_probe / n ? w : 0.0;
   }
   bool usable(double u) const { return window(u) > 0; }
 };
@@ -182,11 +197,12 @@ void take_background_fill(StepState* s, const CacheRanges& r, Displacement* sinc
 
 // A fill costs more than a descent over the step (its boxes are grown by
 // the margin) and pays only when later steps use it: after a fill that
-// served fewer than two later steps (a peg sliding half the margin a step,
-// steps that each start far from the last), the next 8 chances to fill
-// are passed over (plain descents), and the one after that fills.
-// A step that moves at most a quarter of the margin fills regardless (the
-// list then serves the next steps unless the god-object speeds up).
+// served fewer than min_uses later steps (a peg sliding half the margin a
+// step, steps that each start far from the last), the next
+// skip_after_poor_fill chances to fill are passed over (plain descents), and
+// the one after that fills. A step that moves at most slow_fraction of the
+// margin fills regardless (the list then serves the next steps unless the
+// god-object speeds up).
 // The fill is at once, at X0 (u = 0).
 void refill_if_worth(StepState* s, const CacheRanges& r, Displacement* since) {
   ProximityCache& pc = s->ws->cache;
@@ -194,14 +210,14 @@ void refill_if_worth(StepState* s, const CacheRanges& r, Displacement* since) {
   const bool fresh = r.usable(s->u_cached);
   if (fresh) ++pc.uses;
   const double fresh_margin =
-      list_margin(pc.has_last ? Displacement(pc.last_x0, s->X0).bound(rho) : 0.0, margin, step_margin_max(*s));
+      list_margin(*s, pc.has_last ? Displacement(pc.last_x0, s->X0).bound(rho) : 0.0, margin, step_margin_max(*s));
   bool fill = !fresh && r.usable(r.range(Displacement(s->X0, s->X0).bound(rho), fresh_margin));
-  if (fill && 4 * s->start.speed <= margin) {
+  if (fill && s->start.speed <= policy(*s).slow_fraction * margin) {
     pc.rest = 0;
   } else if (fill && pc.rest > 0) {
     fill = --pc.rest == 0;
-  } else if (fill && pc.num_pairs >= 0 && pc.uses < 2) {
-    pc.rest = 8;
+  } else if (fill && pc.num_pairs >= 0 && pc.uses < policy(*s).min_uses) {
+    pc.rest = policy(*s).skip_after_poor_fill;
     fill = false;
   }
   if (!fill) return;
@@ -257,7 +273,7 @@ void search_cached_pairs(StepState* s, const Displacement& since) {
 
 }  // namespace
 
-// Coherence (CcdStepWorkspace::ProximityCache): [0, u_cached] is the range
+// Coherence (proximity_cache.h): [0, u_cached] is the range
 // over which no point moves farther than the margin from the cache's pose;
 // there the cached pairs are the candidates, with no descent. The range is
 // used when it covers the rest of the step (up to a hint's hit), or, when
@@ -272,12 +288,17 @@ void serve_proximity_cache(StepState* s) {
   ProximityCache& pc = s->ws->cache;
   s->cache_keyed = is_keyed(*s);
   if (!s->cache_keyed) pc.fill.active = false;  // a fill for other meshes or settings
-  if (s->tester.done()) return;
+  // More obstacles than the cache can be keyed by: no cache (its keys never grow).
+  if (s->tester.done() || s->num_obstacles > pc.obstacle_capacity) return;
   const CcdStepResult& result = *s->result;
   const double margin = step_margin(*s);
   const double speed = s->start.speed;  // start: at u = 0 (ccd_step)
-  const CacheRanges r{speed, result.hit ? result.u_hit : 1.0, s->hints && s->num_hints > 0 && !result.hit,
-                      speed > 0 ? next_down(0.25 * margin / speed) : 1.0, s->n};
+  const CacheRanges r{speed,
+                      result.hit ? result.u_hit : 1.0,
+                      s->hints && s->num_hints > 0 && !result.hit,
+                      speed > 0 ? next_down(policy(*s).slow_fraction * margin / speed) : 1.0,
+                      s->n,
+                      policy(*s).max_probe_sub_intervals};
   const bool keyed = s->cache_keyed;
   Displacement since(keyed ? pc.ref : s->X0, s->X0);
   s->cache_moved = keyed ? since.bound(s->rho) : std::numeric_limits<double>::infinity();
@@ -289,38 +310,40 @@ void serve_proximity_cache(StepState* s) {
   if (s->u_cached > 0) search_cached_pairs(s, since);
 }
 
-// The background fill (CcdStepSettings::cache_fill_budget node pairs per
+// The background fill (ProximityCacheSettings::fill_budget node pairs per
 // step, while the list in use serves). Each step is taken to move the
 // god-object as much as the last one did (v), and a fill to take as many
 // steps as the last one did (j). A fill is started when the list in use has
 // about j steps left, at the pose the god-object will reach if it goes on
-// so for j steps and 3/4 of the margin further: put in use about j steps
-// from now, that list then serves from 3/4 of the margin behind its pose to
-// the margin ahead. Any pose is sound (the list is for the pose it was
+// so for j steps and fill_lead of the margin further: put in use about j
+// steps from now, that list then serves from fill_lead of the margin behind
+// its pose to the margin ahead. Any pose is sound (the list is for the pose it was
 // filled at); a good guess only makes the list serve longer.
 void fill_cache_in_background(StepState* s) {
   ProximityCache& pc = s->ws->cache;
   ProximityCache::Fill& pf = pc.fill;
   const CcdStepSettings& settings = s->settings;
   const Pose& X0 = s->X0;
-  if (settings.cache_fill_budget > 0 && s->cache_keyed) {
+  if (settings.cache.fill_budget > 0 && s->cache_keyed) {
     if (!pf.active && s->result->u_cached > 0 && pc.has_last) {
       const double v = Displacement(pc.last_x0, X0).bound(s->rho);
       const double j = std::ceil(static_cast<double>(std::max(pc.fill_cost, 1L)) /
-                                 static_cast<double>(settings.cache_fill_budget));
-      const double m = list_margin(v, step_margin(*s), step_margin_max(*s));
+                                 static_cast<double>(settings.cache.fill_budget));
+      const double m = list_margin(*s, v, step_margin(*s), step_margin_max(*s));
       if (v > 0 && v < m && pc.margin - s->cache_moved <= (j + 1) * v) {
-        const double k = j + std::max(0.0, 0.75 * m / v - 1);
+        const double k = j + std::max(0.0, policy(*s).fill_lead * m / v - 1);
         const Quat dq = normalized(X0.q * conjugate(pc.last_x0.q));
         const Pose ahead{X0.p + k * (X0.p - pc.last_x0.p), normalized(quat_exp(k * quat_log(dq)) * X0.q)};
         start_fill(s, &ahead, m);
       }
     }
-    if (pf.active && !pf.complete) run_fill(s, settings.cache_fill_budget);
+    if (pf.active && !pf.complete) run_fill(s, settings.cache.fill_budget);
   }
   // The next step's background fill and list margin follow this step's motion.
   pc.last_x0 = X0;
   pc.has_last = true;
 }
 
-}  // namespace gauss6::detail
+}  // namespace detail
+
+}  // namespace gauss6

@@ -18,24 +18,25 @@ EffectiveSettings resolve_runtime_settings(const Scene& scene, const RuntimeSett
   // A hit is accepted once the features are proven within 1.1 delta: the stop pose keeps
   // at least delta (the guarantee) and the search ends well before rounding-level widths
   // (the default 1e-9 is meant for unit-size queries; docs/benchmarks.md, the delta sweep).
-  settings.ccd.narrow.distance_tolerance = 0.1 * contact.delta;
+  settings.ccd.narrow.distance_tolerance = s.ccd_distance_tolerance * contact.delta;
   // Coherence: a leg that starts in contact keeps the pairs within 64 delta
-  // more than the reach, and the legs after it take their candidates from them
-  // while no point has moved 64 delta from there (ccd_step's proximity cache;
-  // docs/benchmarks.md has the sweep of this margin).
-  settings.ccd.cache_margin = 64 * contact.delta;
-  // A list's margin grows with the god-object's speed up to 256 delta (about
-  // six steps like the last one), and the next list is filled 300 node pairs
-  // a step (about 60 us on the peg) while the one in use serves, at the pose
-  // the god-object is heading for: a sliding god-object seldom waits for a
-  // whole fill, and a resting one scans a short list.
-  settings.ccd.cache_margin_max = 256 * contact.delta;
-  settings.ccd.cache_fill_budget = 300;
+  // (cache_margin) more than the reach, and the legs after it take their
+  // candidates from them while no point has moved that far from there
+  // (proximity_cache.h; docs/benchmarks.md has the sweep of this margin).
+  settings.ccd.cache.margin = s.cache_margin * contact.delta;
+  // A list's margin grows with the god-object's speed up to 256 delta
+  // (cache_margin_max; about six steps like the last one), and the next list
+  // is filled 300 node pairs a step (cache_fill_budget; about 60 us on the
+  // peg) while the one in use serves, at the pose the god-object is heading
+  // for: a sliding god-object seldom waits for a whole fill, and a resting one
+  // scans a short list.
+  settings.ccd.cache.margin_max = s.cache_margin_max * contact.delta;
+  settings.ccd.cache.fill_budget = s.cache_fill_budget;
   contact_generation.distance = contact.delta * (1 + settings.contact_factor);
   // The CCD lists the pairs that may come within the contact distance (and the
   // distance a hit may be accepted at, 0.1 delta more: update_contacts) of each
   // other by the stop pose, so the contact set needs no descent of its own.
-  settings.ccd.near_distance = contact_generation.distance + 0.2 * contact.delta;
+  settings.ccd.near_distance = contact_generation.distance + s.near_slack * contact.delta;
   return effective;
 }
 
@@ -57,6 +58,12 @@ RuntimeModel::RuntimeModel(const Scene& scene, const RuntimeSettings& s) : setti
   if (!(scene.device.max_force > 0) || !(scene.device.max_torque > 0)) fail("device limits must be > 0");
   if (!(s.contact_factor > 0) || !(s.gap_factor > 0 && s.gap_factor < s.contact_factor))
     fail("settings: need 0 < gap_factor < contact_factor");
+  if (!(s.ccd_distance_tolerance > 0 && std::isfinite(s.ccd_distance_tolerance)))
+    fail("settings: ccd_distance_tolerance must be > 0 (and finite)");
+  if (!(s.near_slack >= 0 && std::isfinite(s.near_slack))) fail("settings: near_slack must be >= 0 (and finite)");
+  if (!(s.cache_margin >= 0 && s.cache_margin_max >= 0) || !std::isfinite(s.cache_margin) ||
+      !std::isfinite(s.cache_margin_max) || s.cache_fill_budget < 0)
+    fail("settings: the cache's margins and fill budget must be >= 0 (and finite)");
   if (!(s.device_timeout > 0) || !(s.sim_timeout > 0) || !(s.coupling_timeout > 0))
     fail("settings: timeouts must be > 0");
   if (s.lockstep_sim_period < 1) fail("settings: lockstep_sim_period must be >= 1");

@@ -14,7 +14,11 @@ namespace gauss6 {
 using namespace detail;  // the loops' shared machinery (runtime_detail.h)
 
 SimState::SimState(const RuntimeModel& model)
-    : contacts(kMaxContacts), contact_ws(model.god_mesh_B) {
+    : contacts(kMaxContacts),
+      // The proximity cache keyed by every obstacle of the model (allocated here, not in a step).
+      ccd_ws(CcdStepWorkspace::kBoxCapacity, CcdStepWorkspace::kStackCapacity, CcdStepWorkspace::kCandidateCapacity,
+             std::max(static_cast<int>(model.obstacles.size()), CcdStepWorkspace::kObstacleCapacity)),
+      contact_ws(model.god_mesh_B) {
   xs = model.initial_pose;
   M = mass_matrix_at(model, xs.q);
   contacts.num_contacts = 0;

@@ -8,6 +8,8 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <initializer_list>
+#include <limits>
 #include <random>
 #include <set>
 
@@ -144,7 +146,7 @@ TEST_CASE("BVH: every truly colliding triangle pair is a candidate; ccd_step agr
     h.god_face = -1;
     hints.push_back(h);
     CcdStepSettings probing = settings;
-    probing.cache_margin = i % 3 == 0 ? 0.0 : 0.01;
+    probing.cache.margin = i % 3 == 0 ? 0.0 : 0.01;
     CcdStepResult r_hinted;
     ccd_step(&ob_body, 1, {&god, &gb}, x0, x1, probing, &ws, &r_hinted, hints.data(), static_cast<int>(hints.size()));
     REQUIRE(r_hinted.status == CcdStatus::kOk);
@@ -229,9 +231,9 @@ TEST_CASE("ccd_step: steps served by the proximity cache find the first contact 
   // where the next step starts in contact). Each step must agree with the
   // brute force (the same 1e-5 bound as above) and with a step on a workspace
   // without the cache. Run with the cache refilled at once, refilled in the
-  // background a few node pairs per step (cache_fill_budget: the served steps
+  // background a few node pairs per step (cache.fill_budget: the served steps
   // then take their pairs from a list that was completed steps after the pose
-  // it holds), and with margins that follow the speed (cache_margin_max).
+  // it holds), and with margins that follow the speed (cache.margin_max).
   const TriangleMesh god = make_icosphere(1, 0.5);
   const TriangleMesh slab = concatenate(make_box(3, 3, 1, Vec3(0, 0, -0.5)), make_box(0.4, 0.4, 0.6, Vec3(0.6, 0, 0.3)));
   const Bvh gb = build_bvh(god, 2), sb = build_bvh(slab, 2);
@@ -241,9 +243,9 @@ TEST_CASE("ccd_step: steps served by the proximity cache find the first contact 
   std::uniform_real_distribution<double> U(-1, 1);
   CcdStepSettings settings, plain;
   settings.narrow.min_separation = plain.narrow.min_separation = 1e-4;
-  settings.cache_margin = 0.02;
-  settings.cache_fill_budget = budget;
-  settings.cache_margin_max = margin_max;
+  settings.cache.margin = 0.02;
+  settings.cache.fill_budget = budget;
+  settings.cache.margin_max = margin_max;
   CcdStepWorkspace ws, ws_plain;
   const CcdBody obstacle{&slab, &sb};
   Pose x{Vec3(0.1, 0, 0.5 + 0.01), Quat{}};  // 1 cm above the slab
@@ -292,7 +294,7 @@ TEST_CASE("ccd_step: steps served by the proximity cache find the first contact 
     if (r.hit) hints.push_back(r.pair);
   }
   std::printf("proximity cache (fill budget %ld, margins up to %g): %d of 120 steps served from it, %d fills, %d "
-              "background refills, %d hits, %d give-ups\n", budget, std::max(margin_max, settings.cache_margin), served,
+              "background refills, %d hits, %d give-ups\n", budget, std::max(margin_max, settings.cache.margin), served,
               fills, refills, hits, gave_up);
   CHECK(gave_up <= 6);
   CHECK(served >= 30);
@@ -307,9 +309,9 @@ TEST_CASE("ccd_step: steps served by the proximity cache find the first contact 
 static CcdStepSettings background_fill_settings(double margin, double margin_max, long fill_budget) {
   CcdStepSettings settings;
   settings.narrow.min_separation = 1e-4;
-  settings.cache_margin = margin;
-  settings.cache_margin_max = margin_max;
-  settings.cache_fill_budget = fill_budget;
+  settings.cache.margin = margin;
+  settings.cache.margin_max = margin_max;
+  settings.cache.fill_budget = fill_budget;
   return settings;
 }
 
@@ -331,7 +333,7 @@ TEST_CASE("ccd_step: a ball sliding on a slab into a wall, its cache refilled in
   // the step that meets the wall must stop where it does. (The test below,
   // with the ball wandering, also checks what each list holds.)
   // Run with every list's margin 3 cm, and with margins up to 8 cm sized to
-  // the ball's speed (cache_margin_max; the ball then slides 8 mm a step).
+  // the ball's speed (cache.margin_max; the ball then slides 8 mm a step).
   const TriangleMesh god = make_icosphere(1, 0.5);
   double z_min = 1e300, x_max = -1e300;
   for (Eigen::Index v = 0; v < god.V.rows(); ++v) {
@@ -367,7 +369,7 @@ TEST_CASE("ccd_step: a ball sliding on a slab into a wall, its cache refilled in
     x = target;
   }
   std::printf("sliding into a wall (margins up to %g): %d steps, %d served from the cache, %d background refills\n",
-              std::max(margin_max, settings.cache_margin), steps, served, refills);
+              std::max(margin_max, settings.cache.margin), steps, served, refills);
   CHECK(met_wall);
   CHECK(served >= steps / 2);
   CHECK(refills >= 3);
@@ -378,8 +380,8 @@ TEST_CASE("ccd_step: a ball wandering among blocks, lists filled ahead of it in 
   // The ball wanders 2e-4 above a slab studded with blocks (a hint given, as
   // in contact), its velocity turning a little each step and its speed
   // between 1 and 12 mm a step, now and then reversing: the lists filled ahead
-  // of it (cache_fill_budget) are sometimes where it goes and sometimes not,
-  // and their margins follow its speed (cache_margin_max). A step that meets
+  // of it (cache.fill_budget) are sometimes where it goes and sometimes not,
+  // and their margins follow its speed (cache.margin_max). A step that meets
   // a block stops there, and the next starts from the stop pose. Every step
   // must agree with the brute force, and every tenth step the list in use
   // must hold the pairs its margin promises.
@@ -430,7 +432,7 @@ TEST_CASE("ccd_step: a ball wandering among blocks, lists filled ahead of it in 
     if (k % 10 == 0 && ws.cache.num_pairs >= 0) {
       // The list in use holds every pair within its reach plus its margin at
       // its pose: here, every pair with two corners that close.
-      const CcdStepWorkspace::ProximityCache& pc = ws.cache;
+      const ProximityCache& pc = ws.cache;
       std::set<std::pair<int, int>> listed;
       for (int i = 0; i < pc.num_pairs; ++i) listed.insert({pc.pairs[i].god_face, pc.pairs[i].obstacle_face});
       const double within = (pc.reach + pc.margin) * (1 - 1e-9);
@@ -455,7 +457,7 @@ TEST_CASE("ccd_step: a ball wandering among blocks, lists filled ahead of it in 
   }
   std::printf("wandering among blocks: %d of 250 steps served from the cache, %d background refills, %d hits, "
               "margins up to %g\n", served, refills, hits, widest);
-  CHECK(widest > 1.5 * settings.cache_margin);
+  CHECK(widest > 1.5 * settings.cache.margin);
   CHECK(served >= 125);
   CHECK(refills >= 8);
   CHECK(hits >= 5);
@@ -496,7 +498,7 @@ TEST_CASE("ccd_step: the proximity cache is not served for another mesh behind t
   const Bvh gb = build_bvh(god, 2), sb = build_bvh(slab, 2);
   CcdStepSettings settings;
   settings.narrow.min_separation = 1e-4;
-  settings.cache_margin = 0.02;
+  settings.cache.margin = 0.02;
   double z_min = 1e300, y_max = -1e300;
   for (Eigen::Index v = 0; v < god.V.rows(); ++v) {
     z_min = std::min(z_min, god.V(v, 2));
@@ -528,6 +530,58 @@ TEST_CASE("ccd_step: the proximity cache is not served for another mesh behind t
     if (r.hit && bf.hit) CHECK(std::abs(r.u_hit - bf.u_hit) <= 1e-5);
     if (!swap) CHECK((r.u_cached == 1.0 && !r.cache_filled));  // served whole from the cache
   }
+}
+
+TEST_CASE("ccd_step: the proximity cache's keys never grow, and its settings are checked", "[ccd_step]") {
+  // The cache is keyed by at most obstacle_capacity obstacles (reserved when the
+  // workspace is built): a step with more obstacles is served without the cache,
+  // with the same answer, and the keys' storage never grows in a step. Settings
+  // the cache cannot use are refused as invalid input.
+  const TriangleMesh god = make_icosphere(1, 0.5), slab = make_box(3, 3, 1, Vec3(0, 0, -0.5));
+  const Bvh gb = build_bvh(god, 2), sb = build_bvh(slab, 2);
+  CcdStepSettings settings;
+  settings.narrow.min_separation = 1e-4;
+  settings.cache.margin = 0.02;
+  double z_min = 1e300;
+  for (Eigen::Index v = 0; v < god.V.rows(); ++v) z_min = std::min(z_min, god.V(v, 2));
+  const Pose x0{Vec3(0, 0, 2e-4 - z_min), Quat{}};
+  const Pose x1{x0.p + Vec3(1e-3, 0, -1e-3), x0.q};
+  const CcdBody obstacles[2] = {{&slab, &sb}, {&slab, &sb}};
+  const FeaturePair hint = in_contact_hint();
+  CcdStepWorkspace roomy, narrow(CcdStepWorkspace::kBoxCapacity, CcdStepWorkspace::kStackCapacity,
+                                 CcdStepWorkspace::kCandidateCapacity, /*obstacle_capacity=*/1);
+  const size_t capacity = narrow.cache.obstacles.capacity();
+  CcdStepResult r_roomy, r_narrow;
+  for (int step = 0; step < 3; ++step) {
+    ccd_step(obstacles, 2, {&god, &gb}, x0, x1, settings, &roomy, &r_roomy, &hint, 1);
+    ccd_step(obstacles, 2, {&god, &gb}, x0, x1, settings, &narrow, &r_narrow, &hint, 1);
+    REQUIRE(r_roomy.status == CcdStatus::kOk);
+    REQUIRE(r_narrow.status == CcdStatus::kOk);
+    CHECK(r_roomy.hit);
+    CHECK(r_narrow.hit == r_roomy.hit);
+    CHECK(r_narrow.u_hit == r_roomy.u_hit);
+    CHECK_FALSE(r_narrow.cache_filled);
+    CHECK(r_narrow.u_cached == 0);
+    CHECK(narrow.cache.obstacles.capacity() == capacity);
+  }
+  CHECK(roomy.cache.num_pairs >= 0);  // the control: two obstacles fit the default capacity
+  CHECK(narrow.cache.num_pairs < 0);
+  for (const auto& spoil : std::initializer_list<void (*)(ProximityCacheSettings*)>{
+           [](ProximityCacheSettings* c) { c->margin = -1; },
+           [](ProximityCacheSettings* c) { c->margin_max = std::numeric_limits<double>::infinity(); },
+           [](ProximityCacheSettings* c) { c->steps_per_list = 0; },
+           [](ProximityCacheSettings* c) { c->slow_fraction = 2; },
+           [](ProximityCacheSettings* c) { c->fill_lead = std::numeric_limits<double>::quiet_NaN(); },
+           [](ProximityCacheSettings* c) { c->min_uses = 0; },
+           [](ProximityCacheSettings* c) { c->fill_budget = -1; }}) {
+    CcdStepSettings bad = settings;
+    spoil(&bad.cache);
+    CHECK_FALSE(valid_proximity_cache_settings(bad.cache));
+    CcdStepResult r;
+    ccd_step(obstacles, 1, {&god, &gb}, x0, x1, bad, &roomy, &r, &hint, 1);
+    CHECK(r.status == CcdStatus::kInvalidInput);
+  }
+  CHECK(valid_proximity_cache_settings(ProximityCacheSettings{}));
 }
 
 TEST_CASE("ccd_step: a box falling flat onto a slab, and one tipping onto it", "[ccd_step]") {
@@ -604,7 +658,7 @@ TEST_CASE("ccd_step: a bar pivoting about its lowest corner over a slab agrees w
   std::uniform_real_distribution<double> U(-1, 1);
   CcdStepSettings settings, cached;
   settings.narrow.min_separation = cached.narrow.min_separation = 1e-5;
-  cached.cache_margin = 1e-3;
+  cached.cache.margin = 1e-3;
   CcdStepWorkspace ws, ws_cached;
   int hits = 0;
   for (int i = 0; i < 40; ++i) {

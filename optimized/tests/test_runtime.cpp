@@ -248,6 +248,33 @@ TEST_CASE("runtime: model built once; refused settings and surfaces", "[runtime]
   RuntimeSettings bad;
   bad.gap_factor = 1.0;  // not below contact_factor
   CHECK_THROWS_AS(RuntimeModel(sc, bad), RuntimeError);
+  RuntimeSettings bad_cache;
+  bad_cache.cache_margin = -1;
+  CHECK_THROWS_AS(RuntimeModel(sc, bad_cache), RuntimeError);
+  RuntimeSettings bad_tolerance;
+  bad_tolerance.ccd_distance_tolerance = 0;
+  CHECK_THROWS_AS(RuntimeModel(sc, bad_tolerance), RuntimeError);
+}
+
+// The CCD settings relative to the scene's scale are stated in units of delta
+// (RuntimeSettings) and resolved once into scene units.
+TEST_CASE("runtime: delta-scaled settings resolve into the CCD's", "[runtime]") {
+  const Scene sc = make_scene();
+  RuntimeSettings s;
+  s.cache_margin = 10;
+  s.cache_margin_max = 40;
+  s.cache_fill_budget = 7;
+  s.ccd_distance_tolerance = 0.3;
+  s.near_slack = 0.5;
+  const EffectiveSettings e = resolve_runtime_settings(sc, s);
+  const double d = sc.contact.delta;
+  CHECK(e.runtime.ccd.narrow.min_separation == d);
+  CHECK(e.runtime.ccd.narrow.distance_tolerance == 0.3 * d);
+  CHECK(e.runtime.ccd.cache.margin == 10 * d);
+  CHECK(e.runtime.ccd.cache.margin_max == 40 * d);
+  CHECK(e.runtime.ccd.cache.fill_budget == 7);
+  CHECK(e.contact_generation.distance == d * (1 + s.contact_factor));
+  CHECK(e.runtime.ccd.near_distance == e.contact_generation.distance + 0.5 * d);
 }
 
 TEST_CASE("runtime: a box pressed onto a box never penetrates; the force is up, kh m ks deep", "[runtime]") {

@@ -38,11 +38,12 @@ def _error(message: str) -> int:
 
 def cmd_scene_info(args: argparse.Namespace) -> int:
     from . import LoadError
-    from .scene import effective_settings, format_effective_settings, format_scene_info, scene_info
+    from .scene import effective_settings, format_effective_settings, format_scene_info, load_scene, scene_info
 
     try:
-        info = scene_info(args.scene, self_intersections=not args.no_self_intersections)
-        settings = effective_settings(args.scene)
+        scene = load_scene(args.scene)  # once: the summary and the settings read it
+        info = scene_info(scene, self_intersections=not args.no_self_intersections)
+        settings = effective_settings(scene)
     except LoadError as e:
         return _error(str(e))
     if args.json:  # the documented form; the effective settings only on request

@@ -16,12 +16,26 @@ def _vector(v) -> list[float | None]:
     return [_number(x) for x in v]
 
 
-def scene_info(path: str, self_intersections: bool = True) -> dict[str, Any]:
-    """{"scene": PATH, "bodies": [...]} with exactly the keys of the documented form.
+def load_scene(path) -> _gauss6.Scene:
+    """Loads and validates a scene file and its meshes once; scene_info() and
+    effective_settings() take the result (or a path, which they load).
+
+    Raises gauss6.LoadError (a ValueError naming file, line and key) for a bad scene or mesh."""
+    return _gauss6.load_scene(str(path))
+
+
+def _loaded(scene) -> _gauss6.Scene:
+    return scene if isinstance(scene, _gauss6.Scene) else load_scene(scene)
+
+
+def scene_info(scene, self_intersections: bool = True) -> dict[str, Any]:
+    """{"scene": PATH, "bodies": [...]} with exactly the keys of the documented form,
+    for a loaded scene (load_scene) or a scene file's path.
 
     Raises gauss6.LoadError (a ValueError naming file, line and key) for a bad scene or mesh.
     """
-    raw = _gauss6.scene_summary(str(path), self_intersections)
+    scene = _loaded(scene)
+    raw = _gauss6.scene_summary(scene, self_intersections)
     bodies = []
     for b in raw["bodies"]:
         bodies.append({
@@ -38,7 +52,7 @@ def scene_info(path: str, self_intersections: bool = True) -> dict[str, Any]:
             "bbox_min": _vector(b["bbox_min"]),
             "bbox_max": _vector(b["bbox_max"]),
         })
-    return {"scene": str(path), "bodies": bodies}
+    return {"scene": scene.path, "bodies": bodies}
 
 
 def format_scene_info(info: dict[str, Any]) -> str:
@@ -63,12 +77,13 @@ def format_scene_info(info: dict[str, Any]) -> str:
     return "\n".join(lines)
 
 
-def effective_settings(path: str) -> dict[str, Any]:
-    """The settings a run of the scene uses: the scene's values and the C++ defaults,
-    with the CCD and contact distances derived from delta (resolve_runtime_settings).
+def effective_settings(scene) -> dict[str, Any]:
+    """The settings a run of the scene (loaded, or a path) uses: the scene's values and
+    the C++ defaults, with the CCD and contact distances derived from delta
+    (resolve_runtime_settings).
 
     Raises gauss6.LoadError for a bad scene."""
-    return _gauss6.runtime.effective_settings(str(path))
+    return _gauss6.runtime.effective_settings(_loaded(scene))
 
 
 def format_effective_settings(settings: dict[str, Any]) -> str:

@@ -145,10 +145,16 @@ void bind_core(py::module_& m) {
   m.def("read_qp_instances", &read_qp_instances, py::arg("path"),
         "Reads a projection-instance family file (datasets_generated/qp/README.md).");
 
-  // Scenes.
+  // Scenes: loaded once (load_scene), then summarised here and resolved into
+  // the effective settings by runtime.effective_settings, without reading the
+  // files again.
+  py::class_<Scene>(m, "Scene", "A loaded and validated scene (opaque; gauss6.load_scene).")
+      .def_readonly("path", &Scene::path)
+      .def_readonly("name", &Scene::name);
+  m.def("load_scene", &load_scene, py::arg("path"),
+        "Loads and validates a scene file and its meshes (raises LoadError naming file, line and key).");
   m.def("scene_summary",
-        [](const std::string& path, bool self_intersections) {
-          const Scene scene = load_scene(path);
+        [](const Scene& scene, bool self_intersections) {
           py::list bodies;
           for (const BodySummary& s : summarize_scene(scene, self_intersections)) bodies.append(summary_dict(s));
           py::dict d;
@@ -162,8 +168,7 @@ void bind_core(py::module_& m) {
           d["device"] = to_string(scene.device.kind);
           return d;
         },
-        py::arg("path"), py::arg("self_intersections") = true,
-        "Loads a scene (raises LoadError naming file, line and key) and summarises its bodies.");
+        py::arg("scene"), py::arg("self_intersections") = true, "Summarises a loaded scene's bodies.");
 }
 
 }  // namespace gauss6::python

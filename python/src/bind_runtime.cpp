@@ -30,8 +30,7 @@ Scene load(const std::string& path) { return load_scene(path); }
 
 // The settings a run of the scene uses (resolve_runtime_settings on the default
 // RuntimeSettings): what `gauss6 scene info` prints.
-py::dict effective_settings(const std::string& path) {
-  const Scene scene = load(path);
+py::dict effective_settings(const Scene& scene) {
   const EffectiveSettings e = resolve_runtime_settings(scene, RuntimeSettings{});
   const RuntimeSettings& r = e.runtime;
   const CcdStepSettings& c = r.ccd;
@@ -41,8 +40,8 @@ py::dict effective_settings(const std::string& path) {
                       py::arg("distance_tolerance") = c.narrow.distance_tolerance,
                       py::arg("time_tolerance") = c.narrow.time_tolerance,
                       py::arg("max_iterations") = c.narrow.max_iterations,
-                      py::arg("cache_margin") = c.cache_margin, py::arg("cache_margin_max") = c.cache_margin_max,
-                      py::arg("cache_fill_budget") = c.cache_fill_budget, py::arg("near_distance") = c.near_distance,
+                      py::arg("cache_margin") = c.cache.margin, py::arg("cache_margin_max") = c.cache.margin_max,
+                      py::arg("cache_fill_budget") = c.cache.fill_budget, py::arg("near_distance") = c.near_distance,
                       py::arg("max_sub_intervals") = c.max_sub_intervals,
                       py::arg("sub_interval_angle") = c.sub_interval_angle,
                       py::arg("sub_interval_travel") = c.sub_interval_travel);

@@ -23,5 +23,5 @@ def test_one_python_type_for_every_reader(tmp_path):
     scene = tmp_path / "s.toml"
     scene.write_text('format = "gauss6-scene"\nversion = 1\nname = "x"\nbogus = 1\n')
     with pytest.raises(gauss6.LoadError) as e:
-        _gauss6.scene_summary(str(scene), False)
+        _gauss6.load_scene(str(scene))
     assert str(e.value).startswith(f"{scene}:4:1: bogus: unknown key")

@@ -27,6 +27,7 @@
 #include "gauss6/motion_bounds.h"
 #include "gauss6/near_pairs.h"
 #include "gauss6/pose.h"
+#include "gauss6/proximity_cache.h"
 
 namespace gauss6 {
 
@@ -35,14 +36,7 @@ struct CcdStepSettings {
   int max_sub_intervals = 16;              // u-ranges whose swept boxes are computed separately
   double sub_interval_angle = 0.1;         // radians of rotation per sub-interval (at most)
   double sub_interval_travel = 0.25;       // travel of G per sub-interval, in god-object radii (at most)
-  long cache_fill_budget = 0;              // node pairs per step that refill the cache in the background
-                                           // (0: no background fill)
-  double cache_margin = 0;                 // coherence between steps: keep the pairs within the reach plus this
-                                           // (scene units) at a pose in contact, and take a later step's candidates
-                                           // from them while no point has moved farther than this from that pose
-                                           // (CcdStepWorkspace::ProximityCache; 0: off; the runtime uses 64 delta)
-  double cache_margin_max = 0;             // a list's margin grows up to this (>= cache_margin) to span about six
-                                           // steps like the last one (0: every list's margin is cache_margin)
+  ProximityCacheSettings cache;            // coherence between steps (proximity_cache.h; cache.margin 0: off)
   double near_distance = 0;                // also list the triangle pairs that may come within this (>=
                                            // min_separation) by the stop pose: the near pairs (CcdStepResult)
 };
@@ -75,74 +69,21 @@ struct CcdStepResult {
 
 // Everything ccd_step needs, allocated once.
 struct CcdStepWorkspace {
-  explicit CcdStepWorkspace(int box_capacity = 1 << 14, int stack_capacity = 1024, int candidate_capacity = 1 << 14)
+  // The default capacities. obstacle_capacity: the most obstacles the proximity
+  // cache can be keyed by (a step with more is served without it; nothing grows
+  // in a step).
+  static constexpr int kBoxCapacity = 1 << 14, kStackCapacity = 1024, kCandidateCapacity = 1 << 14,
+                       kObstacleCapacity = 16;
+  explicit CcdStepWorkspace(int box_capacity = kBoxCapacity, int stack_capacity = kStackCapacity,
+                            int candidate_capacity = kCandidateCapacity, int obstacle_capacity = kObstacleCapacity)
       : narrow(box_capacity),
         stack(stack_capacity),
         candidates(static_cast<size_t>(std::max(candidate_capacity, 0))),
-        cache(std::max(candidate_capacity, 0), stack_capacity) {}
+        cache(std::max(candidate_capacity, 0), stack_capacity, obstacle_capacity) {}
   // A candidate triangle pair of one sub-interval and a lower bound of its first contact parameter.
   struct Candidate {
     TrianglePair pair;
     double earliest;
-  };
-  // Coherence between steps (CcdStepSettings::cache_margin). pairs[0 ..
-  // num_pairs) hold every triangle pair not proven farther than reach + margin
-  // apart with the god-object at the exact pose ref: so at any god pose whose
-  // every point lies within `margin` of its place at ref, every pair that may
-  // lie within `reach` is among them. A pose of the god-object in contact
-  // hardly moves from one step to the next (resting, or pressed into an edge
-  // and stopped at once): while a step's motion keeps within the margin of ref,
-  // ccd_step takes its candidates from here instead of descending the trees.
-  // ccd_step refills it (at the step's start) when it cannot serve the step
-  // and a fresh one could (see ccd_step). It is keyed by the god-object's and the obstacles' meshes and
-  // BVHs (pointers), the reach and the settings' margins; clear() it when a
-  // mesh behind the same pointers changes. Each list has its own margin
-  // (CcdStepSettings::cache_margin_max).
-  struct ProximityCache {
-    ProximityCache(int capacity, int stack_capacity)
-        : pairs(static_cast<size_t>(capacity)), fill(capacity, stack_capacity) {}
-    // gap: a lower bound of the pair's distance at ref; radius: the largest
-    // |r_B| of the god triangle's corners. A step whose points move at most
-    // shift + turn |r_B| from ref keeps the pair farther apart than
-    // gap - shift - turn radius.
-    struct Pair {
-      double gap, radius;
-      int32_t god_face, obstacle_face, obstacle;
-    };
-    std::vector<Pair> pairs;
-    int num_pairs = -1;            // -1: empty (never filled, or the pairs did not fit)
-    Pose ref;
-    double reach = 0, margin = 0;  // margin: this list's
-    double margin_min = 0, margin_max = 0;  // the settings it was filled under (keys)
-    int uses = 0;  // later steps served since the fill
-    int rest = 0;  // chances to refill still to pass over (see ccd_step)
-    CcdBody god;
-    std::vector<CcdBody> obstacles;  // grows (allocates) only when a fill sees more obstacles than ever before
-    // A fill in progress (CcdStepSettings::cache_fill_budget): the same kind
-    // of list for the pose `ref` (where the god-object is heading: ccd_step)
-    // and its own margin, built a budget of node pairs per step in the
-    // background while the list above still serves, then swapped in;
-    // finished at once when a step needs it first. Same keys as the list above.
-    struct Fill {
-      Fill(int capacity, int stack_capacity) : pairs(static_cast<size_t>(capacity)), stack(stack_capacity) {}
-      std::vector<Pair> pairs;
-      int num_pairs = 0;
-      Pose ref;
-      double margin = 0;
-      CcdMotion motion;  // still at ref (or the step it started in, when ref is that step's start)
-      BvhStack stack;    // the descent's pending node pairs: stack.items[0 .. pending)
-      int pending = 0;
-      int obstacle = 0;  // the obstacle being descended
-      long cost = 0;     // node pairs tested so far
-      bool active = false, complete = false;
-    } fill;
-    long fill_cost = 0;  // node pairs of the last fill completed
-    Pose last_x0;        // the start of the last step (for the background fill's pose)
-    bool has_last = false;
-    void clear() {
-      num_pairs = -1;
-      fill.active = false;
-    }
   };
   // The triangle pair that stopped the last step run in this workspace
   // (coherence): when it is among a step's hints it is searched first. A
@@ -159,7 +100,7 @@ struct CcdStepWorkspace {
     return {candidates.empty() ? nullptr : &candidates[0].pair, num, sizeof(Candidate)};
   }
   SweptBoxCache swept;                // god boxes of the current sub-interval
-  ProximityCache cache;
+  ProximityCache cache;               // coherence between steps (proximity_cache.h)
 };
 
 // The first contact of the god-object moving from X0 to X1 (the Cayley motion)
@@ -184,14 +125,14 @@ struct CcdStepWorkspace {
 // through the hole. Any hint is a real pair, so the answer's guarantee is the
 // same with or without them; out-of-range hints are ignored.
 //
-// With settings.cache_margin > 0, ws->cache carries candidates from one step
-// to the next (CcdStepWorkspace::ProximityCache): the same answer as a fresh
-// descent, for a fraction of its cost while the god-object stays near a pose.
-// With settings.cache_fill_budget > 0 as well, the next list is filled that
+// With settings.cache.margin > 0, ws->cache carries candidates from one step
+// to the next (proximity_cache.h): the same answer as a fresh descent, for a
+// fraction of its cost while the god-object stays near a pose.
+// With settings.cache.fill_budget > 0 as well, the next list is filled that
 // many node pairs per step, at the pose the god-object is heading for, while
 // the list in use serves.
 void ccd_step(const CcdBody* obstacles, int num_obstacles, const CcdBody& god, const Pose& X0, const Pose& X1,
               const CcdStepSettings& settings, CcdStepWorkspace* ws, CcdStepResult* result,
-              const FeaturePair* hints = nullptr, int num_hints = 0);
+              const FeaturePair* hints = nullptr, int num_hints = 0) noexcept;
 
 }  // namespace gauss6

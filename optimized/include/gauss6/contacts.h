@@ -82,6 +82,6 @@ struct ContactWorkspace {
 // the same set.
 ContactStatus generate_contacts(const CcdBody* obstacles, int num_obstacles, const CcdBody& god, const Pose& X_WB,
                                 const ContactSettings& settings, ContactWorkspace* ws, ContactSet* set,
-                                const NearPairs& near = {});
+                                const NearPairs& near = {}) noexcept;
 
 }  // namespace gauss6

@@ -19,6 +19,15 @@
 
 namespace gauss6 {
 
+// The force and torque a haptic loop may send: the device's (DeviceInfo, the
+// one source of what it can render) lowered by the scene's (model.device). A
+// device limit that is not a positive number (unset, NaN) leaves the scene's.
+struct WrenchLimits {
+  double max_force = 0, max_torque = 0;  // N, N m
+  bool resolved = false;                 // set by resolve_wrench_limits
+};
+WrenchLimits resolve_wrench_limits(const RuntimeModel& model, const DeviceInfo& device);
+
 // Every buffer of the haptic loop.
 struct HapticState {
   uint64_t tick = 0;
@@ -29,13 +38,15 @@ struct HapticState {
   uint32_t active_events = 0;          // conditions that held last tick (events fire on onset)
   bool ended = false;                  // the device ended
   WrenchSample wrench;                 // kCouplingLoop: last Fc read
+  WrenchLimits limits;                 // the device's, resolved at the first tick (a state serves one device)
   HapticTickRecord record;
 };
 
 // t is the run's clock (s): virtual in lockstep runs, steady_clock in threads.
 // One haptic tick: device read, force (the coupling step when coupling != null,
 // else the wrench channel), safety (watchdogs, finiteness, limits), device write.
-// The limits are the device's (device->info()) lowered by the scene's (model.device).
+// The limits are the device's (device->info()) lowered by the scene's (model.device),
+// resolved once, at the state's first tick (h->limits).
 // Writes stats->haptic (and stats->coupling when coupling != null); event onsets
 // go to the observer. Returns false when the device ended (zero force written).
 bool haptic_tick(const RuntimeModel& model, double t, Device* device, RuntimeChannels* channels,

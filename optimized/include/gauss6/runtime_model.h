@@ -32,10 +32,18 @@ enum class ForceSource {
 // is about 1e-4 of their size.
 struct RuntimeSettings {
   ProjectionSettings projection;       // both loops' projections
-  CcdStepSettings ccd;                 // the sim loop's CCD; six fields are derived from the scene's delta
-                                       // (resolve_runtime_settings): what is given there is not used
+  CcdStepSettings ccd;                 // the sim loop's CCD; its distances and the cache's margins and budget are
+                                       // resolved from the settings below (resolve_runtime_settings): the values
+                                       // given in these six fields are not used
+  // Lengths relative to the scene's scale, in units of its delta:
   double contact_factor = 0.5;         // contacts within delta (1 + contact_factor) of the god-object
   double gap_factor = 0.25;            // sim loop keeps contact gaps near delta (1 + gap_factor) (< contact_factor)
+  double ccd_distance_tolerance = 0.1; // a CCD hit is accepted once a pair is proven within (1 + this) delta
+  double near_slack = 0.2;             // the CCD lists the pairs that may come within the contact distance plus
+                                       // this many delta (its near pairs: the contact set needs no descent)
+  double cache_margin = 64;            // the CCD's proximity cache at rest (proximity_cache.h), in delta
+  double cache_margin_max = 256;       // ... at speed (>= cache_margin), in delta
+  long cache_fill_budget = 300;        // node pairs a sim step fills the cache's next list with (not scaled)
   double match_distance = 0;           // coupling: a row is "the same" as a cached one when its body-frame point
                                        // moved less than this (0: 1e-3 of the god-object's radius) ...
   double match_cosine = 1 - 1e-9;      // ... and the cosine of the angle between their normals is above this
@@ -78,14 +86,14 @@ struct RuntimeModel {
 };
 
 // The settings a model runs with: `settings` as given, except the CCD fields
-// derived from the scene's delta, which are overwritten (the value given is not
-// used):
-//   ccd.narrow.min_separation   = delta             (the stop distance)
-//   ccd.narrow.distance_tolerance = 0.1 delta       (a hit is accepted within 1.1 delta)
-//   ccd.cache_margin            = 64 delta          (proximity cache, at rest)
-//   ccd.cache_margin_max        = 256 delta         (proximity cache, at speed)
-//   ccd.cache_fill_budget       = 300               (node pairs a step; not scaled)
-//   ccd.near_distance           = delta (1 + contact_factor) + 0.2 delta
+// resolved from the scene's delta and the delta-scaled settings, which are
+// overwritten (the value given there is not used):
+//   ccd.narrow.min_separation     = delta                          (the stop distance)
+//   ccd.narrow.distance_tolerance = ccd_distance_tolerance delta   (0.1: a hit is accepted within 1.1 delta)
+//   ccd.cache.margin              = cache_margin delta             (64: proximity cache, at rest)
+//   ccd.cache.margin_max          = cache_margin_max delta         (256: proximity cache, at speed)
+//   ccd.cache.fill_budget         = cache_fill_budget              (300 node pairs a step; not scaled)
+//   ccd.near_distance             = delta (1 + contact_factor) + near_slack delta
 // and contact_generation.distance = delta (1 + contact_factor). No validation:
 // RuntimeModel's constructor checks the scene and the settings.
 struct EffectiveSettings {
