@@ -44,6 +44,11 @@ RuntimeModel::RuntimeModel(const Scene& scene, const RuntimeSettings& s) : setti
   auto fail = [&](const std::string& what) {
     throw RuntimeError("scene '" + scene.path + "': " + what);
   };
+  // The scene's settings meet the same rules as in a scene file (scene.h), for
+  // a scene built in code too.
+  for (const SettingsProblem& problem : {check_gains(scene.gains), check_contact_parameters(scene.contact),
+                                         check_surface_settings(scene.surface), check_device_settings(scene.device)})
+    if (problem) fail(problem.message());
   // Surface properties are not rendered by this runtime: refuse rather than
   // silently render a plain surface.
   if (scene.surface.kind == SurfaceKind::kForceShading)
@@ -51,11 +56,6 @@ RuntimeModel::RuntimeModel(const Scene& scene, const RuntimeSettings& s) : setti
   if (scene.surface.kind == SurfaceKind::kTexture)
     fail("surface.kind = texture is not supported by the runtime");
   if (num_triangles(scene.god_object.mesh) == 0) fail("the god-object's mesh is empty");
-  if (!(scene.contact.delta > 0) || !std::isfinite(scene.contact.delta)) fail("contact.delta must be > 0");
-  if (!(scene.gains.ks > 0 && scene.gains.ks <= 1)) fail("gains.ks must be in (0, 1]");
-  if (!(scene.gains.kh >= 0) || !std::isfinite(scene.gains.kh)) fail("gains.kh must be >= 0 and finite");
-  if (!(scene.device.rate_hz > 0 && scene.device.rate_hz <= 10000)) fail("device.rate_hz must be in (0, 10000]");
-  if (!(scene.device.max_force > 0) || !(scene.device.max_torque > 0)) fail("device limits must be > 0");
   if (!(s.contact_factor > 0) || !(s.gap_factor > 0 && s.gap_factor < s.contact_factor))
     fail("settings: need 0 < gap_factor < contact_factor");
   if (!(s.ccd_distance_tolerance > 0 && std::isfinite(s.ccd_distance_tolerance)))
@@ -102,9 +102,8 @@ RuntimeModel::RuntimeModel(const Scene& scene, const RuntimeSettings& s) : setti
   initial_pose = scene.god_object.pose;
   gains = scene.gains;
   contact = scene.contact;
-  offsets.eps = scene.contact.offset_eps;
+  offsets.eps = scene.contact.offset_eps;  // the rules: check_contact_parameters above
   offsets.T = scene.contact.offset_time;
-  if (!valid_offset_settings(offsets)) fail("contact.offset_eps must be < 0 and contact.offset_time > 0");
   device = scene.device;
 
   const EffectiveSettings effective = resolve_runtime_settings(scene, s);

@@ -256,6 +256,35 @@ TEST_CASE("runtime: model built once; refused settings and surfaces", "[runtime]
   CHECK_THROWS_AS(RuntimeModel(sc, bad_tolerance), RuntimeError);
 }
 
+// A scene built in code meets the same rules as a scene file (check_gains and
+// the others, scene.h): the runtime refuses what the loader would, with the
+// rule's own message.
+TEST_CASE("runtime: a scene built in code meets the scene file's rules", "[runtime]") {
+  const Scene sc = make_scene();
+  const auto refusal = [](const Scene& scene) -> std::string {
+    try {
+      RuntimeModel model(scene, RuntimeSettings{});
+    } catch (const RuntimeError& e) {
+      return e.what();
+    }
+    return "";
+  };
+  CHECK(refusal(sc).empty());
+  Scene no_kh = sc;
+  no_kh.gains.kh = 0;  // the loader requires kh > 0
+  CHECK_THAT(refusal(no_kh), Catch::Matchers::Contains("gains.kh: must be > 0"));
+  Scene slow = sc;
+  slow.device.rate_hz = 50;  // the loader requires [100, 10000]
+  CHECK_THAT(refusal(slow), Catch::Matchers::Contains("device.rate_hz: must be in [100, 10000]"));
+  Scene offsets = sc;
+  offsets.contact.offset_eps = 0;  // must be < 0
+  CHECK_THAT(refusal(offsets), Catch::Matchers::Contains("contact.offset_eps: must be < 0"));
+  Scene texture = sc;
+  texture.surface.kind = SurfaceKind::kTexture;
+  texture.surface.wavelength = -1;
+  CHECK_THAT(refusal(texture), Catch::Matchers::Contains("surface.amplitude: must be in (0, 1]"));
+}
+
 // The CCD settings relative to the scene's scale are stated in units of delta
 // (RuntimeSettings) and resolved once into scene units.
 TEST_CASE("runtime: delta-scaled settings resolve into the CCD's", "[runtime]") {

@@ -91,8 +91,9 @@ struct Scene {
 };
 
 // The rules a scene's settings must meet (docs/scene-format.md, "Rules"), stated
-// once: the loader applies them and names the file, line and key; code that builds
-// a Scene itself applies them too. Each check returns the first broken rule, or an
+// once (src/scene_rules.cpp, in the core): the loader applies them and names the
+// file, line and key; the runtime model (runtime_model.h) applies them to any
+// Scene, one built in code included. Each check returns the first broken rule, or an
 // empty problem when every rule holds. NaN and infinities break every rule.
 struct SettingsProblem {
   std::string table;    // the scene file's table ("gains"); empty when the rules hold

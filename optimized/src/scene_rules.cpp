@@ -1,0 +1,66 @@
+// The scene's vocabulary (the names of roles, surface and device kinds) and the
+// rules its settings must meet (check_gains() and the others, scene.h), stated
+// once in the core: the scene loader applies them at each key's line, and the
+// runtime model applies the same rules to a scene built in code.
+#include <cmath>
+
+#include "gauss6/scene.h"
+
+namespace gauss6 {
+
+const char* to_string(BodyRole r) { return r == BodyRole::kObstacle ? "obstacle" : "god_object"; }
+const char* to_string(SurfaceKind k) {
+  switch (k) {
+    case SurfaceKind::kNone: return "none";
+    case SurfaceKind::kForceShading: return "force_shading";
+    case SurfaceKind::kTexture: return "texture";
+  }
+  return "unknown";
+}
+const char* to_string(DeviceKind k) {
+  switch (k) {
+    case DeviceKind::kSimulated: return "simulated";
+    case DeviceKind::kReplay: return "replay";
+    case DeviceKind::kHid: return "hid";
+  }
+  return "unknown";
+}
+
+namespace {
+
+// x is finite and above lo (below hi): NaN and infinities break every settings rule.
+bool finite_above(double x, double lo) { return std::isfinite(x) && x > lo; }
+bool finite_below(double x, double hi) { return std::isfinite(x) && x < hi; }
+
+}  // namespace
+
+SettingsProblem check_gains(const Gains& g) {
+  if (!(finite_above(g.ks, 0) && g.ks <= 1)) return {"gains", "ks", "must be in (0, 1]"};
+  if (!finite_above(g.kh, 0)) return {"gains", "kh", "must be > 0"};
+  return {};
+}
+
+SettingsProblem check_contact_parameters(const ContactParameters& c) {
+  if (!finite_above(c.delta, 0)) return {"contact", "delta", "must be > 0"};
+  if (!finite_below(c.offset_eps, 0)) return {"contact", "offset_eps", "must be < 0"};
+  if (!finite_above(c.offset_time, 0)) return {"contact", "offset_time", "must be > 0"};
+  return {};
+}
+
+SettingsProblem check_surface_settings(const SurfaceSettings& s) {
+  if (s.kind != SurfaceKind::kTexture) return {};
+  if (!(finite_above(s.amplitude, 0) && s.amplitude <= 1)) return {"surface", "amplitude", "must be in (0, 1]"};
+  if (!finite_above(s.wavelength, 0)) return {"surface", "wavelength", "must be > 0"};
+  if (s.axis < 0 || s.axis > 2) return {"surface", "axis", "must be x, y or z"};
+  return {};
+}
+
+SettingsProblem check_device_settings(const DeviceSettings& d) {
+  if (!(std::isfinite(d.rate_hz) && d.rate_hz >= 100 && d.rate_hz <= 10000))
+    return {"device", "rate_hz", "must be in [100, 10000]"};
+  if (!finite_above(d.max_force, 0)) return {"device", "max_force", "must be > 0"};
+  if (!finite_above(d.max_torque, 0)) return {"device", "max_torque", "must be > 0"};
+  return {};
+}
+
+}  // namespace gauss6
