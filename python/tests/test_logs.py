@@ -141,3 +141,32 @@ def test_commands_export_and_import(run, tmp_path, capsys):
                  str(tmp_path / "x.g6trace")]) == 2
     assert "bad.log:2:6: 3 values, the header names 4" in capsys.readouterr().err
     assert main(["trace", "export", str(src)]) == 2
+
+
+def test_an_imported_hapi_log_drives_the_replay_device(tmp_path):
+    """A session recorded by another framework (a HAPI log: a handle circling at 1 kHz, turning
+    about Z, a button pressed halfway) imported as a trace drives gauss6's replay device (C++)."""
+    t = np.arange(401) / 1000.0
+    pos = np.stack([0.02 * np.cos(5 * t), 0.02 * np.sin(5 * t), 0.1 - 0.05 * t], axis=1)
+    angle = 0.8 * t
+    rows = ["TIME POSITION ORIENTATION FORCE TORQUE BUTTONS"] + [
+        f"{t[k]:.5f} {pos[k, 0]:.5f} {pos[k, 1]:.5f} {pos[k, 2]:.5f} 0.00000 0.00000 1.00000 {angle[k]:.5f} "
+        f"0.00000 0.00000 0.00000 0.00000 0.00000 0.00000 {int(k >= 200)}" for k in range(len(t))]
+    log = tmp_path / "session.log"
+    log.write_text("\n".join(rows) + "\n")
+    trace_path = tmp_path / "session.g6trace"
+    assert main(["trace", "import", str(log), "--format", "hapi", "--out", str(trace_path)]) == 0
+
+    replay = gauss6._gauss6.device.ReplayDevice(str(trace_path))
+    assert replay.num_samples == 401 and replay.end_time == pytest.approx(0.4)
+    assert replay.rate_hz == pytest.approx(1000.0)
+    for k in (0, 1, 150, 200, 399):
+        p, q, gripped, buttons, status = replay.read(t[k])
+        np.testing.assert_allclose(p, np.round(pos[k], 5), atol=1e-15)
+        np.testing.assert_allclose(q, [math.cos(0.5 * round(angle[k], 5)), 0, 0, math.sin(0.5 * round(angle[k], 5))],
+                                   atol=1e-15)
+        assert gripped and buttons == int(k >= 200) and status == "ok"
+    # Between two logged frames the pose is interpolated; after the last the replay has ended.
+    p, *_ = replay.read(0.1505)
+    np.testing.assert_allclose(p, 0.5 * (np.round(pos[150], 5) + np.round(pos[151], 5)), atol=1e-12)
+    assert replay.read(0.5)[4] == "ended"
