@@ -301,6 +301,8 @@ def write_report(out: Path, summary: dict, details: dict, wall: float) -> Path:
                   f"steps, {d['ticks_with_contacts']} ticks with contacts; run {d['run_time_s']:.2f} s in "
                   f"{d['wall_s']:.1f} s of wall time.", "",
                   f"![{TITLES[name]}](figure_{name}.png)", "",
+                  *([f"The run in 3D, with its timeline and plots: [view_{name}.html](view_{name}.html) "
+                     "(opens in a web browser from file://).", ""] if f"view_{name}.html" in d.get("figures", []) else []),
                   "| quantity | ours | paper |", "|---|---|---|"]
         ft, ut, hz = s["force_time_us"], s["update_time_ms"], s["constraint_update_hz"]
         pf = p.get("force_time_us", {})
