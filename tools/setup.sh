@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # Brings a clone of gauss6 to a working state, idempotently: Debian packages,
-# the Python venv at .venv (pinned requirements.txt), the CMake build (Release
+# the Python venv at .venv (pinned requirements.txt), the run viewer's npm packages
+# (viewer/package-lock.json) and its bundled script, the CMake build (Release
 # with debug info) with the Python extension, and the `gauss6` command in the venv.
 # A second run only rebuilds incrementally. Called by `make test` and `make reproduce`.
 set -euo pipefail
@@ -38,7 +39,24 @@ if [ "$(cat "$stamp" 2>/dev/null)" != "$want" ]; then
   echo "$want" > "$stamp"
 fi
 
-# 3. CMake build (configured once; later runs build incrementally).
+# 3. The run viewer's script (gauss6 view): three.js and esbuild pinned in viewer/package-lock.json,
+#    installed with `npm ci` (again only when the lock file changes), bundled into viewer/dist/.
+if ! command -v npm >/dev/null; then
+  echo "gauss6 setup: npm not found: install Node.js 20 and npm (the run viewer needs them)" >&2
+  exit 1
+fi
+vstamp=viewer/node_modules/.package-lock.sha256
+vwant=$(sha256sum viewer/package-lock.json | cut -d' ' -f1)
+if [ "$(cat "$vstamp" 2>/dev/null)" != "$vwant" ]; then
+  echo "gauss6 setup: installing the viewer's npm packages"
+  (cd viewer && npm ci --no-audit --no-fund --loglevel=error)
+  echo "$vwant" > "$vstamp"
+fi
+if [ ! -f viewer/dist/gauss6-viewer.js ] || [ -n "$(find viewer/src viewer/package-lock.json -newer viewer/dist/gauss6-viewer.js)" ]; then
+  (cd viewer && npm run --silent build)
+fi
+
+# 4. CMake build (configured once; later runs build incrementally).
 if [ ! -f build/build.ninja ]; then
   cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo \
     -DPython_EXECUTABLE="$root/.venv/bin/python" \
@@ -46,7 +64,7 @@ if [ ! -f build/build.ninja ]; then
 fi
 cmake --build build -j "${GAUSS6_JOBS:-$(nproc)}"
 
-# 4. The gauss6 package and command in the venv (editable: the extension lives in python/gauss6).
+# 5. The gauss6 package and command in the venv (editable: the extension lives in python/gauss6).
 if [ ! -x .venv/bin/gauss6 ]; then
   .venv/bin/python -m pip install -q --disable-pip-version-check --no-deps --no-build-isolation -e python
 fi

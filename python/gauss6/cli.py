@@ -8,7 +8,9 @@
     gauss6 crosscheck ccd [--set NAME] [--json] [--peers]
     gauss6 report qp --out DIR
     gauss6 reproduce peg|bunny|all --out DIR [--threaded]
-    gauss6 trace export TRACE --csv DIR
+    gauss6 trace export TRACE [--csv DIR] [--hapi FILE]
+    gauss6 trace import FILE --format hapi|csv --out TRACE
+    gauss6 view TRACE [TRACE ...] [--scene SCENE] [--out page.html]
     gauss6 device list [--json]
     gauss6 bench [--build DIR] [--out DIR] [--filter REGEX]
     gauss6 sweep [--build DIR] [--out DIR]
@@ -178,7 +180,11 @@ def build_parser() -> argparse.ArgumentParser:
 
     from .reproduce import register as register_reproduce
 
-    register_reproduce(sub)  # reproduce {peg,bunny,all} --out DIR [--threaded]; trace export TRACE --csv DIR
+    register_reproduce(sub)  # reproduce {peg,bunny,all} --out DIR [--threaded]; trace export | import
+
+    from . import view  # the web page of runs
+
+    view.register(sub)
 
     from . import bench, gate, sweeps  # benchmarks, speed against error, the regression gate
 

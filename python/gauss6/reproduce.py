@@ -1,5 +1,7 @@
 """`gauss6 reproduce peg|bunny|all --out DIR [--threaded]`: the paper's scenarios, figures and numbers.
 
+Also the `gauss6 trace export|import` commands (CSV and HAPI device logs: gauss6.logs).
+
 Each scenario (METHOD.md section 7) runs its scene with the simulated device following the
 scene's hand script (datasets_generated/scripts/), through the runtime's three loops
 (lockstep by default: a virtual 1 kHz clock, repeatable bit for bit; --threaded: real
@@ -7,6 +9,7 @@ threads and the wall clock), and writes into DIR:
 
     <name>.g6trace           the run's trace (docs/trace-format.md)
     figure_<name>.png/.svg   the Figure 11 (peg) / Figure 12 (bunny) analogue
+    view_<name>.html         the run in 3D with its timeline and plots (gauss6 view; opens from file://)
     summary.json             per scenario, exactly the keys of SUMMARY_KEYS
     report.md                our numbers beside the paper's, the figures, the machine
 
@@ -255,6 +258,10 @@ def run_scenario(name: str, out: Path, threaded: bool = False, duration: float =
 
         extra["figures"] = [p.name for p in plot_run(trace, TITLES[name], out / f"figure_{name}",
                                                       run["let_go_time"])]
+        from .view import write_view
+
+        extra["figures"].append(write_view([trace_path], scene, out / f"view_{name}.html", labels=[name],
+                                           title=f"gauss6: {TITLES[name]}").name)
     return summary, extra
 
 
@@ -294,6 +301,8 @@ def write_report(out: Path, summary: dict, details: dict, wall: float) -> Path:
                   f"steps, {d['ticks_with_contacts']} ticks with contacts; run {d['run_time_s']:.2f} s in "
                   f"{d['wall_s']:.1f} s of wall time.", "",
                   f"![{TITLES[name]}](figure_{name}.png)", "",
+                  *([f"The run in 3D, with its timeline and plots: [view_{name}.html](view_{name}.html) "
+                     "(opens in a web browser from file://).", ""] if f"view_{name}.html" in d.get("figures", []) else []),
                   "| quantity | ours | paper |", "|---|---|---|"]
         ft, ut, hz = s["force_time_us"], s["update_time_ms"], s["constraint_update_hz"]
         pf = p.get("force_time_us", {})
@@ -360,13 +369,31 @@ def cmd_reproduce(args: argparse.Namespace) -> int:
 
 
 def cmd_trace_export(args: argparse.Namespace) -> int:
-    from .trace import TraceFormatError, export_csv
+    from . import LoadError
+    from .logs import export_trace
 
+    if not (args.csv or args.hapi):
+        print("gauss6: error: trace export: give --csv DIR and/or --hapi FILE", file=sys.stderr)
+        return 2
     try:
-        print(export_csv(args.trace, args.csv))
-    except TraceFormatError as e:
+        print(export_trace(args.trace, hapi=args.hapi, csv=args.csv))
+    except (LoadError, ValueError) as e:
         print(f"gauss6: error: {e}", file=sys.stderr)
         return 2
+    return 0
+
+
+def cmd_trace_import(args: argparse.Namespace) -> int:
+    from . import LoadError
+    from .logs import import_log
+
+    try:
+        out, tr = import_log(args.file, args.format, args.out, scene=args.scene or "")
+    except LoadError as e:
+        print(f"gauss6: error: {e}", file=sys.stderr)
+        return 2
+    print(f"{args.file}: {len(tr.ticks)} ticks ({args.format}), {tr.ticks['t'][0]:g} to {tr.ticks['t'][-1]:g} s "
+          f"-> {out} (a trace the replay device plays back)")
     return 0
 
 
@@ -379,10 +406,17 @@ def register(subparsers) -> None:
     rep.add_argument("--quiet", action="store_true", help="no progress bars")
     rep.set_defaults(func=cmd_reproduce)
     tr = subparsers.add_parser("trace", help="run traces").add_subparsers(dest="action", required=True)
-    ex = tr.add_parser("export", help="write a trace's streams as CSV files")
+    ex = tr.add_parser("export", help="write a trace as CSV files (one per stream) and/or a HAPI device log")
     ex.add_argument("trace", help="trace file (.g6trace)")
-    ex.add_argument("--csv", required=True, help="output directory (ticks.csv, steps.csv, contacts.csv, ...)")
+    ex.add_argument("--csv", help="output directory (ticks.csv, steps.csv, contacts.csv, events.csv, meta.json)")
+    ex.add_argument("--hapi", help="output HAPI DeviceLog, ASCII (TIME POSITION ORIENTATION FORCE TORQUE BUTTONS)")
     ex.set_defaults(func=cmd_trace_export)
+    im = tr.add_parser("import", help="a HAPI device log or CSV recorded elsewhere -> a trace for replay")
+    im.add_argument("file", help="HAPI DeviceLog (ASCII), or a CSV directory (to_csv's files) or ticks CSV")
+    im.add_argument("--format", required=True, choices=["hapi", "csv"])
+    im.add_argument("--out", required=True, help="the trace to write (.g6trace)")
+    im.add_argument("--scene", help="scene name to record in the trace's metadata (for gauss6 view)")
+    im.set_defaults(func=cmd_trace_import)
 
 
 def main(argv: list[str] | None = None) -> int:

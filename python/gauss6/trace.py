@@ -199,3 +199,36 @@ def export_csv(trace_path, out_dir) -> str:
                f"{len(tr.events)} events -> {', '.join(f.name for f in files)} in {out_dir}")
     notes = [str(w.message) for w in caught]
     return "\n".join([summary] + [f"warning: {n}" for n in notes])
+
+
+def trace_metadata(scene: str = "", device: dict | None = None, phases=(), extra: dict | None = None) -> dict:
+    """A trace's metadata with the fields the C++ writer fills (format, version, columns, event codes)."""
+    return {
+        "format": "gauss6-trace", "version": VERSION, "scene": scene,
+        "device": device or {"name": "", "rate_hz": 0.0, "renders_force": False},
+        "phases": [{"name": str(n), "start": float(s)} for n, s in phases],
+        "columns": {**{name: [[c, w] for c, w in cols] for name, cols in COLUMNS.items()},
+                    "end": [["ticks", 1], ["steps", 1], ["contacts", 1], ["events", 1]]},
+        "event_codes": {str(k): v for k, v in EVENT_CODES.items()},
+        "extra": extra or {},
+    }
+
+
+def write_trace(trace: Trace, path) -> Path:
+    """Writes trace (its meta and four streams, one chunk each, then the end chunk with
+    trace.dropped) as a version 1 file that read_trace reads back to the same doubles."""
+    path = Path(path)
+    meta = dict(trace.meta)
+    meta.setdefault("format", "gauss6-trace")
+    meta.setdefault("version", VERSION)
+    meta_bytes = json.dumps(meta, separators=(",", ":")).encode("utf-8")
+    parts = [HEADER.pack(MAGIC, VERSION, 0, len(meta_bytes)), meta_bytes]
+    for ctype, name in STREAMS.items():
+        rows = np.ascontiguousarray(getattr(trace, name), dtype=DTYPES[name])
+        width = sum(w for _, w in COLUMNS[name])
+        parts.append(CHUNK.pack(ctype, width, len(rows)) + rows.view("<f8").tobytes())
+    dropped = [float(trace.dropped.get(k, 0)) for k in ("ticks", "steps", "contacts", "events")]
+    parts.append(CHUNK.pack(END, 4, 1) + np.asarray(dropped, dtype="<f8").tobytes())
+    path.parent.mkdir(parents=True, exist_ok=True)
+    path.write_bytes(b"".join(parts))
+    return path

@@ -1,10 +1,11 @@
-// Bindings of device/: HID enumeration and profiles, the simulated device and
+// Bindings of device/: HID enumeration and profiles, the simulated and replay devices and
 // the trace writer (gauss6._gauss6.device). The trace reader is pure Python
 // (gauss6.trace), so that traces read without the extension too.
 #include <pybind11/eigen.h>
 #include <pybind11/stl.h>
 
 #include "gauss6/hid_device.h"
+#include "gauss6/replay_device.h"
 #include "gauss6/simulated_device.h"
 #include "gauss6/trace.h"
 #include "module.h"
@@ -71,6 +72,27 @@ void bind_device(py::module_& parent) {
       .def("write", [](SimulatedDevice& d, double t, const Vec6& F) { return std::string(to_string(d.write(t, F))); },
            py::arg("t"), py::arg("F"), "Hold the wrench F = (force, torque) until the next write.")
       .def_property_readonly("rate_hz", [](const SimulatedDevice& d) { return d.info().rate_hz; });
+
+  // The replay device, driven from Python: the handle poses of a trace's ticks, played back.
+  py::class_<ReplayDevice>(m, "ReplayDevice")
+      .def(py::init([](const std::string& trace_path) {
+             return std::make_unique<ReplayDevice>(ReplayDevice::from_trace(read_trace(trace_path),
+                                                                            "replay: " + trace_path));
+           }),
+           py::arg("trace"), "The replay device of a trace file's ticks. Raises LoadError for a bad trace and "
+                             "ValueError for times that do not increase or invalid poses.")
+      .def("read", [](ReplayDevice& d, double t) {
+             DeviceState st;
+             d.read(t, &st);
+             return py::make_tuple(Eigen::Vector3d(st.X_WH.p), quat_to(st.X_WH.q), st.gripped, st.buttons,
+                                   to_string(st.status));
+           }, py::arg("t"), "The handle at t (s): returns (p, q, gripped, buttons, status).")
+      .def("write", [](ReplayDevice& d, double t, const Vec6& F) { return std::string(to_string(d.write(t, F))); },
+           py::arg("t"), py::arg("F"), "Keep the wrench F (sent nowhere: a replay renders no force).")
+      .def_property_readonly("end_time", &ReplayDevice::end_time)
+      .def_property_readonly("num_samples", &ReplayDevice::num_samples)
+      .def_property_readonly("rate_hz", [](const ReplayDevice& d) { return d.info().rate_hz; })
+      .def_property_readonly("name", [](const ReplayDevice& d) { return d.info().name; });
 
   py::class_<TraceWriter>(m, "TraceWriter")
       .def(py::init([](const std::string& path, const std::string& scene, const std::string& device, double rate_hz,
