@@ -1,5 +1,6 @@
-// Scripted scenarios: the simulated device, the runtime's loops and a trace of
-// the run, with the property observers fed by the hooks (scenario.h,
+// Scripted and replayed scenarios: a device (the simulated one on a hand
+// script, or the replay device on a recording), the runtime's loops and a trace
+// of the run, with the property observers fed by the hooks (scenario.h,
 // property_observers.h).
 #include "gauss6/scenario.h"
 
@@ -11,6 +12,7 @@
 #include <memory>
 #include <sstream>
 #include <thread>
+#include <vector>
 
 namespace gauss6 {
 
@@ -36,7 +38,7 @@ struct CouplingRecord {
 // written by one thread only (noted), except `time`, an atomic for the progress.
 struct Recorder {
   const RuntimeModel* model = nullptr;
-  const HandScript* script = nullptr;
+  const std::vector<HandPhase>* phases = nullptr;
   TraceWriter* writer = nullptr;
   SeqLock<CouplingRecord> coupling;      // coupling thread -> haptic thread
   std::atomic<double> time{0};           // haptic thread -> caller (progress)
@@ -86,7 +88,7 @@ void on_sim_step(void* user, const SimStepInfo& info) {
 void on_haptic_tick(void* user, const HapticTickRecord& rec) {
   auto* r = static_cast<Recorder*>(user);
   // Phase boundaries and the let-go, at the first tick at or after them.
-  const auto& phases = r->script->phases;
+  const auto& phases = *r->phases;
   while (r->next_phase < phases.size() && rec.time >= phases[r->next_phase].start) {
     r->writer->append(TraceEvent{phases[r->next_phase].start, TraceEventCode::kPhase,
                                  static_cast<double>(r->next_phase)});
@@ -162,36 +164,27 @@ HandScript load_scene_script(const Scene& scene) {
   }
 }
 
-ScenarioResult run_scenario(const Scene& scene, const HandScript& script, const ScenarioOptions& options) {
-  const Clock::time_point wall_start = Clock::now();
+namespace {
+
+void check_options(const ScenarioOptions& options) {
   if (options.trace_path.empty()) throw ScenarioError("run_scenario: options.trace_path is empty");
   if (!(options.progress_period > 0)) throw ScenarioError("run_scenario: progress_period must be > 0");
-  try {
-    validate_hand_script(script);
-  } catch (const std::invalid_argument& e) {
-    throw ScenarioError(e.what());
-  }
+}
 
-  // The model, the device (its rate and limits are the scene's), the run's data.
-  const RuntimeModel model(scene, options.runtime);
-  SimulatedHandleParams handle = options.handle;
-  handle.rate_hz = scene.device.rate_hz;
-  handle.max_force = scene.device.max_force;
-  handle.max_torque = scene.device.max_torque;
-  SimulatedDevice device(script, handle, "simulated: " + (scene.device.script.empty() ? scene.name : scene.device.script));
-  device.reset(0);
+// The run of the model with `device` for `duration` s of run time, recorded in
+// options.trace_path with the phases' start events.
+ScenarioResult run_device(const RuntimeModel& model, const Scene& scene, Device* device,
+                          const std::vector<HandPhase>& phases, double duration, const ScenarioOptions& options,
+                          Clock::time_point wall_start) {
   auto data = std::make_unique<RuntimeData>(model);
-
-  const double end = script.end_time >= 0 ? script.end_time : script.keys.back().t;
-  const double duration = options.duration >= 0 ? options.duration : end;
 
   // The trace: its metadata names the scene, the device and the phases.
   TraceMeta meta;
   meta.scene = scene.name.empty() ? scene.path : scene.name;
-  meta.device = device.info().name;
-  meta.device_rate_hz = device.info().rate_hz;
-  meta.renders_force = device.info().renders_force;
-  for (const HandPhase& p : script.phases) meta.phases.push_back({p.name, p.start});
+  meta.device = device->info().name;
+  meta.device_rate_hz = device->info().rate_hz;
+  meta.renders_force = device->info().renders_force;
+  for (const HandPhase& p : phases) meta.phases.push_back({p.name, p.start});
   meta.extra_json = options.extra_json;
   TraceWriterSettings ts = options.trace;
   ts.background_thread = true;
@@ -204,7 +197,7 @@ ScenarioResult run_scenario(const Scene& scene, const HandScript& script, const 
 
   Recorder rec;
   rec.model = &model;
-  rec.script = &script;
+  rec.phases = &phases;
   rec.writer = writer.get();
   RuntimeObserver observer;
   observer.user = &rec;
@@ -217,10 +210,10 @@ ScenarioResult run_scenario(const Scene& scene, const HandScript& script, const 
   std::atomic<bool> done{false};
   std::thread worker([&] {
     if (options.threaded) {
-      run_threaded(model, &device, duration, nullptr, observer, data.get());
+      run_threaded(model, device, duration, nullptr, observer, data.get());
     } else {
       const long num_ticks = static_cast<long>(std::floor(duration * scene.device.rate_hz + 1e-9)) + 1;
-      run_lockstep(model, &device, num_ticks, observer, data.get());
+      run_lockstep(model, device, num_ticks, observer, data.get());
     }
     done.store(true, std::memory_order_release);
   });
@@ -253,6 +246,44 @@ ScenarioResult run_scenario(const Scene& scene, const HandScript& script, const 
   out.port_energy_final = rec.port.energy;
   out.wall_seconds = std::chrono::duration<double>(Clock::now() - wall_start).count();
   return out;
+}
+
+}  // namespace
+
+ScenarioResult run_scenario(const Scene& scene, const HandScript& script, const ScenarioOptions& options) {
+  const Clock::time_point wall_start = Clock::now();
+  check_options(options);
+  try {
+    validate_hand_script(script);
+  } catch (const std::invalid_argument& e) {
+    throw ScenarioError(e.what());
+  }
+  // The model and the device (its rate and limits are the scene's).
+  const RuntimeModel model(scene, options.runtime);
+  SimulatedHandleParams handle = options.handle;
+  handle.rate_hz = scene.device.rate_hz;
+  handle.max_force = scene.device.max_force;
+  handle.max_torque = scene.device.max_torque;
+  SimulatedDevice device(script, handle, "simulated: " + (scene.device.script.empty() ? scene.name : scene.device.script));
+  device.reset(0);
+  const double end = script.end_time >= 0 ? script.end_time : script.keys.back().t;
+  const double duration = options.duration >= 0 ? options.duration : end;
+  return run_device(model, scene, &device, script.phases, duration, options, wall_start);
+}
+
+ScenarioResult run_replay(const Scene& scene, const Trace& recording, const std::vector<HandPhase>& phases,
+                          const ScenarioOptions& options) {
+  const Clock::time_point wall_start = Clock::now();
+  check_options(options);
+  const RuntimeModel model(scene, options.runtime);
+  std::unique_ptr<ReplayDevice> device;
+  try {
+    device = std::make_unique<ReplayDevice>(ReplayDevice::from_trace(recording));
+  } catch (const std::invalid_argument& e) {
+    throw ScenarioError(std::string("the recording cannot drive the replay device: ") + e.what());
+  }
+  const double duration = options.duration >= 0 ? options.duration : device->end_time();
+  return run_device(model, scene, device.get(), phases, duration, options, wall_start);
 }
 
 }  // namespace gauss6

@@ -182,8 +182,9 @@ def build_parser() -> argparse.ArgumentParser:
 
     register_reproduce(sub)  # reproduce {peg,bunny,all} --out DIR [--threaded]; trace export | import
 
-    from . import view  # the web page of runs
+    from . import replay, view  # a recorded session driving a scene; the web page of runs
 
+    replay.register(sub)
     view.register(sub)
 
     from . import bench, gate, sweeps  # benchmarks, speed against error, the regression gate

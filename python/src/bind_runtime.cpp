@@ -9,6 +9,7 @@
 
 #include <chrono>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "gauss6/reference/ccd.h"
@@ -75,28 +76,22 @@ py::dict loop_dict(const LoopStats& s) {
   return d;
 }
 
-py::dict run(const std::string& scene_path, const std::string& trace_path, bool threaded, double duration,
-             int lockstep_sim_period, const std::string& extra_json, const std::function<void(double)>& progress) {
-  const Scene scene = load(scene_path);
-  HandScript script;
+// The options of a run from Python: lockstep runs produce rows faster than real
+// time (larger rings, frequent flushes); progress(run_time_s) under the GIL.
+ScenarioOptions run_options(const std::string& trace_path, bool threaded, double duration, int lockstep_sim_period,
+                            const std::string& extra_json, const std::function<void(double)>& progress) {
   ScenarioOptions options;
-  try {
-    script = load_scene_script(scene);
-  } catch (const ScenarioError& e) {
-    throw py::value_error(e.what());
-  }
   options.trace_path = trace_path;
   options.threaded = threaded;
   options.duration = duration;
   options.runtime.lockstep_sim_period = lockstep_sim_period;
   options.extra_json = extra_json;
-  // Lockstep runs produce rows faster than real time: larger rings, frequent flushes.
   options.trace.flush_period = 0.1;
   options.trace.tick_capacity = 1u << 17;
   options.trace.step_capacity = 1u << 15;
   options.trace.contact_capacity = 1u << 19;
   if (progress) {
-    options.progress = [&progress](double t) {
+    options.progress = [progress](double t) {
       py::gil_scoped_acquire gil;
       try {
         progress(t);
@@ -105,16 +100,22 @@ py::dict run(const std::string& scene_path, const std::string& trace_path, bool 
       }
     };
   }
-  ScenarioResult r;
-  {
-    py::gil_scoped_release release;
-    try {
-      r = run_scenario(scene, script, options);
-    } catch (const std::exception& e) {
-      py::gil_scoped_acquire gil;
-      throw py::value_error(e.what());
-    }
+  return options;
+}
+
+// Runs `start` without the GIL; its errors reach Python as ValueError.
+template <class Start>
+ScenarioResult run_released(const Start& start) {
+  py::gil_scoped_release release;
+  try {
+    return start();
+  } catch (const std::exception& e) {
+    py::gil_scoped_acquire gil;
+    throw py::value_error(e.what());
   }
+}
+
+py::dict result_dict(const ScenarioResult& r, const std::vector<HandPhase>& phases) {
   py::dict d;
   d["trace"] = r.trace_path;
   d["num_ticks"] = r.num_ticks;
@@ -133,14 +134,38 @@ py::dict run(const std::string& scene_path, const std::string& trace_path, bool 
   d["haptic"] = loop_dict(r.stats.haptic);
   d["coupling"] = loop_dict(r.stats.coupling);
   d["sim"] = loop_dict(r.stats.sim);
-  d["phases"] = [&] {
-    py::list l;
-    for (const HandPhase& p : script.phases) l.append(py::make_tuple(p.name, p.start));
-    return l;
-  }();
+  py::list l;
+  for (const HandPhase& p : phases) l.append(py::make_tuple(p.name, p.start));
+  d["phases"] = l;
+  return d;
+}
+
+py::dict run(const std::string& scene_path, const std::string& trace_path, bool threaded, double duration,
+             int lockstep_sim_period, const std::string& extra_json, const std::function<void(double)>& progress) {
+  const Scene scene = load(scene_path);
+  HandScript script;
+  try {
+    script = load_scene_script(scene);
+  } catch (const ScenarioError& e) {
+    throw py::value_error(e.what());
+  }
+  const ScenarioOptions options = run_options(trace_path, threaded, duration, lockstep_sim_period, extra_json, progress);
+  const ScenarioResult r = run_released([&] { return run_scenario(scene, script, options); });
+  py::dict d = result_dict(r, script.phases);
   d["let_go_time"] = script.let_go_time;
   d["end_time"] = script.end_time;
   return d;
+}
+
+py::dict replay(const std::string& scene_path, const std::string& recording_path, const std::string& trace_path,
+                const std::vector<std::pair<std::string, double>>& phase_list, bool threaded, double duration,
+                int lockstep_sim_period, const std::string& extra_json, const std::function<void(double)>& progress) {
+  const Scene scene = load(scene_path);
+  const Trace recording = read_trace(recording_path);  // TraceError: a gauss6.LoadError
+  std::vector<HandPhase> phases;
+  for (const auto& [name, start] : phase_list) phases.push_back({name, start});
+  const ScenarioOptions options = run_options(trace_path, threaded, duration, lockstep_sim_period, extra_json, progress);
+  return result_dict(run_released([&] { return run_replay(scene, recording, phases, options); }), phases);
 }
 
 // The scene's bodies as the runtime sees them: obstacles in the world frame, the
@@ -229,6 +254,13 @@ void bind_runtime(py::module_& parent) {
         "Runs the scene with its hand script (lockstep by default, or threaded) and writes the trace. Returns a dict "
         "of run statistics and property checks (orthogonality, constraint energy, passivity observer). "
         "progress(run_time_s) is called about every 0.2 s of wall time.");
+  m.def("replay", &replay, py::arg("scene"), py::arg("recording"), py::arg("trace"),
+        py::arg("phases") = std::vector<std::pair<std::string, double>>{}, py::arg("threaded") = false,
+        py::arg("duration") = -1.0, py::arg("lockstep_sim_period") = 1, py::arg("extra_json") = "{}",
+        py::arg("progress") = nullptr,
+        "Replays a recorded session: the handle poses of the trace `recording` drive the scene's runtime through "
+        "the replay device, and the run is written to `trace`. phases: (name, start) pairs to mark. Returns the "
+        "dict of run_scenario.");
   m.def("effective_settings", &effective_settings, py::arg("scene"),
         "The settings a run of the scene uses: the scene's values and the defaults, with the CCD and contact "
         "distances derived from delta (resolve_runtime_settings, runtime_model.h). Raises LoadError.");

@@ -1,6 +1,7 @@
 // Scripted scenarios: a scene, the simulated device driven by a hand script
-// (the paper's peg-in-hole phases a-e, the bunnies), the runtime's three loops
-// (runtime.h), and a trace of the whole run (trace.h, docs/trace-format.md).
+// (the paper's peg-in-hole phases a-e, the bunnies) or the replay device driven
+// by a recorded session (run_replay), the runtime's three loops (runtime.h),
+// and a trace of the whole run (trace.h, docs/trace-format.md).
 //
 // run_scenario() wires the runtime's observer hooks to a TraceWriter:
 //   per haptic tick: t, xh, xs (as the coupling step used it), the wrench sent,
@@ -27,6 +28,7 @@
 #include <string>
 
 #include "gauss6/property_observers.h"
+#include "gauss6/replay_device.h"
 #include "gauss6/runtime.h"
 #include "gauss6/scene.h"
 #include "gauss6/simulated_device.h"
@@ -95,5 +97,18 @@ HandScript load_scene_script(const Scene& scene);
 // Throws ScenarioError (bad options, trace file) or RuntimeError (scene) before
 // the run starts; the run itself does not throw.
 ScenarioResult run_scenario(const Scene& scene, const HandScript& script, const ScenarioOptions& options);
+
+// Replays a recorded session: the handle poses of `recording` (a gauss6 trace,
+// or another framework's log imported as one: docs/trace-format.md) drive the
+// runtime through the ReplayDevice (interpolated between the recorded ticks;
+// the grip and buttons as recorded), and the run is traced as run_scenario's.
+// The run lasts as long as the recording (options.duration >= 0 shortens or
+// lengthens it; past the recording's end the device has ended and the force is
+// zero); `phases` are marked in the trace (may be empty). options.handle is
+// not used. Throws ScenarioError (a recording without ticks or with times that
+// do not increase, bad options, the trace file) or RuntimeError (scene) before
+// the run starts.
+ScenarioResult run_replay(const Scene& scene, const Trace& recording, const std::vector<HandPhase>& phases,
+                          const ScenarioOptions& options);
 
 }  // namespace gauss6
