@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstring>
 
+#include "gauss6/error_allowances.h"
 #include "gauss6/motion.h"
 #include "runtime_detail.h"
 
@@ -94,7 +95,7 @@ void update_contacts(const RuntimeModel& model, SimState* s) {
   // far the double pose xs may lie from the motion's (its deviation, and the
   // rounding of posing the vertices in doubles): when the contact distance is
   // within that, they are the only pairs to test.
-  const double slack = next_up(s->stop_deviation + 1e-13 * (s->xs.p.cwiseAbs().maxCoeff() + model.god_radius));
+  const double slack = round_up(s->stop_deviation + kPoseRounding * (s->xs.p.cwiseAbs().maxCoeff() + model.god_radius)).v;
   const bool near = r.num_near_pairs >= 0 && (r.hit ? r.u_hit : 1.0) >= r.near_u0 && cs.distance + slack <= r.near_reach;
   const ContactStatus status =
       generate_contacts(model.obstacles.data(), static_cast<int>(model.obstacles.size()), model.god, s->xs, cs,
