@@ -5,7 +5,7 @@ SHELL := /bin/bash
 VENV := .venv/bin
 JOBS ?= $(shell nproc)
 
-.PHONY: setup test reproduce bench ctest pytest proofs checks datasets clean wheel-test
+.PHONY: setup test reproduce bench ctest pytest proofs checks datasets clean wheel-test fuzz fuzz-short
 
 setup:
 	@tools/setup.sh
@@ -28,10 +28,23 @@ checks: setup
 	$(VENV)/gauss6 ccd queries $(SHARED_QUERIES) --impl reference
 	$(VENV)/gauss6 crosscheck ccd
 
+# libFuzzer on every parser (fuzz/, clang build in build-fuzz/), FUZZ_SECONDS each
+# (9 targets: 27 minutes at the default); a crash is kept in fuzz/regressions/.
+FUZZ_SECONDS ?= 180
+fuzz: setup
+	@tools/fuzz.sh $(FUZZ_SECONDS)
+
+# The same for a few seconds a target, as part of `make test` (about 1 minute, plus
+# the clang build the first time).
+FUZZ_SHORT_SECONDS ?= 5
+fuzz-short: setup
+	@tools/fuzz.sh $(FUZZ_SHORT_SECONDS)
+
 # Every suite runs even when an earlier one fails; the target fails if any did.
 test: setup
 	@status=0; \
 	$(MAKE) --no-print-directory ctest || status=1; \
+	$(MAKE) --no-print-directory fuzz-short || status=1; \
 	$(MAKE) --no-print-directory pytest || status=1; \
 	$(MAKE) --no-print-directory proofs || status=1; \
 	$(MAKE) --no-print-directory checks || status=1; \
@@ -54,7 +67,7 @@ reproduce: setup
 	$(VENV)/gauss6 reproduce all --out out
 
 clean:
-	rm -rf build out
+	rm -rf build build-fuzz out
 
 # The wheel built from the checkout, installed into a fresh venv (python/tests/test_packaging.py,
 # also run by `make test`: its build of the extension reuses the main build's objects through ccache).

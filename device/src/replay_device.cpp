@@ -9,8 +9,11 @@ namespace gauss6 {
 ReplayDevice::ReplayDevice(std::vector<ReplaySample> samples, std::string name) : samples_(std::move(samples)) {
   if (samples_.empty()) throw std::invalid_argument("replay device: no samples");
   for (size_t i = 0; i < samples_.size(); ++i) {
+    // Same rotation, rescaled by a power of two when its size is out of range (pose.h).
+    samples_[i].X_WH.q = rescaled(samples_[i].X_WH.q);
     if (!std::isfinite(samples_[i].t) || !is_valid_pose(samples_[i].X_WH))
-      throw std::invalid_argument("replay device: sample " + std::to_string(i) + ": time or pose not finite");
+      throw std::invalid_argument("replay device: sample " + std::to_string(i) +
+                                  ": time or pose not finite, or a zero quaternion");
     if (i > 0 && !(samples_[i].t > samples_[i - 1].t))
       throw std::invalid_argument("replay device: sample " + std::to_string(i) + ": times must increase strictly");
   }

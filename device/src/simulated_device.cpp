@@ -19,6 +19,9 @@ void validate_hand_script(const HandScript& s) {
     if (i > 0 && !(k.t > s.keys[i - 1].t))
       throw std::invalid_argument("hand script: key " + std::to_string(i) + ": times must increase strictly");
   }
+  for (size_t i = 0; i < s.phases.size(); ++i)
+    if (!std::isfinite(s.phases[i].start))
+      throw std::invalid_argument("hand script: phase '" + s.phases[i].name + "': start is not finite");
   for (size_t i = 1; i < s.phases.size(); ++i)
     if (s.phases[i].start < s.phases[i - 1].start)
       throw std::invalid_argument("hand script: phase '" + s.phases[i].name + "' starts before the previous one");

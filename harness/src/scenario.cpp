@@ -43,6 +43,8 @@ struct Recorder {
   SeqLock<CouplingRecord> coupling;      // coupling thread -> haptic thread
   std::atomic<double> time{0};           // haptic thread -> caller (progress)
   std::atomic<long> num_sim_steps{0};    // sim thread
+  bool flush_in_run_time = false;        // lockstep: the haptic hook flushes every flush_period of run time
+  std::atomic<double>* run_time_out = nullptr;  // ScenarioOptions::run_time_out
 
   // Haptic thread.
   size_t next_phase = 0;
@@ -126,6 +128,10 @@ void on_haptic_tick(void* user, const HapticTickRecord& rec) {
 
   ++r->num_ticks;
   r->time.store(rec.time, std::memory_order_relaxed);
+  if (r->run_time_out) r->run_time_out->store(rec.time, std::memory_order_relaxed);
+  // A lockstep run is not real time and runs many times faster than the wall clock:
+  // the flush bound is kept in run time, here, not by the writer's wall-clock thread.
+  if (r->flush_in_run_time) r->writer->flush_if_due(rec.time);
 }
 
 void on_event(void* user, const RuntimeEvent& e) {
@@ -203,6 +209,8 @@ ScenarioResult run_device(const RuntimeModel& model, const Scene& scene, Device*
   rec.model = &model;
   rec.phases = &phases;
   rec.writer = writer.get();
+  rec.flush_in_run_time = !options.threaded;
+  rec.run_time_out = options.run_time_out;
   RuntimeObserver observer;
   observer.user = &rec;
   observer.on_event = on_event;

@@ -14,8 +14,10 @@
 #include "../../optimized/tests/mesh_shapes.h"
 #include "gauss6/mass_properties.h"
 #include "gauss6/scenario.h"
+#include "slab_scene.h"
 
 using namespace gauss6;
+using gauss6::test::make_slab_scene;
 
 namespace {
 
@@ -25,33 +27,6 @@ HandKeyframe key(double t, double x, double z) {
   k.t = t;
   k.X_WA.p = Vec3(x, 0, z);
   return k;
-}
-
-// Slab 20 x 20 x 2 cm with its top at z = 0; cube of 2 cm (8 g of water) held
-// 1 cm above it. kh m = 100 N/m.
-Scene make_slab_scene() {
-  Scene s;
-  s.path = "test_scenario (in code)";
-  s.name = "cube_on_slab";
-  Body slab;
-  slab.name = "slab";
-  slab.mesh = test::make_box(0.2, 0.2, 0.02, Vec3(0, 0, -0.01));
-  s.obstacles.push_back(slab);
-  s.god_object.name = "cube";
-  s.god_object.role = BodyRole::kGodObject;
-  s.god_object.mesh = test::make_box(0.02, 0.02, 0.02);
-  s.god_object.pose.p = Vec3(0, 0, 0.02);
-  std::string why;
-  REQUIRE(compute_mass_properties(s.god_object.mesh, 1000.0, &s.god_mass.mass, &why));
-  s.god_mass.density = 1000.0;
-  s.gains.ks = 0.5;
-  s.gains.kh = 100.0 / s.god_mass.mass.mass;
-  s.contact.delta = 1e-6;
-  s.contact.offset_eps = -1e-5;
-  s.contact.offset_time = 0.05;
-  s.device.rate_hz = 1000;
-  s.device.script = "press_and_slide";
-  return s;
 }
 
 // Down 15 mm (5 mm into the slab) in 0.3 s, slide 2 cm along +x, let go.

@@ -1,6 +1,7 @@
 // Poses, pose difference and pose update (METHOD.md section 1).
 #include "gauss6/pose.h"
 
+#include <algorithm>
 #include <cmath>
 
 namespace gauss6 {
@@ -14,13 +15,35 @@ Quat operator*(const Quat& a, const Quat& b) {
 
 Quat conjugate(const Quat& q) { return {q.w, -q.x, -q.y, -q.z}; }
 
-Quat normalized(const Quat& q) {
+namespace {
+constexpr int kMaxQuatExponent = 400;  // largest component kept in [2^-400, 2^400]
+
+double max_abs_component(const Quat& q) {
+  return std::max(std::max(std::abs(q.w), std::abs(q.x)), std::max(std::abs(q.y), std::abs(q.z)));
+}
+}  // namespace
+
+Quat rescaled(const Quat& q) {
+  const double m = max_abs_component(q);
+  if (!(m > 0) || !std::isfinite(m)) return q;
+  int e = 0;
+  std::frexp(m, &e);  // m = f 2^e, f in [0.5, 1)
+  if (e >= -kMaxQuatExponent && e <= kMaxQuatExponent) return q;
+  // Components that fall below the smallest double are < 2^-1074 of the largest:
+  // their part of the rotation is below rounding.
+  return {std::ldexp(q.w, -e), std::ldexp(q.x, -e), std::ldexp(q.y, -e), std::ldexp(q.z, -e)};
+}
+
+Quat normalized(const Quat& q_in) {
+  const Quat q = rescaled(q_in);
   const double n = std::sqrt(q.norm2());
   return {q.w / n, q.x / n, q.y / n, q.z / n};
 }
 
-Mat3 rotation_matrix(const Quat& q) {
-  // Rational form: every entry is a quadratic in (w, x, y, z) over |q|^2.
+Mat3 rotation_matrix(const Quat& q_in) {
+  // Rational form: every entry is a quadratic in (w, x, y, z) over |q|^2, of degree 0:
+  // rescaling by a power of two changes no bit of it, and keeps |q|^2 finite.
+  const Quat q = rescaled(q_in);
   const double w = q.w, x = q.x, y = q.y, z = q.z;
   const double s = q.norm2();
   Mat3 R;
@@ -69,7 +92,9 @@ Pose pose_update(const Pose& xs, const Vec6& a) {
 bool is_valid_pose(const Pose& x) {
   const bool finite = x.p.allFinite() && std::isfinite(x.q.w) && std::isfinite(x.q.x) &&
                       std::isfinite(x.q.y) && std::isfinite(x.q.z);
-  return finite && x.q.norm2() > 1e-200;
+  if (!finite) return false;
+  const double m = max_abs_component(x.q);
+  return m >= std::ldexp(1.0, -kMaxQuatExponent - 1) && m < std::ldexp(1.0, kMaxQuatExponent);
 }
 
 }  // namespace gauss6

@@ -160,3 +160,47 @@ TEST_CASE("Self-intersections: none on closed bodies, some on interpenetrating b
   bad.F(0, 0) = 99;
   CHECK_THROWS_AS(count_self_intersections(bad), std::invalid_argument);
 }
+
+TEST_CASE("Mesh files whose headers are broken or whose counts lie are refused before any reader allocates",
+          "[meshio]") {
+  const TempDir dir;
+  // A `property` line before any `element` line crashed CGAL 5.5's PLY reader.
+  require_file_error(dir.write("property_first.ply", "ply\nformat ascii 1.0\nproperty float x\nelement vertex 1\n"
+                                                     "end_header\n0\n"),
+                     "a 'property' line before any 'element' line");
+  // Counts that lie: a few hundred bytes stating billions of items or list entries.
+  require_file_error(dir.write("lying_vertices.ply", "ply\nformat ascii 1.0\nelement vertex 4000000000\n"
+                                                     "property float x\nproperty float y\nproperty float z\n"
+                                                     "end_header\n0 0 0\n"),
+                     "more than the file can hold");
+  require_file_error(dir.write("lying_list.ply", "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\n"
+                                                 "property float y\nproperty float z\nelement face 1\n"
+                                                 "property list uint int vertex_indices\nend_header\n"
+                                                 "0 0 0\n1 0 0\n0 1 0\n4000000000 0 1 2\n"),
+                     "bad list length");
+  {
+    // Binary: a list length of 2^32 - 1 int32 values in a file of 200 bytes.
+    std::string ply = "ply\nformat binary_little_endian 1.0\nelement face 1\n"
+                      "property list uint int vertex_indices\nend_header\n";
+    ply += std::string("\xff\xff\xff\xff", 4) + std::string(12, '\0');
+    require_file_error(dir.write("lying_binary_list.ply", ply), "more than the file holds");
+  }
+  {
+    std::string ply = "ply\nformat binary_little_endian 1.0\nelement face 1\n"
+                      "property list int int vertex_indices\nend_header\n";
+    ply += std::string("\xff\xff\xff\xff", 4);  // -1 as a list length
+    require_file_error(dir.write("negative_list.ply", ply), "negative or non-integer list length");
+  }
+  require_file_error(dir.write("no_properties.ply", "ply\nformat ascii 1.0\nelement vertex 99999999999\nend_header\n"),
+                     "but no properties");
+  require_file_error(dir.write("lying.off", "OFF\n2000000000 2000000000 0\n0 0 0\n"), "more than a file of");
+  require_file_error(dir.write("short.off", "OFF\n3 1 0\n0 0 0\n1 0 0\n"), "the file holds 2");
+  require_file_error(dir.write("corners.off", "OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n99999999999 0 1 2\n"),
+                     "states more corners than the line holds");
+  require_file_error(dir.write("color.off", "COFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n"), "variant 'COFF'");
+  {
+    std::string stl(80, ' ');
+    stl += std::string("\xff\xff\xff\x7f", 4) + std::string(50, '\0');  // 2^31 - 1 facets announced, 1 present
+    require_file_error(dir.write("lying.stl", stl), "the file holds 1");
+  }
+}

@@ -165,11 +165,18 @@ std::optional<Vec6> brute_force(const Mat6& M, const Vec6& au, const Rows& rows)
       JS.row(i) = J.row(S[i]);
       rhs[i] = b[S[i]] - J.row(S[i]).dot(aul);
     }
-    const MatL MinvJt = Minv * JS.transpose();
-    Eigen::FullPivLU<MatL> lu(JS * MinvJt);
-    lu.setThreshold(1e-14L);
-    if (lu.rank() == s) {
-      const Vec6L a = aul + MinvJt * lu.solve(rhs);
+    // The empty subset is au itself: Eigen's LU of a 0 x 0 matrix is an assertion
+    // failure (undefined behaviour with NDEBUG), so it is not factored.
+    Vec6L a = aul;
+    bool independent = true;
+    if (s > 0) {
+      const MatL MinvJt = Minv * JS.transpose();
+      Eigen::FullPivLU<MatL> lu(JS * MinvJt);
+      lu.setThreshold(1e-14L);
+      independent = lu.rank() == s;
+      if (independent) a = aul + MinvJt * lu.solve(rhs);
+    }
+    if (independent) {
       bool feasible = true;
       for (int k = 0; k < m && feasible; ++k) feasible = J.row(k).dot(a) - b[k] >= -tol[k];
       const Vec6L d = a - aul;

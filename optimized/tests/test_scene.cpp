@@ -4,6 +4,8 @@
 #include <catch2/catch.hpp>
 
 #include <cmath>
+#include <cstdio>
+#include <sstream>
 #include <filesystem>
 #include <fstream>
 #include <string>
@@ -11,6 +13,7 @@
 
 #include <unistd.h>
 
+#include "gauss6/mass_properties.h"
 #include "gauss6/scene.h"
 
 using namespace gauss6;
@@ -202,4 +205,54 @@ TEST_CASE("the settings rules are one function per table and the loader uses the
   CHECK_THAT(load_error(edited("kh = 100.0", "kh = 0.0")), Contains("scene.toml:7:6: gains.kh: must be > 0"));
   CHECK_THAT(load_error(edited("script = \"none\"", "script = \"none\"\nrate_hz = 50.0")),
              Contains("device.rate_hz: must be in [100, 10000]"));
+}
+
+TEST_CASE("the loader refuses what the runtime cannot represent, and names it", "[scene]") {
+  // A 64-bit integer is not narrowed: 2^32 + 1 is not version 1.
+  CHECK_THAT(load_error(edited("version = 1", "version = 4294967297")), Catch::Contains("unsupported version 4294967297"));
+  // A mass in the subnormal range, and a reference point 1e17 away from the mesh.
+  const std::string given = "mass = 1e-320\ncenter_of_mass = [0.0, 0.0, 0.0]\n"
+                            "inertia = [[1e-320, 0.0, 0.0], [0.0, 1e-320, 0.0], [0.0, 0.0, 1e-320]]";
+  CHECK_THAT(load_error(edited("density = 2.0", given)), Catch::Contains("god_object.mass: the mass must be within"));
+  CHECK_THAT(load_error(edited("density = 2.0", "density = 2.0\nreference_point = [1e17, 0.0, 0.0]")),
+             Catch::Contains("god_object.reference_point: must lie within 100 bounding-box diagonals"));
+  CHECK_THAT(load_error(edited("position = [0.0, 0.0, -1.0]", "position = [1e300, 0.0, -1.0]")),
+             Catch::Contains("obstacle[0].position: must be within"));
+  CHECK_THAT(load_error(edited("kind = \"simulated\"\nscript = \"none\"", "kind = \"hid\"\nvendor_id = 4294967297")),
+             Catch::Contains("device.vendor_id: must be a 16-bit USB id"));
+}
+
+TEST_CASE("a quaternion of huge components is normalised, not turned into NaN", "[scene]") {
+  TempScene t(edited("orientation = [1.0, 0.0, 0.0, 1.0]", "orientation = [1e300, 0.0, 0.0, 1e300]"));
+  const Scene s = load_scene(t.path());
+  const Quat q = s.god_object.pose.q;
+  CHECK(q.w == Approx(std::sqrt(0.5)));
+  CHECK(q.z == Approx(std::sqrt(0.5)));
+  CHECK(std::isfinite(q.x));
+}
+
+TEST_CASE("an inside-out closed obstacle is flipped with a warning", "[scene]") {
+  // The box with every face wound the other way: closed, manifold, negative volume.
+  std::string inside_out;
+  std::istringstream in(kBoxObj);
+  for (std::string line; std::getline(in, line);) {
+    if (line.rfind("f ", 0) == 0) {
+      int a, b, c;
+      std::sscanf(line.c_str(), "f %d %d %d", &a, &b, &c);
+      line = "f " + std::to_string(a) + " " + std::to_string(c) + " " + std::to_string(b);
+    }
+    inside_out += line + "\n";
+  }
+  TempScene t(edited("mesh = \"box.obj\"", "mesh = \"inside_out.obj\""));
+  std::ofstream(t.dir / "inside_out.obj") << inside_out;
+  const Scene s = load_scene(t.path());
+  REQUIRE(s.warnings.size() == 1);
+  CHECK_THAT(s.warnings[0], Catch::Contains("obstacle[0].mesh") && Catch::Contains("inside out") &&
+                                Catch::Contains("faces flipped"));
+  MassProperties mp;
+  REQUIRE(compute_mass_properties(s.obstacles[0].mesh, 1.0, &mp, nullptr));
+  CHECK(mp.volume == Approx(1.0));
+  // The shipped box is not touched.
+  TempScene clean(kScene);
+  CHECK(load_scene(clean.path()).warnings.empty());
 }

@@ -13,6 +13,7 @@ naming the file and the problem.
 from __future__ import annotations
 
 import json
+import math
 import struct
 import warnings
 from dataclasses import dataclass, field
@@ -100,8 +101,21 @@ def read_trace(path) -> Trace:
         raise fail(f"metadata block of {meta_len} bytes runs past the end of the file")
     try:
         meta = json.loads(data[HEADER.size:HEADER.size + meta_len].decode("utf-8"))
-    except (UnicodeDecodeError, json.JSONDecodeError):
+    except (ValueError, RecursionError):  # bad UTF-8 or JSON, too many digits, nesting too deep
         raise fail("the metadata block is not valid JSON") from None
+    if not isinstance(meta, dict):
+        raise fail("the metadata block is not a JSON object")
+    codes = meta.get("event_codes", {})
+    if not isinstance(codes, dict) or not all(
+            isinstance(k, str) and k.isdigit() and len(k) < 10 and isinstance(v, str) for k, v in codes.items()):
+        raise fail("metadata: event_codes is not an object of code -> name")
+    phases = meta.get("phases", [])
+    if not isinstance(phases, list) or not all(
+            isinstance(p, dict) and isinstance(p.get("name"), str) and _finite_number(p.get("start"))
+            for p in phases):
+        raise fail("metadata: phases is not a list of {name: string, start: finite number}")
+    if not isinstance(meta.get("scene", ""), str) or not isinstance(meta.get("device", {}), dict):
+        raise fail("metadata: scene must be a string and device an object")
 
     parts: dict[str, list[np.ndarray]] = {name: [] for name in COLUMNS}
     widths = {name: sum(w for _, w in cols) for name, cols in COLUMNS.items()}
@@ -131,6 +145,8 @@ def read_trace(path) -> Trace:
             complete = True
             if nrows >= 1:
                 d = np.frombuffer(data, dtype="<f8", count=4, offset=start)
+                if not _integers_in(d, 0, MAX_COUNT):
+                    raise fail(f"end chunk at byte {pos}: dropped counts {d.tolist()} are not integers in [0, 2^53]")
                 dropped = dict(zip(["ticks", "steps", "contacts", "events"], (int(x) for x in d)))
         else:
             notes.append(f"{path}: skipped a chunk of unknown type {ctype} at byte {pos}")
@@ -144,9 +160,51 @@ def read_trace(path) -> Trace:
     def table(name: str) -> np.ndarray:
         return np.concatenate(parts[name]) if parts[name] else np.zeros(0, dtype=DTYPES[name])
 
-    return Trace(path=path, version=version, meta=meta, ticks=table("ticks"), steps=table("steps"),
-                 contacts=table("contacts"), events=table("events"), complete=complete,
-                 dropped=dropped, warnings=notes)
+    tr = Trace(path=path, version=version, meta=meta, ticks=table("ticks"), steps=table("steps"),
+               contacts=table("contacts"), events=table("events"), complete=complete,
+               dropped=dropped, warnings=notes)
+    problem = _check_integer_columns(tr)
+    if problem:
+        raise fail(problem)
+    return tr
+
+
+def _finite_number(x) -> bool:
+    """x is a JSON number (not a bool) that is a finite double."""
+    if isinstance(x, bool) or not isinstance(x, (int, float)):
+        return False
+    try:
+        return math.isfinite(float(x))
+    except OverflowError:
+        return False
+
+
+MAX_COUNT = float(2 ** 53)  # every count a double holds exactly
+
+
+def _integers_in(values: np.ndarray, lo: float, hi: float) -> bool:
+    """Every value is an integer in [lo, hi] (False for NaN and infinities)."""
+    v = np.asarray(values, dtype="<f8")
+    with np.errstate(invalid="ignore"):
+        return bool(np.all((v >= lo) & (v <= hi) & (np.trunc(v) == v)))
+
+
+def _check_integer_columns(tr: Trace) -> str:
+    """The columns that stand for integers hold integers in range (the C++ reader's
+    check_integer_columns): '' when they do, else the first problem."""
+    checks = [
+        ("ticks", "num_contacts", 0, 2 ** 31 - 1), ("ticks", "status", 0, max(DEVICE_STATUS)),
+        ("ticks", "flags", 0, 2 ** 32 - 1), ("ticks", "buttons", 0, 2 ** 32 - 1),
+        ("steps", "step", 0, MAX_COUNT), ("steps", "num_contacts", 0, 2 ** 31 - 1),
+        ("steps", "status", -2 ** 31, 2 ** 31 - 1), ("contacts", "step", 0, MAX_COUNT),
+        ("events", "code", 0, 2 ** 32 - 1),
+    ]
+    if not np.all(np.isfinite(tr.ticks["t"])):
+        return "ticks: t is not finite"
+    for stream, column, lo, hi in checks:
+        if not _integers_in(getattr(tr, stream)[column], lo, hi):
+            return f"{stream}: {column} is not an integer in [{lo}, {hi}]"
+    return ""
 
 
 def _flat(arr: np.ndarray, name: str) -> tuple[list[str], np.ndarray]:

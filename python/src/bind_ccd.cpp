@@ -146,8 +146,9 @@ struct ExactContact {
 // structures (BVHs, workspace) and, built on first use, the exact ones.
 class CcdMeshPair {
  public:
-  CcdMeshPair(const MatrixX3d& obstacle_V, const MatrixX3i& obstacle_F, const MatrixX3d& god_V,
-              const MatrixX3i& god_F) {
+  CcdMeshPair(const MatrixX3d& obstacle_V, const py::array& obstacle_F_in, const MatrixX3d& god_V,
+              const py::array& god_F_in) {
+    const MatrixX3i obstacle_F = faces_from(obstacle_F_in, "obstacle_F"), god_F = faces_from(god_F_in, "god_F");
     obstacle_.V = obstacle_V;
     obstacle_.F = obstacle_F;
     god_.V = god_V;
@@ -296,7 +297,7 @@ void bind_ccd(py::module_& m) {
 
   py::class_<CcdMeshPair>(ccd, "MeshPair",
                           "An obstacle (world frame) and a god-object (body frame, origin at G) for mesh-level CCD.")
-      .def(py::init<const MatrixX3d&, const MatrixX3i&, const MatrixX3d&, const MatrixX3i&>(), py::arg("obstacle_V"),
+      .def(py::init<const MatrixX3d&, const py::array&, const MatrixX3d&, const py::array&>(), py::arg("obstacle_V"),
            py::arg("obstacle_F"), py::arg("god_V"), py::arg("god_F"))
       .def_property_readonly("god_radius", &CcdMeshPair::god_radius, "max |r_B| over the god-object's vertices")
       .def("step", &CcdMeshPair::step, py::arg("p0"), py::arg("q0"), py::arg("p1"), py::arg("q1"),

@@ -37,6 +37,13 @@ py::dict summary_dict(const BodySummary& s) {
 }
 }  // namespace
 
+Scene load_scene_warning(const std::string& path) {
+  Scene scene = load_scene(path);
+  for (const std::string& w : scene.warnings)
+    if (PyErr_WarnEx(PyExc_UserWarning, w.c_str(), 1) != 0) throw py::error_already_set();
+  return scene;
+}
+
 void bind_core(py::module_& m) {
   // Every load-time error (load_error.h: scenes, meshes, CCD query and projection-
   // instance files) becomes gauss6.LoadError, a ValueError with the same message
@@ -105,20 +112,20 @@ void bind_core(py::module_& m) {
         },
         py::arg("path"), "Reads an OBJ/OFF/PLY/STL triangle mesh: returns (V #Vx3 float64, F #Fx3 int32).");
   m.def("validate_mesh",
-        [](const MatrixX3d& V, const MatrixX3i& F, bool self_intersections) {
+        [](const MatrixX3d& V, const py::array& F, bool self_intersections) {
           TriangleMesh mesh;
           mesh.V = V;
-          mesh.F = F;
+          mesh.F = faces_from(F);
           MeshReport r = validate_mesh(mesh);
           if (self_intersections && r.num_bad_indices == 0) r.num_self_intersections = count_self_intersections(mesh);
           return r;
         },
         py::arg("V"), py::arg("F"), py::arg("self_intersections") = false);
   m.def("mass_properties",
-        [](const MatrixX3d& V, const MatrixX3i& F, double density) {
+        [](const MatrixX3d& V, const py::array& F, double density) {
           TriangleMesh mesh;
           mesh.V = V;
-          mesh.F = F;
+          mesh.F = faces_from(F);
           MassProperties mp;
           std::string error;
           if (!compute_mass_properties(mesh, density, &mp, &error)) throw py::value_error(error);
@@ -151,8 +158,9 @@ void bind_core(py::module_& m) {
   py::class_<Scene>(m, "Scene", "A loaded and validated scene (opaque; gauss6.load_scene).")
       .def_readonly("path", &Scene::path)
       .def_readonly("name", &Scene::name);
-  m.def("load_scene", &load_scene, py::arg("path"),
-        "Loads and validates a scene file and its meshes (raises LoadError naming file, line and key).");
+  m.def("load_scene", &load_scene_warning, py::arg("path"),
+        "Loads and validates a scene file and its meshes (raises LoadError naming file, line and key; "
+        "what the loader repaired, e.g. an inside-out mesh flipped, is a UserWarning).");
   m.def("scene_summary",
         [](const Scene& scene, bool self_intersections) {
           py::list bodies;

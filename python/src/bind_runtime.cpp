@@ -27,7 +27,7 @@ using MatrixX3d = Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor>;
 using MatrixX3i = Eigen::Matrix<int32_t, Eigen::Dynamic, 3, Eigen::RowMajor>;
 
 // A scene's errors reach Python as gauss6.LoadError (bind_core registers it).
-Scene load(const std::string& path) { return load_scene(path); }
+Scene load(const std::string& path) { return load_scene_warning(path); }
 
 // The settings a run of the scene uses (resolve_runtime_settings on the default
 // RuntimeSettings): what `gauss6 scene info` prints.

@@ -5,6 +5,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <cmath>
 #include <atomic>
 #include <bit>
 #include <chrono>
@@ -189,6 +190,40 @@ void put_pose(double* out, const Pose& x) {
 
 Pose get_pose(const double* in) { return {Vec3(in[0], in[1], in[2]), Quat{in[3], in[4], in[5], in[6]}}; }
 
+// v is an integer in [lo, hi] (false for NaN and infinities): the reader's check
+// before a value from the file is cast to an integer type.
+bool integer_in(double v, double lo, double hi) { return v >= lo && v <= hi && std::trunc(v) == v; }
+
+constexpr double kMaxCount = 9007199254740992.0;  // 2^53: every count a double holds exactly
+
+// The integer columns of every row, checked once at read time so that trace_tick()
+// and the replay device cast only in-range values. Empty when all are valid.
+std::string check_integer_columns(const Trace& tr) {
+  auto bad = [](const char* stream, size_t row, const char* column, double v) {
+    return std::string(stream) + " row " + std::to_string(row) + ": " + column + " = " + std::to_string(v) +
+           " is not an integer in range";
+  };
+  for (size_t i = 0; i < tr.ticks.num_rows(); ++i) {
+    const double* r = tr.ticks.row(i);
+    if (!std::isfinite(r[0])) return bad("ticks", i, "t", r[0]);
+    if (!integer_in(r[21], 0, 2147483647.0)) return bad("ticks", i, "num_contacts", r[21]);
+    if (!integer_in(r[23], 0, static_cast<double>(DeviceStatus::kError))) return bad("ticks", i, "status", r[23]);
+    if (!integer_in(r[24], 0, 4294967295.0)) return bad("ticks", i, "flags", r[24]);
+    if (!integer_in(r[25], 0, 4294967295.0)) return bad("ticks", i, "buttons", r[25]);
+  }
+  for (size_t i = 0; i < tr.steps.num_rows(); ++i) {
+    const double* r = tr.steps.row(i);
+    if (!integer_in(r[0], 0, kMaxCount)) return bad("steps", i, "step", r[0]);
+    if (!integer_in(r[3], 0, 2147483647.0)) return bad("steps", i, "num_contacts", r[3]);
+    if (!integer_in(r[4], -2147483648.0, 2147483647.0)) return bad("steps", i, "status", r[4]);
+  }
+  for (size_t i = 0; i < tr.contacts.num_rows(); ++i)
+    if (!integer_in(tr.contacts.row(i)[0], 0, kMaxCount)) return bad("contacts", i, "step", tr.contacts.row(i)[0]);
+  for (size_t i = 0; i < tr.events.num_rows(); ++i)
+    if (!integer_in(tr.events.row(i)[1], 0, 4294967295.0)) return bad("events", i, "code", tr.events.row(i)[1]);
+  return {};
+}
+
 }  // namespace
 
 struct TraceWriter::Impl {
@@ -200,6 +235,7 @@ struct TraceWriter::Impl {
   std::array<std::atomic<uint64_t>, 4> dropped{};
   std::array<uint64_t, 4> written{};
   uint64_t num_flushes = 0, num_chunks = 0;
+  double last_flush_run_time = 0;  // flush_if_due(): the run time of the last flush
   std::vector<double> staging;     // rows_per_chunk x widest row, preallocated
   mutable std::mutex file_mutex;   // the flush thread against flush()/close(): never taken by append
   std::mutex wake_mutex;
@@ -365,6 +401,19 @@ void TraceWriter::flush() {
   impl_->flush_locked();
 }
 
+bool TraceWriter::flush_if_due(double run_time) {
+  Impl& m = *impl_;
+  if (!(run_time - m.last_flush_run_time >= m.settings.flush_period)) return false;
+  m.last_flush_run_time = run_time;
+  std::lock_guard<std::mutex> g(m.file_mutex);
+  try {
+    m.flush_locked();
+  } catch (const TraceError&) {
+    // A failing disk: the run goes on; close() reports it by throwing again.
+  }
+  return true;
+}
+
 void TraceWriter::close() {
   Impl& m = *impl_;
   if (m.thread.joinable()) {
@@ -412,7 +461,12 @@ const std::string& TraceWriter::path() const { return impl_->path; }
 Trace read_trace(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
   if (!in) throw TraceError(path, "cannot open the file");
-  const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  std::string bytes;
+  try {
+    bytes.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+  } catch (const std::bad_alloc&) {
+    throw TraceError(path, "out of memory reading the file");
+  }
   const size_t size = bytes.size();
   auto fail = [&](const std::string& problem) { return TraceError(path, problem); };
 
@@ -433,6 +487,9 @@ Trace read_trace(const std::string& path) {
     throw fail("metadata block of " + std::to_string(meta_len) + " bytes runs past the end of the file");
   trace.meta_json = bytes.substr(kHeader, meta_len);
   if (!nlohmann::json::accept(trace.meta_json)) throw fail("the metadata block is not valid JSON");
+  if (const size_t first = trace.meta_json.find_first_not_of(" \t\r\n");
+      first == std::string::npos || trace.meta_json[first] != '{')
+    throw fail("the metadata block is not a JSON object");
 
   trace.ticks.num_cols = kTickCols;
   trace.steps.num_cols = kStepCols;
@@ -477,6 +534,9 @@ Trace read_trace(const std::string& path) {
           for (int s = 0; s < 4; ++s) {
             double d;
             std::memcpy(&d, payload + 8 * s, 8);
+            if (!integer_in(d, 0, kMaxCount))
+              throw fail("end chunk at byte " + std::to_string(pos) + ": dropped count " + std::to_string(d) +
+                         " is not an integer in [0, 2^53]");
             trace.dropped[s] = static_cast<uint64_t>(d);
           }
         }
@@ -488,11 +548,12 @@ Trace read_trace(const std::string& path) {
     }
     if (table) {
       const size_t old = table->data.size();
-      table->data.resize(old + n);
+      table->data.resize(old + n);  // n * 8 <= the file's size: bounded above
       std::memcpy(table->data.data() + old, payload, n * 8);
     }
     pos += 16 + n * 8;
   }
+  if (const std::string problem = check_integer_columns(trace); !problem.empty()) throw fail(problem);
   if (!trace.complete && trace.warnings.empty())
     trace.warnings.push_back(path + ": no end chunk: the writer did not close the file (a crash loses the last flush period)");
   return trace;

@@ -10,8 +10,10 @@
 //     status, and one contact row per contact (point, normal, separation);
 //   events:          each phase's start (value: its index in the metadata's
 //     phases), the let-go, watchdog trips, the script's end.
-// The writer's background thread flushes the file every flush_period (<= 1 s),
-// so a crash loses at most that much of the run.
+// The file is flushed every flush_period (<= 1 s) of run time, so a crash loses at
+// most that much of the run: a threaded run by the writer's background thread (run
+// time is wall time), a lockstep run (many times faster than the wall clock) from
+// its haptic hook (TraceWriter::flush_if_due).
 //
 // It also feeds the property observers (property_observers.h): per coupling
 // step, orthogonality Fc . ac = 0 and the constraint stage's energy balance
@@ -24,6 +26,7 @@
 #pragma once
 
 #include <array>
+#include <atomic>
 #include <functional>
 #include <string>
 
@@ -53,6 +56,9 @@ struct ScenarioOptions {
   // the run's time so far (s), and once at the end. May be empty.
   std::function<void(double run_time)> progress;
   double progress_period = 0.2;        // s (wall)
+  // When set, each haptic tick stores its run time here (relaxed): what a supervisor
+  // (another thread, or another process through shared memory) sees of the run.
+  std::atomic<double>* run_time_out = nullptr;
 };
 
 struct ScenarioResult {

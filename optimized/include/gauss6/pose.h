@@ -28,7 +28,14 @@ struct Quat {
 
 Quat operator*(const Quat& a, const Quat& b);  // Hamilton product
 Quat conjugate(const Quat& q);
+// q / |q|, computed on rescaled(q), so that no |q| overflows or underflows
+// (a non-zero finite q never normalises to NaN). NaN for a zero or non-finite q.
 Quat normalized(const Quat& q);
+// q times a power of two (exact: R(q) and normalized(q) do not change) so that its
+// largest component lies in [2^-400, 2^400]; q itself when it already does, or when
+// it is zero or not finite. Poses that enter the library from outside (scene files,
+// bindings, replayed samples) are rescaled so that products of them stay finite.
+Quat rescaled(const Quat& q);
 
 // Pose of a body in the world: position of G and orientation.
 struct Pose {
@@ -51,7 +58,9 @@ Vec6 pose_difference(const Pose& xh, const Pose& xs);
 // xs (+) a = (ps + aG, exp(alpha) * qs), the result's quaternion normalised.
 Pose pose_update(const Pose& xs, const Vec6& a);
 
-// True when every coordinate is finite and q is not (numerically) zero.
+// True when every coordinate is finite, q is not zero and its largest component is
+// in [2^-400, 2^400] (see rescaled(): |q|^2 and products of two such quaternions
+// are then finite and non-zero).
 bool is_valid_pose(const Pose& x);
 
 }  // namespace gauss6

@@ -106,6 +106,9 @@ struct Scene {
   ContactParameters contact;
   SurfaceSettings surface;
   DeviceSettings device;
+  // What the loader repaired, one line each ("obstacle[0].mesh: box.off: closed but
+  // inside out (signed volume -0.001): faces flipped"). Empty for a clean scene.
+  std::vector<std::string> warnings;
 };
 
 // The rules a scene's settings must meet (docs/scene-format.md, "Rules"), stated

@@ -10,6 +10,9 @@
 #include <cstddef>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
+#include <limits>
+#include <new>
 #include <string>
 #include <vector>
 
@@ -19,12 +22,17 @@
 #include <CGAL/IO/PLY.h>
 #include <CGAL/IO/STL.h>
 
+#include "load/mesh_file_checks.h"
+
 namespace gauss6 {
 namespace {
 
 using Kernel = CGAL::Simple_cartesian<double>;  // coordinates only: no predicates needed here
 using Point = Kernel::Point_3;
 using Polygon = std::vector<std::size_t>;
+
+// Larger mesh files are refused before they are read (the bunny is 2 MB).
+constexpr std::uintmax_t kMaxMeshFileBytes = std::uintmax_t(1) << 30;
 
 enum class Format { kObj, kOff, kPly, kStl };
 
@@ -65,26 +73,52 @@ TriangleMesh read_mesh(const std::string& path) {
   if (!std::filesystem::is_regular_file(path, ec))
     fail(path, "no such file (or not a regular file)");
   if (!std::ifstream(path, std::ios::binary).good()) fail(path, "cannot open the file for reading");
-  if (std::filesystem::file_size(path, ec) == 0) fail(path, "the file is empty");
+  const std::uintmax_t size = std::filesystem::file_size(path, ec);
+  if (size == 0) fail(path, "the file is empty");
+  if (size > kMaxMeshFileBytes)
+    fail(path, "the file has " + std::to_string(size) + " bytes, more than the " +
+                   std::to_string(kMaxMeshFileBytes) + " a mesh file may have");
+
+  // Headers checked and every count bounded by the file's size before CGAL's
+  // readers allocate anything from them (mesh_file_checks.h).
+  {
+    std::ifstream in(path, std::ios::binary);
+    const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    switch (format) {
+      case Format::kObj: break;  // no counts
+      case Format::kOff: detail::check_off_structure(path, bytes); break;
+      case Format::kPly: detail::check_ply_structure(path, bytes); break;
+      case Format::kStl: detail::check_stl_structure(path, bytes); break;
+    }
+  }
 
   std::vector<Point> points;
   std::vector<Polygon> polygons;
   const auto quiet = CGAL::parameters::verbose(false);
   bool parsed = false;
-  switch (format) {
-    case Format::kObj: parsed = CGAL::IO::read_OBJ(path, points, polygons, quiet); break;
-    case Format::kOff: parsed = CGAL::IO::read_OFF(path, points, polygons, quiet); break;
-    case Format::kPly: parsed = CGAL::IO::read_PLY(path, points, polygons, quiet); break;
-    // CGAL's STL reader already shares exactly equal corners between facets (it
-    // indexes points through a std::map), which is the duplicate-point merge STL
-    // needs; other formats keep the file's own vertex numbering.
-    case Format::kStl: parsed = CGAL::IO::read_STL(path, points, polygons, quiet); break;
+  try {
+    switch (format) {
+      case Format::kObj: parsed = CGAL::IO::read_OBJ(path, points, polygons, quiet); break;
+      case Format::kOff: parsed = CGAL::IO::read_OFF(path, points, polygons, quiet); break;
+      case Format::kPly: parsed = CGAL::IO::read_PLY(path, points, polygons, quiet); break;
+      // CGAL's STL reader already shares exactly equal corners between facets (it
+      // indexes points through a std::map), which is the duplicate-point merge STL
+      // needs; other formats keep the file's own vertex numbering.
+      case Format::kStl: parsed = CGAL::IO::read_STL(path, points, polygons, quiet); break;
+    }
+  } catch (const std::bad_alloc&) {
+    fail(path, "out of memory while reading the file");
+  } catch (const std::exception& e) {
+    fail(path, std::string("cannot parse as ") + format_name(format) + ": " + e.what());
   }
   if (!parsed)
     fail(path, std::string("cannot parse as ") + format_name(format) +
                    " (malformed line, non-numeric or non-finite coordinate, bad face index, "
                    "or no faces)");
   if (points.empty() || polygons.empty()) fail(path, "no vertices or no faces: the mesh is empty");
+  if (points.size() > static_cast<std::size_t>(std::numeric_limits<int32_t>::max()) ||
+      polygons.size() > static_cast<std::size_t>(std::numeric_limits<int32_t>::max()))
+    fail(path, "more than 2^31 - 1 vertices or faces");
 
   // Copy into the library's arrays, checking each face and coordinate.
   TriangleMesh m;

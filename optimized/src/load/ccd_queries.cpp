@@ -124,6 +124,12 @@ std::vector<CcdQuery> read_ccd_queries(const std::string& path, CcdQuery::Kind k
         den = negate(den);
         num = negate(num);
       }
+      // to_double() reads integers of up to 127 bits: refuse wider ones here, by line.
+      for (const std::string* v : {&num, &den})
+        if (v->size() - ((*v)[0] == '-') > 38 ||
+            (v->size() - ((*v)[0] == '-') == 38 && v->substr((*v)[0] == '-') > "170141183460469231731687303715884105727"))
+          fail(path, line_number, "column " + std::to_string(2 * c + (v == &num ? 1 : 2)) +
+                                      ": integer wider than 127 bits");
       p.xyz[c] = {num, den};
     }
     if (++row == 8) {

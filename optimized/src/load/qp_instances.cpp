@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <fstream>
 #include <sstream>
 
@@ -72,7 +73,11 @@ struct Where {
 
   int integer(const json& v, const std::string& key) const {
     if (!v.is_number_integer()) fail(key, "is not an integer");
-    return v.get<int>();
+    // Read as 64 bits and range-checked: get<int>() would narrow 4294967297 to 1.
+    if (v.is_number_unsigned() ? v.get<uint64_t>() > static_cast<uint64_t>(INT32_MAX)
+                               : (v.get<int64_t>() < INT32_MIN || v.get<int64_t>() > INT32_MAX))
+      fail(key, "is out of the range of a 32-bit integer");
+    return static_cast<int>(v.get<int64_t>());
   }
 
   std::string string(const json& v, const std::string& key) const {

@@ -11,6 +11,7 @@
 #include <Eigen/Eigenvalues>
 #include <toml++/toml.h>
 
+#include "gauss6/mass_properties.h"
 #include "gauss6/mesh_io.h"
 
 namespace gauss6 {
@@ -18,6 +19,11 @@ namespace gauss6 {
 namespace {
 
 namespace fs = std::filesystem;
+
+// Coordinates (positions, mesh vertices) beyond this are refused: the CCD's
+// pair tests refuse coordinates beyond 1e30 (src/ccd.cpp); 1e12 leaves room for
+// poses and motions.
+constexpr double kMaxSceneCoordinate = 1e12;
 
 // Reads typed values out of one TOML table, naming file:line:col and the dotted key in errors.
 class TableReader {
@@ -127,6 +133,7 @@ class TableReader {
 
   const toml::table& table() const { return table_; }
   const std::string& file() const { return file_; }
+  const std::string& prefix() const { return prefix_; }
 
  private:
   const std::string& file_;
@@ -161,13 +168,17 @@ Pose read_pose(const TableReader& r) {
   Pose x;
   x.p = r.vector<3>("position", &zero);
   const Eigen::Vector4d q = r.vector<4>("orientation", &identity);
-  require(q.norm() > 1e-12, r, "orientation", "must be a non-zero quaternion (w, x, y, z)");
+  // stableNorm: scaled, so that (1e300, 1e300, 0, 0) neither overflows nor passes as NaN.
+  require(q.stableNorm() > 1e-12, r, "orientation", "must be a non-zero quaternion (w, x, y, z)");
   x.q = normalized(Quat{q[0], q[1], q[2], q[3]});
+  // Positions beyond this are far outside any scene the CCD's bounds serve.
+  require(x.p.cwiseAbs().maxCoeff() <= kMaxSceneCoordinate, r, "position",
+          "must be within " + std::to_string(kMaxSceneCoordinate) + " of the origin");
   return x;
 }
 
 // Reads and validates a body's mesh; the path is relative to the scene file.
-void read_body_mesh(const TableReader& r, Body* body) {
+void read_body_mesh(const TableReader& r, Body* body, std::vector<std::string>* warnings) {
   const std::string rel = r.string("mesh");
   const fs::path scene_dir = fs::path(r.file()).parent_path();
   body->mesh_path = (scene_dir / rel).lexically_normal().string();
@@ -180,8 +191,42 @@ void read_body_mesh(const TableReader& r, Body* body) {
   const MeshReport& rep = body->report;
   if (rep.num_nonfinite_vertices || rep.num_bad_indices || rep.num_degenerate_triangles)
     r.fail(r.node("mesh")->source(), "mesh", body->mesh_path + ": unusable mesh:\n" + rep.describe());
+  if (body->mesh.V.cwiseAbs().maxCoeff() > kMaxSceneCoordinate)
+    r.fail(r.node("mesh")->source(), "mesh",
+           body->mesh_path + ": a vertex coordinate beyond " + std::to_string(kMaxSceneCoordinate));
+  // A closed, consistently oriented mesh whose faces are wound inward encloses a
+  // negative volume: its normals point into the body and contacts with it would
+  // render no force. Flip it, and say so.
+  if (rep.closed()) {
+    MassProperties mp;
+    if (!compute_mass_properties(body->mesh, /*density=*/1.0, &mp, nullptr)) {
+      TriangleMesh flipped = body->mesh;
+      const Eigen::VectorXi second = flipped.F.col(1);
+      flipped.F.col(1) = flipped.F.col(2);
+      flipped.F.col(2) = second;
+      if (compute_mass_properties(flipped, /*density=*/1.0, &mp, nullptr)) {
+        body->mesh = std::move(flipped);
+        warnings->push_back(r.prefix() + "mesh: " + body->mesh_path +
+                            ": closed but inside out (faces wound inward, enclosing a negative volume): "
+                            "faces flipped");
+      }
+    }
+  }
   build_adjacency(&body->mesh);
   compute_vertex_normals(&body->mesh);
+}
+
+// The god-object's mass and inertia about G must give a mass matrix the
+// projection can factor in doubles: every value normal (no subnormals), within
+// [1e-100, 1e100], and the inertia's condition number at most 1e12.
+void check_god_mass(const TableReader& r, const char* key, const MassProperties& mp, const Mat3& I_G) {
+  auto in_range = [](double v) { return std::isfinite(v) && v >= 1e-100 && v <= 1e100; };
+  require(in_range(mp.mass), r, key, "the mass must be within [1e-100, 1e100] (got " + std::to_string(mp.mass) + ")");
+  Eigen::SelfAdjointEigenSolver<Mat3> eig(I_G);
+  const double lo = eig.eigenvalues().minCoeff(), hi = eig.eigenvalues().maxCoeff();
+  require(in_range(lo) && in_range(hi) && hi <= 1e12 * lo, r, key,
+          "the inertia about the reference point must have eigenvalues within [1e-100, 1e100] and a "
+          "condition number of at most 1e12");
 }
 
 }  // namespace
@@ -202,10 +247,12 @@ Scene load_scene(const std::string& path) {
   TableReader top(path, root, "");
   top.allow_only({"format", "version", "name", "gains", "contact", "obstacle", "god_object", "surface", "device"});
   require(top.string("format") == "gauss6-scene", top, "format", "must be \"gauss6-scene\"");
-  scene.version = static_cast<int>(top.integer("version"));
-  require(scene.version == kSceneFormatVersion, top, "version",
-          "unsupported version " + std::to_string(scene.version) + " (this build reads version " +
+  // Compared as the file's 64-bit integer: 4294967297 is not version 1.
+  const int64_t version = top.integer("version");
+  require(version == kSceneFormatVersion, top, "version",
+          "unsupported version " + std::to_string(version) + " (this build reads version " +
               std::to_string(kSceneFormatVersion) + ")");
+  scene.version = static_cast<int>(version);
   scene.name = top.string("name");
 
   // [gains]
@@ -243,7 +290,7 @@ Scene load_scene(const std::string& path) {
       b.name = r.string("name");
       claim_name(r, b.name);
       b.pose = read_pose(r);
-      read_body_mesh(r, &b);
+      read_body_mesh(r, &b, &scene.warnings);
       const double crease_default = b.crease_angle;
       b.crease_angle = r.number("crease_angle", &crease_default);
       require(check_crease_angle(b.crease_angle), r);
@@ -261,7 +308,7 @@ Scene load_scene(const std::string& path) {
     b.name = r.string("name");
     claim_name(r, b.name);
     const Pose X_WM = read_pose(r);  // pose of the mesh's own frame
-    read_body_mesh(r, &b);
+    read_body_mesh(r, &b, &scene.warnings);
     GodObjectMass& gm = scene.god_mass;
     const bool has_density = r.has("density");
     const bool has_given = r.has("mass") || r.has("center_of_mass") || r.has("inertia");
@@ -293,6 +340,17 @@ Scene load_scene(const std::string& path) {
     }
     // Body frame B: origin at G (the centre of mass unless reference_point is given).
     const Vec3 G = r.vector<3>("reference_point", &mp.center_of_mass);
+    // G far from the mesh makes the body-frame vertices lose their digits (a vertex
+    // 1 m from a G 1e17 away is rounded to 16 m): G within 100 bounding-box diagonals.
+    {
+      const Vec3 lo = b.mesh.V.colwise().minCoeff(), hi = b.mesh.V.colwise().maxCoeff();
+      const double diagonal = (hi - lo).norm();
+      require((G - 0.5 * (lo + hi)).norm() <= 100 * diagonal, r, "reference_point",
+              "must lie within 100 bounding-box diagonals of the mesh (" + std::to_string(diagonal) + ")");
+      const Vec3 c = mp.center_of_mass - G;
+      const Mat3 I_G = mp.inertia + mp.mass * (c.squaredNorm() * Mat3::Identity() - c * c.transpose());
+      check_god_mass(r, has_density ? "density" : "mass", mp, I_G);
+    }
     gm.mesh_to_body = G;
     for (int v = 0; v < b.mesh.V.rows(); ++v) b.mesh.V.row(v) -= G.transpose();
     mp.center_of_mass -= G;
@@ -366,6 +424,10 @@ Scene load_scene(const std::string& path) {
     } else if (kind == "hid") {
       d.kind = DeviceKind::kHid;
       const int64_t any = -1;
+      // USB ids are 16-bit; -1 means any.
+      for (const char* k : {"vendor_id", "product_id"})
+        if (const int64_t id = r.integer(k, &any); id < -1 || id > 0xFFFF)
+          require(false, r, k, "must be a 16-bit USB id in [0, 65535] (or -1 for any)");
       d.vendor_id = static_cast<int>(r.integer("vendor_id", &any));
       d.product_id = static_cast<int>(r.integer("product_id", &any));
       const std::string blank;

@@ -119,7 +119,8 @@ class TraceError : public LoadError {
 };
 
 struct TraceWriterSettings {
-  double flush_period = 0.25;           // s between flushes of the background thread (<= 1 s)
+  double flush_period = 0.25;           // s between flushes (<= 1 s): of wall time by the background
+                                        // thread, of run time by flush_if_due()
   size_t tick_capacity = 1u << 15;      // rows per ring, rounded up to a power of two
   size_t step_capacity = 1u << 12;
   size_t contact_capacity = 1u << 16;
@@ -152,6 +153,11 @@ class TraceWriter {
 
   // Non-real-time: write what the rings hold as chunks and flush the file.
   void flush();
+  // Flushes when flush_period s of run time have passed since the last call that
+  // flushed: the bound a crash may lose, in run time, for runs faster than the wall
+  // clock (a lockstep run flushes from its loop's thread, 17-50x real time). Called by
+  // one thread; not for real-time threads (it writes the file). True if it flushed.
+  bool flush_if_due(double run_time);
   // Stops the thread, flushes, writes the end chunk (dropped counts) and closes. Idempotent.
   void close();
 

@@ -1,0 +1,43 @@
+#!/usr/bin/env bash
+# Runs every libFuzzer target of fuzz/ (one per parser) for FUZZ_SECONDS each
+# (argument 1, default 180), in the clang build build-fuzz/ (ASan, UBSan with
+# float-cast-overflow), which it configures and builds first. Each target starts
+# from its checked-in seeds and regressions (fuzz/corpus/<t>/, fuzz/regressions/<t>/)
+# and grows a working corpus in build-fuzz/corpus/<t>/. A crash is copied into
+# fuzz/regressions/<t>/ (check it in: the ctest test fuzz/replay/<t> replays it
+# in every `make test`), and the script fails. Called by `make fuzz` and, for a
+# few seconds a target, by `make test`.
+set -euo pipefail
+root=$(cd "$(dirname "$0")/.." && pwd)
+cd "$root"
+seconds=${1:-${FUZZ_SECONDS:-180}}
+targets=(scene obj off ply stl trace ccd_queries qp_instances hand_script)
+
+if ! command -v clang++ >/dev/null; then
+  echo "gauss6 fuzz: clang++ not found (tools/debian-packages.txt: clang, libclang-rt-14-dev)" >&2
+  exit 1
+fi
+launcher=()
+command -v ccache >/dev/null && launcher=(-DCMAKE_CXX_COMPILER_LAUNCHER=ccache)
+if [ ! -f build-fuzz/build.ninja ]; then
+  cmake -S fuzz -B build-fuzz -G Ninja -DCMAKE_CXX_COMPILER=clang++ -DCMAKE_BUILD_TYPE=RelWithDebInfo "${launcher[@]}" >/dev/null
+fi
+cmake --build build-fuzz -j "${GAUSS6_JOBS:-$(nproc)}"
+
+status=0
+for t in "${targets[@]}"; do
+  mkdir -p "build-fuzz/corpus/$t" "build-fuzz/artifacts/$t"
+  # Quiet unless something is found; the last line says how far it got.
+  if ! build-fuzz/fuzz_"$t" "build-fuzz/corpus/$t" "fuzz/corpus/$t" "fuzz/regressions/$t" \
+       -max_total_time="$seconds" -timeout=10 -rss_limit_mb=2048 -max_len=65536 \
+       -artifact_prefix="build-fuzz/artifacts/$t/" -print_final_stats=0 >"build-fuzz/fuzz_$t.log" 2>&1; then
+    status=1
+    echo "gauss6 fuzz: $t FOUND A CRASH (log: build-fuzz/fuzz_$t.log)"
+    for a in build-fuzz/artifacts/"$t"/*; do
+      [ -f "$a" ] && cp "$a" "fuzz/regressions/$t/" && echo "  kept as fuzz/regressions/$t/$(basename "$a")"
+    done
+  else
+    echo "gauss6 fuzz: $t: $(grep -Eo '#[0-9]+.*(cov|DONE)[^ ]* *[0-9]*' "build-fuzz/fuzz_$t.log" | tail -1) in ${seconds}s, no crash"
+  fi
+done
+exit $status
