@@ -11,6 +11,16 @@ set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
 cd "$root"
 seconds=${1:-${FUZZ_SECONDS:-180}}
+# FUZZ_RUNS=N: a fixed number of inputs per target from a fixed seed instead of a time
+# budget, so that the same build explores the same inputs on any machine (make test's
+# short run: a red result then comes from the change, not from the machine's speed).
+if [ -n "${FUZZ_RUNS:-}" ]; then
+  budget=(-runs="$FUZZ_RUNS" -seed="${FUZZ_SEED:-1}")
+  what="$FUZZ_RUNS inputs (seed ${FUZZ_SEED:-1})"
+else
+  budget=(-max_total_time="$seconds")
+  what="${seconds}s"
+fi
 targets=(scene obj off ply stl trace ccd_queries qp_instances hand_script)
 
 if ! command -v clang++ >/dev/null; then
@@ -29,7 +39,7 @@ for t in "${targets[@]}"; do
   mkdir -p "build-fuzz/corpus/$t" "build-fuzz/artifacts/$t"
   # Quiet unless something is found; the last line says how far it got.
   if ! build-fuzz/fuzz_"$t" "build-fuzz/corpus/$t" "fuzz/corpus/$t" "fuzz/regressions/$t" \
-       -max_total_time="$seconds" -timeout=10 -rss_limit_mb=2048 -max_len=65536 \
+       "${budget[@]}" -timeout=10 -rss_limit_mb=2048 -max_len=65536 \
        -artifact_prefix="build-fuzz/artifacts/$t/" -print_final_stats=0 >"build-fuzz/fuzz_$t.log" 2>&1; then
     status=1
     echo "gauss6 fuzz: $t FOUND A CRASH (log: build-fuzz/fuzz_$t.log)"
@@ -37,7 +47,7 @@ for t in "${targets[@]}"; do
       [ -f "$a" ] && cp "$a" "fuzz/regressions/$t/" && echo "  kept as fuzz/regressions/$t/$(basename "$a")"
     done
   else
-    echo "gauss6 fuzz: $t: $(grep -Eo '#[0-9]+.*(cov|DONE)[^ ]* *[0-9]*' "build-fuzz/fuzz_$t.log" | tail -1) in ${seconds}s, no crash"
+    echo "gauss6 fuzz: $t: $(grep -Eo '#[0-9]+.*(cov|DONE)[^ ]* *[0-9]*' "build-fuzz/fuzz_$t.log" | tail -1) in $what, no crash"
   fi
 done
 exit $status

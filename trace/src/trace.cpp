@@ -546,7 +546,7 @@ Trace read_trace(const std::string& path) {
         trace.warnings.push_back(path + ": skipped a chunk of unknown type " + std::to_string(type) + " at byte " +
                                  std::to_string(pos));
     }
-    if (table) {
+    if (table && n > 0) {  // (an empty chunk adds no row; memcpy takes no null pointer)
       const size_t old = table->data.size();
       table->data.resize(old + n);  // n * 8 <= the file's size: bounded above
       std::memcpy(table->data.data() + old, payload, n * 8);

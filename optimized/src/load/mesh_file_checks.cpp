@@ -130,6 +130,7 @@ bool ply_type_signed(std::string_view type) {
 }
 
 struct PlyProperty {
+  std::string_view name, type;  // type: a scalar's (lists: the items')
   bool is_list = false;
   std::string_view count_type;  // lists only
   int count_size = 0;           // lists only
@@ -162,8 +163,18 @@ void check_ply_structure(const std::string& path, const std::string& bytes) {
   // Header: lines up to "end_header".
   const std::string_view all(bytes);
   if (all.substr(0, 3) != "ply") fail(path, "cannot parse as PLY: the file does not start with 'ply'");
-  const size_t end_tag = all.find("end_header");
+  // "end_header" alone on its line (not inside another line, which a reader may take
+  // for the header's end where this check does not).
+  size_t end_tag = std::string_view::npos;
+  for (size_t at = all.find("\nend_header"); at != std::string_view::npos; at = all.find("\nend_header", at + 1)) {
+    const size_t after = at + 11;
+    if (after == all.size() || all[after] == '\n' || (all[after] == '\r' && after + 1 < all.size() && all[after + 1] == '\n')) {
+      end_tag = at + 1;
+      break;
+    }
+  }
   if (end_tag == std::string_view::npos) fail(path, "cannot parse as PLY: no 'end_header' line");
+  if (all.find("end_header") < end_tag) fail(path, "cannot parse as PLY: 'end_header' inside another header line");
   size_t body = all.find('\n', end_tag);
   body = body == std::string_view::npos ? all.size() : body + 1;
   std::string format;
@@ -191,9 +202,13 @@ void check_ply_structure(const std::string& path, const std::string& bytes) {
         p.count_type = t[2];
         p.count_size = ply_type_size(t[2]);
         p.value_size = ply_type_size(t[3]);
+        p.type = t[3];
+        p.name = t[4];
         if (!p.count_size || !p.value_size) fail(path, at + "unknown type in 'property list'");
       } else if (t.size() == 3) {
         p.value_size = ply_type_size(t[1]);
+        p.type = t[1];
+        p.name = t[2];
         if (!p.value_size) fail(path, at + "unknown property type '" + std::string(t[1]) + "'");
       } else {
         fail(path, at + "expected 'property TYPE NAME' or 'property list COUNT_TYPE TYPE NAME'");
@@ -204,6 +219,20 @@ void check_ply_structure(const std::string& path, const std::string& bytes) {
     }
   }
   if (format.empty()) fail(path, "cannot parse as PLY: no 'format' line");
+  // The vertices' coordinates share one floating-point type: CGAL's reader takes the
+  // point's type from x and reads y and z as that type (another one crashes it).
+  for (const PlyElement& e : elements) {
+    if (e.name != "vertex") continue;
+    std::string_view coordinate_type;
+    for (const PlyProperty& p : e.properties) {
+      if (p.name != "x" && p.name != "y" && p.name != "z") continue;
+      const bool real = p.type == "float" || p.type == "float32" || p.type == "double" || p.type == "float64";
+      if (p.is_list || !real || (!coordinate_type.empty() && p.type != coordinate_type))
+        fail(path, "cannot parse as PLY: the vertex coordinates x, y, z must be scalars of one floating-point type "
+                   "(float or double); '" + std::string(p.name) + "' is " + (p.is_list ? "a list" : std::string(p.type)));
+      coordinate_type = p.type;
+    }
+  }
   for (const PlyElement& e : elements)
     if (e.count > 0 && e.properties.empty())
       fail(path, "cannot parse as PLY: element '" + e.name + "' has " + std::to_string(e.count) + " items but no properties");
