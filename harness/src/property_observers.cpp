@@ -9,6 +9,7 @@ namespace gauss6 {
 
 void CouplingPropertyObserver::add(const CouplingStepInfo& info) noexcept {
   if (!info.has_god_object) return;
+  if (info.shaded) ++num_shaded_steps;
   // Constraint stage's work on the command: au . Fc = -kh |ac - au|_M^2 (<= 0).
   const double w = info.au.dot(info.Fc);
   if (w > 0) energy_injected += w;
@@ -25,6 +26,19 @@ void CouplingPropertyObserver::add(const CouplingStepInfo& info) noexcept {
     max_rel_force_dot_ac = std::max(max_rel_force_dot_ac, std::abs(info.Fc.dot(info.ac)) / (nf * na));
     ++num_orthogonality_checks;
   }
+}
+
+void SimPropertyObserver::add(const RuntimeModel& model, const SimStepInfo& info) noexcept {
+  if (info.status == SimStepStatus::kNoHandle) return;
+  ++num_constraint_checks;
+  max_rel_constraint_violation = std::max(max_rel_constraint_violation, info.max_rel_constraint_violation);
+  max_texture_step = std::max(max_texture_step, info.texture_step);
+  if (!model.surface.active()) return;
+  const Mat6 M = mass_matrix_at(model, info.x_start.q);  // the M of step 3 (at xs before the step)
+  const Vec6 Fs = model.gains.kh * (M * (info.asc - info.au));
+  const double w = Fs.dot(info.ac);
+  if (w > 0) shading_work_injected += w;
+  else shading_work_removed -= w;
 }
 
 double coupling_energy(const RuntimeModel& model, const Quat& q, const Vec6& F) {

@@ -55,6 +55,9 @@ struct Recorder {
 
   // Coupling thread.
   CouplingPropertyObserver constraints;
+
+  // Sim thread.
+  SimPropertyObserver motion;
 };
 
 void on_coupling_step(void* user, const CouplingStepInfo& info) {
@@ -72,6 +75,7 @@ void on_coupling_step(void* user, const CouplingStepInfo& info) {
 void on_sim_step(void* user, const SimStepInfo& info) {
   auto* r = static_cast<Recorder*>(user);
   r->num_sim_steps.fetch_add(1, std::memory_order_relaxed);
+  r->motion.add(*r->model, info);
   TraceStep row;
   row.step = info.step - 1;  // 0, 1, 2, ...
   row.t = info.time;
@@ -250,6 +254,12 @@ ScenarioResult run_device(const RuntimeModel& model, const Scene& scene, Device*
   out.num_offset_steps = rec.constraints.num_offset_steps;
   out.constraint_energy_injected = rec.constraints.energy_injected;
   out.constraint_energy_removed = rec.constraints.energy_removed;
+  out.num_shaded_steps = rec.constraints.num_shaded_steps;
+  out.max_rel_constraint_violation = rec.motion.max_rel_constraint_violation;
+  out.num_constraint_checks = rec.motion.num_constraint_checks;
+  out.shading_work_injected = rec.motion.shading_work_injected;
+  out.shading_work_removed = rec.motion.shading_work_removed;
+  out.max_texture_step = rec.motion.max_texture_step;
   out.port_energy_max = rec.port.energy_max;
   out.port_energy_final = rec.port.energy;
   out.wall_seconds = std::chrono::duration<double>(Clock::now() - wall_start).count();

@@ -5,6 +5,7 @@
 // lockstep runs, and a threaded run.
 #include <catch2/catch.hpp>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -213,4 +214,132 @@ TEST_CASE("run_scenario: a face sliding over a sphere keeps its force (rows that
   }
   REQUIRE(sliding >= 340);
   CHECK(pushed >= 0.95 * sliding);
+}
+
+namespace {
+
+// A 12-sided prism (circumradius 3 cm, axis Y) and an octahedral probe of 5 mm
+// held by its lowest vertex (G at the tip; 0.1 kg, kh m = 1000 N/m), with the
+// given surface; the hand slides the tip around the axis 4 mm inside the flats.
+Scene make_cylinder_scene(SurfaceKind kind) {
+  Scene s;
+  s.path = "test_scenario (in code)";
+  s.name = "cylinder";
+  Body cyl;
+  cyl.name = "cylinder";
+  cyl.mesh = test::make_prism(12, 0.03, 0.08);
+  build_adjacency(&cyl.mesh);
+  cyl.pose.q = normalized(Quat{1, 1, 0, 0});  // axis z -> y: the ring in the xz plane
+  cyl.crease_angle = 45;
+  s.obstacles.push_back(cyl);
+  s.god_object.name = "probe";
+  s.god_object.role = BodyRole::kGodObject;
+  const double r = 0.005;
+  s.god_object.mesh = test::make_mesh({{r, 0, r}, {-r, 0, r}, {0, r, r}, {0, -r, r}, {0, 0, 2 * r}, {0, 0, 0}},
+                                      {{0, 2, 4}, {2, 1, 4}, {1, 3, 4}, {3, 0, 4}, {2, 0, 5}, {1, 2, 5}, {3, 1, 5}, {0, 3, 5}},
+                                      "probe");
+  s.god_object.pose.p = Vec3(0.0386 * std::cos(0.26), 0, 0.0386 * std::sin(0.26));
+  s.god_mass.from_density = false;
+  s.god_mass.mass.mass = 0.1;
+  s.god_mass.mass.center_of_mass = Vec3(0, 0, r);
+  s.god_mass.mass.inertia = 1e-4 * Mat3::Identity();
+  s.gains.ks = 0.5;
+  s.gains.kh = 10000;
+  s.contact.delta = 1e-6;
+  s.contact.offset_eps = -1e-5;
+  s.contact.offset_time = 0.05;
+  s.surface.kind = kind;
+  s.device.rate_hz = 1000;
+  s.device.script = "cylinder_slide";
+  return s;
+}
+
+HandScript make_cylinder_script() {
+  const double inside = 0.03 * std::cos(M_PI / 12) - 0.004, far = 0.0386;
+  HandScript h;
+  auto at = [](double t, double deg, double radius) {
+    HandKeyframe k;
+    k.t = t;
+    k.X_WA.p = Vec3(radius * std::cos(deg * M_PI / 180), 0, radius * std::sin(deg * M_PI / 180));
+    return k;
+  };
+  h.keys = {at(0, 15, far), at(0.3, 15, inside)};
+  for (int deg = 15; deg <= 75; ++deg) h.keys.push_back(at(0.4 + (deg - 15) * 0.02, deg, inside));
+  h.phases = {{"approach", 0.0}, {"slide", 0.4}};
+  h.end_time = 1.7;
+  return h;
+}
+
+// The largest angle (radians) between the force directions of successive ticks
+// with |F| above 0.5 N, over the slide.
+double largest_direction_step(const Trace& tr) {
+  double worst = 0;
+  Vec3 prev = Vec3::Zero();
+  for (size_t i = 0; i < tr.ticks.num_rows(); ++i) {
+    const TraceTick k = trace_tick(tr, i);
+    const Vec3 f = k.F.head<3>();
+    if (k.t < 0.45 || f.norm() < 0.5) {
+      prev.setZero();
+      continue;
+    }
+    const Vec3 d = f.normalized();
+    if (prev != Vec3::Zero()) worst = std::max(worst, std::acos(std::clamp(d.dot(prev), -1.0, 1.0)));
+    prev = d;
+  }
+  return worst;
+}
+
+}  // namespace
+
+// Force shading, both loops (surface.h): property 7 on every sim step, the
+// shaded orthogonality Fc . asc = 0 under Js on every coupling step, bit-for-bit
+// repeatable lockstep runs, and a smoother force direction than the flat facets.
+TEST_CASE("run_scenario: force shading keeps property 7 and the shaded orthogonality", "[scenario][surface]") {
+  const HandScript script = make_cylinder_script();
+  ScenarioOptions options;
+  options.trace_path = temp_trace("shaded_1");
+  const ScenarioResult r = run_scenario(make_cylinder_scene(SurfaceKind::kForceShading), script, options);
+  const Trace a = read_trace(options.trace_path);
+  std::remove(options.trace_path.c_str());
+  // Property 7 on every step with a handle: the projection's feasibility
+  // tolerance is 1e-13 relative; 1e-9 leaves room for the rows' scale.
+  CHECK(r.num_constraint_checks == r.num_sim_steps - 1);  // every step but the first (no handle sample yet)
+  CHECK(r.max_rel_constraint_violation <= 1e-9);
+  // Every coupling step with a snapshot used the shading rows, and their force is
+  // orthogonal to asc (same tolerance as the plain orthogonality above).
+  CHECK(r.num_shaded_steps >= r.num_ticks - 2);
+  CHECK(r.num_orthogonality_checks > 300);
+  CHECK(r.max_rel_force_dot_ac <= 1e-9);
+  CHECK(r.constraint_energy_injected <= 1e-12 * r.constraint_energy_removed);
+  // The shading's work on the god-object's motion is measured (0 on a plain surface).
+  CHECK(std::isfinite(r.shading_work_injected));
+  // The probe never ends inside the prism's circumscribed circle less delta... its
+  // tip stays outside the flats: |xs| >= apothem (property 7 through the CCD).
+  const double apothem = 0.03 * std::cos(M_PI / 12);
+  for (size_t i = 0; i < a.ticks.num_rows(); ++i) {
+    const Vec3 p = trace_tick(a, i).X_WS.p;
+    CHECK(std::hypot(p.x(), p.z()) >= apothem - 1e-12);
+  }
+
+  // Repeatable bit for bit.
+  options.trace_path = temp_trace("shaded_2");
+  run_scenario(make_cylinder_scene(SurfaceKind::kForceShading), script, options);
+  const Trace b = read_trace(options.trace_path);
+  std::remove(options.trace_path.c_str());
+  REQUIRE(a.ticks.num_rows() == b.ticks.num_rows());
+  for (size_t i = 0; i < a.ticks.num_rows(); ++i) {
+    const TraceTick x = trace_tick(a, i), y = trace_tick(b, i);
+    REQUIRE(x.X_WS.p == y.X_WS.p);
+    REQUIRE(x.F == y.F);
+  }
+
+  // The flat facets turn the force by 30 degrees at each edge within a few
+  // ticks; shading spreads it over the facet: its largest step is smaller.
+  options.trace_path = temp_trace("flat");
+  const ScenarioResult flat = run_scenario(make_cylinder_scene(SurfaceKind::kNone), script, options);
+  const Trace c = read_trace(options.trace_path);
+  std::remove(options.trace_path.c_str());
+  CHECK(flat.num_shaded_steps == 0);
+  CHECK(flat.shading_work_injected == 0);
+  CHECK(largest_direction_step(a) < largest_direction_step(c));
 }

@@ -10,6 +10,8 @@
 #include <map>
 #include <numeric>
 
+#include "gauss6/error_allowances.h"
+
 namespace gauss6 {
 
 size_t Bvh::memory_bytes() const {
@@ -42,9 +44,8 @@ Obb fit_obb(const Vec3* points, int num_points) {
     Obb b;
     b.axes = axes;
     b.center = axes * (0.5 * (lo + hi));
-    // Each projection is within 1e-15 |x|_inf of the exact one on the rounded
-    // axes; the centre's own rounding likewise: 1e-13 scale covers both.
-    b.half = 0.5 * (hi - lo) + Vec3::Constant(1e-13 * scale + 1e-300);
+    // The projections' and the centre's rounding (error_allowances.h).
+    b.half = 0.5 * (hi - lo) + Vec3::Constant(kObbFitRounding * scale + kUnderflowFloor);
     const Vec3 grown = b.half + Vec3::Constant(1e-3 * b.half.norm());
     const double size = grown.prod();
     if (size < best_size) {

@@ -7,6 +7,7 @@
 #include <cmath>
 
 #include "gauss6/distance.h"  // closest points: the separating axes of the u-filter
+#include "gauss6/error_allowances.h"
 
 namespace gauss6 {
 
@@ -111,24 +112,13 @@ struct Scales { double u, a, b, coordinate; };
 // squared distances of the intervals from 0, rounded down, exceeds d^2 rounded
 // up. False for NaN bounds (every comparison with NaN is false).
 inline bool excludes(const IVec3& F, double d) {
-  double sum = 0;
+  Lower sum{0};
   for (const Interval& c : F) {
     if (c.lo > d || c.hi < -d) return true;
     const double m = c.lo > 0 ? c.lo : (c.hi < 0 ? -c.hi : 0.0);  // distance of [lo, hi] from 0
-    sum = next_down(sum + next_down(m * m));
+    sum = sum + sqr(Lower{m});
   }
-  return sum > next_up(d * d);
-}
-
-// Upper bound of the Euclidean norm of every vector in the box v (of |F|_2
-// over an enclosure F), rounded up.
-GAUSS6_ALWAYS_INLINE double norm_upper(const IVec3& v) {
-  double s2 = 0;
-  for (const Interval& c : v) {
-    const double m = std::max(std::abs(c.lo), std::abs(c.hi));
-    s2 = next_up(s2 + next_up(m * m));
-  }
-  return next_up(std::sqrt(s2));
+  return sum > sqr(Upper{d});
 }
 
 // n . x for a double vector n and an interval vector x, outward rounded.
@@ -184,9 +174,9 @@ template <class Enclose, class GuideT = NoGuide>
 void bisect(const Enclose& enclose, bool triangle, const Scales& sc, double u_begin, double u_end,
             const CcdSettings& s, CcdWorkspace* ws, CcdResult* r, const GuideT& guides = NoGuide{}) {
   const double d = s.min_separation;
-  // Rounding noise makes F's enclosure at least ~1e-15 of the coordinates wide:
-  // a distance tolerance below that could never be met.
-  const double tol_d = std::max(s.distance_tolerance, 1e-12 * sc.coordinate);
+  // Rounding noise makes F's enclosure a few ulps of the coordinates wide: a
+  // distance tolerance below that could never be met.
+  const double tol_d = std::max(s.distance_tolerance, kDistanceToleranceFloor * sc.coordinate);
   const int capacity = ws->capacity();
   Box* arena = ws->data();
   *r = CcdResult{};
@@ -221,11 +211,11 @@ void bisect(const Enclose& enclose, bool triangle, const Scales& sc, double u_be
       const double n = guide.axis.norm();
       if (guide.valid && n > 0 && std::isfinite(n)) {
         guide.axis /= n;  // any nonzero vector is valid; unit length keeps d |axis| ~ d
-        reach = next_up(d * norm_upper(to_interval(guide.axis)));
+        reach = (d * norm_upper(to_interval(guide.axis))).v;
         if (s.early_hit) {
           // Everything before u0 is settled: accept u0 when a pair there is proven within d + tol_d.
           enclose(Box{{u0, u0}, {guide.a, guide.a}, {guide.b, guide.b}}, &K);
-          const double dist = norm_upper(K.c[0]);
+          const double dist = norm_upper(K.c[0]).v;
           if (dist <= d + tol_d) {
             ++r->iterations;
             r->status = CcdStatus::kOk;
@@ -300,7 +290,7 @@ void bisect(const Enclose& enclose, bool triangle, const Scales& sc, double u_be
       r->hit = true;
       r->u_hit = u0;
       r->time_tolerance_reached = wu;
-      r->distance_reached = norm_upper(F_maybe);
+      r->distance_reached = norm_upper(F_maybe).v;
       return;
     }
     if (!maybe) {
@@ -349,25 +339,14 @@ double max_abs(const Vec3& v) { return v.cwiseAbs().maxCoeff(); }
 namespace {
 
 // Four linearly moving points in plain doubles, and a bound on the rounding
-// error of any corner value of F computed from them as in the enclosures below.
-//
-// Static error bound. Let M bound every input coordinate and r = 2^-53 the unit
-// roundoff; u, a, b lie in [0, 1]. Each rounded operation adds at most r times
-// the magnitude of its result (plus 2^-1075 if it underflows). Bounding the
-// magnitudes and accumulating the errors along the evaluation:
-//   dx = x1 - x0          |dx| <= 2M    error <= 2rM
-//   p = x0 + u dx         |p|  <= 3M    error <= 2rM + 2rM + 3rM = 7rM
-//   w, e1, e2 = p - p'    |.|  <= 6M    error <= 14rM + 6rM = 20rM
-//   a e1, b e2            |.|  <= 6M    error <= 20rM + 6rM = 26rM
-//   (w - a e1) - b e2     |.|  <= 18M   error <= 20 + 26 + 12 + 26 + 18 = 102rM
-// so 128 r M + 64 * 2^-1074 (underflows) bounds the error of every corner value.
-// (A fused multiply-add, if a compiler contracted one, rounds once instead of
-// twice: its error is within the same bound.)
+// error of any corner value of F computed from them as in the enclosures below:
+// kLinearCornerRounding M + kLinearCornerUnderflow, M the largest input
+// coordinate (error_allowances.h derives it along this evaluation).
 // The multilinear argument above then bounds F over the box by the corners'
 // min and max widened by this bound (the widening itself rounded outward).
 struct LinearPoints {
   std::array<std::array<double, 3>, 4> x0, dx;
-  double error = 0;
+  Upper error;
 };
 LinearPoints make_linear_points(const std::array<Vec3, 4>& start, const std::array<Vec3, 4>& end) {
   LinearPoints p;
@@ -378,8 +357,7 @@ LinearPoints make_linear_points(const std::array<Vec3, 4>& start, const std::arr
       p.dx[k][i] = end[k][i] - start[k][i];
       M = std::max({M, std::abs(start[k][i]), std::abs(end[k][i])});
     }
-  const double r = std::ldexp(1.0, -53);
-  p.error = next_up(next_up(128 * r * M) + 64 * std::numeric_limits<double>::denorm_min());
+  p.error = kLinearCornerRounding * Upper{M} + Upper{kLinearCornerUnderflow};
   return p;
 }
 
@@ -413,7 +391,7 @@ void enclose_linear(const LinearPoints& pts, const LinearDifference& ix, const B
       hi[i] = std::max(hi[i], (w + std::max(pa0, pa1)) - std::min(pb0, pb1));
     }
   }
-  for (int i = 0; i < 3; ++i) (*F)[i] = {next_down(lo[i] - pts.error), next_up(hi[i] + pts.error)};
+  for (int i = 0; i < 3; ++i) (*F)[i] = widen({lo[i], hi[i]}, pts.error);
 }
 
 }  // namespace
@@ -550,7 +528,7 @@ void enclose_motion(const CcdMotion& m, Interval u, MotionEnclosure* out) {
   const bool decreasing = (sqr(Interval::point(u.lo)) * s).lo > 1;
   if (!increasing && !decreasing) {
     double cap = 2 * u.hi;
-    if (s.lo > 0) cap = std::min(cap, next_up(1.0 / next_down(std::sqrt(s.lo))));
+    if (s.lo > 0) cap = std::min(cap, (Upper{1.0} / sqrt(Lower{s.lo})).v);
     alpha.hi = std::max(alpha.hi, cap);
   }
   // C = I + alpha K + beta K^2, K = [g]x.
@@ -714,7 +692,7 @@ bool positive_on(const Cubic& c, double u0, double u1) {
   const Interval A2 = (c.k[2] + u3k3) * h2;                      // p''(u0) / 2 h^2
   const Interval A3 = c.k[3] * (h2 * h);
   if (!((a0 + A1 + A2 + A3).lo > 0)) return false;
-  const Interval third{next_down(1.0 / 3), next_up(1.0 / 3)};
+  const Interval third = div_positive(Interval::point(1), Interval::point(3));
   return (a0 + third * A1).lo > 0 && (a0 + third * (2.0 * A1 + A2)).lo > 0;
 }
 
@@ -759,8 +737,7 @@ struct SeparatingAxis {
     c3[j] = along(n, ggw);
   }
   void set_static(Interval proj, const IVec3& n, double d) {
-    const double dn = next_up(d * norm_upper(n));
-    static_proj = {next_down(proj.lo - dn), next_up(proj.hi + dn)};
+    static_proj = widen(proj, d * norm_upper(n));
   }
   // True when the projections are proven apart for every u in [u0, u1].
   bool excludes(const CcdMotion& m, double u0, double u1) const {
@@ -833,7 +810,7 @@ bool accept_point(const Enclose& enclose, double u0, double u1, double a, double
                   int iterations, CcdResult* r) {
   Corners K;
   enclose(Box{{u0, u0}, {a, a}, {b, b}}, &K);
-  const double dist = norm_upper(K.c[0]);  // >= |F| at (u0, a, b)
+  const double dist = norm_upper(K.c[0]).v;  // >= |F| at (u0, a, b)
   if (!(dist <= d + tol)) return false;
   *r = CcdResult{};
   r->status = CcdStatus::kOk;
@@ -901,7 +878,7 @@ void filtered_bisect(const Enclose& enclose, bool triangle, const Scales& sc, UF
                      const CcdSettings& s, CcdWorkspace* ws, CcdResult* r) {
   constexpr int kMaxEvaluations = 256, kStack = 64;
   int evaluations = 1, total_iterations = 0;
-  const double tol_d = std::max(s.distance_tolerance, 1e-12 * sc.coordinate);  // as in bisect()
+  const double tol_d = std::max(s.distance_tolerance, kDistanceToleranceFloor * sc.coordinate);  // as in bisect()
   const auto probe = [&](double u0, double u1, int iterations, CcdResult* res) {
     const Guide g = guides.at(u0);
     return g.valid && accept_point(enclose, u0, u1, g.a, g.b, s.min_separation, tol_d, iterations, res);
@@ -1006,7 +983,7 @@ void rigid_vertex_face(Moving moving, const VertexFacePair& q, const CcdSettings
     // Parameter points whose convex hull holds the part of the box in the
     // triangle (a + b <= 1): the box's corners, its far corner (a1, b1) replaced,
     // when outside, by the points where the line a + b = 1 crosses the edges
-    // a = a1 and b = b1, each moved outward along its edge (next_up(1 - x) >= 1 - x).
+    // a = a1 and b = b1, each moved outward along its edge (rounded up from 1 - x).
     // Proof: the box cut by the half-plane is the convex hull of its corners
     // inside it and the line's crossings with its edges; the crossings with
     // a = a0 and b = b0 lie on edges between kept corners, those with a = a1 and
@@ -1017,8 +994,8 @@ void rigid_vertex_face(Moving moving, const VertexFacePair& q, const CcdSettings
     double pa[5] = {a0, a1, a0, a1, a1}, pb[5] = {b0, b0, b1, b1, b1};
     K->n = 4;
     if (a1 + b1 > 1) {
-      pb[3] = std::clamp(next_up(1 - a1), b0, b1);
-      pa[4] = std::clamp(next_up(1 - b1), a0, a1);
+      pb[3] = std::clamp((Upper{1} - Lower{a1}).v, b0, b1);
+      pa[4] = std::clamp((Upper{1} - Lower{b1}).v, a0, a1);
       K->n = 5;
     }
     if (vertex_moves) {
@@ -1051,7 +1028,7 @@ void rigid_vertex_face(Moving moving, const VertexFacePair& q, const CcdSettings
     if (axis_clears(filter, q.u_begin, q.u_end, r)) return;  // before the coplanarity cubic's set-up
     const CayleyCoefficients cw = cayley_coefficients(m, w);
     const Cubic P = body_point_along(m, w, cw, f0, n);
-    const double dL = next_up(d * norm_upper(n));
+    const double dL = (d * norm_upper(n)).v;
     filter.at_most(P, dL);
     filter.at_least(P, dL);
     // Guide: the face point nearest the vertex's nominal position.
@@ -1077,7 +1054,7 @@ void rigid_vertex_face(Moving moving, const VertexFacePair& q, const CcdSettings
     filtered_bisect(enclose, /*triangle=*/true, sc, filter, [&](UFilter* f) {
       for (int k = 0; k < 3; ++k) {
         const IVec3 mk = cross(n, corner[(k + 1) % 3] - corner[k]);
-        f->at_least(body_point_along(m, w, cw, corner[k], mk), next_up(d * norm_upper(mk)));
+        f->at_least(body_point_along(m, w, cw, corner[k], mk), (d * norm_upper(mk)).v);
       }
     }, Guides<decltype(guide_at), decltype(separated)>{guide_at, separated}, q.u_begin, q.u_end, s, ws, r);
     return;
@@ -1094,7 +1071,7 @@ void rigid_vertex_face(Moving moving, const VertexFacePair& q, const CcdSettings
   const IVec3 nW = mul(m.R0, n), f0W = mul(m.R0, f0);
   const CayleyCoefficients cn = cayley_coefficients(m, nW);
   const Cubic P = static_point_along(m, v, f0W, nW, cn);
-  const double dL = next_up(d * norm_upper(n));  // |C R0 n| = |n|
+  const double dL = (d * norm_upper(n)).v;  // |C R0 n| = |n|
   filter.at_most(P, dL);
   filter.at_least(P, dL);
   // Guide: the point of the nominally moved face nearest the vertex.
@@ -1125,7 +1102,7 @@ void rigid_vertex_face(Moving moving, const VertexFacePair& q, const CcdSettings
     for (int k = 0; k < 3; ++k) {
       const IVec3 mk = cross(n, corner[(k + 1) % 3] - corner[k]), mkW = mul(m.R0, mk);
       f->at_least(static_point_along(m, v, mul(m.R0, corner[k]), mkW, cayley_coefficients(m, mkW)),
-                  next_up(d * norm_upper(mk)));
+                  (d * norm_upper(mk)).v);
     }
   }, Guides<decltype(guide_at), decltype(separated)>{guide_at, separated}, q.u_begin, q.u_end, s, ws, r);
 }
@@ -1191,9 +1168,9 @@ void ccd_rigid_edge_edge(const RigidEdgeEdgeQuery& q, const CcdSettings& s, CcdW
   const Cubic P{{dot(Q, T0) + dot(Z, eb), (dot(Q, T1) + dot(m.dp, T0)) - dot(Z, cb.c1),
                  (dot(Q, T2) + dot(m.dp, T1)) + dot(Z, cb.c2), dot(m.dp, T2)}};
   // L >= |C ea' x eb| on the window: |ea' x eb| + 2 u_end |g| |ea| |eb|.
-  const double g_norm = next_up(std::sqrt(m.g2.hi));
-  const double turn = next_up(next_up(2 * q.u_end * g_norm) * next_up(norm_upper(ea) * norm_upper(eb)));
-  const double dL = next_up(d * next_up(norm_upper(T0) + turn));
+  const Upper g_norm = sqrt(Upper{m.g2.hi});
+  const Upper turn = (2 * q.u_end) * g_norm * (norm_upper(ea) * norm_upper(eb));
+  const double dL = (d * (norm_upper(T0) + turn)).v;
   filter.at_most(P, dL);
   filter.at_least(P, dL);
   // End slabs. Every point of a segment lies between the planes through its
@@ -1222,7 +1199,7 @@ void ccd_rigid_edge_edge(const RigidEdgeEdgeQuery& q, const CcdSettings& s, CcdW
   };
   filtered_bisect(enclose, /*triangle=*/false, sc, filter, [&](UFilter* f) {
     const CayleyCoefficients c0 = cayley_coefficients(m, a0W), c1 = cayley_coefficients(m, a1W);
-    const double rb = next_up(d * norm_upper(eb)), ra = next_up(d * norm_upper(ea));
+    const double rb = (d * norm_upper(eb)).v, ra = (d * norm_upper(ea)).v;
     f->at_least(body_point_along(m, a0W, c0, b0, eb), rb);
     f->at_least(body_point_along(m, a1W, c1, b0, eb), rb, /*join=*/true);
     f->at_most(body_point_along(m, a0W, c0, b1, eb), rb);
@@ -1245,18 +1222,14 @@ StopPose make_stop_pose(const CcdMotion& m, double u, double body_radius) {
     return out;
   }
   // Per world axis i: |dp_i| + rho sum_j |dR_ij|, all rounded up.
-  double sum2 = 0;
+  Upper sum2{0};
   for (int i = 0; i < 3; ++i) {
     const Interval dp = Interval::point(out.pose.p[i]) - e.p[i];
-    double row = 0;
-    for (int j = 0; j < 3; ++j) {
-      const Interval dR = Rq[3 * i + j] - e.R[3 * i + j];
-      row = next_up(row + std::max(std::abs(dR.lo), std::abs(dR.hi)));
-    }
-    const double di = next_up(std::max(std::abs(dp.lo), std::abs(dp.hi)) + next_up(body_radius * row));
-    sum2 = next_up(sum2 + next_up(di * di));
+    Upper row{0};
+    for (int j = 0; j < 3; ++j) row = row + magnitude(Rq[3 * i + j] - e.R[3 * i + j]);
+    sum2 = sum2 + sqr(magnitude(dp) + body_radius * row);
   }
-  out.deviation = next_up(std::sqrt(sum2));
+  out.deviation = sqrt(sum2).v;
   return out;
 }
 

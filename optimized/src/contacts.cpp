@@ -7,6 +7,7 @@
 #include <cmath>
 
 #include "gauss6/distance.h"
+#include "gauss6/error_allowances.h"
 #include "gauss6/feature_pair.h"
 #include "gauss6/motion_bounds.h"
 
@@ -82,12 +83,12 @@ ContactStatus generate_contacts(const CcdBody* obstacles, int num_obstacles, con
     return ws->god_world[v];
   };
   // World box of a body box: centre and half extents through |R|, grown by a
-  // rounding allowance (the double vertices above carry ~1e-16 relative error).
+  // rounding allowance (kBoxPoseRounding: the double vertices above round too).
   const Mat3 absR = R.cwiseAbs();
   const auto god_box = [&](const Aabb& b) {
     const Vec3 c = G + R * (0.5 * (b.lo + b.hi));
     const Vec3 h = absR * (0.5 * (b.hi - b.lo));
-    const Vec3 slack = 1e-12 * (c.cwiseAbs() + h) + Vec3::Constant(1e-300);
+    const Vec3 slack = kBoxPoseRounding * (c.cwiseAbs() + h) + Vec3::Constant(kUnderflowFloor);
     return Aabb{c - h - slack, c + h + slack};
   };
   const double d = settings.distance;

@@ -28,6 +28,15 @@ bool receive_god_object(const RuntimeChannels& ch, CouplingState* s) {
   return true;
 }
 
+// Shaded surfaces: asc for the sim loop's pass 2, with the snapshot it used.
+void publish_shaded_motion(double t, const CouplingStepInfo& info, RuntimeChannels* ch) {
+  ShadedMotionSample m;
+  m.god_sequence = info.god_sequence;
+  m.time = t;
+  for (int i = 0; i < 6; ++i) m.asc[i] = info.ac[i];
+  ch->shaded_motion.write(m);
+}
+
 void publish_wrench(double t, const CouplingStepInfo& info, RuntimeChannels* ch) {
   WrenchSample w;
   w.time = t;
@@ -54,12 +63,16 @@ const CouplingStepInfo& coupling_step(const RuntimeModel& model, double t, Runti
     info.xs = s->xs;
     const int m = s->god.num_contacts;
     info.num_rows = m;
+    // The rows: J, or on a shaded surface the shading rows Js (pass 1 of the
+    // two, surface.h); offsets apply to whichever rows the force comes from.
+    info.shaded = s->god.shaded != 0;
+    const double* J = info.shaded ? s->god.Js : s->god.J;
     // 2. au = ks (xh (-) xs); offsets for the new rows of a new set.
     info.au = model.gains.ks * pose_difference(to_pose(s->handle.p, s->handle.q), s->xs);
     if (info.new_set) {
       const OffsetRule rule{model.offsets, model.match_distance, model.settings.match_cosine,
                             model.settings.projection};
-      const OffsetRows rows{m, s->god.J, s->god.point, s->god.normal};
+      const OffsetRows rows{m, J, s->god.point, info.shaded ? s->god.shaded_normal : s->god.normal};
       info.num_new_offsets = start_offsets(rule, t, info.au, s->M, s->xs, rows, &s->offsets);
     }
     // 3. ac = projection (warm-started), b(t) while offsets run; Fc = kh M (ac - au).
@@ -67,12 +80,13 @@ const CouplingStepInfo& coupling_step(const RuntimeModel& model, double t, Runti
     ProjectionProblem problem;
     problem.M = &s->M;
     problem.au = info.au;
-    problem.J = m > 0 ? s->god.J : nullptr;
+    problem.J = m > 0 ? J : nullptr;
     problem.b = info.num_offset_rows > 0 ? s->offsets.rhs.data() : nullptr;
     problem.num_rows = m;
     info.projection = project(problem, model.settings.projection, &s->projection_ws, &s->projection);
     info.ac = s->projection.ac;
     info.Fc = coupling_force(s->M, info.au, info.ac, model.gains.kh);
+    if (info.shaded) publish_shaded_motion(t, info, channels);  // asc, for the sim loop's pass 2
   }
   // 4. Publish Fc (zero until both xh and a snapshot are known).
   publish_wrench(t, info, channels);

@@ -6,6 +6,8 @@
 
 #include <cmath>
 
+#include "gauss6/error_allowances.h"
+
 namespace gauss6 {
 
 Aabb swept_box(const MotionEnclosure& e, const Aabb& body) {
@@ -23,31 +25,29 @@ void StartFrame::set(const CcdMotion& m, double u, double rho_in) {
   rho = rho_in;
   R = rotation_matrix(sp.pose.q);
   p = sp.pose.p;
-  double dp2 = 0, drift2 = 0;
+  Upper drift2{0};
   for (int i = 0; i < 3; ++i) {
     const Interval& c = m.dp[i];
-    const double a = std::max(std::abs(c.lo), std::abs(c.hi));
-    dp2 = next_up(dp2 + next_up(a * a));
     dp_mid[i] = 0.5 * c.lo + 0.5 * c.hi;
-    const double r = std::max(next_up(c.hi - dp_mid[i]), next_up(dp_mid[i] - c.lo));
-    drift2 = next_up(drift2 + next_up(r * r));
+    drift2 = drift2 + sqr(distance_from(c, dp_mid[i]));
   }
-  drift = next_up(std::sqrt(drift2));
-  turn_rate = next_up(2 * next_up(std::sqrt(m.g2.hi)));
-  double g_err2 = 0;
+  drift = sqrt(drift2).v;
+  const Upper g_norm2{m.g2.hi};
+  turn_rate = (2 * sqrt(g_norm2)).v;
+  Upper g_err2{0};
   for (int i = 0; i < 3; ++i) {
     const Interval& c = m.g[i];
     omega[i] = c.lo + c.hi;  // 2 g_mid (exact: doubling)
-    const double r = std::max(next_up(c.hi - 0.5 * (c.lo + c.hi)), next_up(0.5 * (c.lo + c.hi) - c.lo));
-    g_err2 = next_up(g_err2 + next_up(r * r));
+    g_err2 = g_err2 + sqr(distance_from(c, 0.5 * (c.lo + c.hi)));
   }
-  omega_error = next_up(2 * next_up(std::sqrt(g_err2)));
-  omega2 = next_up(4 * m.g2.hi);
-  g2 = m.g2.hi;
-  omega_norm = next_up(omega.norm() * (1 + 1e-15));
-  dp_max = next_up(std::sqrt(dp2));
-  speed = next_up(dp_max + next_up(turn_rate * rho));
-  static_error = next_up(sp.deviation + next_up(1e-13 * next_up(p.cwiseAbs().maxCoeff() + rho)));
+  omega_error = (2 * sqrt(g_err2)).v;
+  omega2 = (4 * g_norm2).v;
+  g2 = g_norm2.v;
+  omega_norm = round_up(omega.norm() * (1 + kRelativeRounding)).v;
+  dp_max = norm_upper(m.dp).v;
+  speed = (Upper{dp_max} + Upper{turn_rate} * Upper{rho}).v;
+  const Upper p_inf{p.cwiseAbs().maxCoeff()};
+  static_error = (Upper{sp.deviation} + kPoseRounding * (p_inf + Upper{rho})).v;
   if (!std::isfinite(static_error) || !std::isfinite(speed) || !std::isfinite(drift) || !dp_mid.allFinite() ||
       !omega.allFinite() || !std::isfinite(omega_error) || !std::isfinite(omega2)) {
     static_error = speed = drift = turn_rate = dp_max = std::numeric_limits<double>::infinity();
@@ -60,16 +60,17 @@ SweptObbFrame StartFrame::obb_frame(double u1, double d) const {
   SweptObbFrame f;
   f.R = R;
   f.p = p;
-  const double span = next_up(u1 - u0);
+  const Upper span = Upper{u1} - Lower{u0};
+  const Upper omega_n{omega_norm}, error{static_error};
   f.step = (u1 - u0) * dp_mid;
   f.spin = (u1 - u0) * omega;
-  f.spread = next_up(span * omega_norm);
-  // The step's own rounding (relative 2^-53 per coordinate) joins the drift.
-  const double step_error = next_up(1e-15 * f.step.cwiseAbs().maxCoeff() * 2);
-  const double offsets = next_up(next_up(span * next_up(turn_rate + omega_norm)) * next_up(2 * static_error));
-  f.grow = next_up(next_up(next_up(static_error + d) + next_up(next_up(span * drift) + step_error)) + offsets);
-  const double rest = next_up(next_up(omega_error + next_up(lag(span) * omega_norm)) + next_up(0.5 * next_up(span * omega2)));
-  f.turn = next_up(span * rest);
+  f.spread = (span * omega_n).v;
+  // The step's own rounding (two roundings per coordinate) joins the drift.
+  const Upper step_error = round_up(kRelativeRounding * f.step.cwiseAbs().maxCoeff() * 2);
+  const Upper offsets = span * (Upper{turn_rate} + omega_n) * (2 * error);
+  f.grow = (((error + Upper{d}) + (span * Upper{drift} + step_error)) + offsets).v;
+  const Upper rest = (Upper{omega_error} + Upper{lag(span.v)} * omega_n) + 0.5 * (span * Upper{omega2});
+  f.turn = (span * rest).v;
   if (!std::isfinite(f.grow) || !std::isfinite(f.turn) || !std::isfinite(f.spread) || !f.step.allFinite() ||
       !f.spin.allFinite()) {
     f.grow = std::numeric_limits<double>::infinity();
@@ -83,8 +84,8 @@ SweptObbFrame StartFrame::obb_frame(double u1, double d) const {
 Displacement::Displacement(const Pose& a, const Pose& b) {
   const Quat qa = normalized(a.q), qb = normalized(b.q);
   const Vec3 v = qa.w * qb.vec() - qb.w * qa.vec() - qa.vec().cross(qb.vec());  // vec(conj(qa) qb)
-  turn = next_up(next_up(2 * v.norm()) + 1e-14);
-  shift = next_up((b.p - a.p).norm() * (1 + 1e-15));
+  turn = (round_up(2 * v.norm()) + Upper{kQuaternionTurnRounding}).v;
+  shift = round_up((b.p - a.p).norm() * (1 + kRelativeRounding)).v;
   if (!(turn < std::numeric_limits<double>::infinity() && shift < std::numeric_limits<double>::infinity()))
     turn = shift = std::numeric_limits<double>::infinity();
 }

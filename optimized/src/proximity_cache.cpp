@@ -10,6 +10,7 @@
 
 #include "ccd_step_state.h"
 #include "gauss6/distance.h"
+#include "gauss6/rounding.h"
 
 namespace gauss6 {
 
@@ -96,7 +97,7 @@ bool fill_some(StepState* s, long budget) {
   enclose_motion(pf.motion, {0, 0}, &enc);
   s->ws->swept.next_interval();
   const int capacity = static_cast<int>(pf.pairs.size());
-  const double fill_dist = next_up(s->reach + pf.margin);
+  const double fill_dist = (Upper{s->reach} + Upper{pf.margin}).v;
   while (pf.obstacle < s->num_obstacles) {
     int used = 0;
     const TraversalStatus ts = traverse(*s, frame, enc, 0.0, fill_dist, pf.obstacle, &pf.stack, &pf.pending, budget,
@@ -158,7 +159,7 @@ struct CacheRanges {
   // [0, u] keeps every point within m of a list's pose, the points `moved`
   // from there by X0 (0: none).
   double range(double moved, double m) const {
-    const double u = speed > 0 ? next_down(next_down(m - moved) / speed) : 1.0;
+    const double u = speed > 0 ? ((Lower{m} - Upper{moved}) / Upper{speed}).v : 1.0;
     return u > 0 ? std::min(u, 1.0) : 0.0;  // also NaN
   }
   // The part of a cache range [0, u] to search from the cache (0: none): all
@@ -255,7 +256,7 @@ void search_cached_pairs(StepState* s, const Displacement& since) {
   for (int k = 0; k < pc.num_pairs; ++k) {
     const ProximityCache::Pair& c = pc.pairs[static_cast<size_t>(k)];
     ++result->num_triangle_pairs;
-    if (next_down(c.gap - moving.bound(c.radius)) > s->reach) {
+    if (Lower{c.gap} - Upper{moving.bound(c.radius)} > Upper{s->reach}) {
       ++result->num_axis_culls;
       continue;
     }
@@ -296,7 +297,7 @@ void serve_proximity_cache(StepState* s) {
   const CacheRanges r{speed,
                       result.hit ? result.u_hit : 1.0,
                       s->hints && s->num_hints > 0 && !result.hit,
-                      speed > 0 ? next_down(policy(*s).slow_fraction * margin / speed) : 1.0,
+                      speed > 0 ? round_down(policy(*s).slow_fraction * margin / speed).v : 1.0,
                       s->n,
                       policy(*s).max_probe_sub_intervals};
   const bool keyed = s->cache_keyed;

@@ -16,6 +16,7 @@ const char* to_string(RuntimeEventKind k) {
     case RuntimeEventKind::kProjectionFailed: return "projection_failed";
     case RuntimeEventKind::kCcdGaveUp: return "ccd_gave_up";
     case RuntimeEventKind::kContactOverflow: return "contact_overflow";
+    case RuntimeEventKind::kTextureUndersampled: return "texture_undersampled";
   }
   return "unknown";
 }

@@ -49,12 +49,8 @@ RuntimeModel::RuntimeModel(const Scene& scene, const RuntimeSettings& s) : setti
   for (const SettingsProblem& problem : {check_gains(scene.gains), check_contact_parameters(scene.contact),
                                          check_surface_settings(scene.surface), check_device_settings(scene.device)})
     if (problem) fail(problem.message());
-  // Surface properties are not rendered by this runtime: refuse rather than
-  // silently render a plain surface.
-  if (scene.surface.kind == SurfaceKind::kForceShading)
-    fail("surface.kind = force_shading is not supported by the runtime (two-pass scheme not implemented)");
-  if (scene.surface.kind == SurfaceKind::kTexture)
-    fail("surface.kind = texture is not supported by the runtime");
+  for (const Body& b : scene.obstacles)
+    if (const SettingsProblem p = check_crease_angle(b.crease_angle)) fail(b.name + ": " + p.message());
   if (num_triangles(scene.god_object.mesh) == 0) fail("the god-object's mesh is empty");
   if (!(s.contact_factor > 0) || !(s.gap_factor > 0 && s.gap_factor < s.contact_factor))
     fail("settings: need 0 < gap_factor < contact_factor");
@@ -82,7 +78,13 @@ RuntimeModel::RuntimeModel(const Scene& scene, const RuntimeSettings& s) : setti
     }
     obstacle_meshes_W.push_back(std::move(m));
   }
+  for (TriangleMesh& m : obstacle_meshes_W)
+    if (m.adjacency.FE.rows() != m.F.rows()) build_adjacency(&m);
   for (const TriangleMesh& m : obstacle_meshes_W) obstacle_bvhs_W.push_back(build_bvh(m));
+  // Surface properties (surface.h): shading normals and the texture, once.
+  surface = build_surface_model(scene, obstacle_meshes_W);
+  sim_rate_hz = scene.device.rate_hz / s.lockstep_sim_period;
+  if (surface.texture) texture_max_speed = max_texture_speed(shortest_wavelength(surface.field), sim_rate_hz);
   for (size_t k = 0; k < obstacle_meshes_W.size(); ++k) obstacles.push_back({&obstacle_meshes_W[k], &obstacle_bvhs_W[k]});
 
   // God-object: body frame B, origin at G.

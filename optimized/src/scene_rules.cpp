@@ -9,6 +9,15 @@
 namespace gauss6 {
 
 const char* to_string(BodyRole r) { return r == BodyRole::kObstacle ? "obstacle" : "god_object"; }
+const char* to_string(TextureKind k) {
+  switch (k) {
+    case TextureKind::kSine: return "sine";
+    case TextureKind::kBumps: return "bumps";
+    case TextureKind::kHeightMap: return "height_map";
+  }
+  return "unknown";
+}
+
 const char* to_string(SurfaceKind k) {
   switch (k) {
     case SurfaceKind::kNone: return "none";
@@ -52,6 +61,22 @@ SettingsProblem check_surface_settings(const SurfaceSettings& s) {
   if (!(finite_above(s.amplitude, 0) && s.amplitude <= 1)) return {"surface", "amplitude", "must be in (0, 1]"};
   if (!finite_above(s.wavelength, 0)) return {"surface", "wavelength", "must be > 0"};
   if (s.axis < 0 || s.axis > 2) return {"surface", "axis", "must be x, y or z"};
+  if (s.texture == TextureKind::kSine) return {};
+  if (s.axis_v < 0 || s.axis_v > 2 || s.axis_v == s.axis)
+    return {"surface", "axis_v", "must be x, y or z, and not axis"};
+  if (!s.origin.allFinite()) return {"surface", "origin", "must be finite"};
+  if (s.texture != TextureKind::kHeightMap) return {};
+  const HeightMapImage& h = s.height_map;
+  if (h.width < 2 || h.height < 2 || h.values.size() != static_cast<size_t>(h.width) * h.height)
+    return {"surface", "image", "must be an image of at least 2 x 2 pixels"};
+  for (float v : h.values)
+    if (!(v >= 0 && v <= 1)) return {"surface", "image", "values must be in [0, 1]"};
+  return {};
+}
+
+SettingsProblem check_crease_angle(double degrees) {
+  if (!(std::isfinite(degrees) && degrees >= 0 && degrees <= 180))
+    return {"obstacle", "crease_angle", "must be in [0, 180] (degrees)"};
   return {};
 }
 

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstring>
 
+#include "gauss6/error_allowances.h"
 #include "gauss6/motion.h"
 #include "runtime_detail.h"
 
@@ -30,13 +31,40 @@ SimState::SimState(const RuntimeModel& model)
 
 namespace {
 
+// Step 3, pass 1 on shaded surfaces (surface.h): asc = the projection of au
+// under the shading rows Js. The coupling loop computes it at its rate and
+// publishes it with the snapshot it used: when that is this state's last
+// snapshot (same xs, same Js), the sim loop takes the coupling's asc, as the
+// paper splits the two passes; otherwise (no answer yet) it projects au under
+// its own Js. Plain surfaces: asc = au.
+Vec6 shade_command(const RuntimeModel& model, const RuntimeChannels& ch, const Vec6& au, SimState* s,
+                   SimStepInfo* info) {
+  if (!model.surface.active()) return au;
+  ShadedMotionSample sample;
+  if (s->step > 1 && ch.shaded_motion.try_read(&sample) && sample.god_sequence == s->step - 1) {
+    const Vec6 asc = Eigen::Map<const Vec6>(sample.asc);
+    if (asc.allFinite()) {
+      info->asc_from_coupling = true;
+      return asc;
+    }
+  }
+  const int m = s->contacts.num_contacts;
+  ProjectionProblem problem;
+  problem.M = &s->M;
+  problem.au = au;
+  problem.J = m > 0 ? s->shaded_J.data() : nullptr;
+  problem.num_rows = m;
+  project(problem, model.settings.projection, &s->shading_ws, &s->shading);
+  return s->shading.ac;
+}
+
 // Step 3: ac, the M-projection of au with the current contacts. The sim loop
 // also keeps each contact's gap near delta (1 + gap_factor): J_k a >= b_k with
 // b_k = delta (1 + gap_factor) - separation_k (a few delta at most), so that a
 // god-object sliding along a face stays clear of the CCD's stopping distance
 // delta instead of grazing it. If these rows conflict (empty polyhedron), the
 // plain cone J a >= 0 is used. The force (coupling loop) never sees b.
-Vec6 constrain_motion(const RuntimeModel& model, const Vec6& au, SimState* s) {
+Vec6 constrain_motion(const RuntimeModel& model, const Vec6& au, SimState* s, double* max_rel_violation) {
   const int m = s->contacts.num_contacts;
   const double target = model.contact.delta * (1 + model.settings.gap_factor);
   for (int k = 0; k < m; ++k) s->gap_rhs[k] = target - s->contacts.contacts[k].separation;
@@ -51,7 +79,16 @@ Vec6 constrain_motion(const RuntimeModel& model, const Vec6& au, SimState* s) {
     problem.b = nullptr;
     project(problem, model.settings.projection, &s->projection_ws, &s->projection);
   }
-  return s->projection.ac;
+  // Property 7: the rows hold for the motion taken (the check, on every step).
+  const Vec6& ac = s->projection.ac;
+  double worst = 0;
+  for (int k = 0; k < m; ++k) {
+    const Eigen::Map<const Vec6> Jk(problem.J + 6 * k);
+    const double b = problem.b ? problem.b[k] : 0.0;
+    worst = std::max(worst, (b - Jk.dot(ac)) / (Jk.norm() * ac.norm() + std::abs(b) + 1e-300));
+  }
+  *max_rel_violation = worst;
+  return ac;
 }
 
 // One CCD leg along the Cayley motion x0 -> x1, split in halves on a half turn
@@ -94,7 +131,7 @@ void update_contacts(const RuntimeModel& model, SimState* s) {
   // far the double pose xs may lie from the motion's (its deviation, and the
   // rounding of posing the vertices in doubles): when the contact distance is
   // within that, they are the only pairs to test.
-  const double slack = next_up(s->stop_deviation + 1e-13 * (s->xs.p.cwiseAbs().maxCoeff() + model.god_radius));
+  const double slack = round_up(s->stop_deviation + kPoseRounding * (s->xs.p.cwiseAbs().maxCoeff() + model.god_radius)).v;
   const bool near = r.num_near_pairs >= 0 && (r.hit ? r.u_hit : 1.0) >= r.near_u0 && cs.distance + slack <= r.near_reach;
   const ContactStatus status =
       generate_contacts(model.obstacles.data(), static_cast<int>(model.obstacles.size()), model.god, s->xs, cs,
@@ -152,8 +189,8 @@ void advance_god_object(const RuntimeModel& model, const Pose& x_start, const Po
 
 namespace {
 
-// Step 5: publish xs, M, J and the contacts.
-void publish_god_object(double t, SimState* s, RuntimeChannels* ch) {
+// Step 5: publish xs, M, J and the contacts (and Js on shaded surfaces).
+void publish_god_object(double t, bool shaded, SimState* s, RuntimeChannels* ch) {
   GodObjectSnapshot& g = s->snapshot;
   g.sequence = s->step;
   g.time = t;
@@ -163,6 +200,11 @@ void publish_god_object(double t, SimState* s, RuntimeChannels* ch) {
   const int m = std::min(s->contacts.num_contacts, kMaxContacts);
   g.num_contacts = m;
   std::memcpy(g.J, s->contacts.J.data(), sizeof(double) * 6 * static_cast<size_t>(m));
+  g.shaded = shaded ? 1 : 0;
+  if (shaded) {
+    std::memcpy(g.Js, s->shaded_J.data(), sizeof(double) * 6 * static_cast<size_t>(m));
+    std::memcpy(g.shaded_normal, s->shaded_normal, sizeof(double) * 3 * static_cast<size_t>(m));
+  }
   for (int k = 0; k < m; ++k) {
     const Contact& c = s->contacts.contacts[k];
     for (int i = 0; i < 3; ++i) g.point[k][i] = c.point[i], g.normal[k][i] = c.normal[i];
@@ -180,9 +222,30 @@ Vec6 command_motion(const RuntimeModel& model, const SimState& s) {
 // Step 4: xt = xs (+) ac; CCD; xs = xt or the stop pose; the new contact set
 // (and the settling leg by au - ac if the previous contacts' surface fell away).
 void advance_by(const RuntimeModel& model, SimState* s, SimStepInfo* info) {
-  const Vec6 residual = s->contacts.num_contacts > 0 ? Vec6(info->au - info->ac) : Vec6::Zero();
+  const Vec6 residual = s->contacts.num_contacts > 0 ? Vec6(info->asc - info->ac) : Vec6::Zero();
   const Pose x_start = s->xs;  // a copy: the step overwrites s->xs
   advance_god_object(model, x_start, pose_update(x_start, info->ac), residual, s, info);
+}
+
+// Step 4b on shaded surfaces: the shading rows Js of the new contact set
+// (surface.h), and on textured ones the largest distance a contact point moved
+// in this step: beyond half the texture's shortest wavelength the texture is
+// skipped at this speed (the kTextureUndersampled event).
+void shade_contact_set(const RuntimeModel& model, SimState* s, SimStepInfo* info) {
+  if (!model.surface.active()) return;
+  shade_contacts(model.surface, model.obstacle_meshes_W.data(), s->contacts, s->xs.p, kMaxContacts,
+                 s->shaded_J.data(), s->shaded_normal);
+  if (!model.surface.texture) return;
+  const Mat3 R0 = rotation_matrix(info->x_start.q), R1 = rotation_matrix(s->xs.q);
+  const Mat3 R01 = R0 * R1.transpose();
+  double step = 0;
+  for (int k = 0; k < std::min(s->contacts.num_contacts, kMaxContacts); ++k) {
+    const Vec3& I = s->contacts.contacts[k].point;
+    const Vec3 before = info->x_start.p + R01 * (I - s->xs.p);  // the same body point at x_start
+    step = std::max(step, (I - before).norm());
+  }
+  info->texture_step = step;
+  if (step > 0.5 * shortest_wavelength(model.surface.field)) s->step_events |= bit(RuntimeEventKind::kTextureUndersampled);
 }
 
 // Without a handle sample the god-object stays put (and is still published).
@@ -203,13 +266,17 @@ const SimStepInfo& sim_step(const RuntimeModel& model, double t, RuntimeChannels
   s->step_events = 0;
   if (read_handle(*channels, &s->handle)) {      // 1. Read xh.
     info.au = command_motion(model, *s);         // 2. au = ks (xh (-) xs).
-    info.ac = constrain_motion(model, info.au, s);  // 3. ac: projection with the previous step's contacts.
+    info.asc = shade_command(model, *channels, info.au, s, &info);  // 3. Shaded: asc (pass 1, under Js); else au.
+    info.ac = constrain_motion(model, info.asc, s, &info.max_rel_constraint_violation);  // ac: projection of asc
+                                                 //    with the previous step's contacts (property 7 checked).
     info.projection = s->projection.status;
-    advance_by(model, s, &info);                 // 4. CCD from xs towards xs (+) ac; the new contacts.
+    advance_by(model, s, &info);                 // 4. CCD from xs towards xs (+) ac; the new contacts;
+    shade_contact_set(model, s, &info);          //    shaded: their rows Js.
   } else {
     stay_put(*s, &info);
   }
-  publish_god_object(t, s, channels);            // 5. Publish xs, M, J, the contacts (a new sequence number is the flag).
+  publish_god_object(t, model.surface.active(), s, channels);  // 5. Publish xs, M, J (Js), the contacts (a new
+                                                              //    sequence number is the flag).
   info.xs = s->xs;
   info.contacts = &s->contacts;
   info.update_seconds = seconds_since(start);

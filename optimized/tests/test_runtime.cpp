@@ -242,8 +242,17 @@ TEST_CASE("runtime: model built once; refused settings and surfaces", "[runtime]
   const Mat6 M = mass_matrix_at(model, quat_exp(Vec3(0, 0, M_PI / 2)));
   CHECK((M - Mat6(Vec6(1, 1, 1, kSide * kSide / 6, kSide * kSide / 6, kSide * kSide / 6).asDiagonal())).norm() <
         1e-12);
+  // Force shading is rendered (surface.h): the model builds its shading normals once;
+  // a crease angle outside [0, 180] degrees is refused by its rule.
   Scene shaded = sc;
   shaded.surface.kind = SurfaceKind::kForceShading;
+  {
+    const RuntimeModel shaded_model(shaded, RuntimeSettings{});
+    CHECK(shaded_model.surface.shading);
+    CHECK_FALSE(shaded_model.surface.texture);
+    CHECK(shaded_model.surface.obstacles.size() == 1);
+  }
+  shaded.obstacles[0].crease_angle = 200;
   CHECK_THROWS_AS(RuntimeModel(shaded, RuntimeSettings{}), RuntimeError);
   RuntimeSettings bad;
   bad.gap_factor = 1.0;  // not below contact_factor

@@ -17,6 +17,9 @@ Generation is deterministic: the same parameters give byte-identical files, so
 - bunny: bunny.off (about 27,000 triangles, 15 cm tall, metres), from
   glmark2-data's bunny.obj by the CGAL program gauss6_make_bunny
   (datasets_generated/generators/make_bunny.cpp, built by CMake).
+- surfaces: faceted_cylinder.off, slab.off, probe.off and the hand scripts of the
+  Figure 8 and 9 analogues (cylinder_slide.json, texture_slow.json, texture_fast.json),
+  from datasets_generated/generators/surfaces.py (Python, numpy; reuses the peg generator).
 """
 from __future__ import annotations
 
@@ -33,7 +36,7 @@ from tqdm import tqdm
 
 from . import paths
 
-DATASETS = ("peg_in_hole", "bunny")
+DATASETS = ("peg_in_hole", "bunny", "surfaces")
 GENERATORS_DIR = paths.DATASETS_DIR / "generators"
 
 # The bunny: the Stanford bunny as glmark2-data ships it (34,835 vertices, 69,666
@@ -111,12 +114,28 @@ def _generate_bunny(out: Path) -> dict:
     return _write_manifest(out, source, gen.GENERATOR_VERSION, parameters, ["bunny.off"])
 
 
+def _generate_surfaces(out: Path) -> dict:
+    gen = peg_in_hole_generator()  # loaded first: the surfaces generator reuses its meshes and header
+    del gen
+    source = GENERATORS_DIR / "surfaces.py"
+    name = "gauss6_generators_surfaces"
+    module = sys.modules.get(name)
+    if module is None:
+        spec = importlib.util.spec_from_file_location(name, source)
+        module = importlib.util.module_from_spec(spec)
+        sys.modules[name] = module  # dataclasses look their module up there
+        spec.loader.exec_module(module)
+    params = module.SurfacesParams()
+    files = module.generate(out, params)
+    return _write_manifest(out, source, module.GENERATOR_VERSION, params.to_json(), list(files))
+
+
 def generate(name: str, out_dir: Path) -> dict:
     """Generates dataset `name` ("peg_in_hole" or "bunny") into out_dir/<name>/ (its files
     and MANIFEST.json); returns the manifest. Raises ValueError for an unknown name,
     FileNotFoundError when the bunny tool is not built, RuntimeError when a generator's
     own checks fail."""
-    makers = {"peg_in_hole": _generate_peg_in_hole, "bunny": _generate_bunny}
+    makers = {"peg_in_hole": _generate_peg_in_hole, "bunny": _generate_bunny, "surfaces": _generate_surfaces}
     if name not in makers:
         raise ValueError(f"unknown dataset {name!r}; expected one of {', '.join(DATASETS)}")
     out = Path(out_dir) / name

@@ -1,4 +1,4 @@
-"""`gauss6 reproduce peg|bunny|all --out DIR [--threaded]`: the paper's scenarios, figures and numbers.
+"""`gauss6 reproduce peg|bunny|surfaces|all --out DIR [--threaded]`: the paper's scenarios, figures and numbers.
 
 Also the `gauss6 trace export|import` commands (CSV and HAPI device logs: gauss6.logs).
 
@@ -10,7 +10,9 @@ threads and the wall clock), and writes into DIR:
     <name>.g6trace           the run's trace (docs/trace-format.md)
     figure_<name>.png/.svg   the Figure 11 (peg) / Figure 12 (bunny) analogue
     view_<name>.html         the run in 3D with its timeline and plots (gauss6 view; opens from file://)
-    summary.json             per scenario, exactly the keys of SUMMARY_KEYS
+    summary.json             per scenario, exactly the keys of SUMMARY_KEYS; "surfaces": the Figure 8 and 9
+                             analogues' numbers (reproduce_surfaces.py, which defines them; lockstep only)
+    figure_shading.*, figure_texture.*   the Figure 8 / Figure 9 analogues
     report.md                our numbers beside the paper's, the figures, the machine
 
 Definitions of the summary's numbers:
@@ -289,7 +291,7 @@ def _fmt(v) -> str:
     return str(v)
 
 
-def write_report(out: Path, summary: dict, details: dict, wall: float) -> Path:
+def write_report(out: Path, summary: dict, details: dict, wall: float, surfaces: dict | None = None) -> Path:
     m = machine()
     lines = ["# gauss6: the paper's scenarios reproduced", "",
              f"Machine: {m['cpu']}, {m['cores']} cores ({m['system']}, Python {m['python']}). "
@@ -339,6 +341,10 @@ def write_report(out: Path, summary: dict, details: dict, wall: float) -> Path:
     lines += ["Definitions: see `python/gauss6/reproduce.py`. In lockstep runs the clock is virtual (1 kHz), "
               "work times are real; the constraint update rate is the rate a free-running sim loop would reach "
               "(1 / update time).", ""]
+    if surfaces is not None:
+        from .reproduce_surfaces import report_lines
+
+        lines += report_lines(surfaces)
     path = out / "report.md"
     path.write_text("\n".join(lines))
     return path
@@ -347,23 +353,35 @@ def write_report(out: Path, summary: dict, details: dict, wall: float) -> Path:
 def reproduce(which: str, out: Path, threaded: bool = False, show_progress: bool = True) -> dict:
     """Runs 'peg', 'bunny' or 'all'; writes the traces, figures, summary.json and report.md."""
     start = time.monotonic()
-    names = ["peg", "bunny"] if which == "all" else [which]
+    names = ["peg", "bunny"] if which == "all" else ([] if which == "surfaces" else [which])
     out.mkdir(parents=True, exist_ok=True)
     summary, details = {}, {}
     for name in names:
         summary[name], details[name] = run_scenario(name, out, threaded=threaded, show_progress=show_progress)
-    (out / "summary.json").write_text(json.dumps(summary, indent=2) + "\n")
+    surfaces = None
+    if which in ("all", "surfaces"):
+        from .reproduce_surfaces import reproduce_surfaces
+
+        surfaces, _ = reproduce_surfaces(out, show_progress=show_progress)
+    full = {**summary, **({"surfaces": surfaces} if surfaces is not None else {})}
+    (out / "summary.json").write_text(json.dumps(full, indent=2) + "\n")
     (out / "details.json").write_text(json.dumps(details, indent=2) + "\n")
-    write_report(out, summary, details, time.monotonic() - start)
-    return summary
+    write_report(out, summary, details, time.monotonic() - start, surfaces)
+    return full
 
 
 def cmd_reproduce(args: argparse.Namespace) -> int:
     summary = reproduce(args.scenario, Path(args.out), threaded=args.threaded, show_progress=not args.quiet)
     print(json.dumps(summary, indent=2))
-    failed = [n for n, s in summary.items() if s["penetrating_poses"] != 0]
+    failed = [n for n, s in summary.items() if n != "surfaces" and s["penetrating_poses"] != 0]
+    for kind, runs in summary.get("surfaces", {}).items():
+        # Property 7 is the shaded runs' obligation (the plain cylinder run is reported beside them).
+        failed += [f"{kind}/{label}" for label, s in runs.items()
+                   if s["penetrating_poses"] != 0
+                   or (s["shaded_coupling_steps"] > 0 and not s["max_rel_constraint_violation"] <= 1e-9)]
     for n in failed:
-        print(f"gauss6: error: {n}: {summary[n]['penetrating_poses']} god-object poses interpenetrate", file=sys.stderr)
+        print(f"gauss6: error: {n}: god-object poses interpenetrate or violate the true constraints "
+              "(property 7)", file=sys.stderr)
     print(f"written to {args.out}/ (summary.json, report.md, figures, traces)")
     return 1 if failed else 0
 
@@ -400,7 +418,7 @@ def cmd_trace_import(args: argparse.Namespace) -> int:
 def register(subparsers) -> None:
     """Adds `reproduce` and `trace export` to the gauss6 command's subparsers."""
     rep = subparsers.add_parser("reproduce", help="run the paper's scenarios and write figures and summaries")
-    rep.add_argument("scenario", choices=["peg", "bunny", "all"])
+    rep.add_argument("scenario", choices=["peg", "bunny", "surfaces", "all"])
     rep.add_argument("--out", required=True, help="output directory")
     rep.add_argument("--threaded", action="store_true", help="real threads and the wall clock (default: lockstep)")
     rep.add_argument("--quiet", action="store_true", help="no progress bars")

@@ -129,6 +129,12 @@ py::dict result_dict(const ScenarioResult& r, const std::vector<HandPhase>& phas
   d["constraint_energy_removed"] = r.constraint_energy_removed;
   d["port_energy_max"] = r.port_energy_max;
   d["port_energy_final"] = r.port_energy_final;
+  d["num_shaded_steps"] = r.num_shaded_steps;
+  d["max_rel_constraint_violation"] = r.max_rel_constraint_violation;
+  d["num_constraint_checks"] = r.num_constraint_checks;
+  d["shading_work_injected"] = r.shading_work_injected;
+  d["shading_work_removed"] = r.shading_work_removed;
+  d["max_texture_step"] = r.max_texture_step;
   d["rows_written"] = std::vector<uint64_t>(r.trace.written.begin(), r.trace.written.end());
   d["rows_dropped"] = std::vector<uint64_t>(r.trace.dropped.begin(), r.trace.dropped.end());
   d["haptic"] = loop_dict(r.stats.haptic);

@@ -32,8 +32,34 @@ struct CouplingPropertyObserver {
   double energy_injected = 0;
   double energy_removed = 0;
 
+  long num_shaded_steps = 0;           // coupling steps whose rows were the shading rows Js (then ac = asc
+                                       // and the orthogonality above is Fc . asc = 0 under Js)
+
   // Adds one coupling step (steps without a god-object are skipped).
   void add(const CouplingStepInfo& info) noexcept;
+};
+
+// The god-object's own motion over the sim steps.
+//   - Property 7 (METHOD.md section 5): on every step with a handle, the rows
+//     of step 3 hold for ac (SimStepInfo::max_rel_constraint_violation): the
+//     largest relative violation, which must stay at rounding level.
+//   - Shading's energy: the shaded force Fs = kh M (asc - au) is orthogonal to
+//     asc but not to the motion ac the god-object takes (the shading normal is
+//     not the true one): per step Fs . ac = Fs . (ac - asc), the work the
+//     shading does on the god-object's motion, 0 on plain surfaces. Sums of
+//     its positive (injected) and negative parts, in J (M kh folds dt^2 in, as
+//     for the coupling's energy). Bounded per step by |Fs|_M^-1 |ac - asc|_M,
+//     where |ac - asc| grows with the angle between the shading and the true
+//     normals (at most 60 degrees: kMinShadingCosine; at most the crease angle
+//     for shading alone).
+struct SimPropertyObserver {
+  double max_rel_constraint_violation = 0;
+  long num_constraint_checks = 0;      // steps with a handle
+  double shading_work_injected = 0;
+  double shading_work_removed = 0;
+  double max_texture_step = 0;         // largest texture_step (scene units)
+
+  void add(const RuntimeModel& model, const SimStepInfo& info) noexcept;
 };
 
 // V = F^T M^-1 F / (2 kh ks): the energy stored in the coupling spring

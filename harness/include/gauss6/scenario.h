@@ -92,6 +92,14 @@ struct ScenarioResult {
   // k/2 sum |dx|^2), which is why the constraint-stage balance above is kept apart.
   double port_energy_max = 0;          // J
   double port_energy_final = 0;        // J, W + V at the last tick (negative: energy dissipated)
+
+  // Surface properties (surface.h) and property 7 (SimPropertyObserver):
+  long num_shaded_steps = 0;           // coupling steps on the shading rows (orthogonality above is then Fc . asc)
+  double max_rel_constraint_violation = 0;  // property 7, over every sim step with a handle
+  long num_constraint_checks = 0;
+  double shading_work_injected = 0;    // J: sum of max(0, Fs . ac) over sim steps (0 on plain surfaces)
+  double shading_work_removed = 0;     // J
+  double max_texture_step = 0;         // scene units: largest textured-contact displacement in one sim step
 };
 
 // The hand script named by scene.device.script: the file

@@ -23,8 +23,9 @@ inline Aabb inflate(const Aabb& box, double margin) {
   if (margin == 0) return box;
   Aabb out;
   for (int i = 0; i < 3; ++i) {
-    out.lo[i] = next_down(box.lo[i] - margin);
-    out.hi[i] = next_up(box.hi[i] + margin);
+    const Interval side = widen({box.lo[i], box.hi[i]}, Upper{margin});
+    out.lo[i] = side.lo;
+    out.hi[i] = side.hi;
   }
   return out;
 }

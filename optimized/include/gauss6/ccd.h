@@ -100,7 +100,7 @@ struct CcdSettings {
   double time_tolerance = 1e-6;       // accept a box at most this wide in u ...
   double distance_tolerance = 1e-9;   // ... holding a feature-parameter box not excluded whose widths move F by
                                       // at most max(this, u-width x speed) (scene units; raised to 1e-12 of the
-                                      // largest coordinate, the rounding floor)
+                                      // largest coordinate, the rounding floor kDistanceToleranceFloor)
   double min_separation = 0;          // report the first u where the distance may be <= this (scene units, >= 0)
   int max_iterations = 200000;        // boxes examined before a conservative give-up
   bool use_u_filter = true;           // rigid queries: drop u-ranges by the coplanarity cubic and a separating

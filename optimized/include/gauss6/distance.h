@@ -11,6 +11,7 @@
 #include <algorithm>
 #include <limits>
 
+#include "gauss6/error_allowances.h"
 #include "gauss6/pose.h"
 #include "gauss6/rounding.h"
 
@@ -34,12 +35,12 @@ void closest_segment_parameters(const Vec3& p0, const Vec3& p1, const Vec3& q0, 
 // true to stop.
 //
 // Proof. For convex sets and any vector a != 0, dist(A, B) >= (min_B a.y -
-// max_A a.x) / |a| (or the mirror). Whatever the rounded axis a is, each
-// rounded projection fl(a.x) is within 3.4e-16 |a|_1 |x|_inf of a.x (three
-// products and two sums), and the difference of two within twice that plus its
-// own rounding; so raw - 1e-13 |a|_1 s, s the largest coordinate of the six
-// corners, is below the exact gap along a. Dividing by |a| (1 + 1e-12), with
-// the quotient rounded down, covers the roundings of the norm and the quotient.
+// max_A a.x) / |a| (or the mirror). Whatever the rounded axis a is, the
+// computed difference of two projections is within kAxisProductRounding |a|_1
+// s of the exact one, s the largest coordinate of the six corners; so raw less
+// that is below the exact gap along a. Dividing by |a| (1 +
+// kRelativeRoundingWide), the quotient rounded down, covers the roundings of
+// the norm and the quotient (error_allowances.h).
 // A zero or non-finite axis proves nothing (NaN or inf is dropped).
 // extra: one more axis to try first (any vector; nullptr: none), e.g. the
 // direction between the closest points of two features given as degenerate
@@ -60,9 +61,9 @@ GAUSS6_ALWAYS_INLINE void for_each_separating_axis(const Vec3 A[3], const Vec3 B
       b_hi = std::max(b_hi, pb);
     }
     const double side = b_lo - a_hi >= a_lo - b_hi ? 1.0 : -1.0;
-    const double proven = std::max(b_lo - a_hi, a_lo - b_hi) - 1e-13 * a.cwiseAbs().sum() * s;
+    const double proven = std::max(b_lo - a_hi, a_lo - b_hi) - kAxisProductRounding * a.cwiseAbs().sum() * s;
     if (!(proven > 0)) return false;  // also on NaN
-    const double g = next_down(proven / next_up(a.norm() * (1 + 1e-12)));
+    const double g = (Lower{proven} / round_up(a.norm() * (1 + kRelativeRoundingWide))).v;
     if (!(g < std::numeric_limits<double>::infinity())) return false;
     return on_axis(a, g, side);
   };

@@ -24,6 +24,7 @@
 #include "gauss6/bvh.h"
 #include "gauss6/ccd.h"
 #include "gauss6/distance.h"
+#include "gauss6/error_allowances.h"
 #include "gauss6/pose.h"
 
 namespace gauss6 {
@@ -70,11 +71,11 @@ struct TriangleMotion {
 // the largest such time over the 11 axes (and `extra`:
 // for_each_separating_axis), or 0 when none proves g > reach; +inf when an
 // axis proves a gap that the motion never closes. Returns as soon as one axis
-// proves more than `enough`. Rounding: n.v from the rounded axis is within
-// 1e-14 |a|_1 |v|_inf / |a| of the exact one's; a.(omega x r) = r.(a x omega),
-// a sum of a few products of magnitude <= |a|_1 |omega|_inf |r|_inf, within
-// 1e-13 of that; each quotient is rounded up or down the safe way. Inline: the
-// mesh step calls it for every candidate triangle pair and feature pair.
+// proves more than `enough`. Rounding: a.v is within kAxisVelocityRounding
+// |a|_1 |v|_inf of the exact one; a.(omega x r) = r.(a x omega), within
+// kAxisProductRounding |a|_1 |omega|_inf |r|_inf (error_allowances.h); the
+// rest is rounded the safe way. Inline: the mesh step calls it for every
+// candidate triangle pair and feature pair.
 inline double triangle_time_lower_bound(const Vec3 A[3], const Vec3 B[3], const TriangleMotion& m, double reach,
                                         double enough, const Vec3* extra = nullptr) {
   const double v_inf = m.v.cwiseAbs().maxCoeff(), omega_inf = m.omega.cwiseAbs().maxCoeff();
@@ -83,11 +84,11 @@ inline double triangle_time_lower_bound(const Vec3 A[3], const Vec3 B[3], const 
   for (int k = 0; k < 3; ++k) r_inf = std::max(r_inf, r[k].cwiseAbs().maxCoeff());
   double best = 0;
   for_each_separating_axis(A, B, [&](const Vec3& a, double g, double side) GAUSS6_ALWAYS_INLINE_LAMBDA {
-    const double clear = next_down(g - reach);
-    if (!(clear > 0)) return false;
+    const Lower clear = Lower{g} - Upper{reach};
+    if (!(clear.v > 0)) return false;
     const double a_1 = a.cwiseAbs().sum();
     const double along_v = side * a.dot(m.v);
-    double approach = along_v, slack = 1e-14 * a_1 * v_inf;
+    double approach = along_v, slack = kAxisVelocityRounding * a_1 * v_inf;
     if (omega_inf > 0) {
       const Vec3 c = a.cross(m.omega);  // r.(a x omega) = a.(omega x r)
       approach = -std::numeric_limits<double>::infinity();
@@ -95,11 +96,11 @@ inline double triangle_time_lower_bound(const Vec3 A[3], const Vec3 B[3], const 
         const double b = side * r[k].dot(c);
         approach = std::max(approach, along_v + b + m.lag * std::max(0.0, -b));
       }
-      slack += 1e-13 * a_1 * omega_inf * r_inf;
+      slack += kAxisProductRounding * a_1 * omega_inf * r_inf;
     }
-    const double toward = next_up(std::max(0.0, next_up(approach)) + slack);
-    const double speed = next_up(next_up(toward / next_down(a.norm() * (1 - 1e-12))) + m.w);
-    const double t = speed > 0 ? next_down(clear / speed) : std::numeric_limits<double>::infinity();
+    const Upper toward = max(Upper{0.0}, round_up(approach)) + Upper{slack};
+    const Upper speed = toward / round_down(a.norm() * (1 - kRelativeRoundingWide)) + Upper{m.w};
+    const double t = speed.v > 0 ? (clear / speed).v : std::numeric_limits<double>::infinity();
     if (!(t <= std::numeric_limits<double>::infinity())) return false;  // NaN
     best = std::max(best, t);
     return best > enough;
@@ -166,15 +167,15 @@ struct SweptObbFrame {
     out.center = c + p;
     out.half = b.half;
     // |r_B| <= |center| + |half| for every point of the box.
-    const double radius = next_up(next_up(b.center.norm() + b.half.norm()) * (1 + 1e-12));
-    out.grow = turn > 0 ? next_up(grow + next_up(turn * radius)) : grow;
+    const Upper radius = (1 + kRelativeRoundingWide) * round_up(b.center.norm() + b.half.norm());
+    out.grow = turn > 0 ? (Upper{grow} + Upper{turn} * radius).v : grow;
     if (spread > 0) {
       const Vec3 node_step = step + spin.cross(c);
       out.half_step = 0.5 * node_step;
-      // The spread; the roundings of c (as R r_B's), the cross product and the
-      // sum: a few units of 2^-53 of |spin|_inf radius and |step|_inf.
-      const double rounding = 1e-14 * (spin.cwiseAbs().maxCoeff() * radius + step.cwiseAbs().maxCoeff());
-      out.grow = next_up(out.grow + next_up(next_up(spread * next_up(b.half.norm() * (1 + 1e-15))) + rounding));
+      // The spread; the roundings of c (as R r_B's), the cross product and the sum.
+      const double rounding = kSpinRounding * (spin.cwiseAbs().maxCoeff() * radius.v + step.cwiseAbs().maxCoeff());
+      const Upper half = round_up(b.half.norm() * (1 + kRelativeRounding));
+      out.grow = (Upper{out.grow} + (Upper{spread} * half + Upper{rounding})).v;
     } else {
       out.half_step = 0.5 * step;
     }
@@ -186,24 +187,20 @@ struct SweptObbFrame {
 
 // True when a separating axis among the 15 of the two boxes (Gottschalk, Lin
 // and Manocha 1996) proves the swept posed god box `a` (see above) apart from
-// the obstacle's box `b` (world frame). Rounding: every side of every
-// comparison is a sum of at most a dozen products of an entry of |C| (<= 1 +
-// 1e-15) and a number <= s (the largest coordinate, extent or step involved),
-// each within a few units of 2^-53 of itself, and the axes are orthonormal to
-// within 1e-15; 1e-11 s covers all of it many times over, and |C| + 1e-15
-// keeps the cross axes of near-parallel edges from proving a gap out of
-// rounding noise. False on NaN.
+// the obstacle's box `b` (world frame). Rounding: |C| + kObbAxisRounding and
+// grow + kObbSeparationRounding s, s the largest coordinate, extent or step
+// involved (error_allowances.h). False on NaN.
 GAUSS6_ALWAYS_INLINE bool obb_separated(const PosedObb& a, const Obb& b) {
   const Mat3 C = a.axes.transpose() * b.axes;  // C(i, j) = a_i . b_j
   Mat3 A = C.cwiseAbs();
-  A.array() += 1e-15;
+  A.array() += kObbAxisRounding;
   const Vec3 t_w = b.center - (a.center + a.half_step);
   const Vec3 ta = a.axes.transpose() * t_w, tb = b.axes.transpose() * t_w;
   const Vec3 da = a.axes.transpose() * a.half_step, db = b.axes.transpose() * a.half_step;
   const Vec3 &ha = a.half, &hb = b.half;
   const double s = std::max({ha.maxCoeff(), hb.maxCoeff(), t_w.cwiseAbs().maxCoeff(), a.center.cwiseAbs().maxCoeff(),
                              b.center.cwiseAbs().maxCoeff(), a.half_step.cwiseAbs().maxCoeff(), a.grow});
-  const double g = a.grow + 1e-11 * s;
+  const double g = a.grow + kObbSeparationRounding * s;
   for (int i = 0; i < 3; ++i)
     if (std::abs(ta[i]) > ha[i] + A.row(i).dot(hb) + std::abs(da[i]) + g) return true;
   for (int j = 0; j < 3; ++j)
@@ -284,8 +281,7 @@ namespace detail {
 // and |r_B| <= the god radius rho, can lie from the double X:
 //   - static_error: the stop pose's deviation (make_stop_pose: double pose vs
 //     exact motion) plus the double evaluation of R(q) r_B + p and of one
-//     projection n.X (|n| = 1 up to rounding): a few roundings of terms bounded
-//     by |p|_inf + rho, well within 1e-13 (|p|_inf + rho);
+//     projection n.X (|n| = 1 up to rounding): kPoseRounding (|p|_inf + rho);
 //   - the motion: p(u) - p(u0) = (u - u0) dp, with dp within drift of its
 //     midpoint dp_mid, and R(u) R(u0)^T is the turn about g by 2 (atan(u |g|) -
 //     atan(u0 |g|)) <= 2 (u - u0) |g| (atan is 1-Lipschitz), so a body point r_B
@@ -312,10 +308,10 @@ struct StartFrame {
   // and sin(phi) >= phi (1 - phi^2 / 6); so sin(phi) / (2 tau |g|) >= 1 - u1^2
   // |g|^2 - (2 tau |g|)^2 / 6. At most 1.
   double lag(double tau_max) const {
-    const double u1 = std::min(1.0, next_up(u0 + tau_max));
-    const double a = next_up(tau_max * turn_rate);
-    const double l = next_up(next_up(next_up(u1 * u1) * g2) + next_up(next_up(a * a) / 6));
-    return l < 1 ? l : 1.0;  // also NaN
+    const Upper u1 = min(Upper{1.0}, Upper{u0} + Upper{tau_max});
+    const Upper a = Upper{tau_max} * Upper{turn_rate};
+    const Upper l = sqr(u1) * Upper{g2} + sqr(a) / 6;
+    return l.v < 1 ? l.v : 1.0;  // also NaN
   }
 
   // The oriented-box frame of the sub-interval [u0, u1] (PosedObb, SweptObbFrame:
@@ -344,8 +340,9 @@ struct StartFrame {
   // u_limit - u0. w, for r the largest |r_B| of the triangle's corners (>= that
   // of any of its points): drift; (omega_error + tau_max omega2 / 2) r (the
   // exact turn rate's distance from omega, and the second-order term);
-  // turn_rate (static_error + 1e-12 r) (the double corners' offsets from G are
-  // within static_error of the exact ones).
+  // turn_rate (static_error + kCornerOffsetRounding r) (the double corners'
+  // offsets from G are within static_error of the exact ones, and their
+  // subtraction rounds).
   double earliest(const TriangleMesh& gm, int gf, const TriangleMesh& om, int of, double d, double u_limit) const {
     Vec3 X[3], Y[3];
     const double r2 = place(gm, gf, om, of, X, Y);
@@ -358,20 +355,20 @@ struct StartFrame {
   // try first.
   double earliest(const Vec3 X[3], const Vec3 Y[3], double r, double d, double u_limit,
                   const Vec3* extra = nullptr) const {
-    const double tau_max = next_up(u_limit - u0);
+    const Upper tau_max = Upper{u_limit} - Lower{u0};
     TriangleMotion m;
     m.v = dp_mid;
     m.omega = omega;
     m.centre = p;
-    m.lag = lag(tau_max);
-    const double second = next_up(0.5 * next_up(tau_max * omega2));
-    const double offsets = next_up(turn_rate * next_up(static_error + 1e-12 * r));
-    m.w = next_up(next_up(drift + next_up(next_up(omega_error + second) * r)) + offsets);
+    m.lag = lag(tau_max.v);
+    const Upper second = 0.5 * (tau_max * Upper{omega2});
+    const Upper offsets = Upper{turn_rate} * round_up(static_error + kCornerOffsetRounding * r);
+    m.w = ((Upper{drift} + (Upper{omega_error} + second) * Upper{r}) + offsets).v;
     if (!(m.w < std::numeric_limits<double>::infinity())) return u0;
-    const double reach = next_up(static_error + d);
-    const double tau = triangle_time_lower_bound(X, Y, m, reach, tau_max, extra);
+    const Upper reach = Upper{static_error} + Upper{d};
+    const double tau = triangle_time_lower_bound(X, Y, m, reach.v, tau_max.v, extra);
     if (!(tau > 0)) return u0;
-    return next_down(u0 + tau);
+    return (Lower{u0} + Lower{tau}).v;
   }
 
   // A lower bound of the distance of the god triangle gf at u0 (exact) from
@@ -381,14 +378,14 @@ struct StartFrame {
   double gap(const TriangleMesh& gm, int gf, const TriangleMesh& om, int of, double enough, double* r) const {
     Vec3 X[3], Y[3];
     *r = radius(place(gm, gf, om, of, X, Y));
-    const double g = triangle_gap_lower_bound(X, Y, next_up(static_error + enough));
-    return std::max(0.0, next_down(g - static_error));
+    const double g = triangle_gap_lower_bound(X, Y, (Upper{static_error} + Upper{enough}).v);
+    return std::max(0.0, (Lower{g} - Upper{static_error}).v);
   }
 
   // A body point's double position at u0.
   Vec3 pose(const Vec3& r_B) const { return R * r_B + p; }
   // A bound >= sqrt(r2) and <= rho (every body point's |r_B| is).
-  double radius(double r2) const { return std::min(rho, next_up(std::sqrt(r2) * (1 + 1e-15))); }
+  double radius(double r2) const { return std::min(rho, round_up(std::sqrt(r2) * (1 + kRelativeRounding)).v); }
 
  private:
   // The god triangle's corners at u0 (doubles) and the obstacle triangle's;
@@ -410,20 +407,19 @@ struct StartFrame {
 // q / |q|): at most shift + turn |r_B|, with shift >= |p_b - p_a| and turn >=
 // |R(q_b) - R(q_a)|: for unit quaternions R(a)^T R(b) = R(conj(a) b) turns by
 // theta with |vec(conj(a) b)| = sin(theta / 2), and a turn by theta moves a
-// point by at most 2 sin(theta / 2) |r_B|. In doubles the two normalisations
-// and the product's components are within a few units of 2^-53 (every term is
-// at most 1 in magnitude): 1e-14 covers them, and 1e-15 the rounding of
-// |p_b - p_a|. Infinite on non-finite input.
+// point by at most 2 sin(theta / 2) |r_B|. In doubles: kQuaternionTurnRounding
+// covers the two normalisations and the product, kRelativeRounding the
+// rounding of |p_b - p_a|. Infinite on non-finite input.
 struct Displacement {
   double shift = 0, turn = 0;
   Displacement(const Pose& a, const Pose& b);
   // Grown by a motion from b over [0, u] (StartFrame at 0: |dp| <= dp_max, and
   // R(u) R(0)^T turns by at most u turn_rate).
   void add(const StartFrame& f, double u) {
-    shift = next_up(shift + next_up(u * f.dp_max));
-    turn = next_up(turn + next_up(u * f.turn_rate));
+    shift = (Upper{shift} + u * Upper{f.dp_max}).v;
+    turn = (Upper{turn} + u * Upper{f.turn_rate}).v;
   }
-  double bound(double radius) const { return next_up(shift + next_up(turn * radius)); }
+  double bound(double radius) const { return (Upper{shift} + Upper{turn} * Upper{radius}).v; }
 };
 
 }  // namespace detail

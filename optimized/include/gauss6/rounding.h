@@ -1,8 +1,10 @@
 // Rounding-safe arithmetic: next_up / next_down, the branch-free outward
-// rounding of one double, and Interval, the closed interval whose every
-// operation is widened outward, so that a bound computed in doubles holds for
+// rounding of one double; Interval, the closed interval whose every operation
+// is widened outward; and Upper / Lower, one-sided bounds whose every
+// operation rounds the safe way; so that a bound computed in doubles holds for
 // the exact reals it stands for. The conservative bounds of the collision
-// pipeline (ccd.h, aabb.h, the motion bounds) are built on these.
+// pipeline (ccd.h, aabb.h, the motion bounds) are built on these, with the
+// named allowances of error_allowances.h.
 #pragma once
 
 #include <algorithm>
@@ -87,5 +89,72 @@ GAUSS6_ALWAYS_INLINE Interval hull(Interval a, Interval b) { return {std::min(a.
 
 using IVec3 = std::array<Interval, 3>;
 using IMat3 = std::array<Interval, 9>;  // row-major
+
+// ---------------------------------------------------------------------------
+// One-sided bounds: Upper, a double v known to be >= the exact real it stands
+// for, and Lower, one known to be <= it. Each operation computes its double
+// result once, rounded to nearest, and moves it outward by one next_up (Upper)
+// or next_down (Lower): by the proof above, the result bounds the exact result
+// of the same operation on the exact reals, the way its type says, provided
+// the operands bound them the way theirs do and the signs noted below hold
+// (a product of upper bounds bounds the exact product only for nonnegative
+// reals). So a chain of these is a bound of the exact chain, each rounding
+// applied once, by the type.
+//
+// Entering: Upper{x} / Lower{x} state that x already is such a bound (an
+// exact double, a bound rounded the safe way, or an allowance whose margin
+// covers its own rounding); round_up(x) / round_down(x) take x, a computed
+// value within one last rounding of the real it stands for (any earlier error
+// covered by an allowance of error_allowances.h), and move it outward. A
+// plain double operand (a scale s, a divisor) is exact.
+// Leaving: .v. Comparisons prove: Lower > Upper only when the exact reals
+// are ordered so.
+// ---------------------------------------------------------------------------
+
+struct Upper {
+  double v = 0;
+};
+struct Lower {
+  double v = 0;
+};
+
+GAUSS6_ALWAYS_INLINE Upper round_up(double x) { return {next_up(x)}; }
+GAUSS6_ALWAYS_INLINE Lower round_down(double x) { return {next_down(x)}; }
+
+GAUSS6_ALWAYS_INLINE Upper operator+(Upper a, Upper b) { return {next_up(a.v + b.v)}; }
+GAUSS6_ALWAYS_INLINE Upper operator-(Upper a, Lower b) { return {next_up(a.v - b.v)}; }
+// Products and quotients of nonnegative reals (a divisor's real: positive).
+GAUSS6_ALWAYS_INLINE Upper operator*(Upper a, Upper b) { return {next_up(a.v * b.v)}; }
+GAUSS6_ALWAYS_INLINE Upper operator*(double s, Upper a) { return {next_up(s * a.v)}; }  // s >= 0
+GAUSS6_ALWAYS_INLINE Upper operator/(Upper a, Lower b) { return {next_up(a.v / b.v)}; }
+GAUSS6_ALWAYS_INLINE Upper operator/(Upper a, double s) { return {next_up(a.v / s)}; }  // s > 0
+GAUSS6_ALWAYS_INLINE Upper sqr(Upper a) { return {next_up(a.v * a.v)}; }
+GAUSS6_ALWAYS_INLINE Upper sqrt(Upper a) { return {next_up(std::sqrt(a.v))}; }
+GAUSS6_ALWAYS_INLINE Upper max(Upper a, Upper b) { return {std::max(a.v, b.v)}; }  // exact
+GAUSS6_ALWAYS_INLINE Upper min(Upper a, Upper b) { return {std::min(a.v, b.v)}; }  // exact
+
+GAUSS6_ALWAYS_INLINE Lower operator+(Lower a, Lower b) { return {next_down(a.v + b.v)}; }
+GAUSS6_ALWAYS_INLINE Lower operator-(Lower a, Upper b) { return {next_down(a.v - b.v)}; }
+// Quotients and squares of nonnegative reals (a divisor's real: positive).
+GAUSS6_ALWAYS_INLINE Lower operator/(Lower a, Upper b) { return {next_down(a.v / b.v)}; }
+GAUSS6_ALWAYS_INLINE Lower sqr(Lower a) { return {next_down(a.v * a.v)}; }
+GAUSS6_ALWAYS_INLINE Lower sqrt(Lower a) { return {next_down(std::sqrt(a.v))}; }
+
+GAUSS6_ALWAYS_INLINE bool operator>(Lower a, Upper b) { return a.v > b.v; }  // false on NaN
+
+// [lo - e, hi + e] for e >= 0, rounded outward.
+GAUSS6_ALWAYS_INLINE Interval widen(Interval a, Upper e) { return {next_down(a.lo - e.v), next_up(a.hi + e.v)}; }
+// Bounds read off an interval: the largest magnitude of its points (exact),
+// and the largest distance of its points from the double x.
+GAUSS6_ALWAYS_INLINE Upper magnitude(Interval a) { return {std::max(std::abs(a.lo), std::abs(a.hi))}; }
+GAUSS6_ALWAYS_INLINE Upper distance_from(Interval a, double x) {
+  return max(Upper{a.hi} - Lower{x}, Upper{x} - Lower{a.lo});
+}
+// The largest Euclidean norm of the vectors in the box v.
+GAUSS6_ALWAYS_INLINE Upper norm_upper(const IVec3& v) {
+  Upper s2{0};
+  for (const Interval& c : v) s2 = s2 + sqr(magnitude(c));
+  return sqrt(s2);
+}
 
 }  // namespace gauss6

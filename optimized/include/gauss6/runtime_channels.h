@@ -37,6 +37,18 @@ struct GodObjectSnapshot {
   double point[kMaxContacts][3] = {};  // I_k, world frame
   double normal[kMaxContacts][3] = {}; // n_k, world frame
   double separation[kMaxContacts] = {};
+  // Shaded surfaces (surface.h): the shading rows Js (m x 6 row-major) and
+  // their unit normals; shaded = 0 on plain surfaces (then not filled).
+  int32_t shaded = 0;
+  double Js[kMaxContacts * 6] = {};
+  double shaded_normal[kMaxContacts][3] = {};
+};
+
+// coupling -> sim (shaded surfaces): asc, the projection of au under Js (pass 1).
+struct ShadedMotionSample {
+  uint64_t god_sequence = 0;           // the snapshot (sim step) whose xs and Js it used
+  double time = 0;                     // s, when it was computed
+  double asc[6] = {0, 0, 0, 0, 0, 0};  // world frame, a = (aG, alpha)
 };
 
 // coupling -> haptic: the wrench Fc.
@@ -50,6 +62,7 @@ struct RuntimeChannels {
   SeqLock<HandleSample> handle;
   SeqLock<GodObjectSnapshot> god_object;
   SeqLock<WrenchSample> wrench;
+  SeqLock<ShadedMotionSample> shaded_motion;
 };
 
 Pose to_pose(const double p[3], const double q[4]);

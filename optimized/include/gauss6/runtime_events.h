@@ -30,8 +30,10 @@ enum class RuntimeEventKind {
   kProjectionFailed,       // a projection returned kBadInput or kIterationCap
   kCcdGaveUp,              // the sim step's CCD gave up (hit kept conservatively) or refused its input
   kContactOverflow,        // more contacts than kMaxContacts: the set was truncated
+  kTextureUndersampled,    // a textured contact moved more than half the texture's shortest wavelength in one
+                           // sim step: the texture is skipped at this speed (surface.h, max_texture_speed)
 };
-inline constexpr int kNumRuntimeEventKinds = 11;
+inline constexpr int kNumRuntimeEventKinds = 12;
 const char* to_string(RuntimeEventKind k);
 
 struct RuntimeEvent {
@@ -49,6 +51,18 @@ struct SimStepInfo {
   SimStepStatus status = SimStepStatus::kNoHandle;
   Pose xs;                             // after the step
   Vec6 au = Vec6::Zero(), ac = Vec6::Zero();
+  // Shaded surfaces (surface.h): asc, the command after the shading pass (the
+  // coupling loop's, or this step's own when the coupling has not yet answered
+  // the last snapshot); ac = the projection of asc under the true rows J.
+  // Plain surfaces: asc = au.
+  Vec6 asc = Vec6::Zero();
+  bool asc_from_coupling = false;      // asc was the coupling loop's (published for the last snapshot)
+  // Property 7 (METHOD.md section 5), on every step: the rows of step 3 (the
+  // previous contacts J, right-hand sides b) hold for the motion taken:
+  // max_k (b_k - J_k ac) / (|J_k| |ac| + |b_k| + 1e-300), 0 when none is violated.
+  double max_rel_constraint_violation = 0;
+  double texture_step = 0;             // textured contacts: the largest distance a contact point moved in
+                                       // this step (scene units; > half the shortest wavelength: skipped)
   ProjectionStatus projection = ProjectionStatus::kOptimal;
   CcdStatus ccd = CcdStatus::kOk;
   double u_hit = 1;                    // of the last CCD leg
@@ -78,7 +92,11 @@ struct CouplingStepInfo {
   uint64_t god_sequence = 0;
   double god_time = -1;
   Pose xs;                             // the god-object pose the step used (the cached snapshot's)
+  // ac: the projection the force comes from: of au under J, or on a shaded
+  // surface under the shading rows Js (then ac = asc, the motion pass 1 gives
+  // and the sim loop takes, surface.h); Fc = kh M (ac - au).
   Vec6 au = Vec6::Zero(), ac = Vec6::Zero(), Fc = Vec6::Zero();
+  bool shaded = false;                 // the rows were the shading rows Js
   int num_rows = 0, num_offset_rows = 0;  // rows, and rows whose offset still runs
   int num_new_offsets = 0;             // rows offset when this snapshot arrived
   ProjectionStatus projection = ProjectionStatus::kOptimal;

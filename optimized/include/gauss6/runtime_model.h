@@ -14,6 +14,7 @@
 #include "gauss6/offsetting.h"
 #include "gauss6/quasistatics.h"
 #include "gauss6/scene.h"
+#include "gauss6/surface.h"
 
 namespace gauss6 {
 
@@ -83,6 +84,11 @@ struct RuntimeModel {
   RuntimeSettings settings;            // the effective settings (resolve_runtime_settings)
   ContactSettings contact_generation;  // distance = delta (1 + contact_factor)
   double match_distance = 0;           // resolved (never 0)
+  SurfaceModel surface;                // force shading and texture (surface.h); inactive for plain surfaces
+  double sim_rate_hz = 0;              // the constraint update rate the texture bound assumes: lockstep,
+                                       // device rate / lockstep_sim_period; threaded, at most 1 / sim_min_period
+  double texture_max_speed = 0;        // fastest exploration the texture allows at sim_rate_hz (scene units/s;
+                                       // 0 without a texture): max_texture_speed (surface.h)
 };
 
 // The settings a model runs with: `settings` as given, except the CCD fields

@@ -19,9 +19,11 @@ inline constexpr int kSceneFormatVersion = 1;
 
 enum class BodyRole { kObstacle, kGodObject };
 enum class SurfaceKind { kNone, kForceShading, kTexture };
+enum class TextureKind { kSine, kBumps, kHeightMap };
 enum class DeviceKind { kSimulated, kReplay, kHid };
 const char* to_string(BodyRole r);
 const char* to_string(SurfaceKind k);
+const char* to_string(TextureKind k);
 const char* to_string(DeviceKind k);
 
 struct Body {
@@ -32,6 +34,9 @@ struct Body {
                            // or the mesh's own frame (obstacles)
   Pose pose;               // X_WB: obstacles' fixed pose; the god-object's initial pose of G
   MeshReport report;       // validation at load (self-intersections not checked: -1)
+  double crease_angle = 45;  // obstacles, degrees in [0, 180]: force shading keeps an edge whose
+                             // dihedral angle is above this sharp (0: flat; 180: every edge smooth)
+  MatrixX3d given_normals; // obstacles: unit vertex normals from the mesh file (empty: none given)
 };
 
 struct GodObjectMass {
@@ -59,11 +64,24 @@ struct ContactParameters {
   double offset_time = 0.05;  // time T of an offset's return to 0 (s)
 };
 
+// A grey height-map image (texture = height_map), values in [0, 1], row 0 at v = 0.
+struct HeightMapImage {
+  std::string path;        // as resolved
+  int width = 0, height = 0;
+  std::vector<float> values;  // width * height, row-major
+};
+
 struct SurfaceSettings {
   SurfaceKind kind = SurfaceKind::kNone;
-  double amplitude = 0;    // texture: perturbation as a fraction of the force
-  double wavelength = 0;   // texture: period along the axis (scene units)
-  int axis = 0;            // texture: 0 = x, 1 = y, 2 = z
+  bool shading = false;    // texture: on force-shaded normals too (kind = force_shading: always)
+  TextureKind texture = TextureKind::kSine;  // texture: sine along axis, a grid of bumps, a height map
+  double amplitude = 0;    // texture: largest tangential part of the perturbed force, as a fraction of the force
+                           // (the height field's steepest slope: 1 tilts the force by 45 degrees)
+  double wavelength = 0;   // texture: period along the axes (scene units; height map: the image's width)
+  int axis = 0;            // texture: the u axis, 0 = x, 1 = y, 2 = z
+  int axis_v = 1;          // texture bumps / height map: the v axis (not axis)
+  Vec3 origin = Vec3::Zero();  // texture: the point of phase 0 (scene units, world frame)
+  HeightMapImage height_map;   // texture = height_map: the image
 };
 
 struct DeviceSettings {
@@ -109,9 +127,19 @@ SettingsProblem check_gains(const Gains& gains);                         // 0 < 
 SettingsProblem check_contact_parameters(const ContactParameters& contact);  // delta > 0, offset_eps < 0,
                                                                          // offset_time > 0
 SettingsProblem check_surface_settings(const SurfaceSettings& surface);  // texture: 0 < amplitude <= 1,
-                                                                         // wavelength > 0, axis 0, 1 or 2
+                                                                         // wavelength > 0, axis 0, 1 or 2,
+                                                                         // bumps/height map: axis_v another
+                                                                         // axis; height map: an image of
+                                                                         // >= 2 x 2 values in [0, 1]
+SettingsProblem check_crease_angle(double degrees);                      // [[obstacle]]: 0 <= crease_angle <= 180
 SettingsProblem check_device_settings(const DeviceSettings& device);     // 100 <= rate_hz <= 10000,
                                                                          // max_force > 0, max_torque > 0
+
+// Reads a PNG image (any bit depth and colour type; converted to grey by
+// libpng) into *out with values in [0, 1]; false with a message on failure.
+// Writes one (8-bit grey, values rounded) for tests and generators. Load time only.
+bool read_height_map(const std::string& path, HeightMapImage* out, std::string* error);
+bool write_height_map(const std::string& path, const HeightMapImage& image, std::string* error);
 
 // Loads and validates a scene file. Throws SceneError.
 Scene load_scene(const std::string& path);

@@ -17,6 +17,7 @@
 #include "gauss6/runtime_channels.h"
 #include "gauss6/runtime_events.h"
 #include "gauss6/runtime_model.h"
+#include "gauss6/surface.h"
 
 namespace gauss6 {
 
@@ -29,6 +30,12 @@ struct SimState {
   std::array<double, kMaxContacts> gap_rhs{};  // b_k = delta (1 + gap_factor) - separation_k
   ProjectionWorkspace projection_ws;
   ProjectionResult projection;
+  // Shaded surfaces: the shading rows of the current set (published with J)
+  // and pass 1's own projection, used when the coupling's asc is not for the last snapshot.
+  std::array<double, kMaxContacts * 6> shaded_J{};
+  double shaded_normal[kMaxContacts][3] = {};
+  ProjectionWorkspace shading_ws;
+  ProjectionResult shading;
   CcdStepWorkspace ccd_ws;
   CcdStepResult ccd;
   std::array<FeaturePair, kMaxContacts> ccd_hints{};  // the contacts at a leg's start, tested first (ccd_step)

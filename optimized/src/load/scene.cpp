@@ -84,6 +84,13 @@ class TableReader {
     return v;
   }
 
+  bool boolean(const char* key, bool fallback) const {
+    const toml::node* n = table_.get(key);
+    if (!n) return fallback;
+    if (!n->is_boolean()) fail(n->source(), key, "must be true or false");
+    return n->as_boolean()->get();
+  }
+
   int64_t integer(const char* key, const int64_t* fallback = nullptr) const {
     const toml::node* n = table_.get(key);
     if (!n) {
@@ -277,13 +284,16 @@ Scene load_scene(const std::string& path) {
     if (!arr || !arr->is_array_of_tables()) top.fail(n->source(), "obstacle", "must be an array of tables [[obstacle]]");
     for (size_t i = 0; i < arr->size(); ++i) {
       TableReader r(path, *arr->get(i)->as_table(), "obstacle[" + std::to_string(i) + "].");
-      r.allow_only({"name", "mesh", "position", "orientation"});
+      r.allow_only({"name", "mesh", "position", "orientation", "crease_angle"});
       Body b;
       b.role = BodyRole::kObstacle;
       b.name = r.string("name");
       claim_name(r, b.name);
       b.pose = read_pose(r);
       read_body_mesh(r, &b, &scene.warnings);
+      const double crease_default = b.crease_angle;
+      b.crease_angle = r.number("crease_angle", &crease_default);
+      require(check_crease_angle(b.crease_angle), r);
       scene.obstacles.push_back(std::move(b));
     }
   }
@@ -351,23 +361,46 @@ Scene load_scene(const std::string& path) {
   // [surface] (optional)
   {
     TableReader r(path, sub_table(top, "surface", false, empty), "surface.");
-    r.allow_only({"kind", "amplitude", "wavelength", "axis"});
+    r.allow_only({"kind", "shading", "texture", "amplitude", "wavelength", "axis", "axis_v", "origin", "image"});
+    SurfaceSettings& s = scene.surface;
     const std::string none = "none";
     const std::string kind = r.string("kind", &none);
-    if (kind == "none") scene.surface.kind = SurfaceKind::kNone;
-    else if (kind == "force_shading") scene.surface.kind = SurfaceKind::kForceShading;
-    else if (kind == "texture") scene.surface.kind = SurfaceKind::kTexture;
+    if (kind == "none") s.kind = SurfaceKind::kNone;
+    else if (kind == "force_shading") s.kind = SurfaceKind::kForceShading;
+    else if (kind == "texture") s.kind = SurfaceKind::kTexture;
     else r.fail(r.node("kind")->source(), "kind", "must be \"none\", \"force_shading\" or \"texture\"");
-    if (scene.surface.kind == SurfaceKind::kTexture) {
-      scene.surface.amplitude = r.number("amplitude");
-      scene.surface.wavelength = r.number("wavelength");
-      const std::string x = "x";
-      const std::string axis = r.string("axis", &x);
-      if (axis != "x" && axis != "y" && axis != "z") r.fail(r.node("axis")->source(), "axis", "must be x, y or z");
-      scene.surface.axis = axis[0] - 'x';
-      require(check_surface_settings(scene.surface), r);
+    auto read_axis = [&](const char* key, const std::string& fallback) {
+      const std::string a = r.string(key, &fallback);
+      if (a != "x" && a != "y" && a != "z") r.fail(r.node(key)->source(), key, "must be x, y or z");
+      return a[0] - 'x';
+    };
+    if (s.kind == SurfaceKind::kTexture) {
+      s.shading = r.boolean("shading", false);
+      const std::string sine = "sine";
+      const std::string texture = r.string("texture", &sine);
+      if (texture == "sine") s.texture = TextureKind::kSine;
+      else if (texture == "bumps") s.texture = TextureKind::kBumps;
+      else if (texture == "height_map") s.texture = TextureKind::kHeightMap;
+      else r.fail(r.node("texture")->source(), "texture", "must be \"sine\", \"bumps\" or \"height_map\"");
+      s.amplitude = r.number("amplitude");
+      s.wavelength = r.number("wavelength");
+      s.axis = read_axis("axis", "x");
+      const Vec3 zero = Vec3::Zero();
+      s.origin = r.vector<3>("origin", &zero);
+      if (s.texture != TextureKind::kSine) s.axis_v = read_axis("axis_v", s.axis == 1 ? "x" : "y");
+      else if (r.has("axis_v")) r.fail(r.node("axis_v")->source(), "axis_v", "only for texture = bumps or height_map");
+      if (s.texture == TextureKind::kHeightMap) {
+        const fs::path image = fs::path(path).parent_path() / r.string("image");
+        s.height_map.path = image.lexically_normal().string();
+        std::string error;
+        if (!read_height_map(s.height_map.path, &s.height_map, &error))
+          r.fail(r.node("image")->source(), "image", error);
+      } else if (r.has("image")) {
+        r.fail(r.node("image")->source(), "image", "only for texture = \"height_map\"");
+      }
+      require(check_surface_settings(s), r);
     } else {
-      for (const char* k : {"amplitude", "wavelength", "axis"})
+      for (const char* k : {"shading", "texture", "amplitude", "wavelength", "axis", "axis_v", "origin", "image"})
         if (r.has(k)) r.fail(r.node(k)->source(), k, "only for kind = \"texture\"");
     }
   }

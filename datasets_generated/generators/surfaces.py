@@ -1,0 +1,167 @@
+"""The surface-property scenes of METHOD.md section 6 (the paper's Figures 8 and 9):
+meshes and hand scripts.
+
+- faceted_cylinder.off: a 12-sided prism (circumradius 3 cm, length 8 cm, axis Y,
+  centred on the origin), the low-polygon cylinder that force shading makes feel
+  round (Figure 8). Made by the peg generator's make_peg (same code, other sizes).
+- slab.off: a 20 x 6 x 1 cm block (X, Y, Z), top face at z = 0, the surface the
+  bump-and-hole texture is drawn on (Figure 9).
+- probe.off: a regular octahedron of circumradius 5 mm, the held probe; the scenes
+  put its reference point G at its lowest vertex (the tip that explores).
+- cylinder_slide.json: the tip pressed 4 mm past the cylinder's flats, slid over the
+  top half around the axis (15 to 165 degrees) across five edges, then lifted.
+- texture_slow.json / texture_fast.json: the tip pressed 3 mm into the slab and slid
+  along +X over 12 cm at 0.1 m/s and at 0.4 m/s.
+
+Coordinates are correctly rounded doubles (angles through the peg generator's
+40-digit cos/sin), so the files do not depend on the platform's libm.
+
+Usage as a program: python surfaces.py OUT_DIR
+"""
+from __future__ import annotations
+
+import importlib.util
+import json
+import sys
+from dataclasses import asdict, dataclass
+from pathlib import Path
+
+import numpy as np
+
+GENERATOR_VERSION = "1"
+
+
+def _peg_module():
+    name = "gauss6_generators_peg_in_hole"
+    if name in sys.modules:
+        return sys.modules[name]
+    path = Path(__file__).with_name("peg_in_hole.py")
+    spec = importlib.util.spec_from_file_location(name, path)
+    module = importlib.util.module_from_spec(spec)
+    sys.modules[name] = module
+    spec.loader.exec_module(module)
+    return module
+
+
+@dataclass(frozen=True)
+class SurfacesParams:
+    """Lengths in metres, times in seconds."""
+
+    cylinder_radius: float = 0.03
+    cylinder_length: float = 0.08
+    cylinder_sides: int = 12
+    slab_size: tuple = (0.2, 0.06, 0.01)
+    probe_radius: float = 0.005
+    press: float = 0.004            # cylinder: the hand this far inside the flats (apothem)
+    slide_from_deg: int = 15        # cylinder: the slide's start and end angles (from +X towards +Z)
+    slide_to_deg: int = 165
+    slide_time: float = 3.0
+    texture_press: float = 0.003
+    texture_start_x: float = -0.06
+    texture_length: float = 0.12
+    texture_speeds: tuple = (0.1, 0.4)
+
+    def to_json(self) -> dict:
+        d = asdict(self)
+        return {k: list(v) if isinstance(v, tuple) else v for k, v in d.items()}
+
+
+def make_slab(p: SurfacesParams) -> tuple[np.ndarray, np.ndarray]:
+    """The slab: 8 vertices, 12 outward triangles, top face at z = 0."""
+    sx, sy, sz = (0.5 * p.slab_size[0], 0.5 * p.slab_size[1], p.slab_size[2])
+    V = [(x, y, z) for z in (-sz, 0.0) for y in (-sy, sy) for x in (-sx, sx)]
+    # Vertex i = 4 z + 2 y + x (bits); faces counter-clockwise seen from outside.
+    quads = [(0, 2, 3, 1), (4, 5, 7, 6), (0, 1, 5, 4), (2, 6, 7, 3), (0, 4, 6, 2), (1, 3, 7, 5)]
+    F = []
+    for a, b, c, d in quads:
+        F += [(a, b, c), (a, c, d)]
+    return np.array(V, dtype=np.float64), np.array(F, dtype=np.int64)
+
+
+def make_probe(p: SurfacesParams) -> tuple[np.ndarray, np.ndarray]:
+    """The octahedron: vertices on the axes at distance probe_radius, 8 outward triangles."""
+    r = p.probe_radius
+    V = [(r, 0.0, 0.0), (-r, 0.0, 0.0), (0.0, r, 0.0), (0.0, -r, 0.0), (0.0, 0.0, r), (0.0, 0.0, -r)]
+    F = []
+    for sx, sy, sz in [(0, 2, 4), (2, 1, 4), (1, 3, 4), (3, 0, 4), (2, 0, 5), (1, 2, 5), (3, 1, 5), (0, 3, 5)]:
+        F.append((sx, sy, sz))
+    return np.array(V, dtype=np.float64), np.array(F, dtype=np.int64)
+
+
+def _key(t: float, p: tuple) -> dict:
+    return {"t": round(t, 9), "p": [float(x) + 0.0 for x in p], "q": [1.0, 0.0, 0.0, 0.0]}
+
+
+def cylinder_script(p: SurfacesParams) -> dict:
+    """The tip (G) around the cylinder's axis at the flats' apothem less `press`."""
+    peg = _peg_module()
+    n = p.cylinder_sides
+    c15, _ = peg._cos_sin(1, 2 * n)                 # cos(pi / n): apothem / circumradius
+    import decimal
+    ctx = peg._CTX
+    radius = ctx.subtract(ctx.multiply(decimal.Decimal(p.cylinder_radius), c15), decimal.Decimal(p.press))
+    far = decimal.Decimal(p.cylinder_radius + 0.01)
+
+    def at(deg: int, r) -> tuple:
+        c, s = peg._cos_sin(deg, 360)
+        return (float(ctx.multiply(r, c)), 0.0, float(ctx.multiply(r, s)))
+
+    a0, a1 = p.slide_from_deg, p.slide_to_deg
+    keys = [_key(0.0, at(a0, far)), _key(0.5, at(a0, far)), _key(1.0, at(a0, radius))]
+    for i, deg in enumerate(range(a0, a1 + 1)):
+        keys.append(_key(1.5 + p.slide_time * i / (a1 - a0), at(deg, radius)))
+    end = 1.5 + p.slide_time
+    keys += [_key(end + 0.5, at(a1, far))]
+    return {"description": "Figure 8 analogue: the probe's tip pressed past the faceted cylinder's flats and slid "
+                           f"around its axis from {a0} to {a1} degrees (from +X towards +Z) across its edges.",
+            "keys": keys,
+            "phases": [{"name": "approach", "start": 0.0}, {"name": "slide", "start": 1.5},
+                       {"name": "lift", "start": end}],
+            "end_time": end + 1.0}
+
+
+def texture_script(p: SurfacesParams, speed: float) -> dict:
+    """The tip pressed into the slab's top and slid along +X at `speed`."""
+    x0, z = p.texture_start_x, -p.texture_press
+    t_slide = p.texture_length / speed
+    keys = [_key(0.0, (x0, 0.0, 0.01)), _key(0.3, (x0, 0.0, 0.01)), _key(0.8, (x0, 0.0, z)),
+            _key(1.0, (x0, 0.0, z)), _key(1.0 + t_slide, (x0 + p.texture_length, 0.0, z)),
+            _key(1.5 + t_slide, (x0 + p.texture_length, 0.0, 0.01))]
+    return {"description": f"Figure 9 analogue: the probe's tip pressed {p.texture_press * 1000:g} mm into the "
+                           f"textured slab and slid along +X over {p.texture_length * 100:g} cm at {speed:g} m/s.",
+            "keys": keys,
+            "phases": [{"name": "approach", "start": 0.0}, {"name": "slide", "start": 1.0},
+                       {"name": "lift", "start": 1.0 + t_slide}],
+            "end_time": round(2.0 + t_slide, 9)}
+
+
+def generate(out_dir: Path, params: SurfacesParams | None = None) -> dict[str, str]:
+    """Writes the meshes and scripts into out_dir; returns {filename: text}."""
+    p = params or SurfacesParams()
+    peg = _peg_module()
+    cyl = peg.PegInHoleParams(peg_radius=p.cylinder_radius, peg_length=p.cylinder_length,
+                              peg_sides=p.cylinder_sides)
+    meshes = {"faceted_cylinder.off": peg.make_peg(cyl), "slab.off": make_slab(p), "probe.off": make_probe(p)}
+    header = peg.provenance_header("datasets_generated/generators/surfaces.py", p.to_json(),
+                                   __import__("hashlib").sha256(Path(__file__).read_bytes()).hexdigest())
+    header[1] = f"generator_version: {GENERATOR_VERSION}"
+    out = {}
+    for name, (V, F) in meshes.items():
+        problems = peg.check_closed_manifold(F)
+        if problems or not peg.signed_volume(V, F) > 0:
+            raise RuntimeError(f"{name}: not a closed outward manifold: {problems}")
+        out[name] = peg.off_text(V, F, header)
+    scripts = {"cylinder_slide.json": cylinder_script(p)}
+    for speed, label in zip(p.texture_speeds, ("slow", "fast")):
+        scripts[f"texture_{label}.json"] = texture_script(p, speed)
+    for name, s in scripts.items():
+        out[name] = json.dumps(s, indent=1) + "\n"
+    out_dir = Path(out_dir)
+    out_dir.mkdir(parents=True, exist_ok=True)
+    for name, text in out.items():
+        (out_dir / name).write_text(text, encoding="ascii")
+    return out
+
+
+if __name__ == "__main__":
+    generate(Path(sys.argv[1]))
