@@ -4,6 +4,7 @@
 // few tokens.
 #include "load/mesh_file_checks.h"
 
+#include <algorithm>
 #include <cctype>
 #include <cstdint>
 #include <cstring>
@@ -130,6 +131,8 @@ bool ply_type_signed(std::string_view type) {
 }
 
 struct PlyProperty {
+  std::string_view name;
+  std::string_view type;        // scalar: its type; list: an item's type
   bool is_list = false;
   std::string_view count_type;  // lists only
   int count_size = 0;           // lists only
@@ -162,10 +165,21 @@ void check_ply_structure(const std::string& path, const std::string& bytes) {
   // Header: lines up to "end_header".
   const std::string_view all(bytes);
   if (all.substr(0, 3) != "ply") fail(path, "cannot parse as PLY: the file does not start with 'ply'");
-  const size_t end_tag = all.find("end_header");
+  // The header ends at the first line whose first word is end_header, as CGAL reads
+  // it (a mere substring, e.g. inside a comment, does not end it).
+  size_t end_tag = std::string_view::npos, body = all.size();
+  for (size_t line = 0; line < all.size();) {
+    size_t eol = all.find('\n', line);
+    if (eol == std::string_view::npos) eol = all.size();
+    const std::vector<std::string_view> words = tokens_of(all.substr(line, eol - line));
+    if (!words.empty() && words[0] == "end_header") {
+      end_tag = line;
+      body = std::min(eol + 1, all.size());
+      break;
+    }
+    line = eol + 1;
+  }
   if (end_tag == std::string_view::npos) fail(path, "cannot parse as PLY: no 'end_header' line");
-  size_t body = all.find('\n', end_tag);
-  body = body == std::string_view::npos ? all.size() : body + 1;
   std::string format;
   std::vector<PlyElement> elements;
   LineCursor lines(all.substr(0, end_tag));
@@ -188,11 +202,15 @@ void check_ply_structure(const std::string& path, const std::string& bytes) {
       PlyProperty p;
       if (t.size() == 5 && t[1] == "list") {
         p.is_list = true;
+        p.name = t[4];
+        p.type = t[3];
         p.count_type = t[2];
         p.count_size = ply_type_size(t[2]);
         p.value_size = ply_type_size(t[3]);
         if (!p.count_size || !p.value_size) fail(path, at + "unknown type in 'property list'");
       } else if (t.size() == 3) {
+        p.name = t[2];
+        p.type = t[1];
         p.value_size = ply_type_size(t[1]);
         if (!p.value_size) fail(path, at + "unknown property type '" + std::string(t[1]) + "'");
       } else {
@@ -207,6 +225,18 @@ void check_ply_structure(const std::string& path, const std::string& bytes) {
   for (const PlyElement& e : elements)
     if (e.count > 0 && e.properties.empty())
       fail(path, "cannot parse as PLY: element '" + e.name + "' has " + std::to_string(e.count) + " items but no properties");
+  // The types CGAL 5.5's reader assumes without checking (it dereferences a failed
+  // cast otherwise): vertex coordinates float or double, face indices 32-bit integers.
+  for (const PlyElement& e : elements)
+    for (const PlyProperty& p : e.properties) {
+      const bool real = p.type == "float" || p.type == "float32" || p.type == "double" || p.type == "float64";
+      const bool int32 = p.type == "int" || p.type == "int32" || p.type == "uint" || p.type == "uint32";
+      if (e.name == "vertex" && (p.name == "x" || p.name == "y" || p.name == "z") && (p.is_list || !real))
+        fail(path, "cannot parse as PLY: vertex coordinate '" + std::string(p.name) + "' must be float or double");
+      if (e.name == "face" && (p.name == "vertex_indices" || p.name == "vertex_index") && (!p.is_list || !int32))
+        fail(path, "cannot parse as PLY: face property '" + std::string(p.name) +
+                       "' must be a list of 32-bit integers (int or uint)");
+    }
 
   // Body: walk every item of every element, bounding each count by the bytes left.
   const size_t size = all.size();
