@@ -69,7 +69,7 @@ reproduce: setup
 clean:
 	rm -rf build build-fuzz out
 
-# The wheel built from the checkout, installed into a fresh venv (python/tests/test_packaging.py;
-# slow: a CMake build of the extension). Not part of `make test`.
+# The wheel built from the checkout, installed into a fresh venv (python/tests/test_packaging.py,
+# also run by `make test`: its build of the extension reuses the main build's objects through ccache).
 wheel-test: setup
-	GAUSS6_TEST_WHEEL=1 $(VENV)/python -m pytest -q python/tests/test_packaging.py
+	$(VENV)/python -m pytest -q python/tests/test_packaging.py

@@ -56,9 +56,14 @@ if [ ! -f viewer/dist/gauss6-viewer.js ] || [ -n "$(find viewer/src viewer/packa
   (cd viewer && npm run --silent build)
 fi
 
-# 4. CMake build (configured once; later runs build incrementally).
+# 4. CMake build (configured once; later runs build incrementally). Compiled through
+#    ccache (tools/ccache.env: paths relative to the checkout), so that the wheel's own
+#    build of the extension (build-<wheel tag>/, python/tests/test_packaging.py) and
+#    other checkouts' builds reuse these objects.
+. tools/ccache.env
 if [ ! -f build/build.ninja ]; then
   cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo \
+    -DCMAKE_CXX_COMPILER_LAUNCHER=ccache \
     -DPython_EXECUTABLE="$root/.venv/bin/python" \
     -Dpybind11_DIR="$(.venv/bin/python -m pybind11 --cmakedir)"
 fi

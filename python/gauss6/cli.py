@@ -187,6 +187,10 @@ def build_parser() -> argparse.ArgumentParser:
     replay.register(sub)
     view.register(sub)
 
+    from . import validate  # an engine under test driven and judged, or a recorded run judged
+
+    validate.register(sub)
+
     from . import bench, gate, sweeps  # benchmarks, speed against error, the regression gate
 
     bench.register(sub)

@@ -53,6 +53,7 @@ from pathlib import Path
 import numpy as np
 
 from . import paths
+from .exact_checks import count_penetrating, distinct_poses, progress_bar
 
 SCENES = {
     "peg": paths.DATASETS_DIR / "scenes" / "peg_in_hole.toml",
@@ -109,29 +110,6 @@ def _phase_mask(t: np.ndarray, phases: list, names: set) -> np.ndarray:
         if name in names:
             mask |= (t >= start) & (t < end)
     return mask
-
-
-def distinct_poses(trace) -> np.ndarray:
-    """Every distinct god-object pose of the trace (N x 7: p, q), in order of first appearance."""
-    poses = np.hstack([trace.ticks["xs_p"], trace.ticks["xs_q"]])
-    _, first = np.unique(poses, axis=0, return_index=True)
-    return poses[np.sort(first)]
-
-
-def count_penetrating(scene: Path, poses: np.ndarray, show_progress: bool, label: str) -> tuple[int, float]:
-    """(poses with at least one exactly intersecting triangle pair, wall time of the check in s)."""
-    from ._gauss6 import runtime
-
-    bar = _progress_bar(len(poses), f"{label}: exact check", "pose", show_progress)
-    done = [0]
-
-    def progress(n: int) -> None:
-        bar.update(n - done[0])
-        done[0] = n
-
-    result = runtime.count_intersecting_pairs(str(scene), np.ascontiguousarray(poses), progress)
-    bar.close()
-    return int(np.count_nonzero(result["counts"])), float(result["seconds"])
 
 
 def let_go_stable(trace, let_go_time: float) -> tuple[bool, dict]:
@@ -212,14 +190,6 @@ def summarize(name: str, trace, run: dict, penetrating: int, threaded: bool) -> 
     return s, extra
 
 
-def _progress_bar(total, desc: str, unit: str, show: bool):
-    from tqdm import tqdm
-
-    return tqdm(total=total, desc=desc, unit=unit, disable=not show, leave=True, dynamic_ncols=True,
-                bar_format="{l_bar}{bar}| {n:.1f}/{total:.1f} {unit} [{elapsed}<{remaining}]"
-                if unit == "s" else None)
-
-
 def run_scenario(name: str, out: Path, threaded: bool = False, duration: float = -1.0,
                  lockstep_sim_period: int = 1, show_progress: bool = True, check_poses: bool = True,
                  figure: bool = True) -> tuple[dict, dict]:
@@ -233,7 +203,7 @@ def run_scenario(name: str, out: Path, threaded: bool = False, duration: float =
     end = json.loads((paths.DATASETS_DIR / "scripts" / ("peg_in_hole.json" if name == "peg" else "bunny.json"))
                      .read_text())["end_time"]
     total = duration if duration >= 0 else end
-    bar = _progress_bar(total, f"{name}: {'threaded' if threaded else 'lockstep'} run", "s", show_progress)
+    bar = progress_bar(total, f"{name}: {'threaded' if threaded else 'lockstep'} run", "s", show_progress)
     last = [0.0]
 
     def progress(t: float) -> None:

@@ -47,7 +47,7 @@ MIN_FORCE = 0.5                  # N: ticks with a weaker force have no meaningf
 
 def _run(scene: Path, out: Path, label: str, sim_period: int, show_progress: bool) -> tuple[dict, object]:
     from ._gauss6 import runtime
-    from .reproduce import count_penetrating, distinct_poses
+    from .exact_checks import count_penetrating, distinct_poses
     from .trace import read_trace
 
     trace_path = out / f"{label}.g6trace"

@@ -31,6 +31,10 @@ MAX_FRAMES = 20_000  # ticks per run kept in a page; sim steps likewise
 VIEWER_DIR = paths.REPO_ROOT / "viewer"
 BUNDLE = VIEWER_DIR / "dist" / "gauss6-viewer.js"
 TEMPLATE = VIEWER_DIR / "src" / "page.html"
+# An installed wheel carries both in the package (python/CMakeLists.txt); a checkout uses viewer/.
+_INSTALLED = Path(__file__).resolve().parent / "viewer"
+if not VIEWER_DIR.is_dir() and (_INSTALLED / "gauss6-viewer.js").is_file():
+    BUNDLE, TEMPLATE = _INSTALLED / "gauss6-viewer.js", _INSTALLED / "page.html"
 
 
 class ViewerBuildError(RuntimeError):

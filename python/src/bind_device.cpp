@@ -60,10 +60,39 @@ void bind_device(py::module_& parent) {
 
   // The simulated device, driven from Python in lockstep: read(t) then write(t, F).
   py::class_<SimulatedDevice>(m, "SimulatedDevice")
-      .def(py::init([](const std::string& script_json) {
-             return std::make_unique<SimulatedDevice>(hand_script_from_json(script_json, "script"));
+      .def(py::init([](const std::string& script_json, double rate_hz, double max_force, double max_torque,
+                       const std::string& origin) {
+             // As run_scenario builds it: the handle's defaults, the scene's rate and limits.
+             SimulatedHandleParams params;
+             if (rate_hz > 0) params.rate_hz = rate_hz;
+             if (max_force > 0) params.max_force = max_force;
+             if (max_torque > 0) params.max_torque = max_torque;
+             try {
+               auto d = std::make_unique<SimulatedDevice>(hand_script_from_json(script_json, origin), params);
+               d->reset(0);
+               return d;
+             } catch (const std::invalid_argument& e) {
+               throw py::value_error(e.what());
+             }
            }),
-           py::arg("script_json"), "A simulated device from a JSON hand script (default handle parameters).")
+           py::arg("script_json"), py::arg("rate_hz") = 0.0, py::arg("max_force") = 0.0, py::arg("max_torque") = 0.0,
+           py::arg("origin") = "script",
+           "A simulated device from a JSON hand script: the default handle parameters, with the scene's rate and "
+           "limits when given (> 0), reset at t = 0 as run_scenario does (ValueError on a bad script).")
+      .def("reset", &SimulatedDevice::reset, py::arg("t0") = 0.0,
+           "Put the handle on the hand at t0, at rest relative to it, with no force.")
+      .def_property_readonly("end_time", [](const SimulatedDevice& d) {
+             const HandScript& s = d.script();
+             return s.end_time >= 0 ? s.end_time : s.keys.back().t;
+           }, "s: read() reports 'ended' after it")
+      .def_property_readonly("let_go_time", [](const SimulatedDevice& d) { return d.script().let_go_time; })
+      .def_property_readonly("phases", [](const SimulatedDevice& d) {
+             py::list out;
+             for (const HandPhase& p : d.script().phases) out.append(py::make_tuple(p.name, p.start));
+             return out;
+           }, "the script's phases as (name, start) pairs")
+      .def_property_readonly("max_force", [](const SimulatedDevice& d) { return d.info().max_force; })
+      .def_property_readonly("max_torque", [](const SimulatedDevice& d) { return d.info().max_torque; })
       .def("read", [](SimulatedDevice& d, double t) {
              DeviceState st;
              d.read(t, &st);

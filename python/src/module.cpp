@@ -9,4 +9,5 @@ PYBIND11_MODULE(_gauss6, m) {
   gauss6::python::bind_reference(m);
   gauss6::python::bind_ccd(m);
   gauss6::python::bind_runtime(m);
+  gauss6::python::bind_oracle(m);
 }

@@ -21,6 +21,7 @@ void bind_reference(pybind11::module_& m);     // the exact reference (gauss6._g
 void bind_ccd(pybind11::module_& m);           // optimized and exact CCD side by side (gauss6._gauss6.ccd)
 void bind_device(pybind11::module_& m);        // devices and the trace writer (gauss6._gauss6.device)
 void bind_runtime(pybind11::module_& m);       // scripted scenarios and traces (gauss6._gauss6.runtime)
+void bind_oracle(pybind11::module_& m);        // contact generation for the validation oracle (gauss6._gauss6.oracle)
 
 // Poses cross the boundary as p (3,) and q (4,) = (w, x, y, z), the order of pose.h.
 // What enters is checked: finite, q not zero, and q rescaled by a power of two when

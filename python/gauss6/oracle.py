@@ -1,0 +1,533 @@
+"""The validation oracle: judges a run of any engine (a gauss6 trace: the driver's recording, or a
+run the engine recorded itself) against the scene's true meshes, with every geometric verdict
+decided by the exact reference (docs/engine-contract.md, "The checks").
+
+    oracle = Oracle("datasets_generated/scenes/peg_in_hole.toml")
+    result = oracle.judge(read_trace("run.g6trace"))   # an OracleResult: verdicts and time series
+
+The checks (thresholds: harness/oracle.toml, each with its reason):
+  penetration          every displayed pose, exactly (reference count_intersecting_pairs)
+  tunnelling           the in-between motion (METHOD.md s.4) between successive free displayed
+                       poses: swept boxes, then gauss6's conservative CCD, then the exact first
+                       contact (reference mesh_first_contact) on every step the CCD stops
+  force_at_distance    a wrench at a free pose whose exact separation exceeds the bound
+  force_direction      the wrench's distance from the cone of contact wrenches (gauss6's contact
+                       generation within the bound), metric M^-1: tangential and wrong-side shares
+  no_force_when_free   a wrench in free space, or while the handle is on the free side of every
+                       contact (METHOD.md property 3)
+  energy               passivity observer on the device port, over the run and per contact episode
+  force_jumps          the change of the wrench from one tick to the next
+  wrench_sanity        non-finite or over-limit wrenches
+  cost                 the engine's step time: the rate it sustains, its stalls
+Geometric checks skip ticks with a non-finite pose or wrench (wrench_sanity counts them); the
+force checks (3-5) judge free poses only (a penetrating pose has no contact cone, and has
+already failed penetration).
+"""
+from __future__ import annotations
+
+import math
+import tomllib
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from . import paths
+
+THRESHOLDS = paths.REPO_ROOT / "harness" / "oracle.toml"
+
+CHECKS = [
+    ("penetration", "1. penetration of the displayed poses"),
+    ("tunnelling", "2. tunnelling between successive poses"),
+    ("force_at_distance", "3. force at a distance"),
+    ("force_direction", "4. force outside the contact cone"),
+    ("no_force_when_free", "5. force in free space or moving away"),
+    ("energy", "6. energy (passivity)"),
+    ("force_jumps", "7. force jumps"),
+    ("wrench_sanity", "7. non-finite or over-limit wrench"),
+    ("cost", "8. cost (step time)"),
+]
+
+
+def load_thresholds(path=None) -> dict:
+    with open(path or THRESHOLDS, "rb") as f:
+        return tomllib.load(f)
+
+
+@dataclass
+class Verdict:
+    name: str
+    title: str
+    passed: bool
+    count: int               # violating ticks (or poses, steps, episodes: see unit)
+    worst: float             # the worst value (see unit); 0 when nothing was measured
+    unit: str
+    first_time: float | None  # s, the first violation
+    note: str = ""
+    details: dict = field(default_factory=dict)
+
+    def to_json(self) -> dict:
+        return {"name": self.name, "title": self.title, "pass": self.passed, "count": int(self.count),
+                "worst": _num(self.worst), "unit": self.unit, "first_time": _num(self.first_time),
+                "note": self.note, "details": {k: _num(v) for k, v in self.details.items()}}
+
+
+def _num(v):
+    if v is None:
+        return None
+    if isinstance(v, (bool, np.bool_)):
+        return bool(v)
+    if isinstance(v, (int, np.integer)):
+        return int(v)
+    if isinstance(v, (float, np.floating)):
+        return float(v) if math.isfinite(v) else str(float(v))
+    return v
+
+
+@dataclass
+class OracleResult:
+    verdicts: list
+    series: dict             # per tick arrays for the plots: t, separation, cone_distance, energy, ...
+    phases: list             # (name, start)
+
+    @property
+    def passed(self) -> bool:
+        return all(v.passed for v in self.verdicts)
+
+    def verdict(self, name: str) -> Verdict:
+        return next(v for v in self.verdicts if v.name == name)
+
+    def failed(self) -> list[str]:
+        return [v.name for v in self.verdicts if not v.passed]
+
+
+# ---------------------------------------------------------------------------------------------
+# Small geometry helpers (numpy, floating point: only for estimates and the cone, never a verdict
+# that hinges on contact).
+
+def rotation_matrices(q: np.ndarray) -> np.ndarray:
+    """R(q / |q|) for quaternions (n, 4) = (w, x, y, z): (n, 3, 3)."""
+    q = np.atleast_2d(q)
+    w, x, y, z = q[:, 0], q[:, 1], q[:, 2], q[:, 3]
+    n = w * w + x * x + y * y + z * z
+    R = np.empty((len(q), 3, 3))
+    R[:, 0, 0] = w * w + x * x - y * y - z * z
+    R[:, 0, 1] = 2 * (x * y - w * z)
+    R[:, 0, 2] = 2 * (x * z + w * y)
+    R[:, 1, 0] = 2 * (x * y + w * z)
+    R[:, 1, 1] = w * w - x * x + y * y - z * z
+    R[:, 1, 2] = 2 * (y * z - w * x)
+    R[:, 2, 0] = 2 * (x * z - w * y)
+    R[:, 2, 1] = 2 * (y * z + w * x)
+    R[:, 2, 2] = w * w - x * x - y * y + z * z
+    return R / n[:, None, None]
+
+
+def quat_mul(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    aw, ax, ay, az = a[..., 0], a[..., 1], a[..., 2], a[..., 3]
+    bw, bx, by, bz = b[..., 0], b[..., 1], b[..., 2], b[..., 3]
+    return np.stack([aw * bw - ax * bx - ay * by - az * bz, aw * bx + ax * bw + ay * bz - az * by,
+                     aw * by - ax * bz + ay * bw + az * bx, aw * bz + ax * by - ay * bx + az * bw], axis=-1)
+
+
+def pose_difference(pa, qa, pb, qb) -> np.ndarray:
+    """xa (-) xb = (pa - pb, rotation vector of qa conj(qb), shortest way round): (n, 6)."""
+    qa = qa / np.linalg.norm(qa, axis=-1, keepdims=True)
+    qb = qb / np.linalg.norm(qb, axis=-1, keepdims=True)
+    conj = qb * np.array([1.0, -1, -1, -1])
+    r = quat_mul(qa, conj)
+    r = np.where(r[..., :1] < 0, -r, r)
+    s = np.linalg.norm(r[..., 1:], axis=-1)
+    angle = 2 * np.arctan2(s, r[..., 0])
+    scale = np.where(s > 1e-300, angle / np.maximum(s, 1e-300), 2.0)
+    return np.concatenate([pa - pb, r[..., 1:] * scale[..., None]], axis=-1)
+
+
+def _segment_distance(P, A, B):
+    """Distance from points P (n, 1, 3) to segments AB (1, m, 3): (n, m)."""
+    AB = B - A
+    t = np.clip(np.einsum("nmk,nmk->nm", P - A, np.broadcast_to(AB, np.broadcast_shapes(P.shape, AB.shape)))
+                / np.maximum(np.einsum("nmk,nmk->nm", AB, AB), 1e-300), 0, 1)
+    return np.linalg.norm(P - (A + t[..., None] * AB), axis=-1)
+
+
+def point_mesh_distance(P: np.ndarray, V: np.ndarray, F: np.ndarray) -> np.ndarray:
+    """Unsigned distance from points (n, 3) to a triangle mesh's surface (floating point)."""
+    out = np.full(len(P), np.inf)
+    A, B, C = V[F[:, 0]][None], V[F[:, 1]][None], V[F[:, 2]][None]
+    N = np.cross(B - A, C - A)
+    N = N / np.maximum(np.linalg.norm(N, axis=-1, keepdims=True), 1e-300)
+    chunk = max(1, 2_000_000 // max(len(F), 1))
+    for i in range(0, len(P), chunk):
+        X = P[i:i + chunk, None, :]
+        h = np.einsum("nmk,nmk->nm", X - A, np.broadcast_to(N, (len(X),) + N.shape[1:]))
+        foot = X - h[..., None] * N
+        inside = np.ones(h.shape, bool)
+        for U, W in ((A, B), (B, C), (C, A)):
+            inside &= np.einsum("nmk,nmk->nm", np.cross(W - U, foot - U), np.broadcast_to(N, foot.shape)) >= 0
+        d = np.where(inside, np.abs(h), np.inf)
+        for U, W in ((A, B), (B, C), (C, A)):
+            d = np.minimum(d, _segment_distance(X, U, W))
+        out[i:i + chunk] = d.min(axis=1)
+    return out
+
+
+def winding_inside(P: np.ndarray, V: np.ndarray, F: np.ndarray) -> np.ndarray:
+    """Points (n, 3) inside a closed mesh: generalised winding number > 1/2 (floating point)."""
+    inside = np.zeros(len(P), bool)
+    A, B, C = V[F[:, 0]], V[F[:, 1]], V[F[:, 2]]
+    chunk = max(1, 2_000_000 // max(len(F), 1))
+    for i in range(0, len(P), chunk):
+        X = P[i:i + chunk, None, :]
+        a, b, c = A[None] - X, B[None] - X, C[None] - X
+        la, lb, lc = (np.linalg.norm(v, axis=-1) for v in (a, b, c))
+        num = np.einsum("nmk,nmk->nm", a, np.cross(b, c))
+        den = (la * lb * lc + np.einsum("nmk,nmk->nm", a, b) * lc + np.einsum("nmk,nmk->nm", b, c) * la
+               + np.einsum("nmk,nmk->nm", c, a) * lb)
+        inside[i:i + chunk] = np.abs(np.arctan2(num, den).sum(axis=1) / (2 * np.pi)) > 0.5
+    return inside
+
+
+def _nnls(A: np.ndarray, b: np.ndarray) -> np.ndarray:
+    from scipy.optimize import nnls
+
+    return nnls(A, b, maxiter=50 * max(A.shape[1], 1))[0]
+
+
+# ---------------------------------------------------------------------------------------------
+
+class Oracle:
+    """The checks of one scene: its exact mesh pairs (reference), contact generation, mass."""
+
+    def __init__(self, scene_path, thresholds: dict | None = None):
+        from ._gauss6 import ccd, load_scene as _load_scene, oracle as _oracle, runtime
+
+        self.scene_path = str(scene_path)
+        self.thresholds = thresholds or load_thresholds()
+        g = runtime.scene_geometry(self.scene_path)
+        settings = runtime.effective_settings(_load_scene(self.scene_path))
+        self.delta = float(g["delta"])
+        self.mass = float(g["mass"])
+        self.inertia = np.asarray(g["inertia_G_B"], float)
+        self.max_force = float(g["max_force"])
+        self.max_torque = float(settings["device"]["max_torque"])
+        self.rate_hz = float(g["rate_hz"])
+        self.god_V = np.asarray(g["god_V"], float)
+        self.god_F = np.asarray(g["god_F"], np.int32)
+        self.god_radius = float(np.linalg.norm(self.god_V, axis=1).max())
+        self.obstacles = [(name, np.asarray(V, float), np.asarray(F, np.int32)) for name, V, F in g["obstacles"]]
+        self.pairs = [ccd.MeshPair(V, F, self.god_V, self.god_F) for _, V, F in self.obstacles]
+        self.boxes = [(V.min(axis=0), V.max(axis=0)) for _, V, _ in self.obstacles]
+        self.contacts = _oracle.ContactGenerator(self.scene_path)
+
+    # -- exact geometry -------------------------------------------------------------------------
+    def intersecting_pairs(self, p, q) -> int:
+        return sum(int(mp.count_intersecting_pairs(p, q)) for mp in self.pairs)
+
+    def separation(self, p, q, max_distance: float) -> float:
+        """The exact minimum distance (its lower double bracket) if <= max_distance, else +inf."""
+        best = math.inf
+        for mp in self.pairs:
+            s = mp.separation(p, q, max_distance)
+            if s["within"]:
+                best = min(best, float(s["lower"]))
+        return best
+
+    def depth_estimate(self, p, q) -> float:
+        """The deepest tool vertex inside an obstacle: its distance to that obstacle (floating point)."""
+        X = (rotation_matrices(np.asarray(q, float))[0] @ self.god_V.T).T + np.asarray(p, float)
+        depth = 0.0
+        for (_, V, F), (lo, hi) in zip(self.obstacles, self.boxes):
+            cand = X[np.all((X > lo) & (X < hi), axis=1)]
+            if len(cand):
+                inner = cand[winding_inside(cand, V, F)]
+                if len(inner):
+                    depth = max(depth, float(point_mesh_distance(inner, V, F).max()))
+        return depth
+
+    def mass_matrix(self, q) -> np.ndarray:
+        R = rotation_matrices(np.asarray(q, float))[0]
+        M = np.zeros((6, 6))
+        M[:3, :3] = self.mass * np.eye(3)
+        M[3:, 3:] = R @ self.inertia @ R.T
+        return M
+
+    # -- the judgement --------------------------------------------------------------------------
+    def judge(self, trace, progress=None) -> OracleResult:
+        th = self.thresholds
+        delta = self.delta
+        ticks = trace.ticks
+        n = len(ticks)
+        t = np.asarray(ticks["t"], float)
+        xh_p, xh_q = np.asarray(ticks["xh_p"], float), np.asarray(ticks["xh_q"], float)
+        xs_p, xs_q = np.asarray(ticks["xs_p"], float), np.asarray(ticks["xs_q"], float)
+        W = np.asarray(ticks["wrench"], float)
+        finite_pose = np.all(np.isfinite(xs_p), axis=1) & np.all(np.isfinite(xs_q), axis=1)
+        finite_wrench = np.all(np.isfinite(W), axis=1)
+        ok = finite_pose & finite_wrench
+        f_norm = np.linalg.norm(np.where(finite_wrench[:, None], W[:, :3], 0), axis=1)
+        tau_norm = np.linalg.norm(np.where(finite_wrench[:, None], W[:, 3:], 0), axis=1)
+        forced = ok & ((f_norm > th["zero"]["force"]) | (tau_norm > th["zero"]["torque"]))
+        phases = [(p["name"], float(p["start"])) for p in trace.meta.get("phases", [])]
+        say = progress or (lambda *a: None)
+
+        # Distinct displayed poses (consecutive ticks with the same pose share a verdict).
+        X = np.hstack([xs_p, xs_q])
+        new_pose = np.ones(n, bool)
+        new_pose[1:] = np.any(X[1:] != X[:-1], axis=1)
+        pose_id = np.cumsum(new_pose) - 1
+        first_tick = np.flatnonzero(new_pose)
+        pose_ok = finite_pose[first_tick]
+        verdicts = []
+
+        # 1. Penetration: every distinct finite pose, exactly.
+        counts = np.zeros(len(first_tick), np.int64)
+        for j, k in enumerate(first_tick):
+            if pose_ok[j]:
+                counts[j] = self.intersecting_pairs(xs_p[k], xs_q[k])
+            if j % 200 == 0:
+                say("penetration", j, len(first_tick))
+        penetrating_pose = counts > 0
+        pen_tick = penetrating_pose[pose_id] & finite_pose
+        depth = np.zeros(len(first_tick))
+        pen_ids = np.flatnonzero(penetrating_pose)
+        sample = pen_ids[np.unique(np.linspace(0, len(pen_ids) - 1, min(len(pen_ids), th["penetration"]["depth_sample"])
+                                               ).astype(int))] if len(pen_ids) else pen_ids
+        for j in sample:
+            k = first_tick[j]
+            depth[j] = self.depth_estimate(xs_p[k], xs_q[k])
+        max_depth = float(depth.max()) if len(depth) else 0.0
+        verdicts.append(Verdict(
+            "penetration", CHECKS[0][1], int(penetrating_pose.sum()) <= th["penetration"]["max_poses"],
+            int(penetrating_pose.sum()), max_depth / delta, "delta (depth estimate)",
+            float(t[first_tick[pen_ids[0]]]) if len(pen_ids) else None,
+            f"{len(first_tick)} distinct poses checked exactly; depth estimated on {len(sample)}",
+            {"poses": len(first_tick), "penetrating_ticks": int(pen_tick.sum()),
+             "max_intersecting_pairs": int(counts.max()) if len(counts) else 0, "max_depth": max_depth}))
+
+        # 2. Tunnelling: successive free distinct poses; swept boxes, conservative CCD, exact.
+        tt = th["tunnelling"]
+        free_ids = [j for j in range(len(first_tick)) if pose_ok[j] and not penetrating_pose[j]]
+        near = flagged = exact = undecided = 0
+        tunnels: list = []
+        flagged_steps = []
+        for a, b in zip(free_ids[:-1], free_ids[1:]):
+            if b != a + 1:
+                continue  # a penetrating or non-finite pose between: judged by check 1 / 7
+            k0, k1 = first_tick[a], first_tick[b]
+            lo = np.minimum(xs_p[k0], xs_p[k1]) - self.god_radius
+            hi = np.maximum(xs_p[k0], xs_p[k1]) + self.god_radius
+            hit_pairs = []
+            for i, (blo, bhi) in enumerate(self.boxes):
+                if np.all(lo <= bhi) and np.all(hi >= blo):
+                    hit_pairs.append(i)
+            if not hit_pairs:
+                continue
+            near += 1
+            stops = False
+            for i in hit_pairs:
+                r = self.pairs[i].step(xs_p[k0], xs_q[k0], xs_p[k1], xs_q[k1], tt["min_separation"] * delta)
+                if r["hit"] or r["status"] not in ("ok",):
+                    stops = True
+                    break
+            if stops:
+                flagged += 1
+                flagged_steps.append((k0, k1, hit_pairs))
+        if flagged_steps:
+            chosen = np.unique(np.linspace(0, len(flagged_steps) - 1,
+                                           min(len(flagged_steps), tt["max_exact"])).astype(int))
+        else:
+            chosen = np.zeros(0, int)
+        for c, idx in enumerate(chosen):
+            k0, k1, hit_pairs = flagged_steps[idx]
+            say("tunnelling", c, len(chosen))
+            try:
+                hit = any(self.pairs[i].exact_first_contact(xs_p[k0], xs_q[k0], xs_p[k1], xs_q[k1]).hit
+                          for i in hit_pairs)
+            except Exception:  # a half turn: no Cayley motion; undecided
+                undecided += 1
+                continue
+            exact += 1
+            if hit:
+                tunnels.append(k1)
+        undecided += len(flagged_steps) - len(chosen)
+        tunnel_travel = [float(np.linalg.norm(xs_p[k] - xs_p[first_tick[pose_id[k] - 1]])) for k in tunnels]
+        verdicts.append(Verdict(
+            "tunnelling", CHECKS[1][1], not tunnels and undecided == 0, len(tunnels),
+            max(tunnel_travel) / delta if tunnel_travel else 0.0, "delta (step length)",
+            float(t[tunnels[0]]) if tunnels else None,
+            f"{max(len(free_ids) - 1, 0)} steps between free poses; {near} near an obstacle (swept boxes); "
+            f"{flagged} stopped by the conservative CCD; {exact} decided exactly; {undecided} undecided",
+            {"steps": max(len(free_ids) - 1, 0), "near": near, "ccd_flagged": flagged, "exact": exact,
+             "undecided": undecided}))
+
+        # Exact separation at the forced free poses (checks 3-5).
+        bound, free_space = th["distance"]["bound"] * delta, th["distance"]["free_space"] * delta
+        sep = np.full(n, np.nan)
+        judged = forced & ~pen_tick
+        cache: dict = {}
+        for c, k in enumerate(np.flatnonzero(judged)):
+            j = pose_id[k]
+            if j not in cache:
+                s = self.separation(xs_p[k], xs_q[k], bound)
+                if not math.isfinite(s):
+                    s = self.separation(xs_p[k], xs_q[k], free_space)
+                cache[j] = s
+            sep[k] = cache[j]
+            if c % 500 == 0:
+                say("separation", c, int(judged.sum()))
+        at_distance = judged & (sep > bound) & (sep <= free_space)
+        in_free_space = judged & ~(sep <= free_space)
+        ad = np.flatnonzero(at_distance)
+        verdicts.append(Verdict(
+            "force_at_distance", CHECKS[2][1], len(ad) == 0, len(ad),
+            float(np.nanmax(sep[ad])) / delta if len(ad) else 0.0, "delta (separation)",
+            float(t[ad[0]]) if len(ad) else None,
+            f"bound {th['distance']['bound']:g} delta; {int(judged.sum())} ticks with force at free poses",
+            {"ticks_with_force": int(judged.sum()),
+             "max_separation_with_force": float(np.nanmax(np.where(sep <= free_space, sep, np.nan)))
+             if np.any(sep <= free_space) else 0.0}))
+
+        # 4-5. The cone of contact wrenches at the forced free poses within the bound.
+        in_band = judged & (sep <= bound)
+        cone = np.full(n, np.nan)
+        tangential = np.full(n, np.nan)
+        wrong = np.full(n, np.nan)
+        away = np.zeros(n, bool)
+        margin = th["moving_away"]["margin"] * delta
+        diff = pose_difference(xh_p, xh_q, xs_p, xs_q)
+        no_contacts = 0
+        for c, k in enumerate(np.flatnonzero(in_band)):
+            cs = self.contacts.contacts(xs_p[k], xs_q[k], bound)
+            J = np.asarray(cs["J"], float)
+            M = self.mass_matrix(xs_q[k])
+            L = np.linalg.cholesky(M)
+            b = np.linalg.solve(L, W[k])
+            nb = np.linalg.norm(b)
+            if len(J) == 0:
+                no_contacts += 1
+                cone[k] = tangential[k] = 1.0
+                wrong[k] = 0.0
+                continue
+            A = np.linalg.solve(L, J.T)
+            lam = _nnls(A, b)
+            r = b - A @ lam
+            proj = A @ np.linalg.lstsq(A, r, rcond=None)[0]
+            cone[k] = np.linalg.norm(r) / nb
+            wrong[k] = np.linalg.norm(proj) / nb
+            tangential[k] = np.linalg.norm(r - proj) / nb
+            away[k] = bool(np.all(J @ diff[k] >= margin))
+            if c % 500 == 0:
+                say("force cone", c, int(in_band.sum()))
+        td = th["direction"]
+        bad_dir = in_band & ((tangential > td["max_tangential_share"]) | (wrong > td["max_wrong_side_share"]))
+        bd = np.flatnonzero(bad_dir)
+        verdicts.append(Verdict(
+            "force_direction", CHECKS[3][1], len(bd) == 0, len(bd),
+            float(np.nanmax(cone)) if np.any(in_band) else 0.0, "share of |F| (M^-1 metric)",
+            float(t[bd[0]]) if len(bd) else None,
+            f"{int(in_band.sum())} ticks with force within {th['distance']['bound']:g} delta; "
+            f"max tangential {np.nanmax(tangential) if np.any(in_band) else 0:.3g}, "
+            f"max wrong-side {np.nanmax(wrong) if np.any(in_band) else 0:.3g}"
+            + (f"; {no_contacts} without contacts" if no_contacts else ""),
+            {"ticks": int(in_band.sum()),
+             "max_tangential_share": float(np.nanmax(tangential)) if np.any(in_band) else 0.0,
+             "max_wrong_side_share": float(np.nanmax(wrong)) if np.any(in_band) else 0.0,
+             "ticks_without_contacts": no_contacts}))
+
+        free_bad = in_free_space | away
+        fb = np.flatnonzero(free_bad)
+        verdicts.append(Verdict(
+            "no_force_when_free", CHECKS[4][1], len(fb) == 0, len(fb),
+            float(max(f_norm[fb].max(), 0.0)) if len(fb) else 0.0, "N (force)",
+            float(t[fb[0]]) if len(fb) else None,
+            f"{int(in_free_space.sum())} ticks with force beyond {th['distance']['free_space']:g} delta; "
+            f"{int(away.sum())} with the handle on the free side of every contact by "
+            f"{th['moving_away']['margin']:g} delta",
+            {"free_space_ticks": int(in_free_space.sum()), "moving_away_ticks": int(away.sum())}))
+
+        # 6. Energy: passivity observer on the device port, run and contact episodes.
+        from .driver import safe_wrench
+
+        F_applied = np.array([safe_wrench(W[k], self.max_force, self.max_torque)[0] for k in range(n)]) \
+            if n else np.zeros((0, 6))
+        dx = pose_difference(xh_p[1:], xh_q[1:], xh_p[:-1], xh_q[:-1]) if n > 1 else np.zeros((0, 6))
+        work = np.einsum("ij,ij->i", F_applied[:-1], dx) if n > 1 else np.zeros(0)
+        # W(n) plus the energy stored in the coupling between the handle and the displayed tool, as a
+        # spring: V = -1/2 F . (xh (-) xs) >= 0 (gauss6's F^T M^-1 F / (2 kh ks) for one contact; 0 for an
+        # engine that displays the handle's pose).
+        stored = np.maximum(0.0, -0.5 * np.einsum("ij,ij->i", F_applied, diff))
+        energy = np.concatenate([[0.0], np.cumsum(work)]) + stored
+        on = (np.linalg.norm(F_applied[:, :3], axis=1) > th["zero"]["force"]) | \
+             (np.linalg.norm(F_applied[:, 3:], axis=1) > th["zero"]["torque"])
+        episodes = []
+        k = 0
+        while k < n:
+            if on[k]:
+                e = k
+                while e < n and on[e]:
+                    e += 1
+                episodes.append((k, e, float(work[k:min(e, n - 1)].sum())))
+                k = e
+            else:
+                k += 1
+        te = th["energy"]
+        over_port = np.flatnonzero(energy > te["max_port_energy"])
+        bad_eps = [ep for ep in episodes if ep[2] > te["max_episode_energy"]]
+        firsts = ([float(t[over_port[0]])] if len(over_port) else []) + ([float(t[bad_eps[0][0]])] if bad_eps else [])
+        max_episode = max((ep[2] for ep in episodes), default=0.0)
+        verdicts.append(Verdict(
+            "energy", CHECKS[5][1], not len(over_port) and not bad_eps, len(bad_eps) + (1 if len(over_port) else 0),
+            float(max(energy.max() if n else 0.0, max_episode)), "J",
+            min(firsts) if firsts else None,
+            f"port energy max {energy.max() if n else 0:.3g} J, final {energy[-1] if n else 0:.3g} J; "
+            f"{len(episodes)} contact episodes, max episode work {max_episode:.3g} J, "
+            f"energy injected (positive episodes) {sum(max(ep[2], 0) for ep in episodes):.3g} J",
+            {"port_energy_max": float(energy.max()) if n else 0.0, "port_energy_final": float(energy[-1]) if n else 0.0,
+             "episodes": len(episodes), "max_episode_work": max_episode,
+             "energy_injected": float(sum(max(ep[2], 0) for ep in episodes))}))
+
+        # 7. Force jumps; non-finite and over-limit wrenches.
+        tj = th["jumps"]
+        both = finite_wrench[1:] & finite_wrench[:-1]
+        df = np.where(both, np.linalg.norm(np.diff(np.where(finite_wrench[:, None], W, 0)[:, :3], axis=0), axis=1), 0)
+        dtau = np.where(both, np.linalg.norm(np.diff(np.where(finite_wrench[:, None], W, 0)[:, 3:], axis=0), axis=1), 0)
+        jumps = np.flatnonzero((df > tj["max_force_step"]) | (dtau > tj["max_torque_step"])) + 1
+        verdicts.append(Verdict(
+            "force_jumps", CHECKS[6][1], len(jumps) == 0, len(jumps), float(df.max()) if len(df) else 0.0,
+            "N per tick", float(t[jumps[0]]) if len(jumps) else None,
+            f"max force step {df.max() if len(df) else 0:.3g} N, max torque step {dtau.max() if len(dtau) else 0:.3g} N m",
+            {"max_force_step": float(df.max()) if len(df) else 0.0,
+             "max_torque_step": float(dtau.max()) if len(dtau) else 0.0}))
+        slack = 1 + th["limits"]["slack"]
+        over = finite_wrench & ((f_norm > self.max_force * slack) | (tau_norm > self.max_torque * slack))
+        insane = np.flatnonzero(~finite_wrench | ~finite_pose | over)
+        verdicts.append(Verdict(
+            "wrench_sanity", CHECKS[7][1], len(insane) == 0, len(insane),
+            float(max(f_norm.max() / self.max_force, tau_norm.max() / self.max_torque)) if n else 0.0,
+            "of the limit", float(t[insane[0]]) if len(insane) else None,
+            f"{int((~finite_wrench).sum())} non-finite wrenches, {int((~finite_pose).sum())} non-finite poses, "
+            f"{int(over.sum())} over the limits ({self.max_force:g} N, {self.max_torque:g} N m)",
+            {"non_finite_wrench": int((~finite_wrench).sum()), "non_finite_pose": int((~finite_pose).sum()),
+             "over_limit": int(over.sum())}))
+
+        # 8. Cost.
+        tc = th["cost"]
+        st = np.asarray(ticks["force_time"], float)
+        period = 1 / self.rate_hz
+        med = float(np.median(st)) if n else 0.0
+        p99 = float(np.percentile(st, 99)) if n else 0.0
+        cost_ok = med <= tc["max_median_fraction_of_period"] * period and p99 <= tc["max_p99_seconds"]
+        over_period = np.flatnonzero(st > period)
+        verdicts.append(Verdict(
+            "cost", CHECKS[8][1], cost_ok, len(over_period), float(st.max()) if n else 0.0, "s (max step)",
+            float(t[over_period[0]]) if len(over_period) else None,
+            f"median {med * 1e6:.1f} us (sustains {1 / med if med > 0 else math.inf:.0f} Hz), p99 {p99 * 1e3:.3g} ms, "
+            f"{len(over_period)} steps over the {period * 1e3:g} ms tick",
+            {"median_seconds": med, "p99_seconds": p99, "max_seconds": float(st.max()) if n else 0.0,
+             "sustained_hz": 1 / med if med > 0 else None, "steps_over_period": len(over_period)}))
+
+        signed = np.where(pen_tick, -depth[pose_id], sep)
+        series = {"t": t, "separation": signed / delta, "cone_distance": cone, "energy": energy,
+                  "force": f_norm, "penetrating": pen_tick, "step_seconds": st}
+        return OracleResult(verdicts, series, phases)

@@ -1,0 +1,233 @@
+"""`gauss6 validate`: drive an engine under test with the simulated device and judge its run, or judge a
+run it recorded itself (docs/engine-contract.md).
+
+    gauss6 validate --engine ENGINE --scene SCENE [--script NAME] [--duration S] --out DIR
+    gauss6 validate RUN --scene SCENE [--script NAME] --out DIR      (RUN: a .g6trace, or a ticks CSV)
+
+ENGINE: a shared library that exports the C ABI (gauss6/engine.h), by path; a built one by name
+(gauss6, box-penalty, fault); or a Python engine as `python:MODULE:FACTORY` (FACTORY(config)
+returns an object with reset(scene) and step(t, xh_p, xh_q), gauss6.engine). --config passes
+the engine its config text.
+
+DIR receives: run.g6trace (the driven run), report.md (the verdict table, the plots, the
+machine), validation.png/.svg (penetration depth or separation, distance from the force cone,
+port energy over time, the script's phases marked) and validation.json:
+
+    {"format": "gauss6-validation", "version": 1, "pass": bool, "failed": [names],
+     "engine": {"name", "library", "config"} or null, "run": path of the judged trace,
+     "scene": path, "script": path or null, "ticks": int, "duration": s,
+     "thresholds": {"file": path, "version": int},
+     "verdicts": [{"name", "title", "pass", "count", "worst", "unit", "first_time", "note", "details"}],
+     "machine": {"platform", "processor", "cpus", "python"}}
+
+Exit status: 0 when every check passes, 1 when one fails, 2 on a usage or load error.
+"""
+from __future__ import annotations
+
+import argparse
+import importlib
+import json
+import os
+import platform
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+
+from . import oracle as oracle_mod
+from .engine import EngineError, EngineScene, load_engine
+
+FORMAT_VERSION = 1
+
+
+def make_engine(spec: str, config: str = ""):
+    """An engine by spec: python:MODULE:FACTORY, a built engine's name, or a library path."""
+    if spec.startswith("python:"):
+        _, module, factory = spec.split(":", 2)
+        return getattr(importlib.import_module(module), factory)(config)
+    return load_engine(spec, config)
+
+
+def machine() -> dict:
+    return {"platform": platform.platform(), "processor": platform.processor() or platform.machine(),
+            "cpus": os.cpu_count(), "python": platform.python_version()}
+
+
+def _progress(quiet: bool):
+    if quiet:
+        return None, None
+    state = {"last": 0.0}
+
+    def run(t, end):
+        print(f"\r  driving: {t:6.2f} / {end:.2f} s", end="", file=sys.stderr, flush=True)
+
+    def judge(stage, done, total):
+        if time.perf_counter() - state["last"] > 0.5:
+            state["last"] = time.perf_counter()
+            print(f"\r  judging: {stage} {done}/{total}        ", end="", file=sys.stderr, flush=True)
+    return run, judge
+
+
+def plot(result: oracle_mod.OracleResult, out: Path, title: str) -> list[Path]:
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    s = result.series
+    t = s["t"]
+    fig, axes = plt.subplots(3, 1, figsize=(10, 8), sharex=True)
+    ax = axes[0]
+    sep = s["separation"]
+    ax.plot(t, np.where(sep >= 0, sep, np.nan), ".", ms=2, label="exact separation at ticks with force")
+    ax.plot(t, np.where(sep < 0, sep, np.nan), ".", ms=2, color="C3", label="penetration depth (estimate)")
+    if np.any(s["penetrating"]):
+        ax.plot(t[s["penetrating"]], np.zeros(int(s["penetrating"].sum())), "|", color="C3", ms=8,
+                label="penetrating pose (exact)")
+    ax.axhline(0, color="k", lw=0.5)
+    ax.set_ylabel("separation (delta)")
+    ax.set_yscale("symlog", linthresh=1.0)
+    ax.legend(loc="upper right", fontsize=7)
+    ax = axes[1]
+    ax.plot(t, s["cone_distance"], ".", ms=2)
+    ax.set_ylabel("distance from cone\n(share of |F|)")
+    ax.set_yscale("symlog", linthresh=1e-6)
+    ax = axes[2]
+    ax.plot(t, s["energy"], lw=1)
+    ax.set_ylabel("port energy W (J)")
+    ax.set_xlabel("t (s)")
+    for ax in axes:
+        for name, start in result.phases:
+            ax.axvline(start, color="0.6", lw=0.8, ls="--")
+    for name, start in result.phases:
+        axes[0].annotate(name, (start, 1.0), xycoords=("data", "axes fraction"), fontsize=8, va="bottom")
+    fig.suptitle(title)
+    fig.tight_layout()
+    paths = [out / "validation.png", out / "validation.svg"]
+    for p in paths:
+        fig.savefig(p, dpi=110)
+    plt.close(fig)
+    return paths
+
+
+def _fmt(v) -> str:
+    if v is None:
+        return "-"
+    if isinstance(v, float):
+        return f"{v:.3g}"
+    return str(v)
+
+
+def verdict_table(verdicts) -> str:
+    rows = ["| check | verdict | count | worst | first violation (s) | note |", "| --- | --- | --- | --- | --- | --- |"]
+    for v in verdicts:
+        rows.append(f"| {v.title} | {'pass' if v.passed else '**FAIL**'} | {v.count} | {_fmt(v.worst)} {v.unit} | "
+                    f"{_fmt(v.first_time)} | {v.note} |")
+    return "\n".join(rows)
+
+
+def write_outputs(result, out: Path, info: dict) -> dict:
+    title = f"{info.get('engine_name') or 'recorded run'} on {Path(info['scene']).stem}"
+    plot(result, out, title)
+    doc = {"format": "gauss6-validation", "version": FORMAT_VERSION, "pass": result.passed, "failed": result.failed(),
+           "engine": info.get("engine"), "run": info["run"], "scene": info["scene"], "script": info.get("script"),
+           "ticks": info["ticks"], "duration": info["duration"],
+           "thresholds": {"file": info["thresholds"], "version": info["thresholds_version"]},
+           "verdicts": [v.to_json() for v in result.verdicts], "machine": machine()}
+    (out / "validation.json").write_text(json.dumps(doc, indent=2) + "\n")
+    lines = [f"# Validation: {title}", "",
+             f"Verdict: **{'PASS' if result.passed else 'FAIL'}**"
+             + ("" if result.passed else f" ({', '.join(result.failed())})"), "",
+             f"- run: `{info['run']}` ({info['ticks']} ticks, {info['duration']:.3f} s)",
+             f"- scene: `{info['scene']}`" + (f", script `{info['script']}`" if info.get("script") else ""),
+             f"- engine: {info.get('engine_name') or 'recorded offline'}"
+             + (f" (`{info['engine']['library']}`, config `{info['engine']['config']}`)" if info.get("engine") else ""),
+             f"- thresholds: `{info['thresholds']}` (version {info['thresholds_version']})",
+             f"- machine: {machine()['processor']}, {machine()['cpus']} cpus, {machine()['platform']}", "",
+             verdict_table(result.verdicts), "",
+             "Geometric verdicts are exact (gauss6's reference, CGAL); depths are estimates; lengths in units of "
+             "the scene's delta. Definitions and thresholds: docs/engine-contract.md, harness/oracle.toml.", "",
+             "![validation](validation.png)", ""]
+    (out / "report.md").write_text("\n".join(lines))
+    return doc
+
+
+def validate(args) -> int:
+    from .trace import read_trace
+
+    out = Path(args.out)
+    out.mkdir(parents=True, exist_ok=True)
+    thresholds_path = Path(args.thresholds) if args.thresholds else oracle_mod.THRESHOLDS
+    thresholds = oracle_mod.load_thresholds(thresholds_path)
+    run_progress, judge_progress = _progress(args.quiet)
+    info = {"scene": str(args.scene), "thresholds": str(thresholds_path),
+            "thresholds_version": thresholds.get("version")}
+    from .driver import drive, scene_script, script_text
+
+    if args.engine:
+        engine = make_engine(args.engine, args.config)
+        scene = EngineScene.from_scene_file(args.scene)
+        text, script_path = script_text(args.script, args.scene) if args.script else scene_script(args.scene)
+        run_path = out / "run.g6trace"
+        trace = drive(engine, scene, text, run_path, args.duration, run_progress,
+                      extra={"engine_config": args.config, "script": script_path})
+        if run_progress:
+            print(file=sys.stderr)
+        info.update(engine={"name": engine.name, "library": getattr(engine, "path", args.engine),
+                            "config": args.config}, engine_name=engine.name, script=script_path, run=str(run_path))
+    else:
+        run_path = Path(args.run)
+        if run_path.suffix == ".g6trace":
+            trace = read_trace(run_path)
+        else:
+            from .logs import read_csv_dir
+
+            trace = read_csv_dir(run_path, scene=str(args.scene))
+        if args.script:
+            from .driver import script_phases
+
+            text, script_path = script_text(args.script, args.scene)
+            trace.meta["phases"] = [{"name": n, "start": s} for n, s in script_phases(text)]
+            info["script"] = script_path
+        info.update(run=str(run_path), engine_name=trace.meta.get("extra", {}).get("engine"))
+    ticks = trace.ticks
+    info.update(ticks=len(ticks), duration=float(ticks["t"][-1] - ticks["t"][0]) if len(ticks) else 0.0)
+    result = oracle_mod.Oracle(args.scene, thresholds).judge(trace, judge_progress)
+    if judge_progress:
+        print("\r" + " " * 60 + "\r", end="", file=sys.stderr)
+    doc = write_outputs(result, out, info)
+    if args.json:
+        print(json.dumps(doc, indent=2))
+    else:
+        print(verdict_table(result.verdicts))
+        print(f"\n{'PASS' if result.passed else 'FAIL'}: {out / 'report.md'}")
+    return 0 if result.passed else 1
+
+
+def cmd_validate(args: argparse.Namespace) -> int:
+    if bool(args.engine) == bool(args.run):
+        print("gauss6 validate: give either --engine ENGINE or a recorded RUN (not both)", file=sys.stderr)
+        return 2
+    try:
+        return validate(args)
+    except (EngineError, ValueError, FileNotFoundError) as e:
+        print(f"gauss6 validate: {e}", file=sys.stderr)
+        return 2
+
+
+def register(subparsers) -> None:
+    p = subparsers.add_parser("validate", help="drive an engine with the simulated device and judge its run, or "
+                                               "judge a recorded run (exit 1 on a failed check)")
+    p.add_argument("run", nargs="?", help="a recorded run to judge: a .g6trace, or a ticks CSV (docs/engine-contract.md)")
+    p.add_argument("--engine", help="engine library path, a built engine (gauss6, box-penalty, fault), or "
+                                    "python:MODULE:FACTORY")
+    p.add_argument("--config", default="", help="the engine's config text (default: empty)")
+    p.add_argument("--scene", required=True, help="scene TOML file")
+    p.add_argument("--script", help="hand script name or .json path (default: the scene's device.script)")
+    p.add_argument("--duration", type=float, default=None, help="run only the first S seconds of the script")
+    p.add_argument("--out", required=True, help="output directory")
+    p.add_argument("--thresholds", help="thresholds file (default harness/oracle.toml)")
+    p.add_argument("--json", action="store_true", help="print validation.json instead of the table")
+    p.add_argument("--quiet", action="store_true", help="no progress on stderr")
+    p.set_defaults(func=cmd_validate)
