@@ -87,6 +87,12 @@ void qp_instances(const uint8_t* data, size_t size) {
   }
 }
 
+void height_map(const uint8_t* data, size_t size) {
+  HeightMapImage image;
+  std::string error;
+  read_height_map(write_input("height.png", data, size), &image, &error);
+}
+
 void hand_script(const uint8_t* data, size_t size) {
   try {
     hand_script_from_json(std::string(reinterpret_cast<const char*>(data), size), "script.json");
@@ -107,6 +113,7 @@ const std::vector<NamedTarget>& targets() {
       {"ccd_queries", ccd_queries},
       {"qp_instances", qp_instances},
       {"hand_script", hand_script},
+      {"height_map", height_map},
   };
   return all;
 }

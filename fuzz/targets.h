@@ -21,7 +21,8 @@ struct NamedTarget {
   Target run;
 };
 
-// Every target, by name: scene, obj, off, ply, stl, trace, ccd_queries, qp_instances, hand_script.
+// Every target, by name: scene, obj, off, ply, stl, trace, ccd_queries, qp_instances, hand_script,
+// height_map (the PNG height maps of textured surfaces).
 const std::vector<NamedTarget>& targets();
 // The target of that name, or nullptr.
 Target find_target(const std::string& name);

@@ -21,7 +21,7 @@ else
   budget=(-max_total_time="$seconds")
   what="${seconds}s"
 fi
-targets=(scene obj off ply stl trace ccd_queries qp_instances hand_script)
+targets=(scene obj off ply stl trace ccd_queries qp_instances hand_script height_map)
 
 if ! command -v clang++ >/dev/null; then
   echo "gauss6 fuzz: clang++ not found (tools/debian-packages.txt: clang, libclang-rt-14-dev)" >&2
@@ -37,6 +37,7 @@ cmake --build build-fuzz -j "${GAUSS6_JOBS:-$(nproc)}"
 status=0
 for t in "${targets[@]}"; do
   mkdir -p "build-fuzz/corpus/$t" "build-fuzz/artifacts/$t"
+  rm -f "build-fuzz/artifacts/$t"/*  # only what this run finds is copied below
   # Quiet unless something is found; the last line says how far it got.
   if ! build-fuzz/fuzz_"$t" "build-fuzz/corpus/$t" "fuzz/corpus/$t" "fuzz/regressions/$t" \
        "${budget[@]}" -timeout=10 -rss_limit_mb=2048 -max_len=65536 \

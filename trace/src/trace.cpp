@@ -322,7 +322,7 @@ TraceWriter::TraceWriter(const std::string& path, const TraceMeta& meta, const T
   j["event_codes"] = codes;
   try {
     j["extra"] = nlohmann::json::parse(meta.extra_json.empty() ? "{}" : meta.extra_json);
-  } catch (const nlohmann::json::parse_error& e) {
+  } catch (const nlohmann::json::exception& e) {  // parse_error, or out_of_range for a number beyond a double
     throw TraceError(path, std::string("TraceMeta::extra_json is not JSON: ") + e.what());
   }
   const std::string meta_text = j.dump();
@@ -546,7 +546,7 @@ Trace read_trace(const std::string& path) {
         trace.warnings.push_back(path + ": skipped a chunk of unknown type " + std::to_string(type) + " at byte " +
                                  std::to_string(pos));
     }
-    if (table && n > 0) {  // (an empty chunk adds no row; memcpy takes no null pointer)
+    if (table && n > 0) {  // memcpy from an empty vector's null data() is undefined
       const size_t old = table->data.size();
       table->data.resize(old + n);  // n * 8 <= the file's size: bounded above
       std::memcpy(table->data.data() + old, payload, n * 8);

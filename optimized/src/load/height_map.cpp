@@ -4,11 +4,16 @@
 #include <png.h>
 
 #include <cstdint>
+#include <string>
 #include <vector>
 
 #include "gauss6/scene.h"
 
 namespace gauss6 {
+
+namespace {
+constexpr uint64_t kMaxHeightMapPixels = uint64_t(1) << 26;
+}  // namespace
 
 bool read_height_map(const std::string& path, HeightMapImage* out, std::string* error) {
   png_image image{};
@@ -17,8 +22,16 @@ bool read_height_map(const std::string& path, HeightMapImage* out, std::string* 
     *error = path + ": cannot read as PNG (" + image.message + ")";
     return false;
   }
+  // The header's size bounds what is allocated: at most 2^26 pixels (8192 x 8192),
+  // checked before the buffer exists (a 100-byte file may state 10^6 x 10^6).
+  if (static_cast<uint64_t>(image.width) * image.height > kMaxHeightMapPixels) {
+    *error = path + ": a height map of " + std::to_string(image.width) + " x " + std::to_string(image.height) +
+             " pixels, more than the " + std::to_string(kMaxHeightMapPixels) + " allowed";
+    png_image_free(&image);
+    return false;
+  }
   image.format = PNG_FORMAT_LINEAR_Y;  // 16-bit grey, linear
-  std::vector<uint16_t> pixels(PNG_IMAGE_SIZE(image) / sizeof(uint16_t));
+  std::vector<uint16_t> pixels(static_cast<size_t>(image.width) * image.height);
   if (!png_image_finish_read(&image, nullptr, pixels.data(), 0, nullptr)) {
     *error = path + ": cannot decode PNG (" + image.message + ")";
     png_image_free(&image);

@@ -4,6 +4,7 @@
 // few tokens.
 #include "load/mesh_file_checks.h"
 
+#include <algorithm>
 #include <cctype>
 #include <cstdint>
 #include <cstring>
@@ -130,7 +131,8 @@ bool ply_type_signed(std::string_view type) {
 }
 
 struct PlyProperty {
-  std::string_view name, type;  // type: a scalar's (lists: the items')
+  std::string_view name;
+  std::string_view type;        // scalar: its type; list: an item's type
   bool is_list = false;
   std::string_view count_type;  // lists only
   int count_size = 0;           // lists only
@@ -163,20 +165,21 @@ void check_ply_structure(const std::string& path, const std::string& bytes) {
   // Header: lines up to "end_header".
   const std::string_view all(bytes);
   if (all.substr(0, 3) != "ply") fail(path, "cannot parse as PLY: the file does not start with 'ply'");
-  // "end_header" alone on its line (not inside another line, which a reader may take
-  // for the header's end where this check does not).
-  size_t end_tag = std::string_view::npos;
-  for (size_t at = all.find("\nend_header"); at != std::string_view::npos; at = all.find("\nend_header", at + 1)) {
-    const size_t after = at + 11;
-    if (after == all.size() || all[after] == '\n' || (all[after] == '\r' && after + 1 < all.size() && all[after + 1] == '\n')) {
-      end_tag = at + 1;
+  // The header ends at the first line whose first word is end_header, as CGAL reads
+  // it (a mere substring, e.g. inside a comment, does not end it).
+  size_t end_tag = std::string_view::npos, body = all.size();
+  for (size_t line = 0; line < all.size();) {
+    size_t eol = all.find('\n', line);
+    if (eol == std::string_view::npos) eol = all.size();
+    const std::vector<std::string_view> words = tokens_of(all.substr(line, eol - line));
+    if (!words.empty() && words[0] == "end_header") {
+      end_tag = line;
+      body = std::min(eol + 1, all.size());
       break;
     }
+    line = eol + 1;
   }
   if (end_tag == std::string_view::npos) fail(path, "cannot parse as PLY: no 'end_header' line");
-  if (all.find("end_header") < end_tag) fail(path, "cannot parse as PLY: 'end_header' inside another header line");
-  size_t body = all.find('\n', end_tag);
-  body = body == std::string_view::npos ? all.size() : body + 1;
   std::string format;
   std::vector<PlyElement> elements;
   LineCursor lines(all.substr(0, end_tag));
@@ -199,16 +202,16 @@ void check_ply_structure(const std::string& path, const std::string& bytes) {
       PlyProperty p;
       if (t.size() == 5 && t[1] == "list") {
         p.is_list = true;
+        p.name = t[4];
+        p.type = t[3];
         p.count_type = t[2];
         p.count_size = ply_type_size(t[2]);
         p.value_size = ply_type_size(t[3]);
-        p.type = t[3];
-        p.name = t[4];
         if (!p.count_size || !p.value_size) fail(path, at + "unknown type in 'property list'");
       } else if (t.size() == 3) {
-        p.value_size = ply_type_size(t[1]);
-        p.type = t[1];
         p.name = t[2];
+        p.type = t[1];
+        p.value_size = ply_type_size(t[1]);
         if (!p.value_size) fail(path, at + "unknown property type '" + std::string(t[1]) + "'");
       } else {
         fail(path, at + "expected 'property TYPE NAME' or 'property list COUNT_TYPE TYPE NAME'");
@@ -219,23 +222,29 @@ void check_ply_structure(const std::string& path, const std::string& bytes) {
     }
   }
   if (format.empty()) fail(path, "cannot parse as PLY: no 'format' line");
-  // The vertices' coordinates share one floating-point type: CGAL's reader takes the
-  // point's type from x and reads y and z as that type (another one crashes it).
-  for (const PlyElement& e : elements) {
-    if (e.name != "vertex") continue;
-    std::string_view coordinate_type;
-    for (const PlyProperty& p : e.properties) {
-      if (p.name != "x" && p.name != "y" && p.name != "z") continue;
-      const bool real = p.type == "float" || p.type == "float32" || p.type == "double" || p.type == "float64";
-      if (p.is_list || !real || (!coordinate_type.empty() && p.type != coordinate_type))
-        fail(path, "cannot parse as PLY: the vertex coordinates x, y, z must be scalars of one floating-point type "
-                   "(float or double); '" + std::string(p.name) + "' is " + (p.is_list ? "a list" : std::string(p.type)));
-      coordinate_type = p.type;
-    }
-  }
   for (const PlyElement& e : elements)
     if (e.count > 0 && e.properties.empty())
       fail(path, "cannot parse as PLY: element '" + e.name + "' has " + std::to_string(e.count) + " items but no properties");
+  // The types CGAL 5.5's reader assumes without checking (it dereferences a failed
+  // cast otherwise): vertex coordinates float or double, all three of one type (the
+  // reader takes y's and z's from x's), face indices 32-bit integers.
+  for (const PlyElement& e : elements) {
+    std::string_view coordinate_type;
+    for (const PlyProperty& p : e.properties) {
+      const bool real = p.type == "float" || p.type == "float32" || p.type == "double" || p.type == "float64";
+      const bool int32 = p.type == "int" || p.type == "int32" || p.type == "uint" || p.type == "uint32";
+      const bool coordinate = e.name == "vertex" && (p.name == "x" || p.name == "y" || p.name == "z");
+      if (coordinate && (p.is_list || !real))
+        fail(path, "cannot parse as PLY: vertex coordinate '" + std::string(p.name) + "' must be float or double");
+      if (coordinate && !coordinate_type.empty() && p.type != coordinate_type)
+        fail(path, "cannot parse as PLY: vertex coordinates x, y, z must share one type ('" + std::string(p.name) +
+                       "' is " + std::string(p.type) + ", not " + std::string(coordinate_type) + ")");
+      if (coordinate) coordinate_type = p.type;
+      if (e.name == "face" && (p.name == "vertex_indices" || p.name == "vertex_index") && (!p.is_list || !int32))
+        fail(path, "cannot parse as PLY: face property '" + std::string(p.name) +
+                       "' must be a list of 32-bit integers (int or uint)");
+    }
+  }
 
   // Body: walk every item of every element, bounding each count by the bytes left.
   const size_t size = all.size();

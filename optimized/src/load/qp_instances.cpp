@@ -128,6 +128,8 @@ std::vector<QpInstance> read_qp_instances(const std::string& path) {
     doc = json::parse(content);
   } catch (const json::parse_error& e) {
     throw QpInstanceError(path, line_of(content, e.byte), /*key=*/"", std::string("not valid JSON: ") + e.what());
+  } catch (const json::exception& e) {  // e.g. out_of_range 406: a number beyond a double
+    throw QpInstanceError(path, /*line=*/0, /*key=*/"", std::string("not valid JSON: ") + e.what());
   }
   if (!doc.is_object()) file.fail("", "the top level is not a JSON object");
   const json& format = file.member(doc, "format");
