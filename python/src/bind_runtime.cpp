@@ -52,6 +52,14 @@ py::dict effective_settings(const Scene& scene) {
                              py::arg("dependence_tol") = r.projection.dependence_tol,
                              py::arg("max_iterations") = r.projection.max_iterations);
   d["offsets"] = py::dict(py::arg("eps") = scene.contact.offset_eps, py::arg("time") = scene.contact.offset_time);
+  // A texture is felt only up to an exploration speed (METHOD.md 6.2): the bound
+  // at the default constraint update rate (the model computes it: surface.h).
+  if (scene.surface.kind == SurfaceKind::kTexture) {
+    const RuntimeModel model(scene, RuntimeSettings{});
+    d["texture"] = py::dict(py::arg("shortest_wavelength") = shortest_wavelength(model.surface.field),
+                            py::arg("sim_rate_hz") = model.sim_rate_hz,
+                            py::arg("max_exploration_speed") = model.texture_max_speed);
+  }
   d["gains"] = py::dict(py::arg("ks") = scene.gains.ks, py::arg("kh") = scene.gains.kh);
   d["device"] = py::dict(py::arg("rate_hz") = scene.device.rate_hz, py::arg("max_force") = scene.device.max_force,
                          py::arg("max_torque") = scene.device.max_torque);

@@ -119,3 +119,22 @@ def test_scene_info_effective_settings(scene):
     # The text form lists them too.
     text = run_cli("scene", "info", str(cli.SCENES[scene]), "--no-self-intersections")
     assert text.returncode == 0 and "effective settings (delta = " in text.stdout
+
+
+def test_scene_info_texture_speed_bound():
+    """A textured scene's effective settings state the method's sampling bound (METHOD.md 6.2):
+    a texture of shortest wavelength L is felt up to the exploration speed L f / 2 at a constraint
+    update rate f (the default lockstep runs update every tick, so f is the device's rate). The
+    scene's own numbers are read back from its TOML; a plain scene has no texture group."""
+    import tomllib
+
+    path = cli.SCENES["peg"].parent / "texture_slow.toml"
+    toml = tomllib.loads(path.read_text())
+    r = run_cli("scene", "info", str(path), "--json", "--settings", "--no-self-intersections")
+    assert r.returncode == 0, r.stderr
+    t = json.loads(r.stdout)["effective_settings"]["texture"]
+    L, f = toml["surface"]["wavelength"], toml["device"]["rate_hz"]
+    assert t["shortest_wavelength"] == L and t["sim_rate_hz"] == f
+    assert t["max_exploration_speed"] == 0.5 * L * f
+    r = run_cli("scene", "info", str(cli.SCENES["peg"]), "--json", "--settings", "--no-self-intersections")
+    assert "texture" not in json.loads(r.stdout)["effective_settings"]
