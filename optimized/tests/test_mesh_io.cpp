@@ -197,6 +197,11 @@ TEST_CASE("Mesh files whose headers are broken or whose counts lie are refused b
   require_file_error(dir.write("short.off", "OFF\n3 1 0\n0 0 0\n1 0 0\n"), "the file holds 2");
   require_file_error(dir.write("corners.off", "OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n99999999999 0 1 2\n"),
                      "states more corners than the line holds");
+  // CGAL casts face indices read as doubles to size_t: 1e26 or -1 was undefined behaviour.
+  require_file_error(dir.write("huge_index.off", "OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 155555555555555555555555555\n"),
+                     "not a vertex number below 3");
+  require_file_error(dir.write("negative_index.off", "OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 -1\n"),
+                     "not a vertex number below 3");
   require_file_error(dir.write("color.off", "COFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n"), "variant 'COFF'");
   {
     std::string stl(80, ' ');

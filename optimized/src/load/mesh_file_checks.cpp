@@ -111,6 +111,14 @@ void check_off_structure(const std::string& path, const std::string& bytes) {
     if (!parse_count(t[0], &k) || k > t.size() - 1)
       fail(path, "cannot parse as OFF: line " + std::to_string(lines.line()) + ": face " + std::to_string(f) +
                      " states more corners than the line holds (or a bad corner count '" + std::string(t[0]) + "')");
+    // CGAL 5.5 reads indices as doubles and casts them to size_t (undefined beyond
+    // its range): each must be a vertex number here.
+    for (uint64_t c = 1; c <= k; ++c) {
+      uint64_t index = 0;
+      if (!parse_count(t[c], &index) || index >= nv)
+        fail(path, "cannot parse as OFF: line " + std::to_string(lines.line()) + ": face " + std::to_string(f) +
+                       " has corner '" + std::string(t[c]) + "', not a vertex number below " + std::to_string(nv));
+    }
   }
 }
 
