@@ -1,4 +1,46 @@
-"""`gauss6 ccd queries`: continuous-collision query files through one CCD implementation.
+"""Continuous collision detection from Python: per-query calls, and `gauss6 ccd queries`.
+
+Per query (the optimized narrow phase of optimized/include/gauss6/ccd.h, one call
+each; the exact twin of reference/ccd.h beside it):
+
+    from gauss6 import ccd
+    r = ccd.vertex_face(vertex_start, face_start, vertex_end, face_end)   # linear motion
+    r = ccd.edge_edge(edge_a_start, edge_b_start, edge_a_end, edge_b_end)
+    r = ccd.rigid_vertex_face(p0, q0, p1, q1, vertex_B, face_W)           # Cayley rigid motion
+    r = ccd.rigid_face_vertex(p0, q0, p1, q1, face_B, vertex_W)
+    r = ccd.rigid_edge_edge(p0, q0, p1, q1, edge_B, edge_W)
+    r.hit, r.u_hit, r.status, r.time_tolerance_reached, r.distance_reached, r.iterations
+
+Linear: every vertex moves on x(u) = x_start + u (x_end - x_start), u in [0, 1];
+a vertex is (3,), a face (3, 3) and an edge (2, 3), one point a row. Rigid: the
+feature named _B is a body point of the moving body (body frame, origin at G),
+moved by the Cayley motion from pose (p0, q0) to (p1, q1) (q = (w, x, y, z), not
+necessarily unit: METHOD.md sections 1 and 4); the feature named _W is static
+(world frame). Keyword settings (CcdSettings of ccd.h, its defaults when not
+given): u_end (search [0, u_end]), min_separation (report the first u where the
+distance may be <= this; 0: contact), time_tolerance, distance_tolerance,
+max_iterations, and for rigid queries use_u_filter and early_hit.
+
+The answer (QueryResult) is conservative: u_hit <= u*, the exact first contact;
+hit is never False where a contact exists. status is "ok" when the search
+finished within the tolerances; "max_iterations" or "workspace_full" when it gave
+up (hit is then True, u_hit the earliest u not proven free); "invalid_input"
+(non-finite or huge coordinate, bad window); "half_turn" (rigid: a relative
+rotation near 180 degrees, split the step; hit True, u_hit 0).
+time_tolerance_reached is the u-width of the accepted box and distance_reached
+a distance within which the features lie at u_hit. The tests
+(python/tests/test_ccd_queries.py) check u_hit <= u* exactly on every shared
+query and bound u* - u_hit.
+
+The exact answers: exact_vertex_face, exact_edge_edge (same arguments) and
+exact_rigid_vertex_face, exact_rigid_face_vertex, exact_rigid_edge_edge (same
+arguments, u_end keyword) return an ExactToi: hit, lower <= u* <= upper
+(adjacent doubles or equal) and compare(u), the exact sign of u - u*. The
+doubles are taken as the rationals they denote. Slow (GMP): for checks.
+read_query_file(path, kind) returns a query file's points (n, 8, 3), expected,
+line and exact as arrays.
+
+`gauss6 ccd queries`: continuous-collision query files through one CCD implementation.
 
 The files are those of ../shared/data/ccd-sample-queries (the Tight-Inclusion
 benchmark format: 8 rows per query, exact rational coordinates, exact ground
@@ -22,6 +64,21 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from . import _gauss6
+from ._gauss6.ccd import (  # noqa: F401  (per-query CCD, documented above)
+    ExactToi,
+    QueryResult,
+    edge_edge,
+    exact_edge_edge,
+    exact_rigid_edge_edge,
+    exact_rigid_face_vertex,
+    exact_rigid_vertex_face,
+    exact_vertex_face,
+    read_query_file,
+    rigid_edge_edge,
+    rigid_face_vertex,
+    rigid_vertex_face,
+    vertex_face,
+)
 
 KINDS = ("vf", "ee")
 IMPLS = ("optimized", "reference")

@@ -13,6 +13,7 @@
 
 #include <chrono>
 #include <memory>
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -100,6 +101,150 @@ py::dict run_query_file(const std::string& path, const std::string& kind, const 
   d["line"] = line;
   d["inexact"] = inexact;
   d["seconds"] = seconds;
+  return d;
+}
+
+// ---------------------------------------------------------------------------
+// Per-query CCD for users (gauss6.ccd.vertex_face and the others): one query per
+// call, the optimized narrow phase (ccd.h) and its exact twin (reference/ccd.h).
+
+// CcdResult with its status as a Python identifier ("ok", "max_iterations",
+// "workspace_full", "invalid_input", "half_turn").
+struct QueryResult {
+  CcdResult r;
+  std::string status;
+};
+std::string status_name(CcdStatus s) {
+  const std::string full = to_string(s);
+  return full.substr(0, full.find(':'));
+}
+QueryResult make_result(const CcdResult& r) { return {r, status_name(r.status)}; }
+
+// The settings of one call: CcdSettings' defaults unless given (keyword arguments).
+CcdSettings query_settings(double min_separation, std::optional<double> time_tolerance,
+                           std::optional<double> distance_tolerance, std::optional<int> max_iterations,
+                           std::optional<bool> use_u_filter, std::optional<bool> early_hit) {
+  CcdSettings s;
+  s.min_separation = min_separation;
+  if (time_tolerance) s.time_tolerance = *time_tolerance;
+  if (distance_tolerance) s.distance_tolerance = *distance_tolerance;
+  if (max_iterations) s.max_iterations = *max_iterations;
+  if (use_u_filter) s.use_u_filter = *use_u_filter;
+  if (early_hit) s.early_hit = *early_hit;
+  return s;
+}
+
+// One workspace per Python thread, sized once (the queries never allocate; a
+// workspace per call would cost more than most queries).
+CcdWorkspace& query_workspace() {
+  thread_local CcdWorkspace ws;
+  return ws;
+}
+
+using Face = Eigen::Matrix<double, 3, 3, Eigen::RowMajor>;  // one vertex a row
+using Edge = Eigen::Matrix<double, 2, 3, Eigen::RowMajor>;  // one endpoint a row
+std::array<Vec3, 3> rows3(const Face& f) { return {Vec3(f.row(0)), Vec3(f.row(1)), Vec3(f.row(2))}; }
+std::array<Vec3, 2> rows2(const Edge& e) { return {Vec3(e.row(0)), Vec3(e.row(1))}; }
+
+QueryResult linear_vertex_face(const Eigen::Vector3d& v0, const Face& f0, const Eigen::Vector3d& v1, const Face& f1,
+                               double u_end, const CcdSettings& s) {
+  LinearVertexFaceQuery q;
+  q.vertex = {v0, v1};
+  q.face = {rows3(f0), rows3(f1)};
+  q.u_end = u_end;
+  CcdResult r;
+  ccd_linear_vertex_face(q, s, &query_workspace(), &r);
+  return make_result(r);
+}
+QueryResult linear_edge_edge(const Edge& a0, const Edge& b0, const Edge& a1, const Edge& b1, double u_end,
+                             const CcdSettings& s) {
+  LinearEdgeEdgeQuery q;
+  q.edge_a = {rows2(a0), rows2(a1)};
+  q.edge_b = {rows2(b0), rows2(b1)};
+  q.u_end = u_end;
+  CcdResult r;
+  ccd_linear_edge_edge(q, s, &query_workspace(), &r);
+  return make_result(r);
+}
+
+// Rigid queries: the Cayley motion of the two poses; a pose the motion refuses
+// (zero or non-finite quaternion, a half turn) is a status, as in the runtime.
+template <class Query, class Fn>
+QueryResult rigid(const Eigen::Vector3d& p0, const Eigen::Vector4d& q0, const Eigen::Vector3d& p1,
+                  const Eigen::Vector4d& q1, Query q, double u_end, const CcdSettings& s, Fn fn) {
+  CcdMotion motion;
+  CcdResult r;
+  const MotionStatus ms = make_ccd_motion(pose_from(p0, q0), pose_from(p1, q1), &motion);
+  if (ms != MotionStatus::kOk) {
+    r.status = ms == MotionStatus::kHalfTurn ? CcdStatus::kHalfTurn : CcdStatus::kInvalidInput;
+    r.hit = true;  // conservative, as ccd_step
+    r.u_hit = 0;
+    return make_result(r);
+  }
+  q.motion = &motion;
+  q.u_end = u_end;
+  fn(q, s, &query_workspace(), &r);
+  return make_result(r);
+}
+
+// The exact answer (reference/ccd.h) of the same queries, inputs taken as the
+// rationals their doubles denote.
+reference::ExactPoint exact_point(const Vec3& v) { return {mpq_class(v.x()), mpq_class(v.y()), mpq_class(v.z())}; }
+template <size_t N>
+std::array<reference::ExactPoint, N> exact_points(const std::array<Vec3, N>& v) {
+  std::array<reference::ExactPoint, N> out;
+  for (size_t i = 0; i < N; ++i) out[i] = exact_point(v[i]);
+  return out;
+}
+void check_finite(const Eigen::Ref<const Eigen::MatrixXd>& x, const char* name) {
+  if (!x.allFinite()) throw py::value_error(std::string(name) + ": coordinates must be finite");
+}
+reference::ExactCayleyMotion exact_motion(const Eigen::Vector3d& p0, const Eigen::Vector4d& q0,
+                                          const Eigen::Vector3d& p1, const Eigen::Vector4d& q1) {
+  try {
+    return reference::make_exact_cayley_motion(pose_from(p0, q0), pose_from(p1, q1));
+  } catch (const std::domain_error& e) {
+    throw py::value_error(e.what());
+  }
+}
+template <class Fn>
+reference::ExactToi exact_call(Fn fn) {
+  try {
+    return fn();
+  } catch (const std::invalid_argument& e) {
+    throw py::value_error(e.what());
+  }
+}
+
+// A query file (ccd_queries.h) as arrays: points (n, 8, 3) as doubles in file
+// order (rows 0-3 at t = 0, 4-7 at t = 1), expected, line, and exact (every
+// coordinate of the query is the double given).
+py::dict read_query_arrays(const std::string& path, const std::string& kind_name) {
+  const std::vector<CcdQuery> queries = read_ccd_queries(path, kind_from(kind_name));
+  const auto n = static_cast<py::ssize_t>(queries.size());
+  py::array_t<double> points({n, py::ssize_t(8), py::ssize_t(3)});
+  py::array_t<bool> expected(n), exact(n);
+  py::array_t<int> line(n);
+  auto P = points.mutable_unchecked<3>();
+  auto E = expected.mutable_unchecked<1>(), X = exact.mutable_unchecked<1>();
+  auto L = line.mutable_unchecked<1>();
+  for (py::ssize_t i = 0; i < n; ++i) {
+    bool all_exact = true;
+    for (int k = 0; k < 8; ++k) {
+      bool ok = true;
+      const auto x = to_double(queries[i].points[k], &ok);
+      all_exact = all_exact && ok;
+      for (int j = 0; j < 3; ++j) P(i, k, j) = x[j];
+    }
+    E(i) = queries[i].expected;
+    X(i) = all_exact;
+    L(i) = queries[i].line;
+  }
+  py::dict d;
+  d["points"] = points;
+  d["expected"] = expected;
+  d["line"] = line;
+  d["exact"] = exact;
   return d;
 }
 
@@ -276,6 +421,163 @@ void bind_ccd(py::module_& m) {
           py::arg("time_tolerance") = 1e-6,
           "Runs every query of a CCD query file (ccd_queries.h format) through impl ('optimized' or 'reference'): "
           "dict with hit, expected, line (per query), inexact, seconds (primitive calls only).");
+
+  // Per-query CCD (documented for users in python/gauss6/ccd.py).
+  py::class_<QueryResult>(ccd, "QueryResult",
+                          "One CCD query's answer: hit, u_hit (<= the exact first contact u*), status, "
+                          "time_tolerance_reached, distance_reached, iterations.")
+      .def_property_readonly("hit", [](const QueryResult& q) { return q.r.hit; },
+                             "a contact (or, with min_separation > 0, a distance <= min_separation) may occur in "
+                             "[u_begin, u_end]; true on a give-up (conservative)")
+      .def_property_readonly("u_hit", [](const QueryResult& q) { return q.r.u_hit; },
+                             "time of impact: u_hit <= u*; u_end when there is no hit")
+      .def_property_readonly("status", [](const QueryResult& q) { return q.status; },
+                             "'ok', 'max_iterations', 'workspace_full' (gave up: hit reported), 'invalid_input', "
+                             "'half_turn' (rigid: split the step)")
+      .def_property_readonly("time_tolerance_reached", [](const QueryResult& q) { return q.r.time_tolerance_reached; },
+                             "u-width of the accepted box")
+      .def_property_readonly("distance_reached", [](const QueryResult& q) { return q.r.distance_reached; },
+                             "on a hit, the features are within this distance at u_hit (inf on a give-up)")
+      .def_property_readonly("iterations", [](const QueryResult& q) { return q.r.iterations; }, "boxes examined")
+      .def("__repr__", [](const QueryResult& q) {
+        return "<QueryResult status=" + q.status + " hit=" + (q.r.hit ? "True" : "False") +
+               " u_hit=" + py::repr(py::float_(q.r.u_hit)).cast<std::string>() + ">";
+      });
+
+  ccd.def("vertex_face",
+          [](const Eigen::Vector3d& v0, const Face& f0, const Eigen::Vector3d& v1, const Face& f1, double u_end,
+             double min_separation, std::optional<double> tt, std::optional<double> dt, std::optional<int> mi) {
+            return linear_vertex_face(v0, f0, v1, f1, u_end, query_settings(min_separation, tt, dt, mi, {}, {}));
+          },
+          py::arg("vertex_start"), py::arg("face_start"), py::arg("vertex_end"), py::arg("face_end"), py::kw_only(),
+          py::arg("u_end") = 1.0, py::arg("min_separation") = 0.0, py::arg("time_tolerance") = py::none(),
+          py::arg("distance_tolerance") = py::none(), py::arg("max_iterations") = py::none(),
+          "Linear vertex/face CCD: vertex (3,) and face (3, 3) (a vertex a row) at u = 0 and u = 1.");
+  ccd.def("edge_edge",
+          [](const Edge& a0, const Edge& b0, const Edge& a1, const Edge& b1, double u_end, double min_separation,
+             std::optional<double> tt, std::optional<double> dt, std::optional<int> mi) {
+            return linear_edge_edge(a0, b0, a1, b1, u_end, query_settings(min_separation, tt, dt, mi, {}, {}));
+          },
+          py::arg("edge_a_start"), py::arg("edge_b_start"), py::arg("edge_a_end"), py::arg("edge_b_end"),
+          py::kw_only(), py::arg("u_end") = 1.0, py::arg("min_separation") = 0.0,
+          py::arg("time_tolerance") = py::none(), py::arg("distance_tolerance") = py::none(),
+          py::arg("max_iterations") = py::none(),
+          "Linear edge/edge CCD: edges (2, 3) (an endpoint a row) at u = 0 and u = 1.");
+  ccd.def("rigid_vertex_face",
+          [](const Eigen::Vector3d& p0, const Eigen::Vector4d& q0, const Eigen::Vector3d& p1,
+             const Eigen::Vector4d& q1, const Eigen::Vector3d& vertex_B, const Face& face_W, double u_end,
+             double min_separation, std::optional<double> tt, std::optional<double> dt, std::optional<int> mi,
+             std::optional<bool> uf, std::optional<bool> eh) {
+            RigidVertexFaceQuery q;
+            q.vertex_B = vertex_B;
+            q.face_W = rows3(face_W);
+            return rigid(p0, q0, p1, q1, q, u_end, query_settings(min_separation, tt, dt, mi, uf, eh),
+                         ccd_rigid_vertex_face);
+          },
+          py::arg("p0"), py::arg("q0"), py::arg("p1"), py::arg("q1"), py::arg("vertex_B"), py::arg("face_W"),
+          py::kw_only(), py::arg("u_end") = 1.0, py::arg("min_separation") = 0.0,
+          py::arg("time_tolerance") = py::none(), py::arg("distance_tolerance") = py::none(),
+          py::arg("max_iterations") = py::none(), py::arg("use_u_filter") = py::none(),
+          py::arg("early_hit") = py::none(),
+          "Rigid vertex/face CCD: the body's vertex (body frame) under the Cayley motion (p0, q0) -> (p1, q1), "
+          "the face static (world frame).");
+  ccd.def("rigid_face_vertex",
+          [](const Eigen::Vector3d& p0, const Eigen::Vector4d& q0, const Eigen::Vector3d& p1,
+             const Eigen::Vector4d& q1, const Face& face_B, const Eigen::Vector3d& vertex_W, double u_end,
+             double min_separation, std::optional<double> tt, std::optional<double> dt, std::optional<int> mi,
+             std::optional<bool> uf, std::optional<bool> eh) {
+            RigidFaceVertexQuery q;
+            q.face_B = rows3(face_B);
+            q.vertex_W = vertex_W;
+            return rigid(p0, q0, p1, q1, q, u_end, query_settings(min_separation, tt, dt, mi, uf, eh),
+                         ccd_rigid_face_vertex);
+          },
+          py::arg("p0"), py::arg("q0"), py::arg("p1"), py::arg("q1"), py::arg("face_B"), py::arg("vertex_W"),
+          py::kw_only(), py::arg("u_end") = 1.0, py::arg("min_separation") = 0.0,
+          py::arg("time_tolerance") = py::none(), py::arg("distance_tolerance") = py::none(),
+          py::arg("max_iterations") = py::none(), py::arg("use_u_filter") = py::none(),
+          py::arg("early_hit") = py::none(),
+          "Rigid face/vertex CCD: the body's face (body frame) moving, the vertex static (world frame).");
+  ccd.def("rigid_edge_edge",
+          [](const Eigen::Vector3d& p0, const Eigen::Vector4d& q0, const Eigen::Vector3d& p1,
+             const Eigen::Vector4d& q1, const Edge& edge_B, const Edge& edge_W, double u_end,
+             double min_separation, std::optional<double> tt, std::optional<double> dt, std::optional<int> mi,
+             std::optional<bool> uf, std::optional<bool> eh) {
+            RigidEdgeEdgeQuery q;
+            q.edge_B = rows2(edge_B);
+            q.edge_W = rows2(edge_W);
+            return rigid(p0, q0, p1, q1, q, u_end, query_settings(min_separation, tt, dt, mi, uf, eh),
+                         ccd_rigid_edge_edge);
+          },
+          py::arg("p0"), py::arg("q0"), py::arg("p1"), py::arg("q1"), py::arg("edge_B"), py::arg("edge_W"),
+          py::kw_only(), py::arg("u_end") = 1.0, py::arg("min_separation") = 0.0,
+          py::arg("time_tolerance") = py::none(), py::arg("distance_tolerance") = py::none(),
+          py::arg("max_iterations") = py::none(), py::arg("use_u_filter") = py::none(),
+          py::arg("early_hit") = py::none(),
+          "Rigid edge/edge CCD: the body's edge (body frame) moving, the other edge static (world frame).");
+
+  py::class_<reference::ExactToi>(ccd, "ExactToi", "Exact first contact u* of one query (reference).")
+      .def_readonly("hit", &reference::ExactToi::hit)
+      .def_readonly("lower", &reference::ExactToi::lower, "double bracket lower <= u* <= upper")
+      .def_readonly("upper", &reference::ExactToi::upper)
+      .def("compare", [](const reference::ExactToi& t, double u) { return reference::compare_toi(t, u); },
+           py::arg("u"), "Exact sign of u - u* (-1, 0, +1); a miss counts as u* = +infinity.")
+      .def("__repr__", [](const reference::ExactToi& t) {
+        return std::string("<ExactToi hit=") + (t.hit ? "True" : "False") +
+               " lower=" + py::repr(py::float_(t.lower)).cast<std::string>() + ">";
+      });
+  ccd.def("exact_vertex_face",
+          [](const Eigen::Vector3d& v0, const Face& f0, const Eigen::Vector3d& v1, const Face& f1) {
+            check_finite(v0, "vertex_start"), check_finite(f0, "face_start");
+            check_finite(v1, "vertex_end"), check_finite(f1, "face_end");
+            reference::LinearVertexFaceQuery q;
+            q.vertex = {exact_point(v0), exact_point(v1)};
+            q.face = {exact_points(rows3(f0)), exact_points(rows3(f1))};
+            return reference::ccd_linear_vertex_face(q);
+          },
+          py::arg("vertex_start"), py::arg("face_start"), py::arg("vertex_end"), py::arg("face_end"),
+          "Exact first contact over u in [0, 1] of vertex_face's query (no separation): an ExactToi.");
+  ccd.def("exact_edge_edge",
+          [](const Edge& a0, const Edge& b0, const Edge& a1, const Edge& b1) {
+            check_finite(a0, "edge_a_start"), check_finite(b0, "edge_b_start");
+            check_finite(a1, "edge_a_end"), check_finite(b1, "edge_b_end");
+            reference::LinearEdgeEdgeQuery q;
+            q.edge_a = {exact_points(rows2(a0)), exact_points(rows2(a1))};
+            q.edge_b = {exact_points(rows2(b0)), exact_points(rows2(b1))};
+            return reference::ccd_linear_edge_edge(q);
+          },
+          py::arg("edge_a_start"), py::arg("edge_b_start"), py::arg("edge_a_end"), py::arg("edge_b_end"),
+          "Exact first contact over u in [0, 1] of edge_edge's query (no separation): an ExactToi.");
+  ccd.def("exact_rigid_vertex_face",
+          [](const Eigen::Vector3d& p0, const Eigen::Vector4d& q0, const Eigen::Vector3d& p1,
+             const Eigen::Vector4d& q1, const Eigen::Vector3d& vertex_B, const Face& face_W, double u_end) {
+            check_finite(vertex_B, "vertex_B"), check_finite(face_W, "face_W");
+            const reference::ExactCayleyMotion m = exact_motion(p0, q0, p1, q1);
+            return exact_call([&] { return reference::ccd_rigid_vertex_face({&m, vertex_B, rows3(face_W), u_end}); });
+          },
+          py::arg("p0"), py::arg("q0"), py::arg("p1"), py::arg("q1"), py::arg("vertex_B"), py::arg("face_W"),
+          py::kw_only(), py::arg("u_end") = 1.0, "Exact first contact over [0, u_end] of rigid_vertex_face's query.");
+  ccd.def("exact_rigid_face_vertex",
+          [](const Eigen::Vector3d& p0, const Eigen::Vector4d& q0, const Eigen::Vector3d& p1,
+             const Eigen::Vector4d& q1, const Face& face_B, const Eigen::Vector3d& vertex_W, double u_end) {
+            check_finite(face_B, "face_B"), check_finite(vertex_W, "vertex_W");
+            const reference::ExactCayleyMotion m = exact_motion(p0, q0, p1, q1);
+            return exact_call([&] { return reference::ccd_rigid_face_vertex({&m, vertex_W, rows3(face_B), u_end}); });
+          },
+          py::arg("p0"), py::arg("q0"), py::arg("p1"), py::arg("q1"), py::arg("face_B"), py::arg("vertex_W"),
+          py::kw_only(), py::arg("u_end") = 1.0, "Exact first contact over [0, u_end] of rigid_face_vertex's query.");
+  ccd.def("exact_rigid_edge_edge",
+          [](const Eigen::Vector3d& p0, const Eigen::Vector4d& q0, const Eigen::Vector3d& p1,
+             const Eigen::Vector4d& q1, const Edge& edge_B, const Edge& edge_W, double u_end) {
+            check_finite(edge_B, "edge_B"), check_finite(edge_W, "edge_W");
+            const reference::ExactCayleyMotion m = exact_motion(p0, q0, p1, q1);
+            return exact_call([&] { return reference::ccd_rigid_edge_edge({&m, rows2(edge_B), rows2(edge_W), u_end}); });
+          },
+          py::arg("p0"), py::arg("q0"), py::arg("p1"), py::arg("q1"), py::arg("edge_B"), py::arg("edge_W"),
+          py::kw_only(), py::arg("u_end") = 1.0, "Exact first contact over [0, u_end] of rigid_edge_edge's query.");
+  ccd.def("read_query_file", &read_query_arrays, py::arg("path"), py::arg("kind"),
+          "A CCD query file (ccd_queries.h format) as arrays: dict with points (n, 8, 3) as doubles in file order "
+          "(rows 0-3 at u = 0, 4-7 at u = 1), expected, line, exact (each coordinate is the double given).");
 
   py::class_<ExactContact>(ccd, "ExactContact", "Exact first contact u* of a mesh step (reference).")
       .def_property_readonly("hit", [](const ExactContact& c) { return c.contact.toi.hit; })
