@@ -52,10 +52,11 @@ test: setup
 	exit $$status
 
 # Every benchmark suite (JSON, table, plots in out/bench/) and the speed-against-error
-# sweeps (Pareto plots in out/bench/sweeps/): docs/benchmarks.md.
+# sweeps (Pareto plots in out/bench/sweeps/), the peers (out/bench/peers/): docs/benchmarks.md.
 bench: setup
 	$(VENV)/gauss6 bench --build build --out out/bench
 	$(VENV)/gauss6 sweep --build build --out out/bench/sweeps
+	$(VENV)/gauss6 report peers --sample 4 --out out/bench/peers
 
 datasets: setup
 	$(VENV)/gauss6 datasets generate

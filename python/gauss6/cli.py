@@ -7,6 +7,7 @@
     gauss6 ccd queries FILE.csv|DIR [--kind vf|ee] [--impl optimized|reference] [--json]
     gauss6 crosscheck ccd [--set NAME] [--json] [--peers]
     gauss6 report qp --out DIR
+    gauss6 report peers [--out DIR] [--repeats N] [--ccd-only | --qp-only]
     gauss6 reproduce peg|bunny|all --out DIR [--threaded]
     gauss6 trace export TRACE [--csv DIR] [--hapi FILE]
     gauss6 trace import FILE --format hapi|csv --out TRACE
@@ -172,6 +173,9 @@ def build_parser() -> argparse.ArgumentParser:
     rq.add_argument("--out", required=True, help="output directory")
     rq.add_argument("--family", help="one instance family (default: all but warm)")
     rq.set_defaults(func=cmd_report_qp)
+    from . import peers  # CCD and projection peers, in one run
+
+    peers.register(report)
 
     dev = sub.add_parser("device", help="haptic devices").add_subparsers(dest="action", required=True)
     dl = dev.add_parser("list", help="the HID devices hidapi sees, with their gauss6 profile")
