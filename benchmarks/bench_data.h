@@ -26,6 +26,8 @@
 #include "gauss6/ccd_step.h"
 #include "gauss6/mesh_io.h"
 #include "gauss6/pose.h"
+#include "gauss6/qp_instances.h"
+#include "gauss6/quasistatics.h"
 #include "gauss6/runtime.h"
 #include "gauss6/scenario.h"
 #include "gauss6/scene.h"
@@ -42,6 +44,18 @@ inline std::string data_root() {
 inline std::string datasets_dir() { return data_root() + "/datasets_generated"; }
 // The shared test data (../shared/data beside the repository).
 inline std::string shared_data_dir() { return data_root() + "/../shared/data"; }
+
+// The projection problem of a QP instance (datasets_generated/qp/), viewing its
+// arrays (the instance must outlive it), with au as given.
+inline ProjectionProblem problem_of(const QpInstance& q, const Vec6& au) {
+  ProjectionProblem p;
+  p.M = &q.M;
+  p.au = au;
+  p.J = q.J.rows() ? q.J.data() : nullptr;
+  p.b = q.b.size() ? q.b.data() : nullptr;
+  p.num_rows = static_cast<int>(q.J.rows());
+  return p;
+}
 
 // One step of a set: X0 -> X1, poses of G (q as stored: not necessarily unit).
 struct CcdSetStep {

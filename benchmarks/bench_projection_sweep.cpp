@@ -42,12 +42,7 @@ void BM_ProjectionSweep(benchmark::State& state, double feasibility_tol, double 
   double iterations = 0, not_optimal = 0, calls = 0;
   for (auto _ : state) {
     const QpInstance& q = instances[i++ % instances.size()];
-    ProjectionProblem p;
-    p.M = &q.M;
-    p.au = q.au;
-    p.J = q.J.rows() ? q.J.data() : nullptr;
-    p.b = q.b.size() ? q.b.data() : nullptr;
-    p.num_rows = static_cast<int>(q.J.rows());
+    const ProjectionProblem p = problem_of(q, q.au);
     ProjectionWorkspace ws;  // cold
     rec.time(state, [&] { project(p, settings, &ws, &result); });
     benchmark::DoNotOptimize(result.ac);

@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "bench_data.h"
 #include "gauss6/coupling.h"
 #include "gauss6/qp_instances.h"
 #include "gauss6/quasistatics.h"
@@ -33,16 +34,6 @@ std::vector<const QpInstance*> select(const std::string& name, int max_rows) {
   for (const QpInstance& q : family(name))
     if (max_rows < 0 || q.J.rows() <= max_rows) out.push_back(&q);
   return out;
-}
-
-ProjectionProblem problem_of(const QpInstance& q, const Vec6& au) {
-  ProjectionProblem p;
-  p.M = &q.M;
-  p.au = au;
-  p.J = q.J.rows() ? q.J.data() : nullptr;
-  p.b = q.b.size() ? q.b.data() : nullptr;
-  p.num_rows = static_cast<int>(q.J.rows());
-  return p;
 }
 
 // Force computation from a cold workspace, cycling through the family.

@@ -17,7 +17,12 @@
    two-sided Mann-Whitney U-test of the two sample sets (Google Benchmark's
    compare.py test, from /usr/share/benchmark/gbench when installed, else scipy).
    Slower: ratio > 1 + max_slowdown and p < alpha.
-3. Accuracy and properties. Each [[accuracy.check]] runs `python -m gauss6.cli ARGS`
+3. Counts. The fixed workloads of gauss6_count (benchmarks/count_main.cpp) run once a
+   side under callgrind ([count]); per workload, instructions per call. Unlike times,
+   these do not depend on the machine's load (the same binary and data give the same
+   count to the instruction), so no test of significance is needed: more
+   instructions: ratio work / base > 1 + max_increase.
+4. Accuracy and properties. Each [[accuracy.check]] runs `python -m gauss6.cli ARGS`
    with each tree's own package and extension and reads its JSON; the error metrics
    of [accuracy.metrics] are compared (work > base (1 + rel) + abs fails) and the
    [properties] are checked on the working tree (and on the benchmark counters).
@@ -44,6 +49,7 @@ from pathlib import Path
 from . import bench, paths
 
 DEFAULT_CONFIG = paths.REPO_ROOT / "benchmarks" / "gate.toml"
+COUNT_RELPATH = "benchmarks/gauss6_count"    # the fixed workloads counted under callgrind
 GBENCH_DIR = Path("/usr/share/benchmark")  # Debian's libbenchmark-tools (compare.py and gbench)
 
 
@@ -326,6 +332,85 @@ def run_speed(sides: tuple[Side, Side], cfg: dict, out_dir: Path, data_root: Pat
     return merged["base"], merged["work"]
 
 
+def count_binary(build_dir: Path) -> Path:
+    path = Path(build_dir) / COUNT_RELPATH
+    if not path.exists():
+        raise GateError(f"{path}: not built (needs valgrind's valgrind/callgrind.h at configure time: "
+                        "tools/setup.sh installs valgrind; then `cmake --build BUILD --target gauss6_count`)")
+    return path
+
+
+def read_callgrind_dumps(out_file: Path) -> dict[str, int]:
+    """Instructions per client-request dump of a callgrind run: {dump name: Ir total}.
+
+    gauss6_count dumps after each workload (CALLGRIND_DUMP_STATS_AT(name)): files
+    OUT.1, OUT.2, ... each with a line "desc: Trigger: Client Request: <name>" and
+    "totals: <Ir>"."""
+    out: dict[str, int] = {}
+    for f in sorted(out_file.parent.glob(out_file.name + ".*")):
+        name = total = None
+        for line in f.read_text(errors="replace").splitlines():
+            if line.startswith("desc: Trigger: Client Request: "):
+                name = line.split(": ", 3)[3].strip()
+            elif line.startswith("totals:"):
+                total = int(line.split()[1])
+        if name is not None and total is not None:
+            out[name] = total
+    return out
+
+
+def run_counts(side: Side, cfg: dict, out_dir: Path, data_root: Path, plant: float = 0.0,
+               log=print) -> dict[str, float]:
+    """Instructions per call of each gauss6_count workload, one callgrind run of the side's binary."""
+    cc = cfg.get("count", {})
+    valgrind = shutil.which("valgrind")
+    if valgrind is None:
+        raise GateError("valgrind not found: the gate's instruction counts need it (tools/setup.sh installs it; "
+                        "--no-count skips the counts)")
+    run_dir = out_dir / f"count-{side.label}"
+    shutil.rmtree(run_dir, ignore_errors=True)
+    run_dir.mkdir(parents=True)
+    cmd = [valgrind, "--tool=callgrind", f"--callgrind-out-file={run_dir / 'callgrind.out'}",
+           str(count_binary(side.build)), "--calls", str(run_dir / "calls.json")]
+    if cc.get("filter"):
+        cmd += ["--filter", cc["filter"]]
+    if plant:
+        cmd += ["--plant", str(plant)]
+    log(f"gate: instruction counts (callgrind): {side.label}")
+    proc = subprocess.run(cmd, capture_output=True, text=True, env=dict(os.environ, GAUSS6_BENCH_DATA_ROOT=str(data_root)),
+                          timeout=float(cc.get("timeout", 1800)))
+    if proc.returncode != 0:
+        raise GateError(f"{' '.join(cmd)} failed ({proc.returncode}):\n{proc.stderr[-2000:]}")
+    calls = json.loads((run_dir / "calls.json").read_text())
+    totals = read_callgrind_dumps(run_dir / "callgrind.out")
+    missing = sorted(set(calls) - set(totals))
+    if missing:
+        raise GateError(f"{run_dir}: no callgrind dump for {', '.join(missing)}")
+    return {name: totals[name] / n for name, n in calls.items()}
+
+
+@dataclass
+class CountRow:
+    name: str
+    base: float | None   # instructions per call
+    work: float | None
+    ratio: float | None
+    verdict: str  # "more instructions" (fails), "fewer", "same", "new", "gone"
+
+
+def compare_counts(base: dict[str, float], work: dict[str, float], count_cfg: dict) -> list[CountRow]:
+    limit = float(count_cfg["max_increase"])
+    rows = []
+    for name in sorted(set(base) | set(work)):
+        if name not in base or name not in work:
+            rows.append(CountRow(name, base.get(name), work.get(name), None, "new" if name in work else "gone"))
+            continue
+        ratio = work[name] / base[name] if base[name] else math.inf
+        verdict = "more instructions" if ratio > 1 + limit else "fewer" if ratio < 1 - limit else "same"
+        rows.append(CountRow(name, base[name], work[name], ratio, verdict))
+    return rows
+
+
 def run_accuracy(side: Side, cfg: dict, log=print) -> dict[str, object]:
     """Every [[accuracy.check]] through the side's own package; flattened results."""
     env = dict(os.environ, PYTHONPATH=str(side.source / "python"), GAUSS6_BUILD_DIR=str(side.build))
@@ -366,6 +451,15 @@ def format_report(result: dict) -> str:
         ratio = "-" if r["ratio"] is None or not math.isfinite(r["ratio"]) else f"{r['ratio']:.3f}"
         lines.append(f"{r['name'][:45]:<46}{_ns(r['base_ns']):>11}{_ns(r['work_ns']):>11}{ratio:>8}{p:>8}"
                      f"{_ns(r['base_p99_ns']):>11}{_ns(r['work_p99_ns']):>11}  {r['verdict'].upper() if r['verdict'] == 'slower' else r['verdict']}")
+    if result.get("count"):
+        lines += ["", f"{'instructions per call (callgrind)':<46}{'base':>14}{'work':>14}{'ratio':>8}  verdict"
+                  f" (threshold +{100 * result['max_instruction_increase']:.0f}%)"]
+        for r in result["count"]:
+            def n(v):
+                return "-" if v is None else f"{v:,.0f}"
+            ratio = "-" if r["ratio"] is None else f"{r['ratio']:.4f}"
+            verdict = r["verdict"].upper() if r["verdict"] == "more instructions" else r["verdict"]
+            lines.append(f"{r['name'][:45]:<46}{n(r['base']):>14}{n(r['work']):>14}{ratio:>8}  {verdict}")
     if result["accuracy"]:
         lines += ["", f"{'accuracy / property':<66}{'base':>12}{'work':>12}{'limit':>12}  verdict"]
         for r in result["accuracy"]:
@@ -378,18 +472,25 @@ def format_report(result: dict) -> str:
     if result.get("benchmark_files_differing"):
         lines += ["", "note: these benchmark files do not compile against the base, which ran its own version: "
                   + ", ".join(result["benchmark_files_differing"])]
+    if result.get("count_note"):
+        lines += ["", "note: " + result["count_note"]]
     lines += ["", "FAILED: " + "; ".join(result["failures"]) if result["failures"] else "PASSED"]
     return "\n".join(lines)
 
 
-def decide(speed: list[SpeedRow], accuracy: list[AccuracyRow], cfg: dict, base_label: str) -> dict:
+def decide(speed: list[SpeedRow], accuracy: list[AccuracyRow], cfg: dict, base_label: str,
+           count: list[CountRow] | None = None) -> dict:
     failures = [f"{r.name} slower x{r.ratio:.3f} (p = {r.p_value:.3g})" for r in speed if r.verdict == "slower"]
+    failures += [f"{r.name} more instructions per call x{r.ratio:.4f}" for r in count or []
+                 if r.verdict == "more instructions"]
     failures += [f"{r.path} less accurate ({r.work!r} > {r.limit!r})" for r in accuracy if r.verdict == "less accurate"]
     failures += [f"{r.path} violated ({r.work!r})" for r in accuracy if r.verdict == "violated"]
     sp = cfg["speed"]
     return {"base": base_label, "metric": sp.get("metric", "p50_ns"), "max_slowdown": float(sp["max_slowdown"]),
             "alpha": float(sp["alpha"]), "passed": not failures, "failures": failures,
-            "speed": [asdict(r) for r in speed], "accuracy": [asdict(r) for r in accuracy]}
+            "speed": [asdict(r) for r in speed], "accuracy": [asdict(r) for r in accuracy],
+            "count": [asdict(r) for r in count or []],
+            "max_instruction_increase": float(cfg.get("count", {}).get("max_increase", math.nan))}
 
 
 def run_gate(args: argparse.Namespace, log=print) -> dict:
@@ -432,6 +533,14 @@ def run_gate(args: argparse.Namespace, log=print) -> dict:
     out_dir = cache / "runs"
     base_s, work_s = run_speed((base, work), cfg, out_dir, repo, log)
     speed = compare_speed(base_s, work_s, sp)
+    count, count_note = None, ""
+    if cfg.get("count", {}).get("enabled", False) and not args.no_count:
+        if not (base.build / COUNT_RELPATH).exists() and (work.build / COUNT_RELPATH).exists():
+            # A base older than the counts whose own benchmarks/ ran (overlay fallback).
+            count_note = f"no instruction counts: the base build has no {COUNT_RELPATH}"
+        else:
+            count = compare_counts(run_counts(base, cfg, out_dir, repo, log=log),
+                                   run_counts(work, cfg, out_dir, repo, log=log), cfg["count"])
     accuracy_base, accuracy_work = {}, bench_properties(work_s, cfg)
     if not args.no_accuracy:
         accuracy_base.update(run_accuracy(base, cfg, log))
@@ -440,9 +549,10 @@ def run_gate(args: argparse.Namespace, log=print) -> dict:
     for path, v in accuracy_work.items():  # a check that could not run in the working tree fails the gate
         if path.endswith("/runs") and v is False:
             accuracy.append(AccuracyRow(path, accuracy_base.get(path), False, True, "violated"))
-    result = decide(speed, accuracy, cfg, base_label)
+    result = decide(speed, accuracy, cfg, base_label, count)
     result["runs_dir"] = str(out_dir)
     result["benchmark_files_differing"] = fallbacks
+    result["count_note"] = count_note
     return result
 
 
@@ -475,6 +585,7 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--rounds", type=int, default=None, help="override [speed] rounds")
     p.add_argument("--repetitions", type=int, default=None, help="override [speed] repetitions")
     p.add_argument("--min-time", type=float, default=None, help="override [speed] min_time")
+    p.add_argument("--no-count", action="store_true", help="skip the instruction counts (callgrind)")
     p.add_argument("--no-accuracy", action="store_true", help="skip the accuracy checks (speed and bench properties only)")
 
 

@@ -11,6 +11,7 @@ from __future__ import annotations
 import copy
 import json
 import os
+import shutil
 import subprocess
 import sys
 from pathlib import Path
@@ -163,6 +164,52 @@ def test_config_is_complete():
 # One real run: the same build on both sides (identical revisions), interleaved.
 # ---------------------------------------------------------------------------------------
 
+# ---------------------------------------------------------------------------------------
+# Instruction counts (callgrind): deterministic, a plain threshold.
+# ---------------------------------------------------------------------------------------
+
+def test_count_comparison_flags_an_increase_beyond_the_threshold():
+    limit = CONFIG["count"]["max_increase"]
+    base = {"CcdQuery/unit-tests": 1000.0, "ForceCold/box": 500.0}
+    rows = gate.compare_counts(base, {"CcdQuery/unit-tests": 1000.0 * (1 + 2 * limit), "ForceCold/box": 500.0},
+                               CONFIG["count"])
+    assert {r.name: r.verdict for r in rows} == {"CcdQuery/unit-tests": "more instructions", "ForceCold/box": "same"}
+    result = gate.decide([], [], CONFIG, "synthetic", rows)
+    assert not result["passed"] and "more instructions" in result["failures"][0]
+    assert "MORE INSTRUCTIONS" in gate.format_report(result)
+    within = gate.compare_counts(base, {k: v * (1 + limit / 2) for k, v in base.items()}, CONFIG["count"])
+    assert gate.decide([], [], CONFIG, "synthetic", within)["passed"]
+
+
+def _build_with_count() -> Path | None:
+    for b in (paths.build_dir(), paths.REPO_ROOT / "build-gate"):
+        if (b / gate.COUNT_RELPATH).exists():
+            return b
+    return None
+
+
+@pytest.mark.skipif(_build_with_count() is None or shutil.which("valgrind") is None,
+                    reason="gauss6_count not built or valgrind missing (tools/setup.sh installs it)")
+def test_real_counts_are_deterministic_and_flag_a_planted_regression(tmp_path):
+    # One workload (the cold projection of the box family: 300 calls, a few seconds
+    # under callgrind), the same binary three times: twice as it is (the counts must
+    # be equal to the instruction, whatever the load), once with a planted
+    # regression of 5% more work (gauss6_count --plant 0.05), which must fail.
+    cfg = copy.deepcopy(CONFIG)
+    cfg["count"]["filter"] = "ForceCold/box"
+    side = gate.Side("work", paths.REPO_ROOT, _build_with_count())
+    first = gate.run_counts(side, cfg, tmp_path / "a", paths.REPO_ROOT, log=lambda m: None)
+    again = gate.run_counts(side, cfg, tmp_path / "b", paths.REPO_ROOT, log=lambda m: None)
+    planted = gate.run_counts(side, cfg, tmp_path / "c", paths.REPO_ROOT, plant=0.05, log=lambda m: None)
+    assert set(first) == {"ForceCold/box"} and first["ForceCold/box"] > 1000
+    assert first == again
+    rows = gate.compare_counts(first, again, cfg["count"])
+    assert [r.verdict for r in rows] == ["same"] and rows[0].ratio == 1.0
+    rows = gate.compare_counts(first, planted, cfg["count"])
+    assert [r.verdict for r in rows] == ["more instructions"], rows
+    assert not gate.decide([], [], cfg, "planted", rows)["passed"]
+
+
 def _build_with_bench() -> Path | None:
     for b in (paths.build_dir(), paths.REPO_ROOT / "build-gate"):
         if (b / bench.BENCH_RELPATH).exists():
@@ -174,7 +221,7 @@ def _build_with_bench() -> Path | None:
 def test_real_identical_run_passes_and_planted_slowdown_fails(tmp_path):
     build = _build_with_bench()
     cmd = [sys.executable, "-m", "gauss6.gate", "--base-build", str(build), "--work-build", str(build),
-           "--no-build-work", "--no-accuracy", "--json", "--cache-dir", str(tmp_path),
+           "--no-build-work", "--no-accuracy", "--no-count", "--json", "--cache-dir", str(tmp_path),
            "--filter", "ForceWarm/box/m|CcdQuery/unit-tests/vf", "--rounds", "3", "--repetitions", "3",
            "--min-time", "0.02"]
     env = dict(os.environ, PYTHONPATH=str(paths.REPO_ROOT / "python"))
