@@ -80,6 +80,7 @@ void on_sim_step(void* user, const SimStepInfo& info) {
   row.step = info.step - 1;  // 0, 1, 2, ...
   row.t = info.time;
   row.update_time = info.update_seconds;
+  row.update_cpu_time = info.update_cpu_seconds;
   row.num_contacts = info.num_contacts;
   row.status = static_cast<int>(info.status);
   r->writer->append(row);

@@ -259,6 +259,7 @@ void stay_put(const SimState& s, SimStepInfo* info) {
 
 const SimStepInfo& sim_step(const RuntimeModel& model, double t, RuntimeChannels* channels, SimState* s) noexcept {
   const Clock::time_point start = Clock::now();
+  const double cpu_start = thread_cpu_seconds();
   SimStepInfo& info = s->info;
   info = SimStepInfo{};
   info.step = ++s->step;
@@ -280,6 +281,7 @@ const SimStepInfo& sim_step(const RuntimeModel& model, double t, RuntimeChannels
   info.xs = s->xs;
   info.contacts = &s->contacts;
   info.update_seconds = seconds_since(start);
+  info.update_cpu_seconds = thread_cpu_seconds() - cpu_start;
   return info;
 }
 

@@ -105,7 +105,7 @@ def drive(engine, scene: EngineScene, script_json: str, out_path, duration: floa
         row["num_contacts"] = max(m, 0)
         row["force_time"] = step.step_seconds if step.step_seconds is not None else 0.0
         row["flags"] = (flags_gripped if gripped else 0) | (flags_clamped if clamped else 0)
-        steps[n] = (n, t, row["force_time"], max(m, 0), 0)
+        steps[n] = (n, t, row["force_time"], max(m, 0), 0, np.nan)  # CPU time not measured
         if m > 0:
             c = np.asarray(step.contacts, dtype=float)
             block = np.zeros(m, dtype=trace_mod.DTYPES["contacts"])

@@ -303,6 +303,8 @@ def read_csv_dir(path, scene: str = "") -> Trace:
         ticks["flags"] = TICK_FLAGS["gripped"]
     streams = {name: _read_stream_csv(files[name], name, ["t"]) if name in files else _empty(name)
                for name in ("steps", "contacts", "events")}
+    if "steps" in files and "update_cpu_time" not in files["steps"].read_text(encoding="utf-8").split("\n", 1)[0]:
+        streams["steps"]["update_cpu_time"] = np.nan  # not measured (a version 1 trace's export)
     meta_path = path / "meta.json" if path.is_dir() else None
     dropped: dict = {}
     if meta_path is not None and meta_path.exists():

@@ -24,18 +24,20 @@ import numpy as np
 from ._gauss6 import LoadError
 
 MAGIC = b"G6TRACE\0"
-VERSION = 1
+VERSION = 2             # written; version 2 added the steps' update_cpu_time
+OLDEST_VERSION = 1      # read: versions 1 and 2 (a version 1 step has update_cpu_time NaN)
 HEADER = struct.Struct("<8sIIQ")  # magic, version, flags, metadata length
 CHUNK = struct.Struct("<IIQ")     # type, row width (float64 values), row count
 
 TICKS, STEPS, CONTACTS, EVENTS, END = 1, 2, 3, 4, 5
 STREAMS = {TICKS: "ticks", STEPS: "steps", CONTACTS: "contacts", EVENTS: "events"}
 
-# Version 1 columns (name, width); the metadata repeats them under "columns".
+# Version 2 columns (name, width); the metadata repeats them under "columns".
 COLUMNS = {
     "ticks": [("t", 1), ("xh_p", 3), ("xh_q", 4), ("xs_p", 3), ("xs_q", 4), ("wrench", 6),
               ("num_contacts", 1), ("force_time", 1), ("status", 1), ("flags", 1), ("buttons", 1)],
-    "steps": [("step", 1), ("t", 1), ("update_time", 1), ("num_contacts", 1), ("status", 1)],
+    "steps": [("step", 1), ("t", 1), ("update_time", 1), ("num_contacts", 1), ("status", 1),
+              ("update_cpu_time", 1)],
     "contacts": [("step", 1), ("t", 1), ("point", 3), ("normal", 3), ("separation", 1)],
     "events": [("t", 1), ("code", 1), ("value", 1)],
 }
@@ -95,8 +97,8 @@ def read_trace(path) -> Trace:
     magic, version, _flags, meta_len = HEADER.unpack_from(data, 0)
     if magic != MAGIC:
         raise fail('not a gauss6 trace: bad magic (expected "G6TRACE\\0")')
-    if version != VERSION:
-        raise fail(f"unsupported trace version {version} (this reader reads version {VERSION})")
+    if not OLDEST_VERSION <= version <= VERSION:
+        raise fail(f"unsupported trace version {version} (this reader reads versions {OLDEST_VERSION} to {VERSION})")
     if meta_len > len(data) - HEADER.size:
         raise fail(f"metadata block of {meta_len} bytes runs past the end of the file")
     try:
@@ -119,6 +121,8 @@ def read_trace(path) -> Trace:
 
     parts: dict[str, list[np.ndarray]] = {name: [] for name in COLUMNS}
     widths = {name: sum(w for _, w in cols) for name, cols in COLUMNS.items()}
+    if version == 1:
+        widths["steps"] -= 1  # without update_cpu_time
     complete, dropped, notes = False, {}, []
     pos = HEADER.size + meta_len
     while pos < len(data):
@@ -139,7 +143,13 @@ def read_trace(path) -> Trace:
                          "read up to the last complete chunk")
             break
         start, nbytes = pos + CHUNK.size, nrows * ncols * 8
-        if name:
+        if name == "steps" and version == 1:  # widened: update_cpu_time NaN (not measured)
+            old = np.frombuffer(data, dtype=_dtype(COLUMNS["steps"][:-1]), count=nrows, offset=start)
+            rows = np.full(nrows, np.nan, dtype=DTYPES["steps"])
+            for field in old.dtype.names:
+                rows[field] = old[field]
+            parts[name].append(rows)
+        elif name:
             parts[name].append(np.frombuffer(data, dtype=DTYPES[name], count=nrows, offset=start))
         elif ctype == END:
             complete = True
@@ -274,7 +284,7 @@ def trace_metadata(scene: str = "", device: dict | None = None, phases=(), extra
 
 def write_trace(trace: Trace, path) -> Path:
     """Writes trace (its meta and four streams, one chunk each, then the end chunk with
-    trace.dropped) as a version 1 file that read_trace reads back to the same doubles."""
+    trace.dropped) as a current-version file that read_trace reads back to the same doubles."""
     path = Path(path)
     meta = dict(trace.meta)
     meta.setdefault("format", "gauss6-trace")

@@ -161,10 +161,12 @@ void bind_device(py::module_& parent) {
            py::arg("num_contacts") = 0, py::arg("force_time") = 0.0, py::arg("status") = 0, py::arg("flags") = 0,
            py::arg("buttons") = 0)
       .def("append_step",
-           [](TraceWriter& w, uint64_t step, double t, double update_time, int num_contacts, int status) {
-             return w.append(TraceStep{step, t, update_time, num_contacts, status});
+           [](TraceWriter& w, uint64_t step, double t, double update_time, int num_contacts, int status,
+              double update_cpu_time) {
+             return w.append(TraceStep{step, t, update_time, num_contacts, status, update_cpu_time});
            },
-           py::arg("step"), py::arg("t"), py::arg("update_time"), py::arg("num_contacts"), py::arg("status") = 0)
+           py::arg("step"), py::arg("t"), py::arg("update_time"), py::arg("num_contacts"), py::arg("status") = 0,
+           py::arg("update_cpu_time") = std::numeric_limits<double>::quiet_NaN())
       .def("append_contact",
            [](TraceWriter& w, uint64_t step, double t, const Eigen::Vector3d& point, const Eigen::Vector3d& normal,
               double separation) { return w.append(TraceContact{step, t, point, normal, separation}); },

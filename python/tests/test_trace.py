@@ -39,7 +39,7 @@ def test_round_trip_cpp_write_python_read(tmp_path):
     path = tmp_path / "run.g6trace"
     write_sample(path)
     tr = trace.read_trace(path)
-    assert tr.complete and tr.warnings == [] and tr.version == 1
+    assert tr.complete and tr.warnings == [] and tr.version == trace.VERSION == 2
     assert len(tr.ticks) == 300 and len(tr.steps) == 20 and len(tr.contacts) == 40 and len(tr.events) == 2
     i = np.arange(300)
     # Doubles are stored as they are: exact equality.
@@ -59,6 +59,41 @@ def test_round_trip_cpp_write_python_read(tmp_path):
     assert tr.dropped == {"ticks": 0, "steps": 0, "contacts": 0, "events": 0}
     # The metadata's column list is the one this reader uses.
     assert [tuple(c) for c in tr.meta["columns"]["ticks"]] == trace.COLUMNS["ticks"]
+
+
+def test_update_cpu_time_round_trips_and_version_1_traces_stay_readable(tmp_path):
+    # Version 2 added the steps' update_cpu_time (the sim thread's CPU time); a
+    # writer call without it records NaN (not measured).
+    path = tmp_path / "run.g6trace"
+    w = _device.TraceWriter(str(path), scene="s", device="d", rate_hz=1000.0, phases=[], extra_json="{}",
+                            background_thread=False)
+    assert w.append_step(0, 0.001, 2e-4, 1, 0, update_cpu_time=1.5e-4)
+    assert w.append_step(1, 0.002, 3e-4, 1)
+    w.close()
+    tr = trace.read_trace(path)
+    np.testing.assert_array_equal(tr.steps["update_cpu_time"][:1], [1.5e-4])
+    assert np.isnan(tr.steps["update_cpu_time"][1])
+    # The same trace as a version 1 file (steps of 5 values, no update_cpu_time):
+    # read with update_cpu_time NaN and every other column as written.
+    v1 = trace.Trace(path=path, version=1, meta=dict(tr.meta, version=1), ticks=tr.ticks, steps=tr.steps,
+                     contacts=tr.contacts, events=tr.events, complete=True, dropped=tr.dropped, warnings=[])
+    data = bytearray(trace.write_trace(v1, tmp_path / "v2.g6trace").read_bytes())
+    meta_len = trace.HEADER.unpack_from(data, 0)[3]
+    out = bytearray(trace.HEADER.pack(trace.MAGIC, 1, 0, meta_len)) + data[trace.HEADER.size:trace.HEADER.size + meta_len]
+    pos = trace.HEADER.size + meta_len
+    while pos < len(data):
+        ctype, ncols, nrows = trace.CHUNK.unpack_from(data, pos)
+        rows = np.frombuffer(data, dtype="<f8", count=nrows * ncols, offset=pos + trace.CHUNK.size).reshape(nrows, ncols)
+        if ctype == trace.STEPS:
+            rows, ncols = rows[:, :5], 5
+        out += trace.CHUNK.pack(ctype, ncols, nrows) + np.ascontiguousarray(rows).tobytes()
+        pos += trace.CHUNK.size + 8 * nrows * trace.CHUNK.unpack_from(data, pos)[1]
+    old = tmp_path / "v1.g6trace"
+    old.write_bytes(bytes(out))
+    steps = trace.read_trace(old).steps  # (the C++ reader: trace/tests/test_trace.cpp)
+    assert np.isnan(steps["update_cpu_time"]).all()
+    np.testing.assert_array_equal(steps["update_time"], [2e-4, 3e-4])
+    np.testing.assert_array_equal(steps["step"], [0, 1])
 
 
 def test_truncated_trace_reads_complete_chunks_with_a_warning(tmp_path):

@@ -12,6 +12,7 @@
 #include <condition_variable>
 #include <cstdio>
 #include <cstring>
+#include <limits>
 #include <ctime>
 #include <fstream>
 #include <mutex>
@@ -42,7 +43,7 @@ const std::vector<TraceColumn>& trace_columns(TraceChunk chunk) {
       {"t", 1}, {"xh_p", 3}, {"xh_q", 4}, {"xs_p", 3}, {"xs_q", 4}, {"wrench", 6},
       {"num_contacts", 1}, {"force_time", 1}, {"status", 1}, {"flags", 1}, {"buttons", 1}};
   static const std::vector<TraceColumn> steps = {
-      {"step", 1}, {"t", 1}, {"update_time", 1}, {"num_contacts", 1}, {"status", 1}};
+      {"step", 1}, {"t", 1}, {"update_time", 1}, {"num_contacts", 1}, {"status", 1}, {"update_cpu_time", 1}};
   static const std::vector<TraceColumn> contacts = {
       {"step", 1}, {"t", 1}, {"point", 3}, {"normal", 3}, {"separation", 1}};
   static const std::vector<TraceColumn> events = {{"t", 1}, {"code", 1}, {"value", 1}};
@@ -60,11 +61,11 @@ const std::vector<TraceColumn>& trace_columns(TraceChunk chunk) {
 
 namespace {
 
-// Row width of a known chunk type; 0 for an unknown one.
-size_t expected_cols(uint32_t type) {
+// Row width of a known chunk type in a file of the given version; 0 for an unknown type.
+size_t expected_cols(uint32_t type, uint32_t version) {
   switch (static_cast<TraceChunk>(type)) {
     case TraceChunk::kTicks: return kTickCols;
-    case TraceChunk::kSteps: return kStepCols;
+    case TraceChunk::kSteps: return version == 1 ? kStepColsV1 : kStepCols;
     case TraceChunk::kContacts: return kContactCols;
     case TraceChunk::kEvents: return kEventCols;
     case TraceChunk::kEnd: return kEndCols;
@@ -380,7 +381,8 @@ bool TraceWriter::append(const TraceTick& r) noexcept {
 
 bool TraceWriter::append(const TraceStep& r) noexcept {
   const std::array<double, kStepCols> row = {static_cast<double>(r.step), r.t, r.update_time,
-                                             static_cast<double>(r.num_contacts), static_cast<double>(r.status)};
+                                             static_cast<double>(r.num_contacts), static_cast<double>(r.status),
+                                             r.update_cpu_time};
   return push_row(*impl_->rings[1], impl_->dropped[1], row);
 }
 
@@ -480,9 +482,9 @@ Trace read_trace(const std::string& path) {
   std::memcpy(&trace.version, bytes.data() + 8, 4);
   std::memcpy(&flags, bytes.data() + 12, 4);
   std::memcpy(&meta_len, bytes.data() + 16, 8);
-  if (trace.version != kTraceVersion)
-    throw fail("unsupported trace version " + std::to_string(trace.version) + " (this reader reads version " +
-               std::to_string(kTraceVersion) + ")");
+  if (trace.version < kTraceOldestVersion || trace.version > kTraceVersion)
+    throw fail("unsupported trace version " + std::to_string(trace.version) + " (this reader reads versions " +
+               std::to_string(kTraceOldestVersion) + " to " + std::to_string(kTraceVersion) + ")");
   if (meta_len > size - kHeader)
     throw fail("metadata block of " + std::to_string(meta_len) + " bytes runs past the end of the file");
   trace.meta_json = bytes.substr(kHeader, meta_len);
@@ -509,7 +511,7 @@ Trace read_trace(const std::string& path) {
     std::memcpy(&type, bytes.data() + pos, 4);
     std::memcpy(&num_cols, bytes.data() + pos + 4, 4);
     std::memcpy(&num_rows, bytes.data() + pos + 8, 8);
-    const size_t expected = expected_cols(type);
+    const size_t expected = expected_cols(type, trace.version);
     if (expected != 0 && num_cols != expected)
       throw fail("chunk at byte " + std::to_string(pos) + " of type " + std::to_string(type) + " has rows of " +
                  std::to_string(num_cols) + " values, expected " + std::to_string(expected));
@@ -546,7 +548,16 @@ Trace read_trace(const std::string& path) {
         trace.warnings.push_back(path + ": skipped a chunk of unknown type " + std::to_string(type) + " at byte " +
                                  std::to_string(pos));
     }
-    if (table && n > 0) {  // memcpy from an empty vector's null data() is undefined
+    if (table == &trace.steps && num_cols == kStepColsV1 && n > 0) {
+      // Version 1 steps: widened to the current row, update_cpu_time NaN (not measured).
+      const size_t old = table->data.size();
+      table->data.resize(old + static_cast<size_t>(num_rows) * kStepCols);  // bounded as below
+      for (size_t i = 0; i < static_cast<size_t>(num_rows); ++i) {
+        double* row = table->data.data() + old + i * kStepCols;
+        std::memcpy(row, payload + i * kStepColsV1 * 8, kStepColsV1 * 8);
+        row[kStepColsV1] = std::numeric_limits<double>::quiet_NaN();
+      }
+    } else if (table && n > 0) {  // memcpy from an empty vector's null data() is undefined
       const size_t old = table->data.size();
       table->data.resize(old + n);  // n * 8 <= the file's size: bounded above
       std::memcpy(table->data.data() + old, payload, n * 8);

@@ -2,6 +2,9 @@
 #include <catch2/catch.hpp>
 
 #include <chrono>
+#include <cmath>
+#include <cstring>
+#include <iterator>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -104,6 +107,54 @@ TEST_CASE("trace round trip: every row and field comes back bit-exact", "[trace]
   CHECK(meta["extra"]["ks"] == 0.5);
   CHECK(meta["columns"]["ticks"].size() == trace_columns(TraceChunk::kTicks).size());
   CHECK(meta["machine"]["cores"].get<int>() >= 1);
+}
+
+TEST_CASE("version 1 traces stay readable: steps without update_cpu_time read it as NaN", "[trace]") {
+  const fs::path path = temp_path("v2.g6trace");
+  {
+    TraceWriter w(path.string(), TraceMeta{}, TraceWriterSettings{});
+    TraceStep st;
+    st.step = 4;
+    st.update_time = 2e-4;
+    st.num_contacts = 3;
+    st.update_cpu_time = 1.5e-4;
+    REQUIRE(w.append(st));
+    w.close();
+  }
+  const Trace now = read_trace(path.string());
+  REQUIRE(now.steps.num_rows() == 1);
+  CHECK(now.steps.row(0)[5] == 1.5e-4);
+  // Rewritten as version 1: header version 1, the steps' rows without their last value.
+  std::ifstream in(path, std::ios::binary);
+  const std::string b((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  uint64_t meta_len = 0;
+  std::memcpy(&meta_len, b.data() + 16, 8);
+  std::string out = b.substr(0, 24 + meta_len);
+  const uint32_t v1 = 1;
+  std::memcpy(out.data() + 8, &v1, 4);
+  for (size_t pos = 24 + meta_len; pos + 16 <= b.size();) {
+    uint32_t type = 0, cols = 0;
+    uint64_t rows = 0;
+    std::memcpy(&type, b.data() + pos, 4);
+    std::memcpy(&cols, b.data() + pos + 4, 4);
+    std::memcpy(&rows, b.data() + pos + 8, 8);
+    const uint32_t keep = type == static_cast<uint32_t>(TraceChunk::kSteps) ? cols - 1 : cols;
+    std::string head = b.substr(pos, 16);
+    std::memcpy(head.data() + 4, &keep, 4);
+    out += head;
+    for (uint64_t r = 0; r < rows; ++r) out += b.substr(pos + 16 + r * cols * 8, keep * 8);
+    pos += 16 + rows * cols * 8;
+  }
+  const fs::path old = temp_path("v1.g6trace");
+  std::ofstream(old, std::ios::binary) << out;
+  const Trace tr = read_trace(old.string());
+  CHECK(tr.version == 1);
+  REQUIRE(tr.steps.num_cols == kStepCols);
+  REQUIRE(tr.steps.num_rows() == 1);
+  CHECK(tr.steps.row(0)[0] == 4.0);
+  CHECK(tr.steps.row(0)[2] == 2e-4);
+  CHECK(tr.steps.row(0)[3] == 3.0);
+  CHECK(std::isnan(tr.steps.row(0)[5]));
 }
 
 TEST_CASE("trace cut mid-chunk reads up to the last complete chunk, with a warning", "[trace]") {

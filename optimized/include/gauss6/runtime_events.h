@@ -82,6 +82,8 @@ struct SimStepInfo {
   Vec6 residual = Vec6::Zero();
   bool settled = false;
   double update_seconds = 0;           // wall time of the whole step (steady_clock)
+  double update_cpu_seconds = 0;       // the sim thread's CPU time in the step (CLOCK_THREAD_CPUTIME_ID):
+                                       // the step's work without the time the thread was preempted
   const ContactSet* contacts = nullptr;  // the contact set at xs (valid during the hook call only)
 };
 

@@ -26,15 +26,19 @@
 
 namespace gauss6 {
 
-inline constexpr uint32_t kTraceVersion = 1;
+// Version 2 added the steps' update_cpu_time column; readers read versions 1 and 2
+// (a version 1 step reads with update_cpu_time NaN: not measured).
+inline constexpr uint32_t kTraceVersion = 2;
+inline constexpr uint32_t kTraceOldestVersion = 1;
 inline constexpr char kTraceMagic[8] = {'G', '6', 'T', 'R', 'A', 'C', 'E', '\0'};
 
 // Chunk types (docs/trace-format.md). Readers skip types they do not know.
 enum class TraceChunk : uint32_t { kTicks = 1, kSteps = 2, kContacts = 3, kEvents = 4, kEnd = 5 };
 
-// Row widths in float64 values, fixed by version 1.
+// Row widths in float64 values, fixed by the version (2; version 1: kStepColsV1).
 inline constexpr size_t kTickCols = 26;     // t, xh (p 3, q 4), xs (p 3, q 4), F (6), contacts, force time, status, flags, buttons
-inline constexpr size_t kStepCols = 5;      // step, t, update time, contacts, status
+inline constexpr size_t kStepCols = 6;      // step, t, update time, contacts, status, update CPU time
+inline constexpr size_t kStepColsV1 = 5;    // version 1: without the update CPU time
 inline constexpr size_t kContactCols = 9;   // step, t, point (3), normal (3), separation
 inline constexpr size_t kEventCols = 3;     // t, code, value
 inline constexpr size_t kEndCols = 4;       // rows dropped: ticks, steps, contacts, events
@@ -75,9 +79,10 @@ struct TraceTick {
 struct TraceStep {
   uint64_t step = 0;            // 0, 1, 2, ... in the run
   double t = 0;                 // s since the run started, when the step finished
-  double update_time = 0;       // s spent in the step
+  double update_time = 0;       // s spent in the step (wall clock)
   int num_contacts = 0;
   int status = 0;               // the sim step's status code (0: ok)
+  double update_cpu_time = 0;   // s of the sim thread's CPU time in the step (NaN: not measured, version 1)
 };
 
 struct TraceContact {
