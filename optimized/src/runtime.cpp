@@ -1,6 +1,9 @@
 // The two run modes of the three loops, lockstep and threaded (runtime.h).
 #include "gauss6/runtime.h"
 
+#include <pthread.h>
+#include <sched.h>
+
 #include <algorithm>
 #include <cmath>
 #include <thread>
@@ -37,6 +40,37 @@ void run_sim_step(const RuntimeModel& model, double t, const RuntimeObserver& ob
 
 }  // namespace
 
+namespace {
+
+// What a loop's thread asks of the OS (RuntimeSettings::realtime_priority,
+// pin_threads), called first thing in the thread; the outcome goes to its stats.
+// role: 0 haptic, 1 coupling, 2 sim.
+void apply_thread_policy(const RuntimeSettings& settings, int role, LoopStats* stats) {
+  if (settings.realtime_priority > 0) {
+    sched_param p{};
+    p.sched_priority = std::max(1, settings.realtime_priority - role);
+    const int err = pthread_setschedparam(pthread_self(), SCHED_FIFO, &p);
+    stats->realtime = err == 0 ? 1 : -err;
+    stats->realtime_priority_applied = err == 0 ? p.sched_priority : 0;
+  }
+  if (settings.pin_threads) {
+    const int n = static_cast<int>(std::thread::hardware_concurrency());
+    if (n < 2) return;
+    cpu_set_t set;
+    CPU_ZERO(&set);
+    if (role == 0) {
+      CPU_SET(n - 1, &set);
+    } else {
+      for (int c = 0; c < n - 1; ++c) CPU_SET(c, &set);
+    }
+    const int err = pthread_setaffinity_np(pthread_self(), sizeof set, &set);
+    stats->pinned_cpu = err == 0 ? (role == 0 ? n - 1 : 0) : -1;
+    stats->pin_error = err == 0 ? 0 : -err;
+  }
+}
+
+}  // namespace
+
 void run_lockstep(const RuntimeModel& model, Device* device, long num_ticks, const RuntimeObserver& observer,
                   RuntimeData* data) {
   const double rate = model.device.rate_hz;
@@ -69,6 +103,7 @@ void run_threaded(const RuntimeModel& model, Device* device, double seconds, con
 
   // Sim loop: as fast as it goes, at most one step per sim_min_period.
   std::thread sim([&] {
+    apply_thread_policy(settings, 2, &data->stats.sim);
     while (!quit.load(std::memory_order_acquire)) {
       const double t = seconds_since(start);
       run_sim_step(model, t, observer, data);
@@ -80,6 +115,7 @@ void run_threaded(const RuntimeModel& model, Device* device, double seconds, con
   std::thread coupling;
   if (coupling_thread) {
     coupling = std::thread([&] {
+      apply_thread_policy(settings, 1, &data->stats.coupling);
       while (!quit.load(std::memory_order_acquire)) {
         const double t = seconds_since(start);
         const CouplingStepInfo& info = coupling_step(model, t, &data->channels, &data->coupling);
@@ -98,6 +134,7 @@ void run_threaded(const RuntimeModel& model, Device* device, double seconds, con
   // is an overrun and the schedule resyncs to now.
   std::thread haptic([&] {
     LoopStats& hs = data->stats.haptic;
+    apply_thread_policy(settings, 0, &hs);
     double scheduled = 0, t = 0;
     for (;;) {
       std::this_thread::sleep_until(at(scheduled));

@@ -16,6 +16,7 @@
     gauss6 bench [--build DIR] [--out DIR] [--filter REGEX]
     gauss6 sweep [--build DIR] [--out DIR]
     gauss6 gate --base REV [--json]
+    gauss6 rate [--rate-hz 10000] [--duration 60] --out DIR
 
 Every subcommand exits non-zero on a failed check, with a message naming the problem.
 """
@@ -195,9 +196,10 @@ def build_parser() -> argparse.ArgumentParser:
 
     validate.register(sub)
 
-    from . import bench, gate, sweeps  # benchmarks, speed against error, the regression gate
+    from . import bench, gate, haptic_rate, sweeps  # benchmarks, speed against error, the gate, the 10 kHz run
 
     bench.register(sub)
+    haptic_rate.register(sub)
     sweeps.register(sub)
     gate.register(sub)
     return p

@@ -77,6 +77,10 @@ py::dict loop_dict(const LoopStats& s) {
   d["period_mean"] = s.period.mean();
   d["max_jitter"] = s.max_jitter;
   d["overruns"] = s.overruns;
+  d["realtime"] = s.realtime;
+  d["realtime_priority"] = s.realtime_priority_applied;
+  d["pinned_cpu"] = s.pinned_cpu;
+  d["pin_error"] = s.pin_error;
   py::dict events;
   for (int k = 0; k < kNumRuntimeEventKinds; ++k)
     if (s.event_counts[k]) events[to_string(static_cast<RuntimeEventKind>(k))] = s.event_counts[k];
@@ -155,15 +159,25 @@ py::dict result_dict(const ScenarioResult& r, const std::vector<HandPhase>& phas
 }
 
 py::dict run(const std::string& scene_path, const std::string& trace_path, bool threaded, double duration,
-             int lockstep_sim_period, const std::string& extra_json, const std::function<void(double)>& progress) {
-  const Scene scene = load(scene_path);
+             int lockstep_sim_period, const std::string& extra_json, const std::function<void(double)>& progress,
+             double rate_hz, int realtime_priority, bool pin_threads, double hold_until) {
+  Scene scene = load(scene_path);
+  if (rate_hz != 0) {
+    if (!(rate_hz >= 1 && rate_hz <= 1e5)) throw py::value_error("rate_hz must be in [1, 1e5] (0: the scene's)");
+    scene.device.rate_hz = rate_hz;
+  }
+  if (realtime_priority < 0 || realtime_priority > 99) throw py::value_error("realtime_priority must be in [0, 99]");
   HandScript script;
   try {
     script = load_scene_script(scene);
   } catch (const ScenarioError& e) {
     throw py::value_error(e.what());
   }
-  const ScenarioOptions options = run_options(trace_path, threaded, duration, lockstep_sim_period, extra_json, progress);
+  // The hand holds still after its last key until hold_until (s), when later than the script's end.
+  if (hold_until > script.end_time) script.end_time = hold_until;
+  ScenarioOptions options = run_options(trace_path, threaded, duration, lockstep_sim_period, extra_json, progress);
+  options.runtime.realtime_priority = realtime_priority;
+  options.runtime.pin_threads = pin_threads;
   const ScenarioResult r = run_released([&] { return run_scenario(scene, script, options); });
   py::dict d = result_dict(r, script.phases);
   d["let_go_time"] = script.let_go_time;
@@ -264,10 +278,14 @@ void bind_runtime(py::module_& parent) {
   py::module_ m = parent.def_submodule("runtime", "Scripted scenarios: the runtime's loops, traces, exact checks");
   m.def("run_scenario", &run, py::arg("scene"), py::arg("trace"), py::arg("threaded") = false,
         py::arg("duration") = -1.0, py::arg("lockstep_sim_period") = 1, py::arg("extra_json") = "{}",
-        py::arg("progress") = nullptr,
+        py::arg("progress") = nullptr, py::arg("rate_hz") = 0.0, py::arg("realtime_priority") = 0,
+        py::arg("pin_threads") = false, py::arg("hold_until") = -1.0,
         "Runs the scene with its hand script (lockstep by default, or threaded) and writes the trace. Returns a dict "
         "of run statistics and property checks (orthogonality, constraint energy, passivity observer). "
-        "progress(run_time_s) is called about every 0.2 s of wall time.");
+        "progress(run_time_s) is called about every 0.2 s of wall time. rate_hz overrides the scene's haptic rate "
+        "(0: the scene's); realtime_priority and pin_threads are RuntimeSettings' (threaded runs; each loop's "
+        "outcome in its dict: realtime 1 applied / 0 not asked / -errno, pinned_cpu, pin_error); hold_until (s): "
+        "the hand holds still after the script until then.");
   m.def("replay", &replay, py::arg("scene"), py::arg("recording"), py::arg("trace"),
         py::arg("phases") = std::vector<std::pair<std::string, double>>{}, py::arg("threaded") = false,
         py::arg("duration") = -1.0, py::arg("lockstep_sim_period") = 1, py::arg("extra_json") = "{}",

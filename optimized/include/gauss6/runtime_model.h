@@ -55,6 +55,12 @@ struct RuntimeSettings {
   int lockstep_sim_period = 1;         // lockstep: haptic ticks per sim step (>= 1)
   double sim_min_period = 0.0005;      // threaded: a sim step starts at most every this many seconds
   double coupling_min_period = 0;      // threaded, kCouplingLoop: same for coupling steps (0: back to back)
+  // Threaded: what the loops ask of the OS to meet their deadlines (each outcome in
+  // LoopStats::realtime / pinned_cpu: the machine may refuse).
+  int realtime_priority = 0;           // > 0: the haptic loop runs SCHED_FIFO at this priority, the coupling
+                                       // loop one below, the sim loop two below (>= 1); 0: the default policy
+  bool pin_threads = false;            // true: the haptic loop on the last CPU alone, the other loops on the
+                                       // others (no pinning on a single-CPU machine)
 };
 
 // The immutable model: built once from a Scene, shared read-only by every loop.

@@ -29,6 +29,13 @@ struct LoopStats {
   double max_jitter = 0;               // paced loops: max |actual start - scheduled start| (s)
   long overruns = 0;                   // paced loops: starts more than one period late (the schedule then resyncs)
   long event_counts[kNumRuntimeEventKinds] = {};  // events reported by this loop (onsets)
+  // Threaded runs (RuntimeSettings::realtime_priority, pin_threads): 1 SCHED_FIFO applied at
+  // realtime_priority_applied, 0 not asked, -errno refused (EPERM: no CAP_SYS_NICE, no RT budget);
+  // pinned_cpu the CPU the thread is bound to (-1: not pinned), pin_error -errno when refused.
+  int realtime = 0;
+  int realtime_priority_applied = 0;
+  int pinned_cpu = -1;
+  int pin_error = 0;
   double last_start = -1;              // s, internal
   void add_start(double t);            // records a start at t (updates period)
 };
