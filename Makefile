@@ -62,10 +62,12 @@ datasets: setup
 	$(VENV)/gauss6 datasets generate
 
 # Regenerates the datasets in place (byte-identical: `gauss6 datasets check`), then runs
-# the paper's scenarios: out/summary.json, out/report.md, the figures and the traces.
+# the paper's scenarios: out/summary.json, out/report.md, the figures and the traces; then
+# the full-resolution bunnies (issue 20's third scenario, about 20 s): out/bunny_full/.
 reproduce: setup
 	$(VENV)/gauss6 datasets generate
 	$(VENV)/gauss6 reproduce all --out out
+	$(VENV)/gauss6 reproduce bunny_full --out out/bunny_full
 
 clean:
 	rm -rf build build-fuzz out

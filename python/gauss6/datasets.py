@@ -36,13 +36,16 @@ from tqdm import tqdm
 
 from . import paths
 
-DATASETS = ("peg_in_hole", "bunny", "surfaces")
+DATASETS = ("peg_in_hole", "bunny", "bunny_full", "surfaces")
 GENERATORS_DIR = paths.DATASETS_DIR / "generators"
 
 # The bunny: the Stanford bunny as glmark2-data ships it (34,835 vertices, 69,666
 # triangles, arbitrary units, Y up), decimated and scaled to 15 cm along Y.
 BUNNY_INPUT = Path("/usr/share/glmark2/models/bunny.obj")
 BUNNY_TARGET_FACES = 27000
+# The full-resolution bunny (issue 20's third scenario): the same input, scale and
+# repairs, no decimation (a target of the input's own 69,666 triangles).
+BUNNY_FULL_TARGET_FACES = 69666
 BUNNY_HEIGHT = 0.15  # metres
 BUNNY_TOOL = "datasets_generated/gauss6_make_bunny"
 
@@ -92,7 +95,7 @@ def _generate_peg_in_hole(out: Path) -> dict:
     return _write_manifest(out, GENERATORS_DIR / "peg_in_hole.py", gen.GENERATOR_VERSION, params.to_json(), list(files))
 
 
-def _generate_bunny(out: Path) -> dict:
+def _generate_bunny(out: Path, target_faces: int = BUNNY_TARGET_FACES) -> dict:
     gen = peg_in_hole_generator()  # owns the OFF provenance header's format
     source = GENERATORS_DIR / "make_bunny.cpp"
     if not BUNNY_INPUT.exists():
@@ -100,12 +103,12 @@ def _generate_bunny(out: Path) -> dict:
     parameters = {
         "input": str(BUNNY_INPUT),
         "input_sha256": sha256_file(BUNNY_INPUT),
-        "target_faces": BUNNY_TARGET_FACES,
+        "target_faces": target_faces,
         "height": BUNNY_HEIGHT,
     }
     header = gen.provenance_header(_relative(source), parameters, sha256_file(source))
     cmd = [str(paths.tool(BUNNY_TOOL)), str(BUNNY_INPUT), str(out / "bunny.off"),
-           str(BUNNY_TARGET_FACES), repr(BUNNY_HEIGHT)]
+           str(target_faces), repr(BUNNY_HEIGHT)]
     for line in header:
         cmd += ["--comment", line]
     r = subprocess.run(cmd, capture_output=True, text=True)
@@ -135,7 +138,8 @@ def generate(name: str, out_dir: Path) -> dict:
     and MANIFEST.json); returns the manifest. Raises ValueError for an unknown name,
     FileNotFoundError when the bunny tool is not built, RuntimeError when a generator's
     own checks fail."""
-    makers = {"peg_in_hole": _generate_peg_in_hole, "bunny": _generate_bunny, "surfaces": _generate_surfaces}
+    makers = {"peg_in_hole": _generate_peg_in_hole, "bunny": _generate_bunny,
+              "bunny_full": lambda out: _generate_bunny(out, BUNNY_FULL_TARGET_FACES), "surfaces": _generate_surfaces}
     if name not in makers:
         raise ValueError(f"unknown dataset {name!r}; expected one of {', '.join(DATASETS)}")
     out = Path(out_dir) / name

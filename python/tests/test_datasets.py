@@ -88,6 +88,11 @@ def test_bunny_regenerates_byte_identical(tmp_path):
     assert_regenerates("bunny", BUNNY_DIR, tmp_path)
 
 
+def test_full_resolution_bunny_regenerates_byte_identical(tmp_path):
+    bunny_tool()
+    assert_regenerates("bunny_full", paths.DATASETS_DIR / "bunny_full", tmp_path)
+
+
 def test_check_all_reports_a_changed_file(tmp_path, monkeypatch):
     # A copy of the committed peg dataset with one coordinate changed in its last digit.
     shutil.copytree(PEG_DIR, tmp_path / "peg_in_hole")
