@@ -13,7 +13,7 @@ CCD (per query): every query of ../shared/data/ccd-sample-queries through
   its "gave up" column is empty);
 - exact: gauss6.ccd.exact_vertex_face / exact_edge_edge (the reference: root isolation).
 --sample K keeps every K-th query of each file (`make bench`: K = 4; the slowest
-peer queries take a second each on this machine, so the full 7,279 take long).
+peer queries take a second each on this machine, so the full 3,824 take several minutes).
 Each call is timed in Python (time.perf_counter_ns around the call alone, the arguments
 prepared before), the implementations interleaved query by query so that they share the
 machine's load; a query's time is the fastest of --repeats calls (one call when it takes
