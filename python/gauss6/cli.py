@@ -191,6 +191,10 @@ def build_parser() -> argparse.ArgumentParser:
 
     validate.register(sub)
 
+    from . import reference_speed  # the exact first contact's speed, filtered and exact-only
+
+    reference_speed.register(sub)
+
     from . import bench, gate, sweeps  # benchmarks, speed against error, the regression gate
 
     bench.register(sub)
