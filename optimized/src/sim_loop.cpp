@@ -120,6 +120,23 @@ bool ccd_leg(const RuntimeModel& model, const Pose& x0, const Pose& x1, int num_
   return true;
 }
 
+// Whether the CCD proves the Cayley motion x0 -> x1 free of contact with every
+// obstacle (it never misses one: u_hit <= u*). Searched for contact itself
+// (min_separation 0, so a motion that ends delta from a surface is not
+// refused for reaching delta), without the proximity cache or near pairs, in
+// its own workspace (s->check_ws, s->check: the legs' state is left as it
+// was). A hit, a give-up, invalid input or a half turn answer false.
+bool motion_free(const RuntimeModel& model, const Pose& x0, const Pose& x1, int num_hints, SimState* s) {
+  CcdStepSettings settings = model.settings.ccd;
+  settings.narrow.min_separation = 0;
+  settings.near_distance = 0;
+  settings.cache.margin = settings.cache.margin_max = 0;
+  settings.cache.fill_budget = 0;
+  ccd_step(model.obstacles.data(), static_cast<int>(model.obstacles.size()), model.god, x0, x1, settings,
+           &s->check_ws, &s->check, s->ccd_hints.data(), num_hints);
+  return s->check.status == CcdStatus::kOk && !s->check.hit;
+}
+
 // The contact set at s->xs: every pair within delta (1 + contact_factor), and
 // at least the pair that stopped the last leg (s->ccd). Sets the overflow event.
 void update_contacts(const RuntimeModel& model, SimState* s) {
@@ -146,42 +163,67 @@ void update_contacts(const RuntimeModel& model, SimState* s) {
 // Step 4: CCD along x_start -> x_target, then xs = its end or the stop pose and
 // the contact set at xs; then, when that leg ended free and out of contact while
 // the previous contacts withheld part of the command, the settling leg by the
-// withheld part (sim_loop.h).
+// withheld part, whose end is kept only when the direct motion x_start -> end is
+// free of contact, the first leg shortened otherwise (sim_loop.h).
 void advance_god_object(const RuntimeModel& model, const Pose& x_start, const Pose& x_target, const Vec6& residual,
                         SimState* s, SimStepInfo* info) noexcept {
   info->x_start = x_start;
   info->x_target = x_target;
   info->residual = residual;
   info->settled = false;
+  info->num_shortenings = 0;
   info->num_halves = 1;
-  s->xs = x_start;
   // The contacts at x_start (the set of the last step, at s->xs) are the pairs
   // most likely to stop either leg: ccd_step tests them first.
   const int num_hints = std::min(s->contacts.num_contacts, kMaxContacts);
   for (int k = 0; k < num_hints; ++k) s->ccd_hints[k] = s->contacts.contacts[k].features;
-  const bool moved = ccd_leg(model, x_start, x_target, num_hints, s, &info->num_halves);
-  info->ccd = s->ccd.status;
-  info->u_hit = s->ccd.u_hit;
-  info->status = !moved ? SimStepStatus::kInvalidStep
-                        : (s->ccd.hit ? SimStepStatus::kContact : SimStepStatus::kFree);
-  update_contacts(model, s);
+  Pose target = x_target;
+  for (;;) {
+    s->xs = x_start;
+    const bool moved = ccd_leg(model, x_start, target, num_hints, s, &info->num_halves);
+    info->ccd = s->ccd.status;
+    info->u_hit = s->ccd.u_hit;
+    info->status = !moved ? SimStepStatus::kInvalidStep
+                          : (s->ccd.hit ? SimStepStatus::kContact : SimStepStatus::kFree);
+    update_contacts(model, s);
 
-  // Settling leg: the linearised constraints J a >= 0 hold to first order only,
-  // so a motion along a contact's tangent plane lifts off a surface that curves
-  // or creases away under it. The god-object then moves on by what the previous
-  // contacts withheld, au - ac, from where it ended (the total command is at
-  // most au, as without contacts), and stops delta before the surface again.
-  const bool lifted_off = moved && !s->ccd.hit && s->contacts.num_contacts == 0;
-  if (lifted_off && residual.allFinite() && residual != Vec6::Zero()) {
+    // Settling leg: the linearised constraints J a >= 0 hold to first order only,
+    // so a motion along a contact's tangent plane lifts off a surface that curves
+    // or creases away under it. The god-object then moves on by what the previous
+    // contacts withheld, au - ac, from where it ended (the total command is at
+    // most au, as without contacts), and stops delta before the surface again.
+    const bool lifted_off = moved && !s->ccd.hit && s->contacts.num_contacts == 0;
+    if (!(lifted_off && residual.allFinite() && residual != Vec6::Zero())) break;
     info->settled = true;
     const Pose from = s->xs;
+    const CcdStepResult first_leg = s->ccd;  // to restore on a refusal (plain data: no allocation)
+    const double first_deviation = s->stop_deviation;
     int halves = 1;
-    if (ccd_leg(model, from, pose_update(from, residual), num_hints, s, &halves)) {
-      if (s->ccd.hit) info->status = SimStepStatus::kContact;
-      update_contacts(model, s);
-    }
+    const bool settled = ccd_leg(model, from, pose_update(from, residual), num_hints, s, &halves);
     if (info->ccd == CcdStatus::kOk) info->ccd = s->ccd.status;
     info->u_hit = s->ccd.u_hit;
+    if (!settled) break;  // s->xs is still the first leg's end
+    // Each leg is free of contact, but the step publishes only its end: the
+    // motion between two published poses is the direct one, x_start -> end,
+    // which can cut through the crease the two legs went round (property 5,
+    // METHOD.md s.5). The end is kept only when the CCD proves that motion free.
+    if (motion_free(model, x_start, s->xs, num_hints, s)) {
+      if (s->ccd.hit) info->status = SimStepStatus::kContact;
+      update_contacts(model, s);
+      break;
+    }
+    // Refused: back to the first leg's end (free; its contact set, empty, is
+    // still s->contacts) and, while shortenings are left, the whole step again
+    // with the first leg halved (split_step: half the travel, half the
+    // rotation): a shorter slide sags less under the crease, and one that stays
+    // in the contact band needs no settling.
+    s->xs = from;
+    s->ccd = first_leg;
+    s->stop_deviation = first_deviation;
+    info->u_hit = first_leg.u_hit;
+    if (info->num_shortenings == kMaxSettleShortenings) break;
+    ++info->num_shortenings;
+    target = split_step(x_start, target);
   }
   s->M = mass_matrix_at(model, s->xs.q);
   info->num_contacts = s->contacts.num_contacts;

@@ -583,25 +583,50 @@ TEST_CASE("runtime: lockstep runs are repeatable bit for bit", "[runtime]") {
   }
 }
 
+// The lowest height_over_crease of the god-object over the straight motion
+// between two poses of the same orientation (a pure translation, as every
+// motion of these tests: the Cayley motion between them). Per vertex, the
+// height max(z, n . x) along the segment is convex and piecewise linear in u:
+// its minimum is at an end or where the two planes' distances are equal. The
+// octahedron's tip is its lowest point and the crease's top falls at most 20
+// degrees, less than its faces' 45, so the tip outside the wedge keeps the
+// whole body outside: > 0 means the motion is free of contact.
+double lowest_over_crease_along(const RuntimeModel& model, const Pose& a, const Pose& b) {
+  REQUIRE((a.q.w == b.q.w && a.q.x == b.q.x && a.q.y == b.q.y && a.q.z == b.q.z));
+  double h = INFINITY;
+  for (int v = 0; v < model.god_mesh_B.V.rows(); ++v) {
+    const Vec3 r = model.god_mesh_B.V.row(v).transpose();
+    const Vec3 wa = transform_point(a, r), wb = transform_point(b, r);
+    auto height = [&](double u) {
+      const Vec3 w = wa + u * (wb - wa);
+      return std::max(w.z(), kSlopeNormal.dot(w));
+    };
+    h = std::min({h, height(0), height(1)});
+    const double fa = wa.z() - kSlopeNormal.dot(wa), fb = wb.z() - kSlopeNormal.dot(wb);
+    if (fa * fb < 0) h = std::min(h, height(fa / (fa - fb)));
+  }
+  return h;
+}
+
 TEST_CASE("runtime: a step that lifts off a convex crease settles back onto the surface", "[runtime]") {
-  // The tip rests on the flat part, kDelta (1 + gap_factor) above it, 1 mm
-  // before the crease. The step slides it 3 mm along +x (the command projected
-  // on the flat face's contact): it ends over the slope, 2 mm tan(20 deg) =
-  // 0.73 mm (73 delta) above it, far out of the contact band.
+  // The tip rests on the flat part, kDelta (1 + gap_factor) above it, just
+  // before the crease; the step slides it along +x (the command projected on
+  // the flat face's contact), over the slope and out of the contact band.
   const RuntimeModel model(make_crease_scene(), RuntimeSettings{});
   const double gap = kDelta * (1 + model.settings.gap_factor);
-  const Pose x0{Vec3(-0.001, 0, kHalf + gap), Quat{}};
-  const Pose x1{x0.p + Vec3(0.003, 0, 0), Quat{}};
   const Vec6 pressing = (Vec6() << 0, 0, -0.005, 0, 0, 0).finished();  // what the flat face's rows withheld
   SimState s(model);
   SimStepInfo info;
-
-  // At x0: in contact with the flat face.
-  advance_god_object(model, x0, x0, Vec6::Zero(), &s, &info);
-  REQUIRE(info.status == SimStepStatus::kFree);
-  REQUIRE(info.num_contacts > 0);
+  auto start_at = [&](const Pose& x0) {  // in contact with the flat face at x0
+    advance_god_object(model, x0, x0, Vec6::Zero(), &s, &info);
+    REQUIRE(info.status == SimStepStatus::kFree);
+    REQUIRE(info.num_contacts > 0);
+  };
 
   SECTION("nothing withheld: the god-object ends in free space (no settling)") {
+    const Pose x0{Vec3(-0.001, 0, kHalf + gap), Quat{}};
+    const Pose x1{x0.p + Vec3(0.003, 0, 0), Quat{}};
+    start_at(x0);
     advance_god_object(model, x0, x1, Vec6::Zero(), &s, &info);
     CHECK(info.status == SimStepStatus::kFree);
     CHECK_FALSE(info.settled);
@@ -609,9 +634,17 @@ TEST_CASE("runtime: a step that lifts off a convex crease settles back onto the 
     CHECK(s.xs.p.x() == Approx(x1.p.x()).margin(1e-12));
     CHECK(height_over_crease(model, s.xs) > 50 * kDelta);
   }
-  SECTION("the pressing part withheld: it settles on the slope in the same step") {
+  SECTION("the pressing part withheld, a short step: it settles on the slope in the same step") {
+    // 1 delta before the crease, 4 delta along: 2.5 delta from the slope at
+    // the first leg's end (out of the band, 1.5 delta); the settled end is 0.4
+    // delta below the flat part's plane, and the direct motion to it passes
+    // about 0.9 delta over the crease.
+    const Pose x0{Vec3(-kDelta, 0, kHalf + gap), Quat{}};
+    const Pose x1{x0.p + Vec3(4 * kDelta, 0, 0), Quat{}};
+    start_at(x0);
     advance_god_object(model, x0, x1, pressing, &s, &info);
     CHECK(info.settled);
+    CHECK(info.num_shortenings == 0);
     CHECK(info.status == SimStepStatus::kContact);
     CHECK(info.ccd == CcdStatus::kOk);
     CHECK(info.num_contacts > 0);
@@ -622,7 +655,7 @@ TEST_CASE("runtime: a step that lifts off a convex crease settles back onto the 
     CHECK(info.residual == pressing);
     // The settling leg only went down (-z) from the first leg's end.
     CHECK(s.xs.p.x() == Approx(x1.p.x()).margin(1e-12));
-    CHECK(s.xs.p.z() < x1.p.z() - 50 * kDelta);
+    CHECK(s.xs.p.z() < x1.p.z() - kDelta);
     // Stopped delta before the slope: at least delta (1 - 1e-3) (stop-pose
     // rounding), and in the contact band; the tip is the nearest point, over
     // the slope, so the plane distance is the exact distance there.
@@ -631,6 +664,27 @@ TEST_CASE("runtime: a step that lifts off a convex crease settles back onto the 
     CHECK(h <= kDelta * (1 + model.settings.contact_factor));
     for (int k = 0; k < s.contacts.num_contacts; ++k)
       CHECK(s.contacts.contacts[k].normal.dot(kSlopeNormal) == Approx(1).margin(1e-12));
+    // Property 5: the motion between the step's two poses is free of contact.
+    CHECK(lowest_over_crease_along(model, x0, s.xs) > 0.5 * kDelta);
+  }
+  SECTION("the pressing part withheld, a long step: the settled end is refused (the direct motion cuts the crease)") {
+    // 1 mm before the crease, 3 mm along: the first leg ends 0.73 mm (73 delta)
+    // over the slope; settling there would put the tip 2 mm along the slope,
+    // and the straight motion from x0 to it passes 0.23 mm (23 delta) under the
+    // crease: each leg is free, the motion between the published poses is not.
+    // Halved twice, the slide (0.75 mm) stays on the flat part, in contact
+    // with it: no settling, no dropout.
+    const Pose x0{Vec3(-0.001, 0, kHalf + gap), Quat{}};
+    const Pose x1{x0.p + Vec3(0.003, 0, 0), Quat{}};
+    start_at(x0);
+    advance_god_object(model, x0, x1, pressing, &s, &info);
+    CHECK(info.settled);
+    CHECK(info.num_shortenings == 2);
+    CHECK(info.status == SimStepStatus::kFree);
+    CHECK(info.num_contacts > 0);
+    CHECK(s.xs.p.x() == Approx(x0.p.x() + 0.003 / 4).margin(1e-12));
+    // Property 5, the check that failed before the refusal (-23 delta: through the crease).
+    CHECK(lowest_over_crease_along(model, x0, s.xs) > 0.5 * kDelta);
   }
 }
 

@@ -196,6 +196,14 @@ def build_parser() -> argparse.ArgumentParser:
 
     validate.register(sub)
 
+    from . import certify  # a recorded run certified exactly (properties 5 and 6)
+
+    certify.register(sub)
+
+    from . import reference_speed  # the exact first contact's speed, filtered and exact-only
+
+    reference_speed.register(sub)
+
     from . import bench, gate, haptic_rate, sweeps  # benchmarks, speed against error, the gate, the 10 kHz run
 
     bench.register(sub)

@@ -1,9 +1,10 @@
 """Exact checks of recorded god-object poses against a scene, shared by the figures of
-`gauss6 reproduce` (reproduce.py, reproduce_surfaces.py): the distinct poses of a trace and
-how many of them exactly intersect an obstacle (the reference's CGAL test, through the
-bindings), with a progress bar."""
+`gauss6 reproduce` (reproduce.py, reproduce_surfaces.py) and `gauss6 certify` (certify.py): the
+distinct poses of a trace and how many of them exactly intersect an obstacle (the reference's CGAL
+test, through the bindings), with a progress bar; a scene's exact mesh pairs (ExactScene)."""
 from __future__ import annotations
 
+import math
 from pathlib import Path
 
 import numpy as np
@@ -39,3 +40,43 @@ def count_penetrating(scene: Path, poses: np.ndarray, show_progress: bool, label
     result = runtime.count_intersecting_pairs(str(scene), np.ascontiguousarray(poses), progress)
     bar.close()
     return int(np.count_nonzero(result["counts"])), float(result["seconds"])
+
+
+class ExactScene:
+    """A scene's obstacles (world frame) and god-object as the reference's exact mesh pairs."""
+
+    def __init__(self, scene_path, thresholds: dict | None = None):
+        from . import oracle
+        from ._gauss6 import ccd, runtime
+
+        g = runtime.scene_geometry(str(scene_path))
+        self.delta = float(g["delta"])
+        self.bound = float((thresholds or oracle.load_thresholds())["distance"]["bound"]) * self.delta
+        god_V = np.asarray(g["god_V"], float)
+        god_F = np.asarray(g["god_F"], np.int32)
+        self.god_radius = float(np.linalg.norm(god_V, axis=1).max())
+        obstacles = [(np.asarray(V, float), np.asarray(F, np.int32)) for _, V, F in g["obstacles"]]
+        self.pairs = [ccd.MeshPair(V, F, god_V, god_F) for V, F in obstacles]
+        self.boxes = [(V.min(axis=0), V.max(axis=0)) for V, _ in obstacles]
+
+    def near(self, p0, p1) -> list[int]:
+        """Obstacles whose box meets the god-object's swept box over the motion p0 -> p1 (G's segment grown
+        by the radius, 1e-9 relative more for rounding): the others cannot be touched."""
+        r = self.god_radius * (1 + 1e-9)
+        lo = np.minimum(p0, p1) - r
+        hi = np.maximum(p0, p1) + r
+        return [i for i, (blo, bhi) in enumerate(self.boxes) if np.all(lo <= bhi) and np.all(hi >= blo)]
+
+    def intersecting_pairs(self, p, q) -> int:
+        return sum(int(mp.count_intersecting_pairs(p, q)) for mp in self.pairs)
+
+    def separation_within(self, p, q, max_distance: float) -> tuple[float, bool]:
+        """(a certified upper bound of the exact minimum distance if it is <= max_distance, else +inf;
+        whether exact arithmetic was needed): reference separation_within over the obstacles."""
+        best, exact = math.inf, False
+        for mp in self.pairs:
+            s = mp.separation_within(p, q, max_distance)
+            exact = exact or s["exact"]
+            if s["within"]:
+                best = min(best, float(s["upper"]))
+        return best, exact

@@ -29,9 +29,9 @@ Definitions of the summary's numbers:
   penetrating_poses      god-object poses (every distinct xs of the trace's ticks: in lockstep runs every
                          pose the sim loop took; in --threaded runs the poses the haptic loop saw) at
                          which the exact check finds an intersecting triangle pair: must be 0. The
-                         check (gauss6._gauss6.runtime.count_intersecting_pairs) is the reference's
-                         count_intersecting_pairs: box culling, then CGAL's filtered predicate (interval
-                         arithmetic, rational arithmetic where the intervals cannot decide)
+                         check is `gauss6 certify`'s (certify.py), which also certifies the motion between
+                         successive poses and the separations at the poses with contacts (properties 5
+                         and 6), written to certify_<name>.md/.json; a run it does not certify fails
   max_abs_fy_outside_cd  peg: max |force Y| (N) over ticks outside phases (c) and (d)
   max_fy_in_c            peg: max force Y (N) during phase (c): the paper's is never positive
   max_rel_force_dot_ac   per coupling step, |Fc . ac| / (|Fc| |ac|) (max; steps with a running offset excluded)
@@ -57,7 +57,7 @@ from pathlib import Path
 import numpy as np
 
 from . import paths
-from .exact_checks import count_penetrating, distinct_poses, progress_bar
+from .exact_checks import distinct_poses, progress_bar
 
 SCENES = {
     "peg": paths.DATASETS_DIR / "scenes" / "peg_in_hole.toml",
@@ -231,11 +231,26 @@ def run_scenario(name: str, out: Path, threaded: bool = False, duration: float =
     with warnings.catch_warnings():
         warnings.simplefilter("error", TraceWarning)  # the writer closed cleanly: a warning is a bug
         trace = read_trace(trace_path)
-    penetrating, check_seconds = -1, 0.0
+    penetrating, check_seconds, cert = -1, 0.0, None
     if check_poses:
-        penetrating, check_seconds = count_penetrating(scene, distinct_poses(trace), show_progress, name)
+        # Properties 5 and 6 on every step of the run, exactly (gauss6 certify): its pose check gives
+        # penetrating_poses; certify_<name>.md/.json say what else it certified, by which path.
+        from .certify import certify, write_report as write_certificate
+
+        cbar = progress_bar(len(trace.ticks), f"{name}: certify", "tick", show_progress)
+        cert = certify(scene, trace_path, progress=lambda done, total: cbar.update(done - cbar.n))
+        cbar.close()
+        write_certificate(cert, scene, trace_path, out, name=f"certify_{name}")
+        penetrating, check_seconds = cert.num_violations["pose"], cert.seconds
     summary, extra = summarize(name, trace, run, penetrating, threaded)
     extra["pose_check_s"] = check_seconds
+    if cert is not None:
+        first = cert.first_violation()
+        extra["certify"] = {"certified": cert.passed, "poses": cert.poses, "motions": cert.motions,
+                            "separations": cert.separations, "paths": dict(cert.paths),
+                            "violations": dict(cert.num_violations), "seconds": cert.seconds,
+                            "first_violation": None if first is None else
+                            {"kind": first.kind, "tick": first.tick, "t": first.t, "detail": first.detail}}
     extra["distinct_poses"] = int(len(distinct_poses(trace)))
     extra["mode"] = "threaded" if threaded else f"lockstep (sim step every {lockstep_sim_period} tick(s))"
     if figure:
@@ -304,6 +319,11 @@ def write_report(out: Path, summary: dict, details: dict, wall: float, surfaces:
         lines.append(f"| max contacts | {s['max_contacts']} | {p.get('max_contacts', '-')} |")
         lines.append(f"| penetrating poses (exact check of {d['distinct_poses']} distinct poses in "
                      f"{d.get('pose_check_s', 0.0):.1f} s) | {s['penetrating_poses']} | 0 |")
+        if "certify" in d:
+            c = d["certify"]
+            lines.append(f"| certified exactly ([certify_{name}.md](certify_{name}.md)): {c['poses']} poses free, "
+                         f"{c['motions']} motions between them free of contact, {c['separations']} separations "
+                         f"with contacts within the bound | {'yes' if c['certified'] else 'NO'} | - |")
         lines.append(f"| max abs(Fc . ac) / (abs(Fc) abs(ac)), {d['orthogonality_checks']} steps | "
                      f"{_fmt(s['max_rel_force_dot_ac'])} | 0 (footnote 3) |")
         lines.append(f"| energy injected by the constraints (J); removed | {_fmt(s['energy_injected'])}; "
@@ -360,6 +380,12 @@ def cmd_reproduce(args: argparse.Namespace) -> int:
     summary = reproduce(args.scenario, Path(args.out), threaded=args.threaded, show_progress=not args.quiet)
     print(json.dumps(summary, indent=2))
     failed = [n for n, s in summary.items() if n != "surfaces" and s["penetrating_poses"] != 0]
+    details = json.loads((Path(args.out) / "details.json").read_text())
+    uncertified = [n for n, d in details.items() if not d.get("certify", {}).get("certified", True)]
+    for n in uncertified:
+        print(f"gauss6: error: {n}: not certified (certify_{n}.md: {details[n]['certify']['first_violation']})",
+              file=sys.stderr)
+    failed += [n for n in uncertified if n not in failed]
     for kind, runs in summary.get("surfaces", {}).items():
         # Property 7 is the shaded runs' obligation (the plain cylinder run is reported beside them).
         failed += [f"{kind}/{label}" for label, s in runs.items()

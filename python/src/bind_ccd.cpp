@@ -351,10 +351,10 @@ class CcdMeshPair {
 
   // Exact first contact u* of the Cayley motion X0 -> X1 (mesh_first_contact).
   ExactContact exact_first_contact(const Eigen::Vector3d& p0, const Eigen::Vector4d& q0, const Eigen::Vector3d& p1,
-                                   const Eigen::Vector4d& q1) {
+                                   const Eigen::Vector4d& q1, bool filtered) {
     const reference::ExactMeshPair& m = exact();
     const auto t0 = Clock::now();
-    ExactContact c{reference::mesh_first_contact(m, pose_from(p0, q0), pose_from(p1, q1)), 0};
+    ExactContact c{reference::mesh_first_contact(m, pose_from(p0, q0), pose_from(p1, q1), filtered), 0};
     c.seconds = seconds_since(t0);
     return c;
   }
@@ -388,6 +388,20 @@ class CcdMeshPair {
     d["lower"] = s.lower;
     d["upper"] = s.upper;
     d["squared_distance"] = s.within ? s.squared_distance.get_str() : std::string();
+    return d;
+  }
+
+  py::dict separation_within(const Eigen::Vector3d& p, const Eigen::Vector4d& q, double max_distance) {
+    reference::SeparationBound s;
+    try {
+      s = reference::separation_within(exact(), pose_from(p, q), max_distance);
+    } catch (const std::invalid_argument& e) {
+      throw py::value_error(e.what());
+    }
+    py::dict d;
+    d["within"] = s.within;
+    d["upper"] = s.upper;
+    d["exact"] = s.exact;
     return d;
   }
 
@@ -593,6 +607,10 @@ void bind_ccd(py::module_& m) {
                              },
                              "every feature pair touching exactly at u*, as (kind, god feature, obstacle feature)")
       .def_property_readonly("num_candidate_pairs", [](const ExactContact& c) { return c.contact.num_candidate_pairs; })
+      .def_property_readonly("num_filtered_pairs", [](const ExactContact& c) { return c.contact.num_filtered_pairs; },
+                             "candidate pairs ruled out by the interval filter")
+      .def_property_readonly("num_exact_pairs", [](const ExactContact& c) { return c.contact.num_exact_pairs; },
+                             "candidate pairs solved exactly (root isolation)")
       .def_readonly("seconds", &ExactContact::seconds)
       .def("compare", [](const ExactContact& c, double u) { return reference::compare_toi(c.contact.toi, u); },
            py::arg("u"), "Exact sign of u - u* (-1, 0, +1); a miss counts as u* = +infinity.");
@@ -607,13 +625,18 @@ void bind_ccd(py::module_& m) {
            "Optimized ccd_step: dict with status, hit, u_hit, pair (its kind), pair_ids (the pair in canonical ids, "
            "as ExactContact.pairs), stop_p, stop_q, deviation, seconds (fastest run).")
       .def("exact_first_contact", &CcdMeshPair::exact_first_contact, py::arg("p0"), py::arg("q0"), py::arg("p1"),
-           py::arg("q1"), "Exact mesh_first_contact of the Cayley motion X0 -> X1: an ExactContact.")
+           py::arg("q1"), py::arg("filtered") = true,
+           "Exact mesh_first_contact of the Cayley motion X0 -> X1: an ExactContact (filtered=False: every "
+           "candidate pair solved exactly, the same answer; for comparisons).")
       .def("pair_first_contact", &CcdMeshPair::pair_first_contact, py::arg("pair"), py::arg("p0"), py::arg("q0"),
            py::arg("p1"), py::arg("q1"),
            "Exact first contact over [0, 1] of one feature pair (kind, god feature, obstacle feature) alone under "
            "the Cayley motion X0 -> X1: an ExactContact (ValueError on ids that do not fit the kind or the meshes).")
       .def("count_intersecting_pairs", &CcdMeshPair::count_intersecting_pairs, py::arg("p"), py::arg("q"),
            "Exact number of intersecting (god, obstacle) triangle pairs at pose (p, q).")
+      .def("separation_within", &CcdMeshPair::separation_within, py::arg("p"), py::arg("q"), py::arg("max_distance"),
+           "Whether the exact minimum distance at pose (p, q) is <= max_distance (reference separation_within): "
+           "dict with within, upper (a certified upper bound of it when within) and exact (Gmpq was needed).")
       .def("separation", &CcdMeshPair::separation, py::arg("p"), py::arg("q"), py::arg("max_distance"),
            "Exact minimum distance at pose (p, q) over pairs within max_distance: dict with within, lower, upper.");
 }

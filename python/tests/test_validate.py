@@ -81,18 +81,17 @@ def test_gauss6_engine_raises_no_alarm_on_the_peg(tmp_path, peg_oracle):
 
 
 def test_gauss6_engine_on_the_bunny_only_its_known_findings(tmp_path):
-    """No false alarm on the bunny; two true findings, confirmed exactly, characterised here so that a
-    change of the runtime that fixes (or worsens) them shows. In the approach (t < 0.3 s) the
-    god-object, catching up with the hand from the scene's initial pose in mm steps, brushes the
-    static bunny: at three sim steps the direct in-between motion (METHOD.md s.4) between two
-    successive displayed poses, both free, touches it (exact mesh_first_contact hits at u* = 0.057,
-    0.0087, 0.00086), though each leg the sim step took was free (a step with a settling leg
-    displays only its end): METHOD.md property 5 as stated is not met. At the third the god-object
-    leaves the contact by 3.2 mm in one step and the force drops by 0.84 N in a tick."""
+    """No false alarm on the bunny; one true finding, characterised here so that a change of the runtime
+    that fixes (or worsens) it shows. In the approach (t < 0.3 s) the god-object, catching up with the
+    hand from the scene's initial pose in mm steps, brushes the static bunny, and at one step it leaves
+    the contact by 3.2 mm and the force drops by 0.84 N in a tick. (There were also three steps whose
+    direct in-between motion touched the bunny, u* = 0.057, 0.0087, 0.00086, though each leg of the
+    step was free: a settling step displayed only its end. Since the sim loop keeps a settled end only
+    when the CCD proves the direct motion to it free, METHOD.md property 5 holds: none is left.)"""
     result = Oracle(BUNNY).judge(_run(tmp_path, load_engine("gauss6"), scene=BUNNY, duration=BUNNY_SLICE))
-    assert result.failed() == ["tunnelling", "force_jumps"], [v.to_json() for v in result.verdicts if not v.passed]
+    assert result.failed() == ["force_jumps"], [v.to_json() for v in result.verdicts if not v.passed]
     tunnels, jumps = result.verdict("tunnelling"), result.verdict("force_jumps")
-    assert tunnels.count == 3 and tunnels.details["undecided"] == 0 and tunnels.first_time < 0.3
+    assert tunnels.count == 0 and tunnels.details["undecided"] == 0 and tunnels.details["near"] > 1000
     assert jumps.count == 1 and 0.5 < jumps.worst < 1.0 and jumps.first_time < 0.3
     assert result.verdict("force_direction").details["ticks"] > 100
 

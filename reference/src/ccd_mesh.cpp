@@ -1,11 +1,14 @@
 // Exact mesh-level queries of the reference: first contact of a moving mesh
 // against a static one under the Cayley motion (conservative box culling, then
-// the exact primitives of ccd_exact.cpp), exact triangle/triangle intersection
+// the interval filter of ccd_filter.cpp, the exact primitives of ccd_exact.cpp
+// for the pairs it cannot rule out), exact triangle/triangle intersection
 // count and exact separation distance at a pose. The posed-mesh queries cull
 // pairs on conservative boxes (groups of god-object faces, "body" here, against a walk of the
 // obstacle's face tree) and decide each pair with CGAL's filtered predicates:
 // interval arithmetic first, Gmpq only when the intervals cannot decide. See gauss6/reference/ccd.h.
 #include "gauss6/reference/ccd.h"
+
+#include "ccd_filter.h"
 
 #include <algorithm>
 #include <cmath>
@@ -533,7 +536,7 @@ ExactMeshPair make_exact_mesh_pair(const TriangleMesh& god_B, const TriangleMesh
   return mp;
 }
 
-MeshContact mesh_first_contact(const ExactMeshPair& mp, const Pose& X0, const Pose& X1) {
+MeshContact mesh_first_contact(const ExactMeshPair& mp, const Pose& X0, const Pose& X1, bool filtered) {
   const ExactCayleyMotion motion = make_exact_cayley_motion(X0, X1);
   const TriangleMesh& god = mp.god;
 
@@ -569,7 +572,17 @@ MeshContact mesh_first_contact(const ExactMeshPair& mp, const Pose& X0, const Po
   auto u_max = [&out] { return out.toi.hit ? std::max(out.toi.upper, std::nextafter(0.0, 1.0)) : 1.0; };
   // One loop for every kind (kPairKinds): each god-object feature's swept box
   // (the hull of its vertices' swept boxes) against the obstacle's tree of the
-  // other feature.
+  // other feature. Unfiltered, every candidate is solved exactly at once;
+  // filtered, the interval filter (ccd_filter.h) rules out most and bounds the
+  // first contact of the rest from below, which are then solved exactly in
+  // order of that bound until it passes the best contact found.
+  struct Candidate {
+    PairKind kind;
+    FeatureId god, obstacle;
+    double earliest;
+  };
+  std::vector<Candidate> undecided;
+  const detail::IntervalMotionPtr interval_motion(motion);
   const MeshFeatures god_features{god, mp.god_edges}, obstacle_features{mp.obstacle, mp.obstacle_edges};
   for (const PairKindInfo& info : kPairKinds) {
     const PairSolver solve = kPairSolvers[int(info.kind)];
@@ -584,9 +597,28 @@ MeshContact mesh_first_contact(const ExactMeshPair& mp, const Pose& X0, const Po
       query_tree(tree, box, [&](int item) {
         ++out.num_candidate_pairs;
         const FeatureId of = obstacle_features.id(info.obstacle, item);
-        record(solve(motion, god_points, obstacle_features.points(of), u_max()), {info.kind, gf, of}, &out);
+        if (!filtered) {
+          ++out.num_exact_pairs;
+          record(solve(motion, god_points, obstacle_features.points(of), u_max()), {info.kind, gf, of}, &out);
+          return;
+        }
+        const detail::FilterVerdict verdict =
+            detail::filter_pair(*interval_motion.motion, info.kind, god_points, obstacle_features.points(of), 1.0);
+        if (verdict.excluded)
+          ++out.num_filtered_pairs;
+        else
+          undecided.push_back({info.kind, gf, of, verdict.earliest});
       });
     }
+  }
+  std::stable_sort(undecided.begin(), undecided.end(),
+                   [](const Candidate& a, const Candidate& b) { return a.earliest < b.earliest; });
+  for (const Candidate& c : undecided) {
+    // No contact before c.earliest: beyond the best contact's upper bound, c and the rest cannot touch at u*.
+    if (out.toi.hit && c.earliest > out.toi.upper) break;
+    ++out.num_exact_pairs;
+    record(kPairSolvers[int(c.kind)](motion, god_features.points(c.god), obstacle_features.points(c.obstacle), u_max()),
+           {c.kind, c.god, c.obstacle}, &out);
   }
   return out;
 }
@@ -684,6 +716,53 @@ ExactSeparation separation_distance(const ExactMeshPair& mp, const Pose& X, doub
     out.lower = x == 0 ? 0.0 : std::nextafter(std::sqrt(x), 0.0);
     out.upper = x_hi == 0 ? 0.0 : std::nextafter(std::sqrt(x_hi), HUGE_VAL);
   }
+  return out;
+}
+
+SeparationBound separation_within(const ExactMeshPair& mp, const Pose& X, double max_distance) {
+  if (!(max_distance >= 0 && std::isfinite(max_distance)))
+    throw std::invalid_argument("separation_within: max_distance must be finite and >= 0");
+  const PosedBody posed(mp.god, X);
+  const ToInterval to_interval;
+  SeparationBound out;
+  std::vector<std::pair<int32_t, int32_t>> undecided;
+  {
+    CGAL::Protect_FPU_rounding<true> upward;  // Interval_nt_advanced needs it
+    const IntervalKernel::FT m2 = CGAL::square(IntervalKernel::FT(max_distance));
+    double best_sup = HUGE_VAL;  // the least upper bound of a pair's squared distance
+    candidate_pairs(mp, posed, max_distance, [&](int32_t f, int32_t of) {
+      try {
+        const IntervalKernel::FT d2 = CGAL::squared_distance(to_interval(BodyFace{&posed, &mp.god, f}),
+                                                             to_interval(ObstacleFace{&mp.obstacle, of}));
+        if (std::isfinite(d2.sup()) && d2.inf() > m2.sup()) return;  // farther than max_distance
+        if (std::isfinite(d2.sup()) && d2.sup() <= m2.inf()) {
+          best_sup = std::min(best_sup, d2.sup());
+          return;
+        }
+      } catch (CGAL::Uncertain_conversion_exception&) {
+      }
+      undecided.emplace_back(f, of);
+    });
+    if (best_sup < HUGE_VAL) {
+      out.within = true;
+      out.upper = std::nextafter(std::sqrt(best_sup), HUGE_VAL);  // rounded upward, one more step for safety
+      return out;
+    }
+  }
+  // The intervals proved no pair within: exactly, the pairs they could not rule out.
+  const ToExact to_exact;
+  const CGAL::Gmpq max2 = CGAL::Gmpq(max_distance) * CGAL::Gmpq(max_distance);
+  for (const auto& [f, of] : undecided) {
+    const CGAL::Gmpq d2 =
+        CGAL::squared_distance(to_exact(BodyFace{&posed, &mp.god, f}), to_exact(ObstacleFace{&mp.obstacle, of}));
+    if (d2 <= max2) {
+      out.within = out.exact = true;
+      const double x = CGAL::to_interval(d2).second;  // >= d2
+      out.upper = std::nextafter(std::sqrt(x), HUGE_VAL);
+      return out;
+    }
+  }
+  out.exact = !undecided.empty();
   return out;
 }
 

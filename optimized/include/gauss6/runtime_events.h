@@ -81,6 +81,11 @@ struct SimStepInfo {
   Pose x_start, x_target;
   Vec6 residual = Vec6::Zero();
   bool settled = false;
+  // Times the settling leg's end was refused, the step then done again with the
+  // first leg halved: the direct motion x_start -> that end was not proven free
+  // (it cut a convex crease the two legs went round; property 5 holds for the
+  // motion between published poses). 0 when it was kept or did not run.
+  int num_shortenings = 0;
   double update_seconds = 0;           // wall time of the whole step (steady_clock)
   double update_cpu_seconds = 0;       // the sim thread's CPU time in the step (CLOCK_THREAD_CPUTIME_ID):
                                        // the step's work without the time the thread was preempted

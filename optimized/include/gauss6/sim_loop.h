@@ -38,6 +38,8 @@ struct SimState {
   ProjectionResult shading;
   CcdStepWorkspace ccd_ws;
   CcdStepResult ccd;
+  CcdStepWorkspace check_ws;           // the settling step's check of its direct motion (advance_god_object)
+  CcdStepResult check;
   std::array<FeaturePair, kMaxContacts> ccd_hints{};  // the contacts at a leg's start, tested first (ccd_step)
   double stop_deviation = 0;           // of xs from the motion's exact pose (make_stop_pose)
   ContactWorkspace contact_ws;
@@ -64,9 +66,17 @@ const SimStepInfo& sim_step(const RuntimeModel& model, double t, RuntimeChannels
 // moves on from s->xs by residual, with its own CCD and contact set, so that a
 // god-object pressed against a surface follows it instead of floating off it
 // for a step (which the force would show as a dropout). Each leg's motion is
-// free of contact (the CCD's guarantee). Sets info's x_start, x_target,
-// residual, settled, ccd (the first status other than kOk over the legs),
-// u_hit, num_halves, status and num_contacts. Real time: no allocation.
+// free of contact (the CCD's guarantee), and so is the motion between the two
+// poses the step goes from and to: the settling leg's end is kept only when a
+// CCD with min_separation 0 proves the direct Cayley motion x_start -> end free
+// of contact. Otherwise the step is done again with the first leg halved
+// (split_step: half the travel, half the rotation), at most kMaxSettleShortenings times; after the last,
+// s->xs is the first leg's end (free, out of contact). Sets info's x_start,
+// x_target, residual, settled, num_shortenings, ccd (the first status other
+// than kOk over the legs of the last try), u_hit, num_halves, status and
+// num_contacts. Real time: no allocation; at most 5 ccd_step calls a try (two a
+// leg, one check), 20 over the 1 + kMaxSettleShortenings tries.
+constexpr int kMaxSettleShortenings = 3;
 void advance_god_object(const RuntimeModel& model, const Pose& x_start, const Pose& x_target, const Vec6& residual,
                         SimState* s, SimStepInfo* info) noexcept;
 

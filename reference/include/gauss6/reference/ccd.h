@@ -179,7 +179,9 @@ struct MeshContact {
   ExactToi toi;                        // first contact over all feature pairs
   std::vector<FeaturePairIds> pairs;   // every pair touching exactly at u* (empty on a miss), in
                                        // canonical ids (gauss6/feature_ids.h)
-  int64_t num_candidate_pairs = 0;     // pairs whose swept boxes overlap (each solved exactly)
+  int64_t num_candidate_pairs = 0;     // pairs whose swept boxes overlap
+  int64_t num_filtered_pairs = 0;      // of those, ruled out by the interval filter (no exact arithmetic)
+  int64_t num_exact_pairs = 0;         // of those, solved exactly (root isolation)
 };
 
 // Exact first contact over u in [0, 1] of the Cayley motion X0 -> X1: minimum
@@ -187,8 +189,16 @@ struct MeshContact {
 // pairs (the kinds of kPairKinds, in its order). Culling is conservative: a
 // pair is skipped only when the swept box of the god-object's feature
 // (provably containing its whole path) misses the obstacle feature's box.
+// Filtered (the default), as CGAL's filtered kernels: each candidate pair's
+// coplanarity polynomial is first enclosed in interval arithmetic (Interval_nt)
+// and its Bernstein form on [0, 1] checked for a root, the sub-intervals that may
+// hold one isolated by subdivision and the contact test evaluated over each in
+// intervals; only the pairs this cannot rule out are solved exactly, in order of
+// the filter's lower bound on their contact, until that bound passes the best
+// contact found. The answer (u*, its touching pairs) is the same exact answer as
+// unfiltered (filtered = false: every candidate solved exactly; for tests).
 // Throws as make_exact_cayley_motion.
-MeshContact mesh_first_contact(const ExactMeshPair& meshes, const Pose& X0, const Pose& X1);
+MeshContact mesh_first_contact(const ExactMeshPair& meshes, const Pose& X0, const Pose& X1, bool filtered = true);
 
 // Exact first contact over u in [0, u_max] of one feature pair (any vertices
 // of the two meshes: an edge id need not be a mesh edge) under the motion.
@@ -219,5 +229,19 @@ struct ExactSeparation {
 // arithmetic, and only the pairs that can still be the minimum are evaluated
 // in Gmpq.
 ExactSeparation separation_distance(const ExactMeshPair& meshes, const Pose& X, double max_distance);
+
+// Whether the exact minimum triangle/triangle distance between the god-object at
+// pose X and the obstacle is <= max_distance (>= 0), the question of property 6,
+// without computing the minimum: each candidate pair's squared distance is
+// enclosed in interval arithmetic, and any enclosure below max_distance^2 proves
+// it; only when none does are the pairs the intervals could not rule out
+// evaluated in Gmpq. Far faster than separation_distance where faces slide
+// parallel at the contact distance (its exact pass then visits every such pair).
+struct SeparationBound {
+  bool within = false;  // the exact minimum distance is <= max_distance
+  double upper = 0;     // when within: a certified upper bound of that minimum
+  bool exact = false;   // decided with Gmpq (the intervals could not decide)
+};
+SeparationBound separation_within(const ExactMeshPair& meshes, const Pose& X, double max_distance);
 
 }  // namespace gauss6::reference
