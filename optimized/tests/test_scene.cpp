@@ -151,7 +151,7 @@ TEST_CASE("bad scenes are errors that name the file, line and key", "[scene]") {
   CHECK_THAT(load_error(edited("density = 2.0", "density = \"heavy\"")), Contains("god_object.density: must be a number"));
   CHECK_THAT(load_error(edited("position = [0.0, 0.0, 1.0]", "position = [0.0, 1.0]")),
              Contains("god_object.position: must be an array of 3 numbers"));
-  CHECK_THAT(load_error(edited("version = 1", "version = 2")), Contains("version: unsupported version 2"));
+  CHECK_THAT(load_error(edited("version = 1", "version = 3")), Contains("version: unsupported version 3"));
   CHECK_THAT(load_error(edited("kind = \"simulated\"", "kind = \"telepathic\"")), Contains("device.kind: must be"));
   CHECK_THAT(load_error(edited("script = \"none\"", "script = \"none\"\ntrace = \"x.g6t\"")),
              Contains("device.trace: not a key of a \"simulated\" device"));
@@ -164,6 +164,30 @@ TEST_CASE("bad scenes are errors that name the file, line and key", "[scene]") {
              Contains("obstacle[0].mesh") && Contains("nowhere.obj"));
   // TOML syntax errors carry the parser's line.
   CHECK_THAT(load_error(edited("ks = 0.5", "ks = = 0.5")), Contains("scene.toml:6:"));
+}
+
+// Version 2 states a texture's amplitude in scene units; version 1 stated the
+// height field's steepest slope, converted at load into the same field.
+TEST_CASE("texture amplitudes are in scene units; version 1's slopes are converted", "[scene]") {
+  using Catch::Matchers::Contains;
+  const auto text = [](int version, const char* texture, const char* amplitude) {
+    const std::string s = edited("version = 1", "version = " + std::to_string(version));
+    const size_t device = s.find("[device]");
+    return s.substr(0, device) + "[surface]\nkind = \"texture\"\ntexture = \"" + texture + "\"\namplitude = " +
+           amplitude + "\nwavelength = 0.01\n\n" + s.substr(device);
+  };
+  const auto amplitude = [&](int version, const char* texture, const char* a) {
+    TempScene t(text(version, texture, a));
+    return load_scene(t.path()).surface.amplitude;
+  };
+  const double pi = 3.14159265358979323846;
+  CHECK(amplitude(2, "sine", "0.0008") == 0.0008);
+  CHECK(std::abs(amplitude(1, "sine", "0.5") - 0.5 * 0.01 / (2 * pi)) <= 1e-18);
+  CHECK(std::abs(amplitude(1, "bumps", "0.5") - 0.5 * 0.01 / pi) <= 1e-18);
+  // Scene units have no upper bound; a version 1 slope still must be in (0, 1].
+  CHECK(amplitude(2, "sine", "2.0") == 2.0);
+  CHECK_THAT(load_error(text(1, "sine", "2.0")), Contains("surface.amplitude: must be in (0, 1] (version 1: a slope)"));
+  CHECK_THAT(load_error(text(2, "sine", "0.0")), Contains("surface.amplitude: must be > 0"));
 }
 
 TEST_CASE("given mass properties are validated", "[scene]") {

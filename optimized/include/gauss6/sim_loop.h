@@ -36,6 +36,7 @@ struct SimState {
   double shaded_normal[kMaxContacts][3] = {};
   ProjectionWorkspace shading_ws;
   ProjectionResult shading;
+  std::array<double, kMaxContacts * 6> held_J{};  // textures: -J_k of the contacts the command presses on
   CcdStepWorkspace ccd_ws;
   CcdStepResult ccd;
   std::array<FeaturePair, kMaxContacts> ccd_hints{};  // the contacts at a leg's start, tested first (ccd_step)
