@@ -4,12 +4,15 @@ for summary.json and their report.md section.
 
 - Figure 8 (`shading`): the faceted cylinder (datasets_generated/scenes/cylinder_plain.toml,
   cylinder_shaded.toml) explored by the probe's tip slid around its axis across five
-  edges, without and with force shading. Numbers, per run:
+  edges, without and with force shading, and with shading and a sine texture combined
+  (cylinder_textured.toml, bumps of 0.4 mm every 1 cm along X). Numbers, per run:
     max_direction_jump_deg   the largest change of the force's direction over 1 mm of the
                              hand's path during the slide (ticks with |F| > 0.5 N): at an
                              edge of the flat facets the force turns by the 30-degree
                              dihedral within that; shading spreads it over the facet
     max_direction_step_deg   the same between successive ticks
+    slide_ticks_without_contact   ticks of the slide whose contact set was empty (no force):
+                             the god-object lifted off the surface it was pressed on
 - Figure 9 (`texture`): the sine texture (wavelength 1 cm, bumps of 0.8 mm: steepest
   slope 0.503) on a flat slab explored at 0.1 m/s and 0.4 m/s with a sim step every 20
   ticks (a 50 Hz constraint update rate, the paper's low rates on large models): the
@@ -37,7 +40,8 @@ import numpy as np
 from . import paths
 
 SCENES = paths.DATASETS_DIR / "scenes"
-SHADING_RUNS = {"plain": "cylinder_plain.toml", "shaded": "cylinder_shaded.toml"}
+SHADING_RUNS = {"plain": "cylinder_plain.toml", "shaded": "cylinder_shaded.toml",
+                "textured": "cylinder_textured.toml"}  # textured: shading and a texture combined
 TEXTURE_RUNS = {"slow": "texture_slow.toml", "fast": "texture_fast.toml"}
 TEXTURE_SIM_PERIOD = 20          # haptic ticks per sim step in the texture runs (50 Hz)
 MIN_FORCE = 0.5                  # N: ticks with a weaker force have no meaningful direction
@@ -56,6 +60,8 @@ def _run(scene: Path, out: Path, label: str, sim_period: int, show_progress: boo
     sim = run["sim"]
     numbers = {
         "penetrating_poses": penetrating,
+        "slide_ticks": int(_slide_mask(trace).sum()),
+        "slide_ticks_without_contact": int((_slide_mask(trace) & (trace.ticks["num_contacts"] == 0)).sum()),
         "max_rel_constraint_violation": run["max_rel_constraint_violation"],
         "constraint_checks": run["num_constraint_checks"],
         "max_rel_force_dot_asc": run["max_rel_force_dot_ac"],
@@ -236,14 +242,26 @@ def report_lines(summary: dict) -> list[str]:
     s, t = summary["shading"], summary["texture"]
     lines = ["## Surface properties (Figures 8 and 9 analogues)", "",
              "![shading](figure_shading.png)", "", "![texture](figure_texture.png)", "",
-             "| run | largest direction jump over 1 mm (deg) | per tick (deg) | property 7 (max rel. violation) "
+             "| run | largest direction jump over 1 mm (deg) | per tick (deg) | slide ticks without contact "
+             "| property 7 (max rel. violation) "
              "| Fc.asc (max rel.) | shading work in / out (J) | port energy max (J) | penetrating poses |",
-             "| --- | --- | --- | --- | --- | --- | --- | --- |"]
+             "| --- | --- | --- | --- | --- | --- | --- | --- | --- |"]
     for label, n in s.items():
         lines.append(f"| cylinder, {label} | {n['max_direction_jump_deg']:.3g} | {n['max_direction_step_deg']:.3g} | "
+                     f"{n['slide_ticks_without_contact']} of {n['slide_ticks']} | "
                      f"{n['max_rel_constraint_violation']:.3g} | {n['max_rel_force_dot_asc']:.3g} | "
                      f"{n['shading_work_injected']:.3g} / {n['shading_work_removed']:.3g} | "
                      f"{n['port_energy_max']:.3g} | {n['penetrating_poses']} |")
+    lifted = {label: n for label, n in s.items() if n["slide_ticks_without_contact"] * 20 > n["slide_ticks"]}
+    for label, n in lifted.items():
+        # The direction jumps count ticks with a force only: say when many have none.
+        lines += ["", f"**Contact dropouts, cylinder {label}:** the contact set is empty on "
+                  f"{n['slide_ticks_without_contact']} of {n['slide_ticks']} ticks of the slide (the force drops to "
+                  "zero there; the direction jumps above leave those ticks out). Pass 2 moves the god-object by asc "
+                  "projected under the true rows, and asc leans off the facet where the shading normal leans "
+                  "against the motion: the god-object lifts off, and the next step brings it back. Not fixed yet "
+                  "(holding the pressed contacts, as the textured slab does, removes the dropouts but keeps the "
+                  "god-object on the facet's plane past the edge: a 14.6-degree jump)."]
     lines += ["", "| run | speed bound (m/s) | bumps crossed | bumps missed | texture events | property 7 | "
               "shading work in / out (J) | port energy max (J) | penetrating poses |",
               "| --- | --- | --- | --- | --- | --- | --- | --- | --- |"]

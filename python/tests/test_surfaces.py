@@ -44,3 +44,51 @@ def test_fast_texture_run_misses_bumps_and_says_so(texture_runs):
     assert crossed >= 8 and missed > crossed // 2
     assert run["sim"]["events"]["texture_undersampled"] >= 1
     assert run["max_rel_constraint_violation"] <= 1e-9
+
+
+def _slide_force_angles(trace) -> tuple[np.ndarray, np.ndarray]:
+    """(hand time, force direction in the XZ plane in degrees) over the slide's ticks with a force."""
+    F = trace.ticks["wrench"][:, :3]
+    ok = rs._slide_mask(trace) & (np.linalg.norm(F, axis=1) > rs.MIN_FORCE)
+    return trace.ticks["t"][ok], np.degrees(np.arctan2(F[ok, 2], F[ok, 0]))
+
+
+def test_shading_and_texture_combine(tmp_path):
+    """The cylinder force-shaded under a sine texture (cylinder_textured.toml): property 7 and
+    the shaded orthogonality hold on every step, the pressed contact is held through the slide,
+    and the texture tilts the shaded force (its direction departs from the shaded run's by the
+    texture's slope, up to 14 degrees, both ways)."""
+    from gauss6.exact_checks import count_penetrating, distinct_poses
+
+    runs = {}
+    for name in ("cylinder_shaded", "cylinder_textured"):
+        run = runtime.run_scenario(str(rs.SCENES / f"{name}.toml"), str(tmp_path / f"{name}.g6trace"))
+        runs[name] = (run, read_trace(tmp_path / f"{name}.g6trace"))
+    run, trace = runs["cylinder_textured"]
+    assert run["max_rel_constraint_violation"] <= 1e-9
+    assert run["max_rel_force_dot_ac"] <= 1e-9 and run["num_shaded_steps"] >= run["num_ticks"] - 2
+    slide = rs._slide_mask(trace)
+    assert np.sum(slide & (trace.ticks["num_contacts"] == 0)) <= 0.01 * slide.sum()
+    scene = rs.SCENES / "cylinder_textured.toml"
+    assert count_penetrating(scene, distinct_poses(trace), False, "textured")[0] == 0
+    t_shaded, a_shaded = _slide_force_angles(runs["cylinder_shaded"][1])
+    t_textured, a_textured = _slide_force_angles(trace)
+    common, i, j = np.intersect1d(np.round(t_shaded, 6), np.round(t_textured, 6), return_indices=True)
+    diff = a_textured[j] - a_shaded[i]
+    assert common.size > 1000
+    assert diff.max() > 5 and diff.min() < -5 and diff.std() > 3
+
+
+def test_threaded_shaded_run_keeps_property_7(tmp_path):
+    """The shaded cylinder in the threaded runtime (sim and coupling loops on their own threads,
+    asc handed over between them): property 7 on every sim step, the shaded orthogonality on every
+    coupling step, no penetrating pose. 2 s of real time (the approach and the slide's start)."""
+    from gauss6.exact_checks import count_penetrating, distinct_poses
+
+    scene = rs.SCENES / "cylinder_shaded.toml"
+    run = runtime.run_scenario(str(scene), str(tmp_path / "threaded.g6trace"), threaded=True, duration=2.0)
+    trace = read_trace(tmp_path / "threaded.g6trace")
+    assert run["num_constraint_checks"] > 100 and run["num_shaded_steps"] > 1000
+    assert run["max_rel_constraint_violation"] <= 1e-9
+    assert run["max_rel_force_dot_ac"] <= 1e-9
+    assert count_penetrating(scene, distinct_poses(trace), False, "threaded")[0] == 0
