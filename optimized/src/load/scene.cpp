@@ -188,6 +188,24 @@ void read_body_mesh(const TableReader& r, Body* body, std::vector<std::string>* 
   } catch (const MeshFileError& e) {
     r.fail(r.node("mesh")->source(), "mesh", e.what());
   }
+  // Vertex normals the file gives (PLY nx, ny, nz): force shading uses them (surface.h).
+  try {
+    body->given_normals = read_vertex_normals(body->mesh_path);
+  } catch (const MeshFileError& e) {
+    r.fail(r.node("mesh")->source(), "mesh", e.what());
+  }
+  MatrixX3d& given = body->given_normals;
+  if (given.rows() > 0 && given.rows() != body->mesh.V.rows())
+    r.fail(r.node("mesh")->source(), "mesh",
+           body->mesh_path + ": " + std::to_string(given.rows()) + " vertex normals for " +
+               std::to_string(body->mesh.V.rows()) + " vertices");
+  for (Eigen::Index v = 0; v < given.rows(); ++v) {
+    const double n = given.row(v).norm();
+    if (!(n > 0) || !std::isfinite(n))
+      r.fail(r.node("mesh")->source(), "mesh",
+             body->mesh_path + ": vertex " + std::to_string(v) + "'s normal is zero or not finite");
+    given.row(v) /= n;
+  }
   body->report = validate_mesh(body->mesh);
   const MeshReport& rep = body->report;
   if (rep.num_nonfinite_vertices || rep.num_bad_indices || rep.num_degenerate_triangles)
@@ -207,9 +225,10 @@ void read_body_mesh(const TableReader& r, Body* body, std::vector<std::string>* 
       flipped.F.col(2) = second;
       if (compute_mass_properties(flipped, /*density=*/1.0, &mp, nullptr)) {
         body->mesh = std::move(flipped);
+        given = -given;  // the file's vertex normals, if any, turn with its faces
         warnings->push_back(r.prefix() + "mesh: " + body->mesh_path +
                             ": closed but inside out (faces wound inward, enclosing a negative volume): "
-                            "faces flipped");
+                            "faces flipped" + (given.rows() > 0 ? " (and the file's vertex normals)" : ""));
       }
     }
   }
