@@ -92,3 +92,49 @@ def test_threaded_shaded_run_keeps_property_7(tmp_path):
     assert run["max_rel_constraint_violation"] <= 1e-9
     assert run["max_rel_force_dot_ac"] <= 1e-9
     assert count_penetrating(scene, distinct_poses(trace), False, "threaded")[0] == 0
+
+
+def test_height_map_texture_run(tmp_path):
+    """A height-map texture (a 16-bit grey PNG written here with Pillow: one sine period across
+    16 pixels, tiled every 2 cm along X; 3 mm high) on the slab, explored by the slow slide
+    in lockstep (a sim step every tick): the tip stays on the slab, property 7 holds, and the
+    force tilts as the image's slope at the god-object's position, the same in every tile."""
+    from PIL import Image
+
+    width, L = 16, 0.02
+    profile = 0.5 + 0.5 * np.sin(2 * np.pi * (np.arange(width) + 0.5) / width)
+    Image.fromarray(np.tile(np.round(profile * 65535).astype(np.uint16), (2, 1))).save(tmp_path / "ripples.png")
+    text = (rs.SCENES / "texture_slow.toml").read_text()
+    text = text.replace('"../surfaces/', f'"{rs.SCENES.parent / "surfaces"}/').replace('name = "texture_slow"',
+                                                                                       'name = "height_map"')
+    surface = text[text.index("[surface]"):text.index("[device]")]
+    text = text.replace(surface, '[surface]\nkind = "texture"\ntexture = "height_map"\nimage = "ripples.png"\n'
+                                 f'amplitude = 0.003\nwavelength = {L}\naxis = "x"\naxis_v = "y"\n\n')
+    scene = tmp_path / "height_map.toml"
+    scene.write_text(text)
+    run = runtime.run_scenario(str(scene), str(tmp_path / "hm.g6trace"))
+    trace = read_trace(tmp_path / "hm.g6trace")
+    assert run["max_rel_constraint_violation"] <= 1e-9
+    slide = rs._slide_mask(trace)
+    assert np.all(trace.ticks["num_contacts"][slide] > 0)
+    F, x = trace.ticks["wrench"][:, :3], trace.ticks["xs_p"][:, 0]
+    ok = slide & (np.abs(F[:, 2]) > rs.MIN_FORCE)
+    tilt = F[ok, 0] / F[ok, 2]
+    # The image's slope along X at each tick's x (pixel i at x = i pitch, tiled): bilinear
+    # interpolation makes it constant between neighbouring pixels.
+    pitch = L / width
+    i = np.floor(x[ok] / pitch).astype(int)
+    slope = (profile[(i + 1) % width] - profile[i % width]) / pitch
+    assert ok.sum() > 500
+    assert np.corrcoef(tilt, -slope)[0, 1] > 0.99
+    # Periodic: ticks a tile apart (same phase within 0.05 mm, in the same pixel interval and
+    # 0.01 mm clear of its ends, where the contact point and x may fall on either side) feel the
+    # same tilt.
+    frac = x[ok] / pitch
+    clear = np.abs(frac - np.round(frac)) * pitch > 1e-5
+    phase = np.mod(x[ok], L)
+    order = np.argsort(phase)
+    pairs = (np.abs(np.diff(phase[order])) < 5e-5) & (i[order][1:] % width == i[order][:-1] % width)
+    pairs &= clear[order][1:] & clear[order][:-1]
+    assert pairs.sum() > 50
+    assert np.max(np.abs(np.diff(tilt[order]))[pairs]) < 1e-9
