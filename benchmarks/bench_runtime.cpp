@@ -10,6 +10,16 @@
 // into the top and slides it along X while pressing; the fixtures run 1 s of
 // lockstep first, so that every timed call is in contact. Virtual time advances
 // 1 ms per call. Counters: p50/p99/max per call (ns), mean contact rows.
+//
+// Surface properties (surface.h), each next to the same geometry plain, on the
+// Figure 8 and 9 scenes with their own hand scripts (datasets_generated/scenes/),
+// warmed up into the slide, 1000 timed ticks within it:
+//   CouplingStep/cylinder/{plain,shaded}, CouplingStep/slab/{plain,texture}:
+//                 the coupling step (shaded: projection under Js, asc published);
+//   SimStep/cylinder/{plain,shaded}, SimStep/slab/{plain,texture}: one sim step
+//                 (shaded: pass 2 from the coupling's asc, the new set's Js;
+//                 texture: the held contacts, the texture's perturbation), a
+//                 haptic tick after each (not timed), as lockstep runs them.
 #include <benchmark/benchmark.h>
 
 #include <memory>
@@ -17,6 +27,7 @@
 
 #include "bench_data.h"
 #include "gauss6/runtime.h"
+#include "gauss6/scenario.h"
 #include "gauss6/scene.h"
 #include "gauss6/simulated_device.h"
 #include "latency.h"
@@ -100,6 +111,74 @@ void time_ticks(benchmark::State& state, bool with_sim) {
 void BM_HapticTick(benchmark::State& state) { time_ticks(state, false); }
 void BM_LockstepTick(benchmark::State& state) { time_ticks(state, true); }
 
+// A surface scene's run (the scene's own script and device limits, as run_scenario
+// builds them), its surface kept or turned off, warmed up to warm_up seconds.
+std::unique_ptr<PegRun> make_surface_run(const std::string& scene_name, bool plain, double warm_up) {
+  auto r = std::make_unique<PegRun>();
+  r->scene = load_scene(datasets_dir() + "/scenes/" + scene_name + ".toml");
+  const HandScript script = load_scene_script(r->scene);
+  if (plain) r->scene.surface = SurfaceSettings{};
+  r->model = std::make_unique<RuntimeModel>(r->scene, RuntimeSettings{});
+  SimulatedHandleParams handle;
+  handle.rate_hz = r->scene.device.rate_hz;
+  handle.max_force = r->scene.device.max_force;
+  handle.max_torque = r->scene.device.max_torque;
+  r->device = std::make_unique<SimulatedDevice>(script, handle);
+  r->device->reset(0);
+  r->data = std::make_unique<RuntimeData>(*r->model);
+  const long warm_ticks = static_cast<long>(warm_up / kDt);
+  run_lockstep(*r->model, r->device.get(), warm_ticks, RuntimeObserver{}, r->data.get());
+  r->t = warm_ticks * kDt;
+  return r;
+}
+
+// The Figure 8 slide starts at 1.5 s (3 s long), the Figure 9 slow slide at 1 s (1.2 s long).
+std::unique_ptr<PegRun> make_surface_run(const std::string& which) {
+  if (which == "cylinder/plain") return make_surface_run("cylinder_plain", false, 2.0);
+  if (which == "cylinder/shaded") return make_surface_run("cylinder_shaded", false, 2.0);
+  if (which == "slab/plain") return make_surface_run("texture_slow", true, 1.1);
+  return make_surface_run("texture_slow", false, 1.1);  // slab/texture
+}
+
+void BM_SurfaceCouplingStep(benchmark::State& state, const std::string& which) {
+  auto r = make_surface_run(which);
+  RuntimeData& d = *r->data;
+  LatencyRecorder rec;
+  double rows = 0, calls = 0;
+  for (auto _ : state) {
+    r->t += kDt;
+    sim_step(*r->model, r->t, &d.channels, &d.sim);  // the run goes on: a new snapshot each tick
+    const CouplingStepInfo* info = nullptr;
+    rec.time(state, [&] { info = &coupling_step(*r->model, r->t, &d.channels, &d.coupling); });
+    benchmark::DoNotOptimize(info);
+    if (!haptic_tick(*r->model, r->t, r->device.get(), &d.channels, &d.haptic, &d.coupling, RuntimeObserver{},
+                     &d.stats))
+      return state.SkipWithError("the device ended");
+    rows += d.coupling.god.num_contacts;
+    calls += 1;
+  }
+  rec.report(state);
+  state.counters["rows_per_call"] = rows / calls;
+}
+
+void BM_SurfaceSimStep(benchmark::State& state, const std::string& which) {
+  auto r = make_surface_run(which);
+  RuntimeData& d = *r->data;
+  LatencyRecorder rec;
+  double rows = 0, calls = 0;
+  for (auto _ : state) {
+    r->t += kDt;
+    rec.time(state, [&] { sim_step(*r->model, r->t, &d.channels, &d.sim); });
+    if (!haptic_tick(*r->model, r->t, r->device.get(), &d.channels, &d.haptic, &d.coupling, RuntimeObserver{},
+                     &d.stats))
+      return state.SkipWithError("the device ended");
+    rows += d.sim.contacts.num_contacts;
+    calls += 1;
+  }
+  rec.report(state);
+  state.counters["rows_per_call"] = rows / calls;
+}
+
 void register_all() {
   benchmark::RegisterBenchmark("CouplingStep/peg/pressing_sliding", BM_CouplingStep)
       ->UseManualTime()->Iterations(kTimedTicks);
@@ -107,6 +186,13 @@ void register_all() {
       ->UseManualTime()->Iterations(kTimedTicks);
   benchmark::RegisterBenchmark("LockstepTick/peg/pressing_sliding", BM_LockstepTick)
       ->UseManualTime()->Iterations(kTimedTicks)->Unit(benchmark::kMicrosecond);
+  for (const char* which : {"cylinder/plain", "cylinder/shaded", "slab/plain", "slab/texture"}) {
+    benchmark::RegisterBenchmark((std::string("CouplingStep/") + which).c_str(), BM_SurfaceCouplingStep,
+                                 std::string(which))
+        ->UseManualTime()->Iterations(1000);
+    benchmark::RegisterBenchmark((std::string("SimStep/") + which).c_str(), BM_SurfaceSimStep, std::string(which))
+        ->UseManualTime()->Iterations(1000)->Unit(benchmark::kMicrosecond);
+  }
 }
 
 const int registered = (register_all(), 0);

@@ -43,8 +43,10 @@ std::string write_input(const char* name, const uint8_t* data, size_t size) {
 
 void mesh(const char* file, const uint8_t* data, size_t size) {
   try {
-    const TriangleMesh m = read_mesh(write_input(file, data, size));
+    const std::string path = write_input(file, data, size);
+    const TriangleMesh m = read_mesh(path);
     validate_mesh(m);
+    read_vertex_normals(path);  // as the scene loader does after read_mesh (PLY nx, ny, nz)
   } catch (const LoadError&) {
   }
 }

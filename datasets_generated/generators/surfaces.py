@@ -10,8 +10,12 @@ meshes and hand scripts.
   put its reference point G at its lowest vertex (the tip that explores).
 - cylinder_slide.json: the tip pressed 4 mm past the cylinder's flats, slid over the
   top half around the axis (15 to 165 degrees) across five edges, then lifted.
-- texture_slow.json / texture_fast.json: the tip pressed 3 mm into the slab and slid
-  along +X over 12 cm at 0.1 m/s and at 0.4 m/s.
+- texture_slow.json / texture_fast.json: the tip pressed 6 mm into the slab and slid
+  along +X over 12 cm at 0.1 m/s and at 0.4 m/s. The press is deep against the
+  hand's lead over the god-object (2 to 4 mm along X at a 50 Hz sim step and
+  ks = 0.5): on a texture's downhill slope the tilted constraint plane drops by
+  the slope times that lead, and a shallower press leaves the hand above it
+  (no force) at the slopes the figure must show.
 
 Coordinates are correctly rounded doubles (angles through the peg generator's
 40-digit cos/sin), so the files do not depend on the platform's libm.
@@ -28,7 +32,7 @@ from pathlib import Path
 
 import numpy as np
 
-GENERATOR_VERSION = "1"
+GENERATOR_VERSION = "2"  # 2: the texture scripts press 6 mm (1: 3 mm)
 
 
 def _peg_module():
@@ -56,7 +60,7 @@ class SurfacesParams:
     slide_from_deg: int = 15        # cylinder: the slide's start and end angles (from +X towards +Z)
     slide_to_deg: int = 165
     slide_time: float = 3.0
-    texture_press: float = 0.003
+    texture_press: float = 0.006
     texture_start_x: float = -0.06
     texture_length: float = 0.12
     texture_speeds: tuple = (0.1, 0.4)

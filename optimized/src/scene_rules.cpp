@@ -58,7 +58,7 @@ SettingsProblem check_contact_parameters(const ContactParameters& c) {
 
 SettingsProblem check_surface_settings(const SurfaceSettings& s) {
   if (s.kind != SurfaceKind::kTexture) return {};
-  if (!(finite_above(s.amplitude, 0) && s.amplitude <= 1)) return {"surface", "amplitude", "must be in (0, 1]"};
+  if (!finite_above(s.amplitude, 0)) return {"surface", "amplitude", "must be > 0"};
   if (!finite_above(s.wavelength, 0)) return {"surface", "wavelength", "must be > 0"};
   if (s.axis < 0 || s.axis > 2) return {"surface", "axis", "must be x, y or z"};
   if (s.texture == TextureKind::kSine) return {};

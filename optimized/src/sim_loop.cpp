@@ -58,6 +58,40 @@ Vec6 shade_command(const RuntimeModel& model, const RuntimeChannels& ch, const V
   return s->shading.ac;
 }
 
+// Pass 2's input on textured surfaces: asc slides along the textured tangent
+// plane, which leans away from the true surface wherever the texture tilts the
+// normal against the motion (an uphill slope); projected under J alone (J asc
+// >= 0 holds there) the god-object lifted off the slab it was pressed on (by up
+// to 0.9 mm in the Figure 9 run), its contact set emptied at the next step and
+// the force dropped to zero for a sim period: 9 of 11 bumps were missed under
+// the speed bound. A texture perturbs the force's direction only, so a true
+// contact the command presses on (J_k au < 0) stays a contact: asc is first
+// M-projected on J_k a <= 0 for those rows (the god-object slides along the
+// true surface, and leaves it only when the user pulls away), then pass 2
+// projects that under J as before (property 7 is the final projection's).
+// Force shading alone keeps the paper's pass 2: there the shaded plane is the
+// smooth surface the facets approximate, which the god-object follows across
+// an edge (Figure 8). Plain surfaces never come here.
+Vec6 hold_pressed_contacts(const RuntimeModel& model, const Vec6& au, const Vec6& asc, SimState* s) {
+  if (!model.surface.texture) return asc;
+  const int m = std::min(s->contacts.num_contacts, kMaxContacts);
+  int n = 0;
+  for (int k = 0; k < m; ++k) {
+    const Eigen::Map<const Vec6> Jk(s->contacts.J.data() + 6 * k);
+    if (!(Jk.dot(au) < 0)) continue;
+    for (int i = 0; i < 6; ++i) s->held_J[6 * n + i] = -Jk[i];
+    ++n;
+  }
+  if (n == 0) return asc;
+  ProjectionProblem problem;
+  problem.M = &s->M;
+  problem.au = asc;
+  problem.J = s->held_J.data();
+  problem.num_rows = n;
+  project(problem, model.settings.projection, &s->shading_ws, &s->shading);
+  return s->shading.status == ProjectionStatus::kOptimal && s->shading.ac.allFinite() ? s->shading.ac : asc;
+}
+
 // Step 3: ac, the M-projection of au with the current contacts. The sim loop
 // also keeps each contact's gap near delta (1 + gap_factor): J_k a >= b_k with
 // b_k = delta (1 + gap_factor) - separation_k (a few delta at most), so that a
@@ -79,13 +113,20 @@ Vec6 constrain_motion(const RuntimeModel& model, const Vec6& au, SimState* s, do
     problem.b = nullptr;
     project(problem, model.settings.projection, &s->projection_ws, &s->projection);
   }
-  // Property 7: the rows hold for the motion taken (the check, on every step).
+  // Property 7: the rows hold for the motion taken (the check, on every step),
+  // relative to the problem's own scale as the projection's feasibility
+  // tolerance is (quasistatics.h: the input's |au| as well as |ac|): ac is
+  // computed from au, so its rounding scales with |au|. Relative to |ac| alone,
+  // a god-object held still against a facet (|ac| 1e-12, |au| 1e-2 in the
+  // plain cylinder run) showed b - J ac = 4e-19 (the rounding of b = target -
+  // separation itself) as a 3e-7 "violation".
   const Vec6& ac = s->projection.ac;
+  const double scale = std::max(ac.norm(), au.norm());  // au: this projection's input
   double worst = 0;
   for (int k = 0; k < m; ++k) {
     const Eigen::Map<const Vec6> Jk(problem.J + 6 * k);
     const double b = problem.b ? problem.b[k] : 0.0;
-    worst = std::max(worst, (b - Jk.dot(ac)) / (Jk.norm() * ac.norm() + std::abs(b) + 1e-300));
+    worst = std::max(worst, (b - Jk.dot(ac)) / (Jk.norm() * scale + std::abs(b) + 1e-300));
   }
   *max_rel_violation = worst;
   return ac;
@@ -310,8 +351,10 @@ const SimStepInfo& sim_step(const RuntimeModel& model, double t, RuntimeChannels
   if (read_handle(*channels, &s->handle)) {      // 1. Read xh.
     info.au = command_motion(model, *s);         // 2. au = ks (xh (-) xs).
     info.asc = shade_command(model, *channels, info.au, s, &info);  // 3. Shaded: asc (pass 1, under Js); else au.
-    info.ac = constrain_motion(model, info.asc, s, &info.max_rel_constraint_violation);  // ac: projection of asc
-                                                 //    with the previous step's contacts (property 7 checked).
+    info.ac = constrain_motion(model, hold_pressed_contacts(model, info.au, info.asc, s), s,
+                               &info.max_rel_constraint_violation);  // ac: projection of asc (textured: held
+                                                 //    on the pressed contacts) with the previous step's contacts
+                                                 //    (property 7 checked).
     info.projection = s->projection.status;
     advance_by(model, s, &info);                 // 4. CCD from xs towards xs (+) ac; the new contacts;
     shade_contact_set(model, s, &info);          //    shaded: their rows Js.

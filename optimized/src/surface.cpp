@@ -95,33 +95,32 @@ double field_at(const TextureField& t, double su, double sv, double* du, double*
   const double L = t.wavelength, A = t.amplitude;
   switch (t.kind) {
     case TextureKind::kSine: {
-      // h = A L / (2 pi) sin(2 pi su / L): steepest slope A.
+      // h = A sin(2 pi su / L): bumps and holes of height A; steepest slope 2 pi A / L.
       const double w = 2 * kPi / L;
-      *du = A * std::cos(w * su);
+      *du = A * w * std::cos(w * su);
       *dv = 0;
-      return A / w * std::sin(w * su);
+      return A * std::sin(w * su);
     }
     case TextureKind::kBumps: {
-      // h = A L / pi s(su) s(sv), s(x) = (1 - cos(2 pi x / L)) / 2: a grid of round bumps of
-      // period L, zero on the grid lines; steepest slope A.
+      // h = A s(su) s(sv), s(x) = (1 - cos(2 pi x / L)) / 2: a grid of round bumps of
+      // period L and height A, zero on the grid lines; steepest slope pi A / L.
       const double w = 2 * kPi / L;
       const double s_u = 0.5 * (1 - std::cos(w * su)), s_v = 0.5 * (1 - std::cos(w * sv));
       const double ds_u = 0.5 * w * std::sin(w * su), ds_v = 0.5 * w * std::sin(w * sv);
-      const double k = A * L / kPi;
-      *du = k * ds_u * s_v;
-      *dv = k * s_u * ds_v;
-      return k * s_u * s_v;
+      *du = A * ds_u * s_v;
+      *dv = A * s_u * ds_v;
+      return A * s_u * s_v;
     }
     case TextureKind::kHeightMap: {
-      // The image tiles the plane, pixel pitch L / width; h = A pitch image: a
-      // step of 1 between neighbouring pixels is a slope A.
+      // The image tiles the plane, pixel pitch L / width; h = A image: a step of
+      // 1 between neighbouring pixels is a slope A / pitch.
       if (t.values == nullptr || t.width < 2 || t.height < 2) return *du = *dv = 0;
       const double pitch = L / t.width;
       double dx, dy;
       const double h = height_map_at(t, su / pitch, sv / pitch, &dx, &dy);
-      *du = A * dx;
-      *dv = A * dy;
-      return A * pitch * h;
+      *du = A * dx / pitch;
+      *dv = A * dy / pitch;
+      return A * h;
     }
   }
   return *du = *dv = 0;
@@ -234,6 +233,16 @@ Vec3 texture_gradient(const TextureField& t, const Vec3& x) noexcept {
   const Vec3 r = x - t.origin;
   field_at(t, r.dot(t.u), r.dot(t.v), &du, &dv);
   return du * t.u + dv * t.v;
+}
+
+double texture_slope_per_amplitude(TextureKind kind, double wavelength, int width) noexcept {
+  if (!(wavelength > 0)) return 0;
+  switch (kind) {
+    case TextureKind::kSine: return 2 * kPi / wavelength;
+    case TextureKind::kBumps: return kPi / wavelength;
+    case TextureKind::kHeightMap: return width > 0 ? width / wavelength : 0;
+  }
+  return 0;
 }
 
 double shortest_wavelength(const TextureField& t) noexcept {

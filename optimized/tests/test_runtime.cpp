@@ -291,7 +291,7 @@ TEST_CASE("runtime: a scene built in code meets the scene file's rules", "[runti
   Scene texture = sc;
   texture.surface.kind = SurfaceKind::kTexture;
   texture.surface.wavelength = -1;
-  CHECK_THAT(refusal(texture), Catch::Matchers::Contains("surface.amplitude: must be in (0, 1]"));
+  CHECK_THAT(refusal(texture), Catch::Matchers::Contains("surface.amplitude: must be > 0"));
 }
 
 // The CCD settings relative to the scene's scale are stated in units of delta

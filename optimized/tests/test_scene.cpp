@@ -5,15 +5,16 @@
 
 #include <cmath>
 #include <cstdio>
-#include <sstream>
 #include <filesystem>
 #include <fstream>
+#include <sstream>
 #include <string>
 #include <system_error>
 
 #include <unistd.h>
 
 #include "gauss6/mass_properties.h"
+#include "gauss6/runtime_model.h"
 #include "gauss6/scene.h"
 
 using namespace gauss6;
@@ -81,9 +82,8 @@ std::string edited(const std::string& from, const std::string& to) {
   return s.replace(at, from.size(), to);
 }
 
-// The loader's error message for a scene text (fails the test when it loads).
-std::string load_error(const std::string& text) {
-  TempScene t(text);
+// The loader's error message for a scene already written (fails the test when it loads).
+std::string load_error_at(const TempScene& t) {
   try {
     load_scene(t.path());
   } catch (const SceneError& e) {
@@ -92,6 +92,9 @@ std::string load_error(const std::string& text) {
   FAIL("the scene loaded but should not have");
   return "";
 }
+
+// The loader's error message for a scene text (fails the test when it loads).
+std::string load_error(const std::string& text) { return load_error_at(TempScene(text)); }
 
 }  // namespace
 
@@ -151,7 +154,7 @@ TEST_CASE("bad scenes are errors that name the file, line and key", "[scene]") {
   CHECK_THAT(load_error(edited("density = 2.0", "density = \"heavy\"")), Contains("god_object.density: must be a number"));
   CHECK_THAT(load_error(edited("position = [0.0, 0.0, 1.0]", "position = [0.0, 1.0]")),
              Contains("god_object.position: must be an array of 3 numbers"));
-  CHECK_THAT(load_error(edited("version = 1", "version = 2")), Contains("version: unsupported version 2"));
+  CHECK_THAT(load_error(edited("version = 1", "version = 3")), Contains("version: unsupported version 3"));
   CHECK_THAT(load_error(edited("kind = \"simulated\"", "kind = \"telepathic\"")), Contains("device.kind: must be"));
   CHECK_THAT(load_error(edited("script = \"none\"", "script = \"none\"\ntrace = \"x.g6t\"")),
              Contains("device.trace: not a key of a \"simulated\" device"));
@@ -164,6 +167,86 @@ TEST_CASE("bad scenes are errors that name the file, line and key", "[scene]") {
              Contains("obstacle[0].mesh") && Contains("nowhere.obj"));
   // TOML syntax errors carry the parser's line.
   CHECK_THAT(load_error(edited("ks = 0.5", "ks = = 0.5")), Contains("scene.toml:6:"));
+}
+
+// Version 2 states a texture's amplitude in scene units; version 1 stated the
+// height field's steepest slope, converted at load into the same field.
+TEST_CASE("texture amplitudes are in scene units; version 1's slopes are converted", "[scene]") {
+  using Catch::Matchers::Contains;
+  const auto text = [](int version, const char* texture, const char* amplitude) {
+    const std::string s = edited("version = 1", "version = " + std::to_string(version));
+    const size_t device = s.find("[device]");
+    return s.substr(0, device) + "[surface]\nkind = \"texture\"\ntexture = \"" + texture + "\"\namplitude = " +
+           amplitude + "\nwavelength = 0.01\n\n" + s.substr(device);
+  };
+  const auto amplitude = [&](int version, const char* texture, const char* a) {
+    TempScene t(text(version, texture, a));
+    return load_scene(t.path()).surface.amplitude;
+  };
+  const double pi = 3.14159265358979323846;
+  CHECK(amplitude(2, "sine", "0.0008") == 0.0008);
+  CHECK(std::abs(amplitude(1, "sine", "0.5") - 0.5 * 0.01 / (2 * pi)) <= 1e-18);
+  CHECK(std::abs(amplitude(1, "bumps", "0.5") - 0.5 * 0.01 / pi) <= 1e-18);
+  // Scene units have no upper bound; a version 1 slope still must be in (0, 1].
+  CHECK(amplitude(2, "sine", "2.0") == 2.0);
+  CHECK_THAT(load_error(text(1, "sine", "2.0")), Contains("surface.amplitude: must be in (0, 1] (version 1: a slope)"));
+  CHECK_THAT(load_error(text(2, "sine", "0.0")), Contains("surface.amplitude: must be > 0"));
+}
+
+// Vertex normals from a PLY file (nx, ny, nz) reach the scene, normalised, for
+// force shading; a count that does not match the vertices is refused by name.
+TEST_CASE("vertex normals given in a PLY mesh are loaded for force shading", "[scene]") {
+  using Catch::Matchers::Contains;
+  // The box of kBoxObj, each vertex's normal along its outward diagonal (length sqrt(3), not unit).
+  const double c[8][3] = {{0, 0, 0}, {2, 0, 0}, {2, 1, 0}, {0, 1, 0}, {0, 0, 0.5}, {2, 0, 0.5}, {2, 1, 0.5}, {0, 1, 0.5}};
+  const int f[12][3] = {{0, 2, 1}, {0, 3, 2}, {4, 5, 6}, {4, 6, 7}, {0, 1, 5}, {0, 5, 4},
+                        {1, 2, 6}, {1, 6, 5}, {2, 3, 7}, {2, 7, 6}, {3, 0, 4}, {3, 4, 7}};
+  auto ply = [&](int num_normals_rows) {
+    std::ostringstream o;
+    o << "ply\nformat ascii 1.0\nelement vertex 8\nproperty double x\nproperty double y\nproperty double z\n"
+      << (num_normals_rows ? "property double nx\nproperty double ny\nproperty double nz\n" : "")
+      << "element face 12\nproperty list uchar int vertex_indices\nend_header\n";
+    for (const auto& v : c) {
+      o << v[0] << " " << v[1] << " " << v[2];
+      if (num_normals_rows) o << " " << (v[0] > 0 ? 1 : -1) << " " << (v[1] > 0 ? 1 : -1) << " " << (v[2] > 0 ? 1 : -1);
+      o << "\n";
+    }
+    for (const auto& t : f) o << "3 " << t[0] << " " << t[1] << " " << t[2] << "\n";
+    return o.str();
+  };
+  TempScene t(edited("mesh = \"box.obj\"", "mesh = \"box.ply\""));
+  std::ofstream(t.dir / "box.ply") << ply(1);
+  const Scene s = load_scene(t.path());
+  const MatrixX3d& N = s.obstacles[0].given_normals;
+  REQUIRE(N.rows() == 8);
+  for (int v = 0; v < 8; ++v) {
+    CHECK(std::abs(N.row(v).norm() - 1) <= 1e-15);
+    CHECK(N(v, 0) * (c[v][0] > 0 ? 1 : -1) > 0.57);  // along the outward diagonal: 1 / sqrt(3) each
+  }
+  // Force shading takes them as they are: every corner of a vertex gets its given normal.
+  {
+    std::string shaded = edited("mesh = \"box.obj\"", "mesh = \"box.ply\"");
+    shaded.insert(shaded.find("[device]"), "[surface]\nkind = \"force_shading\"\n\n");
+    std::ofstream(t.dir / "scene.toml") << shaded;
+    const Scene sc = load_scene(t.path());
+    const RuntimeModel model(sc, RuntimeSettings{});  // the floor: identity orientation, normals as given
+    const SurfaceModel& surface = model.surface;
+    REQUIRE(surface.obstacles.size() == 1);
+    const TriangleMesh& m = sc.obstacles[0].mesh;
+    for (int f = 0; f < num_triangles(m); ++f)
+      for (int k = 0; k < 3; ++k)
+        CHECK((surface.obstacles[0].corner_normals[3 * f + k] - N.row(m.F(f, k)).transpose()).norm() <= 1e-15);
+    std::ofstream(t.dir / "scene.toml") << edited("mesh = \"box.obj\"", "mesh = \"box.ply\"");
+  }
+  // Without normals in the file: none given (the shading computes them); the god-object's OBJ neither.
+  std::ofstream(t.dir / "box.ply") << ply(0);
+  CHECK(load_scene(t.path()).obstacles[0].given_normals.rows() == 0);
+  CHECK(load_scene(t.path()).god_object.given_normals.rows() == 0);
+  // A zero normal is refused, naming the vertex.
+  std::string zero = ply(1);
+  zero.replace(zero.find("0 0 0 -1 -1 -1"), 14, "0 0 0 0 0 0");
+  std::ofstream(t.dir / "box.ply") << zero;
+  CHECK_THAT(load_error_at(t), Contains("vertex 0's normal is zero or not finite"));
 }
 
 TEST_CASE("given mass properties are validated", "[scene]") {

@@ -111,18 +111,19 @@ TEST_CASE("surface: a contact's shading row interpolates the face's corner norma
 
 TEST_CASE("surface: textures' gradients match their height fields; the sampling bound", "[surface]") {
   TextureField t;
-  t.amplitude = 0.5;
+  t.amplitude = 0.0008;  // scene units: 0.8 mm bumps of 1 cm
   t.wavelength = 0.01;
   t.u = Vec3::UnitX();
   t.v = Vec3::UnitY();
   t.origin = Vec3(0.001, 0, 0);
   const float image[12] = {0.f, 0.25f, 1.f, 0.5f, 0.75f, 0.f, 0.1f, 0.9f, 0.3f, 0.6f, 0.2f, 0.4f};
   // Central differences, step 1e-7 L: truncation about (1e-7)^2 of the
-  // curvature, so 1e-6 of the steepest slope (the amplitude) holds with room.
+  // curvature, so 1e-6 of the steepest slope holds with room.
   for (TextureKind kind : {TextureKind::kSine, TextureKind::kBumps, TextureKind::kHeightMap}) {
     t.kind = kind;
     if (kind == TextureKind::kHeightMap) t.width = 4, t.height = 3, t.values = image;
     const double h = 1e-7 * t.wavelength;
+    const double slope = t.amplitude * texture_slope_per_amplitude(kind, t.wavelength, t.width);
     // Points inside pixels for the height map (its pitch is L / 4): 1/3 and 2/3 of a pixel.
     for (const Vec3 x : {Vec3(0.001 + 0.0025 / 3, 0.0025 * 2 / 3, 0.0), Vec3(0.0043, 0.0071, 0.002),
                          Vec3(-0.0121, 0.0033, -0.01)}) {
@@ -130,14 +131,19 @@ TEST_CASE("surface: textures' gradients match their height fields; the sampling 
       for (int i = 0; i < 3; ++i) {
         const Vec3 e = Vec3::Unit(i) * h;
         const double fd = (texture_height(t, x + e) - texture_height(t, x - e)) / (2 * h);
-        CHECK(std::abs(fd - g[i]) <= 1e-6 * t.amplitude);
+        CHECK(std::abs(fd - g[i]) <= 1e-6 * slope);
       }
-      CHECK(g.norm() <= std::sqrt(2.0) * t.amplitude * 1 + 1e-12);
+      CHECK(g.norm() <= std::sqrt(2.0) * slope * (1 + 1e-12));
     }
   }
-  // Sine: h = A L / (2 pi) sin(2 pi (x - x0) / L), slope A at the origin.
+  // Sine: h = A sin(2 pi (x - x0) / L), steepest slope 2 pi A / L at the origin; height A a quarter
+  // wavelength on.
   t.kind = TextureKind::kSine;
-  CHECK(std::abs(texture_gradient(t, t.origin).x() - t.amplitude) <= 1e-15);
+  CHECK(std::abs(texture_gradient(t, t.origin).x() - 2 * 3.14159265358979323846 * t.amplitude / t.wavelength) <= 1e-15);
+  CHECK(std::abs(texture_height(t, t.origin + Vec3(t.wavelength / 4, 0, 0)) - t.amplitude) <= 1e-18);
+  // Bumps: height A at a cell's centre.
+  t.kind = TextureKind::kBumps;
+  CHECK(std::abs(texture_height(t, t.origin + Vec3(t.wavelength / 2, t.wavelength / 2, 0)) - t.amplitude) <= 1e-18);
   CHECK(shortest_wavelength(t) == t.wavelength);
   t.kind = TextureKind::kHeightMap;
   CHECK(shortest_wavelength(t) == 2 * t.wavelength / 4);

@@ -4,19 +4,23 @@ for summary.json and their report.md section.
 
 - Figure 8 (`shading`): the faceted cylinder (datasets_generated/scenes/cylinder_plain.toml,
   cylinder_shaded.toml) explored by the probe's tip slid around its axis across five
-  edges, without and with force shading. Numbers, per run:
+  edges, without and with force shading, and with shading and a sine texture combined
+  (cylinder_textured.toml, bumps of 0.4 mm every 1 cm along X). Numbers, per run:
     max_direction_jump_deg   the largest change of the force's direction over 1 mm of the
                              hand's path during the slide (ticks with |F| > 0.5 N): at an
                              edge of the flat facets the force turns by the 30-degree
                              dihedral within that; shading spreads it over the facet
     max_direction_step_deg   the same between successive ticks
-- Figure 9 (`texture`): the sine texture (wavelength 1 cm, amplitude 0.5) on a flat slab
-  explored at 0.1 m/s and 0.4 m/s with a sim step every 20 ticks (a 50 Hz constraint
-  update rate, the paper's low rates on large models): the stated bound is
-  v_max = L_min f / 2 = 0.25 m/s. Numbers, per run:
-    bumps_traversed, bumps_missed   periods of the texture the tip crossed during the slide,
-                             and those in which the force's tilt along X did not reach half
-                             the texture's slope both ways (a bump is its rise and its fall)
+    slide_ticks_without_contact   ticks of the slide whose contact set was empty (no force):
+                             the god-object lifted off the surface it was pressed on
+- Figure 9 (`texture`): the sine texture (wavelength 1 cm, bumps of 0.8 mm: steepest
+  slope 0.503) on a flat slab explored at 0.1 m/s and 0.4 m/s with a sim step every 20
+  ticks (a 50 Hz constraint update rate, the paper's low rates on large models): the
+  stated bound is v_max = L_min f / 2 = 0.25 m/s. Numbers, per run:
+    bumps_traversed, bumps_missed   whole periods of the texture the god-object crossed
+                             during the slide, and those in which the force's tilt along X
+                             (ticks with |Fz| > 0.5 N) did not reach half the texture's
+                             steepest slope both ways (a bump is its rise and its fall)
     texture_events           kTextureUndersampled onsets (the runtime's warning)
     speed_bound              v_max (m/s) at the run's update rate
 - For every run: property 7 (max_rel_constraint_violation over every sim step), the
@@ -36,12 +40,10 @@ import numpy as np
 from . import paths
 
 SCENES = paths.DATASETS_DIR / "scenes"
-SHADING_RUNS = {"plain": "cylinder_plain.toml", "shaded": "cylinder_shaded.toml"}
+SHADING_RUNS = {"plain": "cylinder_plain.toml", "shaded": "cylinder_shaded.toml",
+                "textured": "cylinder_textured.toml"}  # textured: shading and a texture combined
 TEXTURE_RUNS = {"slow": "texture_slow.toml", "fast": "texture_fast.toml"}
 TEXTURE_SIM_PERIOD = 20          # haptic ticks per sim step in the texture runs (50 Hz)
-TEXTURE_WAVELENGTH = 0.01        # m (the scenes' surface.wavelength)
-TEXTURE_AMPLITUDE = 0.5          # the scenes' surface.amplitude: the largest tilt's tangent
-TEXTURE_ORIGIN_X = 0.0
 MIN_FORCE = 0.5                  # N: ticks with a weaker force have no meaningful direction
 
 
@@ -58,6 +60,8 @@ def _run(scene: Path, out: Path, label: str, sim_period: int, show_progress: boo
     sim = run["sim"]
     numbers = {
         "penetrating_poses": penetrating,
+        "slide_ticks": int(_slide_mask(trace).sum()),
+        "slide_ticks_without_contact": int((_slide_mask(trace) & (trace.ticks["num_contacts"] == 0)).sum()),
         "max_rel_constraint_violation": run["max_rel_constraint_violation"],
         "constraint_checks": run["num_constraint_checks"],
         "max_rel_force_dot_asc": run["max_rel_force_dot_ac"],
@@ -105,20 +109,36 @@ def direction_jumps(trace) -> tuple[float, float]:
     return worst, float(steps.max(initial=0.0))
 
 
-def bumps(trace) -> tuple[int, int]:
-    """(periods crossed during the slide, periods whose tilt did not reach half the slope both ways)."""
+def sine_texture(scene: Path) -> dict:
+    """The scene's sine texture along X: wavelength, amplitude (scene units), origin's x and
+    steepest slope 2 pi A / L (surface.h), read from its TOML."""
+    import tomllib
+
+    s = tomllib.loads(Path(scene).read_text())["surface"]
+    if s.get("texture", "sine") != "sine" or s.get("axis", "x") != "x":
+        raise ValueError(f"{scene}: the Figure 9 analysis needs a sine texture along x")
+    L, A = float(s["wavelength"]), float(s["amplitude"])
+    return {"wavelength": L, "amplitude": A, "origin_x": float(s.get("origin", [0.0])[0]),
+            "slope": 2 * np.pi * A / L}
+
+
+def bumps(trace, texture: dict) -> tuple[int, int]:
+    """(whole periods the god-object crossed during the slide, those whose force tilt did not
+    reach half the texture's steepest slope both ways)."""
     F = trace.ticks["wrench"][:, :3]
     x = trace.ticks["xs_p"][:, 0]
-    ok = _slide_mask(trace) & (np.abs(F[:, 2]) > MIN_FORCE)
-    tilt = F[ok, 0] / F[ok, 2]
-    k = np.floor((x[ok] - TEXTURE_ORIGIN_X) / TEXTURE_WAVELENGTH).astype(int)
-    if k.size == 0:
+    slide = _slide_mask(trace)
+    if not slide.any():
         return 0, 0
-    crossed = range(int(k.min()) + 1, int(k.max()))  # whole periods only
+    ok = slide & (np.abs(F[:, 2]) > MIN_FORCE)
+    tilt = F[ok, 0] / F[ok, 2]
+    L, x0, half = texture["wavelength"], texture["origin_x"], 0.5 * texture["slope"]
+    k = np.floor((x[ok] - x0) / L).astype(int)
+    crossed = range(int(np.floor((x[slide].min() - x0) / L)) + 1, int(np.floor((x[slide].max() - x0) / L)))
     missed = 0
     for period in crossed:
         t = tilt[k == period]
-        if not (t.size and t.max() > 0.5 * TEXTURE_AMPLITUDE and t.min() < -0.5 * TEXTURE_AMPLITUDE):
+        if not (t.size and t.max() > half and t.min() < -half):
             missed += 1
     return len(crossed), missed
 
@@ -135,14 +155,16 @@ def reproduce_surfaces(out: Path, show_progress: bool = True) -> tuple[dict, dic
         traces[f"cylinder_{label}"] = trace
     rate = 1000.0 / TEXTURE_SIM_PERIOD
     for label, scene in TEXTURE_RUNS.items():
+        texture = sine_texture(SCENES / scene)
         numbers, trace = _run(SCENES / scene, out, f"texture_{label}", TEXTURE_SIM_PERIOD, show_progress)
-        numbers["bumps_traversed"], numbers["bumps_missed"] = bumps(trace)
+        numbers["bumps_traversed"], numbers["bumps_missed"] = bumps(trace, texture)
         numbers["texture_events"] = int(numbers["events"].get("texture_undersampled", 0))
         numbers["update_hz"] = rate
-        numbers["speed_bound"] = 0.5 * TEXTURE_WAVELENGTH * rate
+        numbers["speed_bound"] = 0.5 * texture["wavelength"] * rate
+        numbers["texture_slope"] = texture["slope"]
         summary["texture"][label] = numbers
         traces[f"texture_{label}"] = trace
-    figures = plot_surfaces(traces, out)
+    figures = plot_surfaces(traces, out, sine_texture(SCENES / TEXTURE_RUNS["slow"]))
     return summary, {"figures": figures}
 
 
@@ -158,7 +180,7 @@ def _save(fig, out: Path, stem: str) -> list[str]:
     return names
 
 
-def plot_surfaces(traces: dict, out: Path) -> list[str]:
+def plot_surfaces(traces: dict, out: Path, texture: dict) -> list[str]:
     """figure_shading.png/svg (Figure 8) and figure_texture.png/svg (Figure 9)."""
     import matplotlib
 
@@ -202,8 +224,8 @@ def plot_surfaces(traces: dict, out: Path) -> list[str]:
         tr = traces[f"texture_{label}"]
         F, xs = tr.ticks["wrench"][:, :3], tr.ticks["xs_p"]
         ok = _slide_mask(tr) & (np.abs(F[:, 2]) > MIN_FORCE)
-        ax[i].plot(x * 100, TEXTURE_AMPLITUDE * np.cos(2 * np.pi * (x - TEXTURE_ORIGIN_X) / TEXTURE_WAVELENGTH)
-                   * -1, "k:", lw=0.8, label="texture's tilt (-dh/dx)")
+        phase = 2 * np.pi * (x - texture["origin_x"]) / texture["wavelength"]
+        ax[i].plot(x * 100, -texture["slope"] * np.cos(phase), "k:", lw=0.8, label="texture's tilt (-dh/dx)")
         ax[i].plot(xs[ok, 0] * 100, F[ok, 0] / F[ok, 2], ".", ms=2, label="force tilt Fx/Fz")
         ax[i].set_ylabel("tilt")
         ax[i].set_title(f"{label}: {'0.1' if label == 'slow' else '0.4'} m/s (bound 0.25 m/s at 50 Hz)")
@@ -220,14 +242,30 @@ def report_lines(summary: dict) -> list[str]:
     s, t = summary["shading"], summary["texture"]
     lines = ["## Surface properties (Figures 8 and 9 analogues)", "",
              "![shading](figure_shading.png)", "", "![texture](figure_texture.png)", "",
-             "| run | largest direction jump over 1 mm (deg) | per tick (deg) | property 7 (max rel. violation) "
+             "| run | largest direction jump over 1 mm (deg) | per tick (deg) | slide ticks without contact "
+             "| property 7 (max rel. violation) "
              "| Fc.asc (max rel.) | shading work in / out (J) | port energy max (J) | penetrating poses |",
-             "| --- | --- | --- | --- | --- | --- | --- | --- |"]
+             "| --- | --- | --- | --- | --- | --- | --- | --- | --- |"]
     for label, n in s.items():
         lines.append(f"| cylinder, {label} | {n['max_direction_jump_deg']:.3g} | {n['max_direction_step_deg']:.3g} | "
+                     f"{n['slide_ticks_without_contact']} of {n['slide_ticks']} | "
                      f"{n['max_rel_constraint_violation']:.3g} | {n['max_rel_force_dot_asc']:.3g} | "
                      f"{n['shading_work_injected']:.3g} / {n['shading_work_removed']:.3g} | "
                      f"{n['port_energy_max']:.3g} | {n['penetrating_poses']} |")
+    lifted = {label: n for label, n in s.items() if n["slide_ticks_without_contact"] * 20 > n["slide_ticks"]}
+    for label, n in lifted.items():
+        # The direction jumps count ticks with a force only: say when many have none.
+        lines += ["", f"**Contact dropouts, cylinder {label}:** the contact set is empty on "
+                  f"{n['slide_ticks_without_contact']} of {n['slide_ticks']} ticks of the slide (the force drops to "
+                  "zero there; the direction jumps above leave those ticks out). Pass 2 moves the god-object by asc "
+                  "projected under the true rows, and asc leans off the facet where the shading normal leans "
+                  "against the motion: the god-object lifts off, and the next step brings it back. Not fixed yet "
+                  "(holding the pressed contacts, as the textured slab does, removes the dropouts but keeps the "
+                  "god-object on the facet's plane past the edge: a 14.6-degree jump)."]
+    if "textured" in s:
+        lines += ["", "Cylinder, textured (shading under a sine texture of slope 0.25): the texture tilts the shaded "
+                  "force by up to 14 degrees; its largest steps come on ticks where the contact set changes "
+                  "between one and three contacts near an edge (the cause is not investigated yet)."]
     lines += ["", "| run | speed bound (m/s) | bumps crossed | bumps missed | texture events | property 7 | "
               "shading work in / out (J) | port energy max (J) | penetrating poses |",
               "| --- | --- | --- | --- | --- | --- | --- | --- | --- |"]
@@ -236,13 +274,16 @@ def report_lines(summary: dict) -> list[str]:
                      f"{n['texture_events']} | {n['max_rel_constraint_violation']:.3g} | "
                      f"{n['shading_work_injected']:.3g} / {n['shading_work_removed']:.3g} | "
                      f"{n['port_energy_max']:.3g} | {n['penetrating_poses']} |")
-    slow = t.get("slow")
-    if slow and slow["bumps_missed"] * 2 > slow["bumps_traversed"]:
-        # The paper's Figure 9 has every bump felt under the speed bound: say so when this run does not.
-        lines += ["", f"**Not yet the paper's Figure 9:** the slow run, under the speed bound, misses "
-                  f"{slow['bumps_missed']} of {slow['bumps_traversed']} bumps, where every bump should be felt. "
-                  "A defect of this implementation's texture rendering, not of the method (suspected: the "
-                  "god-object lifts off the slab on the texture's uphill slopes and the contact set empties)."]
+    slow, fast = t.get("slow"), t.get("fast")
+    if slow and fast:
+        # The paper's Figure 9: every bump felt under the speed bound, some skipped over it.
+        lines += ["", f"Under the bound ({slow['speed_bound']:.3g} m/s) the slow run feels "
+                  f"{slow['bumps_traversed'] - slow['bumps_missed']} of {slow['bumps_traversed']} bumps; over it the "
+                  f"fast run misses {fast['bumps_missed']} of {fast['bumps_traversed']} (sampled at most "
+                  "1.25 times a period, the texture aliases) and raises `texture_undersampled`."]
+        if slow["bumps_missed"] > 0 or fast["bumps_missed"] == 0:
+            lines += ["", "**Not the paper's Figure 9:** every bump should be felt under the bound and some "
+                      "missed over it."]
     lines += ["", "Shading and textures can inject energy: the shaded force is orthogonal to the shaded motion asc, "
               "not to the motion ac the god-object takes, and its work on it is Fs . (ac - asc) (Coq: "
               "`shading_work`). That work is bounded per step by |Fs| |ac - asc|, which grows with the angle "

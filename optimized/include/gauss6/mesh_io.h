@@ -21,6 +21,13 @@ namespace gauss6 {
 // a triangle, a vertex index out of range or a non-finite coordinate. Does not
 // validate the mesh (see validate_mesh() and count_self_intersections()).
 TriangleMesh read_mesh(const std::string& path);
+// The vertex normals a mesh file gives, one row per vertex as stored (not
+// normalised), or an empty matrix when it gives none. PLY: the vertex element's
+// nx, ny, nz properties (all three), read with CGAL's point-set PLY reader. OBJ
+// `vn` lines are not read (CGAL 5.5's OBJ reader discards them, and they belong
+// to face corners, not vertices); OFF and STL carry no vertex normals. Call after
+// read_mesh() succeeded on the same path. Throws MeshFileError.
+MatrixX3d read_vertex_normals(const std::string& path);
 // Writes by extension (.obj .off .ply .stl). OBJ/OFF are text with 17 significant
 // digits and PLY is binary (both round-trip doubles exactly); binary STL stores
 // 32-bit floats. Throws MeshFileError.

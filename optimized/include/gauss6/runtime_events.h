@@ -59,7 +59,11 @@ struct SimStepInfo {
   bool asc_from_coupling = false;      // asc was the coupling loop's (published for the last snapshot)
   // Property 7 (METHOD.md section 5), on every step: the rows of step 3 (the
   // previous contacts J, right-hand sides b) hold for the motion taken:
-  // max_k (b_k - J_k ac) / (|J_k| |ac| + |b_k| + 1e-300), 0 when none is violated.
+  // max_k (b_k - J_k ac) / (|J_k| max(|ac|, |a_in|) + |b_k| + 1e-300), 0 when
+  // none is violated, a_in the projected input (au, or asc when shaded): the
+  // scale of the projection's own feasibility tolerance (1e-13, quasistatics.h),
+  // which bounds it (the reproduce runs: 5e-14 plain, 1e-13 shaded; the property
+  // tests allow 1e-9).
   double max_rel_constraint_violation = 0;
   double texture_step = 0;             // textured contacts: the largest distance a contact point moved in
                                        // this step (scene units; > half the shortest wavelength: skipped)

@@ -15,7 +15,8 @@
 
 namespace gauss6 {
 
-inline constexpr int kSceneFormatVersion = 1;
+inline constexpr int kSceneFormatVersion = 2;        // what this build writes and documents
+inline constexpr int kOldestSceneFormatVersion = 1;  // the oldest it reads (docs/scene-format.md, Versions)
 
 enum class BodyRole { kObstacle, kGodObject };
 enum class SurfaceKind { kNone, kForceShading, kTexture };
@@ -75,8 +76,8 @@ struct SurfaceSettings {
   SurfaceKind kind = SurfaceKind::kNone;
   bool shading = false;    // texture: on force-shaded normals too (kind = force_shading: always)
   TextureKind texture = TextureKind::kSine;  // texture: sine along axis, a grid of bumps, a height map
-  double amplitude = 0;    // texture: largest tangential part of the perturbed force, as a fraction of the force
-                           // (the height field's steepest slope: 1 tilts the force by 45 degrees)
+  double amplitude = 0;    // texture: the height field's amplitude, scene units (surface.h: sine A sin, bumps of
+                           // height A, height map A times the image); version 1 files' slope is converted at load
   double wavelength = 0;   // texture: period along the axes (scene units; height map: the image's width)
   int axis = 0;            // texture: the u axis, 0 = x, 1 = y, 2 = z
   int axis_v = 1;          // texture bumps / height map: the v axis (not axis)
@@ -126,7 +127,7 @@ struct SettingsProblem {
 SettingsProblem check_gains(const Gains& gains);                         // 0 < ks <= 1, kh > 0
 SettingsProblem check_contact_parameters(const ContactParameters& contact);  // delta > 0, offset_eps < 0,
                                                                          // offset_time > 0
-SettingsProblem check_surface_settings(const SurfaceSettings& surface);  // texture: 0 < amplitude <= 1,
+SettingsProblem check_surface_settings(const SurfaceSettings& surface);  // texture: amplitude > 0,
                                                                          // wavelength > 0, axis 0, 1 or 2,
                                                                          // bumps/height map: axis_v another
                                                                          // axis; height map: an image of

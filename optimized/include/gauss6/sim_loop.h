@@ -36,6 +36,7 @@ struct SimState {
   double shaded_normal[kMaxContacts][3] = {};
   ProjectionWorkspace shading_ws;
   ProjectionResult shading;
+  std::array<double, kMaxContacts * 6> held_J{};  // textures: -J_k of the contacts the command presses on
   CcdStepWorkspace ccd_ws;
   CcdStepResult ccd;
   CcdStepWorkspace check_ws;           // the settling step's check of its direct motion (advance_god_object)

@@ -27,7 +27,11 @@
 // Textures (bump mapping of the force direction): a height field h over the
 // world (the paper's sine along an axis, a grid of bumps, or a height-map image
 // tiled over the plane of two axes, the point projected along the third), of
-// amplitude A and wavelength L in scene units. At each contact, the
+// amplitude A and wavelength L in scene units: h = A sin(2 pi u / L) (bumps and
+// holes, steepest slope 2 pi A / L); h = A s(u) s(v), s(x) = (1 - cos(2 pi x /
+// L)) / 2 (round bumps of height A, steepest slope pi A / L); h = A times the
+// image (in [0, 1]) tiled with pitch L / width (a step of 1 between neighbouring
+// pixels is a slope A width / L). At each contact, the
 // perturbation g_k = -(grad h)_t, the gradient's part in the contact's tangent
 // plane, with |g_k| clamped to kMaxTextureSlope; g = the average of the g_k
 // over the contacts (several contacts: the perturbations are averaged, section
@@ -98,6 +102,10 @@ SurfaceModel build_surface_model(const Scene& scene, const std::vector<TriangleM
 // h(x) and grad h(x) (world frame) of the texture at a world point.
 double texture_height(const TextureField& t, const Vec3& x) noexcept;
 Vec3 texture_gradient(const TextureField& t, const Vec3& x) noexcept;
+// The texture's steepest slope per unit of amplitude (1 / scene units): 2 pi / L
+// for the sine, pi / L for the bumps, width / L for a height map (0 when L or
+// the width is not positive). A texture's steepest slope is A times it.
+double texture_slope_per_amplitude(TextureKind kind, double wavelength, int width) noexcept;
 // The texture's shortest wavelength (scene units): L for the sine and the
 // bumps, two pixels for a height map.
 double shortest_wavelength(const TextureField& t) noexcept;

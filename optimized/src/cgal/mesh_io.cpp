@@ -11,6 +11,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <sstream>
 #include <limits>
 #include <new>
 #include <string>
@@ -21,6 +22,8 @@
 #include <CGAL/IO/OFF.h>
 #include <CGAL/IO/PLY.h>
 #include <CGAL/IO/STL.h>
+#include <CGAL/IO/read_ply_points.h>
+#include <CGAL/property_map.h>
 
 #include "load/mesh_file_checks.h"
 
@@ -145,6 +148,49 @@ TriangleMesh read_mesh(const std::string& path) {
     }
   }
   return m;
+}
+
+MatrixX3d read_vertex_normals(const std::string& path) {
+  if (format_of(path) != Format::kPly) return {};
+  std::ifstream in(path, std::ios::binary);
+  if (!in) fail(path, "cannot open the file for reading");
+  // The header (checked by read_mesh): does the vertex element have nx, ny and nz?
+  bool in_vertex = false;
+  int found = 0;
+  for (std::string line; std::getline(in, line);) {
+    std::istringstream words(line);
+    std::string first, type, name;
+    words >> first;
+    if (first == "end_header") break;
+    if (first == "element") {
+      words >> name;
+      in_vertex = name == "vertex" || name == "vertices";
+    } else if (first == "property" && in_vertex && words >> type >> name) {
+      if (name == "nx" || name == "ny" || name == "nz") ++found;
+    }
+  }
+  if (found != 3) return {};
+  using PointNormal = std::pair<Point, Kernel::Vector_3>;
+  std::vector<PointNormal> read;
+  in.clear();
+  in.seekg(0);
+  bool parsed = false;
+  try {
+    parsed = CGAL::IO::read_PLY_with_properties(
+        in, std::back_inserter(read), CGAL::IO::make_ply_point_reader(CGAL::First_of_pair_property_map<PointNormal>()),
+        CGAL::IO::make_ply_normal_reader(CGAL::Second_of_pair_property_map<PointNormal>()));
+  } catch (const std::bad_alloc&) {
+    fail(path, "out of memory while reading the vertex normals");
+  } catch (const std::exception& e) {
+    fail(path, std::string("cannot read the vertex normals: ") + e.what());
+  }
+  if (!parsed) fail(path, "cannot read the vertex normals (nx, ny, nz)");
+  MatrixX3d N(static_cast<Eigen::Index>(read.size()), 3);
+  for (std::size_t i = 0; i < read.size(); ++i) {
+    const Kernel::Vector_3& n = read[i].second;
+    N.row(static_cast<Eigen::Index>(i)) << n.x(), n.y(), n.z();
+  }
+  return N;
 }
 
 void write_mesh(const std::string& path, const TriangleMesh& m) {

@@ -1,4 +1,4 @@
-// The TOML scene loader (docs/scene-format.md, version 1), with toml++. It applies
+// The TOML scene loader (docs/scene-format.md, versions 1 and 2), with toml++. It applies
 // the rules of the scene's settings (check_gains() and the others: scene_rules.cpp)
 // at each key's line. Every error names the file, the line and column, and the key.
 #include "gauss6/scene.h"
@@ -13,6 +13,7 @@
 
 #include "gauss6/mass_properties.h"
 #include "gauss6/mesh_io.h"
+#include "gauss6/surface.h"
 
 namespace gauss6 {
 
@@ -187,6 +188,24 @@ void read_body_mesh(const TableReader& r, Body* body, std::vector<std::string>* 
   } catch (const MeshFileError& e) {
     r.fail(r.node("mesh")->source(), "mesh", e.what());
   }
+  // Vertex normals the file gives (PLY nx, ny, nz): force shading uses them (surface.h).
+  try {
+    body->given_normals = read_vertex_normals(body->mesh_path);
+  } catch (const MeshFileError& e) {
+    r.fail(r.node("mesh")->source(), "mesh", e.what());
+  }
+  MatrixX3d& given = body->given_normals;
+  if (given.rows() > 0 && given.rows() != body->mesh.V.rows())
+    r.fail(r.node("mesh")->source(), "mesh",
+           body->mesh_path + ": " + std::to_string(given.rows()) + " vertex normals for " +
+               std::to_string(body->mesh.V.rows()) + " vertices");
+  for (Eigen::Index v = 0; v < given.rows(); ++v) {
+    const double n = given.row(v).norm();
+    if (!(n > 0) || !std::isfinite(n))
+      r.fail(r.node("mesh")->source(), "mesh",
+             body->mesh_path + ": vertex " + std::to_string(v) + "'s normal is zero or not finite");
+    given.row(v) /= n;
+  }
   body->report = validate_mesh(body->mesh);
   const MeshReport& rep = body->report;
   if (rep.num_nonfinite_vertices || rep.num_bad_indices || rep.num_degenerate_triangles)
@@ -206,9 +225,10 @@ void read_body_mesh(const TableReader& r, Body* body, std::vector<std::string>* 
       flipped.F.col(2) = second;
       if (compute_mass_properties(flipped, /*density=*/1.0, &mp, nullptr)) {
         body->mesh = std::move(flipped);
+        given = -given;  // the file's vertex normals, if any, turn with its faces
         warnings->push_back(r.prefix() + "mesh: " + body->mesh_path +
                             ": closed but inside out (faces wound inward, enclosing a negative volume): "
-                            "faces flipped");
+                            "faces flipped" + (given.rows() > 0 ? " (and the file's vertex normals)" : ""));
       }
     }
   }
@@ -249,9 +269,9 @@ Scene load_scene(const std::string& path) {
   require(top.string("format") == "gauss6-scene", top, "format", "must be \"gauss6-scene\"");
   // Compared as the file's 64-bit integer: 4294967297 is not version 1.
   const int64_t version = top.integer("version");
-  require(version == kSceneFormatVersion, top, "version",
-          "unsupported version " + std::to_string(version) + " (this build reads version " +
-              std::to_string(kSceneFormatVersion) + ")");
+  require(version >= kOldestSceneFormatVersion && version <= kSceneFormatVersion, top, "version",
+          "unsupported version " + std::to_string(version) + " (this build reads versions " +
+              std::to_string(kOldestSceneFormatVersion) + " to " + std::to_string(kSceneFormatVersion) + ")");
   scene.version = static_cast<int>(version);
   scene.name = top.string("name");
 
@@ -397,6 +417,15 @@ Scene load_scene(const std::string& path) {
           r.fail(r.node("image")->source(), "image", error);
       } else if (r.has("image")) {
         r.fail(r.node("image")->source(), "image", "only for texture = \"height_map\"");
+      }
+      if (version == 1) {
+        // Version 1's amplitude was the height field's steepest slope, in (0, 1]: the
+        // same field in scene units (surface.h) is A = slope L / (2 pi) for the sine,
+        // slope L / pi for the bumps, slope L / width (a pixel's pitch) for a height map.
+        if (!(s.amplitude > 0 && s.amplitude <= 1))
+          r.fail(r.node("amplitude")->source(), "amplitude", "must be in (0, 1] (version 1: a slope)");
+        const double per = texture_slope_per_amplitude(s.texture, s.wavelength, s.height_map.width);
+        if (per > 0) s.amplitude /= per;  // else the wavelength's rule below names the problem
       }
       require(check_surface_settings(s), r);
     } else {
