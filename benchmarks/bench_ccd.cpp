@@ -20,10 +20,14 @@
 // Counters: p50/p99/max per step (ns; wall clock, and cpu_*: the thread's CPU
 // time, which leaves out preemption on a loaded machine), hits per step, narrow-phase pair tests
 // and boxes per step, candidate triangle pairs and those dropped by the face
-// slab bound (no pair test), contacts at the stop pose (of the step's last leg).
+// slab bound (no pair test), contacts at the stop pose (of the step's last leg);
+// the slowest step's index and counts (slowest_*), and the steps over 1 ms and
+// over 100 us of CPU time (cpu_steps_over_*).
 #include <benchmark/benchmark.h>
 
 #include <cmath>
+#include <cstdio>
+#include <cstdlib>
 #include <memory>
 #include <string>
 #include <vector>
@@ -214,16 +218,38 @@ void time_steps(benchmark::State& state, const RuntimeModel& model, const std::v
   const size_t capacity = std::max<size_t>(steps.size(), 1 << 16);
   LatencyRecorder rec(capacity), cpu(capacity);
   PerCallCounters counters;
+  // The slowest step (CPU time) and what it did; GAUSS6_BENCH_STEP_LOG=<file>
+  // writes one line per step (index, CPU ns and the same counts) for profiles.
+  double slowest_ns = -1, over_1ms = 0, over_100us = 0;
+  std::FILE* log = std::getenv("GAUSS6_BENCH_STEP_LOG") ? std::fopen(std::getenv("GAUSS6_BENCH_STEP_LOG"), "w") : nullptr;
   size_t i = 0;
   for (auto _ : state) {
     double iteration_ns = 0;
     for (size_t k = 0; k < steps_per_iteration; ++k) {
-      const ScenarioStep& st = steps[i++ % steps.size()];
+      const size_t index = i++ % steps.size();
+      const ScenarioStep& st = steps[index];
       const double cpu0 = thread_cpu_ns();
       iteration_ns += rec.sample([&] { advance_god_object(model, st.x_start, st.x_target, st.residual, &sim, &info); });
-      cpu.add(thread_cpu_ns() - cpu0);
+      const double cpu_ns = thread_cpu_ns() - cpu0;
+      cpu.add(cpu_ns);
       benchmark::DoNotOptimize(sim.contacts.num_contacts);
       const CcdStepResult& r = sim.ccd;  // the step's last leg
+      over_1ms += cpu_ns > 1e6;
+      over_100us += cpu_ns > 1e5;
+      if (cpu_ns > slowest_ns) {
+        slowest_ns = cpu_ns;
+        state.counters["slowest_step"] = static_cast<double>(index);
+        state.counters["slowest_pair_tests"] = r.num_pair_tests;
+        state.counters["slowest_boxes"] = static_cast<double>(r.num_box_iterations);
+        state.counters["slowest_node_pairs"] = r.num_node_pairs;
+        state.counters["slowest_fill_node_pairs"] = r.num_fill_node_pairs;
+        state.counters["slowest_triangle_pairs"] = r.num_triangle_pairs;
+        state.counters["slowest_settled"] = info.settled;
+      }
+      if (log != nullptr)
+        std::fprintf(log, "%zu %.0f %d %ld %d %d %d %d %d %d\n", index, cpu_ns, r.num_pair_tests, r.num_box_iterations,
+                     r.num_node_pairs, r.num_fill_node_pairs, r.num_triangle_pairs, static_cast<int>(info.settled),
+                     static_cast<int>(info.status == SimStepStatus::kContact), r.num_sub_intervals);
       counters.add("hits", info.status == SimStepStatus::kContact);
       counters.add("settling_legs", info.settled);
       counters.add("gave_up", info.ccd != CcdStatus::kOk);
@@ -236,10 +262,13 @@ void time_steps(benchmark::State& state, const RuntimeModel& model, const std::v
     }
     state.SetIterationTime(iteration_ns * 1e-9);
   }
+  if (log != nullptr) std::fclose(log);
   rec.report(state);
   cpu.report(state, "cpu_");
   counters.report(state);
   state.counters["steps"] = static_cast<double>(steps.size());
+  state.counters["cpu_steps_over_1ms"] = over_1ms;
+  state.counters["cpu_steps_over_100us"] = over_100us;
 }
 
 void BM_CcdStep(benchmark::State& state, const std::string& scene_name, const std::string& script) {

@@ -21,7 +21,10 @@
 // u_hit the features are already within distance_reached; if they truly touch
 // in the accepted interval, u* - u_hit <= time_tolerance_reached (in practice
 // u* - u_hit <= 2 time_tolerance unless the motion grazes: see the tests).
-// Rigid queries first drop u-ranges with cheap cubic filters; with early_hit the
+// Rigid queries first drop u-ranges with cheap cubic filters (the coplanarity
+// cubic's roots isolated in Bernstein form, and slabs); linear queries that a
+// short bisection (64 boxes) does not decide continue with the same filters
+// and guides (sliding contacts, nearly parallel edges: ccd.cpp); with early_hit the
 // earliest kept u-interval is accepted without the bisection when a feature
 // pair there is proven within min_separation + distance_tolerance (the same
 // acceptance rule; everything before it was proven free, so u_hit <= u*).
@@ -104,8 +107,10 @@ struct CcdSettings {
   double min_separation = 0;          // report the first u where the distance may be <= this (scene units, >= 0)
   int max_iterations = 200000;        // boxes examined before a conservative give-up
   bool use_u_filter = true;           // rigid queries: drop u-ranges by the coplanarity cubic and a separating
-                                      // axis before the bisection (conservative; false: bisection alone)
-  bool early_hit = true;              // rigid queries with the u-filter: accept the earliest u-interval the filter
+                                      // axis before the bisection; linear queries: the same filter and guides for
+                                      // what a 64-box bisection leaves undecided (conservative; false: bisection
+                                      // alone)
+  bool early_hit = true;              // queries with the u-filter: accept the earliest u-interval the filter
                                       // keeps (at most time_tolerance wide, all before it excluded) without the
                                       // bisection when the features' nominal closest points there are proven within
                                       // min_separation + distance_tolerance at its start (same acceptance rule as
