@@ -15,11 +15,13 @@ or on an existing Dask cluster (scheduler="tcp://host:port"); in every case the
 results are merged in chunk order, so the summary is the same. With an output folder,
 each finished chunk's result is written at once (out/chunks/NNNNNN.json, written to a
 temporary name then renamed: a file present is complete), after out/campaign.json
-(the campaign's name, parameters and chunk list); a run into a folder that already
+(the campaign's name, parameters and the sha256 of its chunk list); a run into a folder that already
 holds the same campaign takes the finished chunks from disk and runs only the others,
 so a killed campaign resumes where it stopped. A folder holding another campaign is
 refused. Dask retries the tasks of a worker that dies (`allowed_failures`), so a lost
-worker costs only its unfinished chunks. Progress is a tqdm bar on stderr.
+worker costs only its unfinished chunks. A chunk that raises stops the campaign with a
+CampaignError naming it (the chunks finished before stay written). Progress is a tqdm
+bar on stderr.
 """
 from __future__ import annotations
 
@@ -148,7 +150,7 @@ def run_campaign(campaign: Campaign, out: Path | str | None = None, workers: int
     with _progress(len(campaign.chunks), resumed, campaign.name, show_progress) as bar:
         if todo and scheduler is None and n_workers == 0:
             for i in todo:
-                results[i] = campaign.run_chunk(campaign.chunks[i])
+                results[i] = _result_of(campaign, i, lambda: campaign.run_chunk(campaign.chunks[i]))
                 store.save(i, campaign.chunks[i], results[i])
                 bar.update(1)
         elif todo:
@@ -157,13 +159,26 @@ def run_campaign(campaign: Campaign, out: Path | str | None = None, workers: int
     return CampaignRun(summary, len(todo), resumed, time.perf_counter() - t0, n_workers)
 
 
+def _result_of(campaign: Campaign, i: int, get: Callable[[], Any]) -> Any:
+    """A chunk's result, or CampaignError naming the chunk (its own error chained)."""
+    try:
+        return get()
+    except Exception as e:  # noqa: BLE001  (any error of a chunk, named with it)
+        raise CampaignError(f"{campaign.name}: chunk {i} {_dumps(campaign.chunks[i])} failed: "
+                            f"{type(e).__name__}: {e}") from e
+
+
 def _run_distributed(campaign: Campaign, todo: list[int], results: list, store: _Store, bar, n_workers: int,
                      scheduler: str | None) -> int:
     """The chunks of `todo` as Dask tasks; each result saved as it arrives. Returns the
     number of workers the cluster had at the start."""
     import logging
 
-    from distributed import Client, LocalCluster, as_completed
+    try:
+        from distributed import Client, LocalCluster, as_completed
+    except ImportError:
+        raise CampaignError("Dask distributed is not installed (pip install -r requirements.txt, or the "
+                            "'campaign' extra of the gauss6 package); --workers 0 runs serially without it") from None
 
     # The cluster's own INFO lines would interleave with the progress bar.
     for name in ("distributed", "distributed.worker", "distributed.scheduler", "distributed.nanny"):
@@ -188,7 +203,7 @@ def _run_distributed(campaign: Campaign, todo: list[int], results: list, store: 
             index = {f.key: i for f, i in zip(futures, todo)}
             for fut in as_completed(futures):
                 i = index[fut.key]
-                results[i] = fut.result()  # raises the chunk's own error
+                results[i] = _result_of(campaign, i, fut.result)
                 store.save(i, campaign.chunks[i], results[i])
                 bar.update(1)
                 fut.release()

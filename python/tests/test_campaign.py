@@ -245,3 +245,10 @@ def test_a_stop_pair_sliding_at_delta_is_within_delta_and_a_far_one_a_violation(
                if not pair.pair_first_contact(ids, p0, q0, p1, q1).hit
                and cc.pair_distance(ids, meshes, stop_p, stop_q) > 10 * delta)
     assert cc.classify_stop_pair(pair, st, {**opt, "pair_ids": far}, ex, meshes, delta)[0] == "violation"
+
+
+def test_a_failing_chunk_is_named():
+    with pytest.raises(campaign.CampaignError, match=r"chunk 0 .*no QP family 'nope'"):
+        campaign.run_campaign(campaign.Campaign("bad", [{"family": "nope", "seed": 1, "index": 0, "size": 1,
+                                                         "osqp": False}], crosscheck_qp.run_seeded_chunk,
+                                                lambda r: r), workers=0, show_progress=False)
