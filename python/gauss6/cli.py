@@ -75,7 +75,7 @@ def cmd_crosscheck_qp(args: argparse.Namespace) -> int:
 
     if args.seeded is not None:
         return run_seeded_campaign(args, "qp")
-    result, failures, reports = crosscheck([args.family] if args.family else None, tolerance=args.tolerance,
+    result, failures, reports = crosscheck(args.family or None, tolerance=args.tolerance,
                                   with_osqp=not args.no_osqp, show_progress=not args.json)
     if args.json:
         print(json.dumps(result))
@@ -93,7 +93,7 @@ def run_seeded_campaign(args: argparse.Namespace, what: str) -> int:
     if what == "qp":
         from .crosscheck_qp import format_table, seeded_campaign
 
-        families = [args.family] if args.family else None
+        families = args.family or None
         make = lambda: seeded_campaign(args.seeded, args.seed, families, with_osqp=args.osqp,  # noqa: E731
                                        tolerance=args.tolerance, chunk_size=args.chunk_size)
     else:
@@ -185,7 +185,9 @@ def build_parser() -> argparse.ArgumentParser:
     cc = sub.add_parser("crosscheck", help="optimized against exact (and peers)").add_subparsers(
         dest="what", required=True)
     ccq = cc.add_parser("qp", help="the projection: certificate on every instance, exact solve on a sample, OSQP")
-    ccq.add_argument("--family", help="one instance family (default: all)")
+    ccq.add_argument("--family", action="append",
+                     help="an instance family (repeatable with --seeded; default: all the stored ones; with "
+                          "--seeded also m200, m1000, redundant_m200, redundant_m1000)")
     ccq.add_argument("--json", action="store_true", help="machine-readable output")
     ccq.add_argument("--tolerance", type=float, default=1e-9, help="max relative error in the M-norm (default 1e-9)")
     ccq.add_argument("--no-osqp", action="store_true", help="skip the OSQP cross-check")

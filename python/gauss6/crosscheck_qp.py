@@ -277,13 +277,13 @@ def crosscheck(families: list[str] | None = None, tolerance: float = DEFAULT_TOL
 
 
 def format_table(result: dict, reports: list[FamilyReport]) -> str:
-    head = (f"{'family':<10} {'count':>6} {'err ac':>10} {'err force':>10} {'kkt':>10} {'cert fail':>9} "
+    head = (f"{'family':<15} {'count':>6} {'err ac':>10} {'err force':>10} {'kkt':>10} {'cert fail':>9} "
             f"{'near-deg':>8} {'exact':>6} {'osqp err':>10} {'osqp x':>6}  statuses")
     lines = [head, "-" * len(head)]
     for f, r in zip(result["families"], reports):
         f = dict(f, near_degenerate=r.near_degenerate, exact_solves=r.exact_solves, osqp_failures=r.osqp_failures)
         st = ", ".join(f"{k} {v}" for k, v in f["statuses"].items())
-        lines.append(f"{f['name']:<10} {f['count']:>6} {f['max_rel_err_ac']:>10.2e} {f['max_rel_err_force']:>10.2e} "
+        lines.append(f"{f['name']:<15} {f['count']:>6} {f['max_rel_err_ac']:>10.2e} {f['max_rel_err_force']:>10.2e} "
                      f"{f['max_kkt_residual']:>10.2e} {f['certificate_failures']:>9} {f['near_degenerate']:>8} "
                      f"{f['exact_solves']:>6} {f['osqp_max_rel_err_ac']:>10.2e} {f['osqp_failures']:>6}  {st}")
     lines.append(f"tolerance {result['tolerance']:g}: {'OK' if result['ok'] else 'FAILED'}")
@@ -302,7 +302,7 @@ def seeded_campaign(count: int, seed: int = 1, families: list[str] | None = None
     from . import qp_seeded
     from .campaign import Campaign
 
-    names = families or qp_seeded.family_names()
+    names = families or qp_seeded.default_family_names()
     size = chunk_size or qp_seeded.CHUNK_SIZE
     if count < 1 or size < 1:
         raise ValueError(f"a campaign of {count} instances in chunks of {size}: both must be >= 1")
