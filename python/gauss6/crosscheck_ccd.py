@@ -151,7 +151,6 @@ class SetResult:
                 "pair_within_tolerance": self.pair_within_tolerance, "pair_violations": self.pair_violations,
                 "pair_within_delta": self.pair_within_delta}
 
-
     # A campaign chunk's result travels as JSON (state) and chunks add up (absorb).
     MAX_FAILURES_KEPT = 20
 
