@@ -5,7 +5,7 @@ SHELL := /bin/bash
 VENV := .venv/bin
 JOBS ?= $(shell nproc)
 
-.PHONY: setup test reproduce bench ctest pytest proofs checks datasets clean wheel-test fuzz fuzz-short
+.PHONY: setup test reproduce bench ctest pytest proofs checks datasets clean wheel-test fuzz fuzz-short campaigns
 
 setup:
 	@tools/setup.sh
@@ -27,6 +27,14 @@ checks: setup
 	$(VENV)/gauss6 ccd queries $(SHARED_QUERIES) --impl optimized
 	$(VENV)/gauss6 ccd queries $(SHARED_QUERIES) --impl reference
 	$(VENV)/gauss6 crosscheck ccd
+
+# The full seeded campaigns (README.md, "Collision detection"), on all cores; a rerun
+# resumes from out/campaigns/. CCD_STEPS: the exact CCD judgement takes 0.05-0.4 s a step.
+CCD_STEPS ?= 100000
+QP_INSTANCES ?= 1000000
+campaigns: setup
+	$(VENV)/gauss6 crosscheck qp --seeded $(QP_INSTANCES) --out out/campaigns/qp-$(QP_INSTANCES)
+	$(VENV)/gauss6 crosscheck ccd --seeded $(CCD_STEPS) --out out/campaigns/ccd-$(CCD_STEPS)
 
 # libFuzzer on every parser (fuzz/, clang build in build-fuzz/), FUZZ_SECONDS each
 # (10 targets: 30 minutes at the default); a crash is kept in fuzz/regressions/.

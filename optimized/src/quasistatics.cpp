@@ -118,14 +118,14 @@ bool update_cache(const ProjectionProblem& pb, ProjectionWorkspace& ws) noexcept
     const double norm2 = Ak.squaredNorm();
     ws.row_norm[k] = std::sqrt(norm2);
     ws.inv_row_norm[k] = norm2 > 0 ? 1.0 / ws.row_norm[k] : 1.0;
-    for (int j = 0; j < 6; ++j) ws.A_t[kMaxContacts * j + k] = Ak[j];
+    for (int j = 0; j < 6; ++j) ws.A_t[static_cast<size_t>(ws.capacity) * j + k] = Ak[j];
   }
   if (m > 0) std::memcpy(ws.J.data(), pb.J, sizeof(double) * 6 * m);
   ws.num_rows = m;
   return true;
 }
 
-// The m x 6 matrix A stored column by column with stride kMaxContacts.
+// The m x 6 matrix A stored column by column with stride ws.capacity.
 using ColumnsOfA = Eigen::Map<const Eigen::Matrix<double, Eigen::Dynamic, 6>, 0, Eigen::OuterStride<>>;
 
 inline Eigen::Map<const Vec6> row(const ProjectionWorkspace& ws, int k) noexcept {
@@ -271,7 +271,7 @@ bool valid_settings(const ProjectionSettings& s) noexcept {
 ProjectionStatus zero_force_result(const ProjectionProblem& pb, ProjectionStatus status,
                                    int iterations, ProjectionResult* res) noexcept {
   res->ac = all_finite(pb.au.data(), 6) ? pb.au : Vec6::Zero();
-  res->lambda.fill(0.0);
+  std::fill(res->lambda.begin(), res->lambda.end(), 0.0);
   res->num_active = 0;
   res->status = status;
   res->iterations = iterations;
@@ -313,6 +313,18 @@ const char* to_string(ProjectionStatus status) noexcept {
   return "unknown";
 }
 
+ProjectionResult::ProjectionResult(int max_rows) : lambda(static_cast<size_t>(std::max(max_rows, 0)), 0.0) {}
+
+ProjectionWorkspace::ProjectionWorkspace(int max_rows)
+    : capacity(std::max(max_rows, 0)),
+      J(6 * static_cast<size_t>(capacity)),
+      A(6 * static_cast<size_t>(capacity)),
+      A_t(6 * static_cast<size_t>(capacity)),
+      row_norm(static_cast<size_t>(capacity)),
+      inv_row_norm(static_cast<size_t>(capacity)),
+      slack(static_cast<size_t>(capacity)),
+      in_active(static_cast<size_t>(capacity)) {}
+
 void ProjectionWorkspace::reset() noexcept {
   has_M = false;
   num_rows = -1;
@@ -321,7 +333,7 @@ void ProjectionWorkspace::reset() noexcept {
   Q.setIdentity();
   R.setZero();
   rotations_since_rebuild = 0;
-  in_active.fill(0);
+  std::fill(in_active.begin(), in_active.end(), static_cast<unsigned char>(0));
 }
 
 ProjectionStatus project(const ProjectionProblem& pb, const ProjectionSettings& settings,
@@ -329,7 +341,7 @@ ProjectionStatus project(const ProjectionProblem& pb, const ProjectionSettings& 
   if (res == nullptr) return ProjectionStatus::kBadInput;
   const int m = pb.num_rows;
   if (workspace == nullptr || !valid_settings(settings) || pb.M == nullptr || m < 0 ||
-      m > kMaxContacts || (m > 0 && pb.J == nullptr) || !all_finite(pb.au.data(), 6) ||
+      m > workspace->capacity || m > res->max_rows() || (m > 0 && pb.J == nullptr) || !all_finite(pb.au.data(), 6) ||
       (pb.b != nullptr && !all_finite(pb.b, m)))
     return zero_force_result(pb, ProjectionStatus::kBadInput, 0, res);
   ProjectionWorkspace& ws = *workspace;
@@ -376,7 +388,7 @@ ProjectionStatus project(const ProjectionProblem& pb, const ProjectionSettings& 
     double* slack = ws.slack.data();
     {
       Eigen::Map<Eigen::VectorXd> s_map(slack, m);
-      s_map.noalias() = ColumnsOfA(ws.A_t.data(), m, 6, Eigen::OuterStride<>(kMaxContacts)) * y;
+      s_map.noalias() = ColumnsOfA(ws.A_t.data(), m, 6, Eigen::OuterStride<>(ws.capacity)) * y;
       if (b) s_map -= Eigen::Map<const Eigen::VectorXd>(b, m);
     }
     int p = -1;

@@ -105,6 +105,23 @@ Rows random_rows(std::mt19937_64& rng, int m, const Vec6& au, Push push) {
   return rows;
 }
 
+// The rows of base followed by copies of them up to total rows, in turn an exact
+// duplicate, a copy scaled by 10^[-1, 1] and the average of two rows: with b = 0
+// the feasible cone, hence the answer, is that of base alone.
+Rows with_copies(std::mt19937_64& rng, const Rows& base, int total) {
+  std::uniform_real_distribution<double> u01(0, 1);
+  std::uniform_int_distribution<int> pick(0, base.m() - 1);
+  Rows rows = base;
+  while (rows.m() < total) {
+    const int kind = rows.m() % 3;
+    const Vec6 r = base.row(pick(rng));
+    if (kind == 0) rows.add(r);                                      // exact duplicate
+    if (kind == 1) rows.add(std::pow(10.0, -1 + 2 * u01(rng)) * r);  // scaled copy
+    if (kind == 2) rows.add(0.5 * (r + base.row(pick(rng))));        // average of two
+  }
+  return rows;
+}
+
 Vec6 random_vec(std::mt19937_64& rng, double scale = 1) {
   std::normal_distribution<double> g;
   Vec6 v;
@@ -272,8 +289,10 @@ void check_kkt(const Mat6& M, const Vec6& au, const Rows& rows, const Projection
 
 ProjectionResult solve_cold(const Mat6& M, const Vec6& au, const Rows& rows,
                             const ProjectionSettings& settings = {}) {
-  ProjectionWorkspace ws;
-  ProjectionResult res;
+  // Workspace and result sized for the rows (any number; at least the default).
+  const int capacity = std::max(rows.m(), gauss6::kDefaultMaxContacts);
+  ProjectionWorkspace ws(capacity);
+  ProjectionResult res(capacity);
   ProjectionSettings s = settings;
   s.warm_start = false;
   gauss6::project(make_problem(M, au, rows), s, &ws, &res);
@@ -341,12 +360,57 @@ TEST_CASE("projection with 50 rows meets KKT", "[qp]") {
   }
 }
 
+TEST_CASE("any number of rows: 200 and 1000, redundant and not", "[qp]") {
+  // The capacity is the workspace's and the result's, fixed when they are built.
+  // Not redundant: KKT within the solver's tolerances (check_kkt). Redundant (8
+  // distinct rows and copies up to m: duplicates, scaled copies, averages): the
+  // answer of the distinct rows alone by brute force, 1e-9 relative in the M-norm.
+  // (Against the exact reference: python/tests/test_many_rows.py.)
+  std::mt19937_64 rng(200);
+  const ProjectionSettings settings;
+  for (int m : {200, 1000}) {
+    for (double cond : {1.0, 1e4}) {
+      for (Push push : {Push::kSome, Push::kAll}) {
+        const Mat6 M = random_spd(rng, cond);
+        const Vec6 au = random_vec(rng);
+        INFO("m " << m << " cond " << cond);
+        const Rows rows = random_rows(rng, m, au, push);
+        const ProjectionResult res = solve_cold(M, au, rows, settings);
+        REQUIRE(res.max_rows() >= m);
+        check_kkt(M, au, rows, res, settings);
+        const Rows base = random_rows(rng, 8, au, push);
+        const Rows copies = with_copies(rng, base, m);
+        const ProjectionResult red = solve_cold(M, au, copies, settings);
+        check_kkt(M, au, copies, red, settings);
+        const auto truth = brute_force(M, au, base);
+        REQUIRE(truth.has_value());
+        check_same(M, au, red.ac, *truth);
+      }
+    }
+  }
+}
+
+TEST_CASE("more rows than the workspace or the result holds is refused, not truncated", "[qp]") {
+  std::mt19937_64 rng(65);
+  const Mat6 M = random_spd(rng, 10);
+  const Vec6 au = random_vec(rng);
+  const Rows rows = random_rows(rng, 65, au, Push::kAll);
+  ProjectionWorkspace small_ws;  // the default capacity, 64 rows
+  ProjectionResult big_res(65);
+  REQUIRE(small_ws.max_rows() == gauss6::kDefaultMaxContacts);
+  CHECK(gauss6::project(make_problem(M, au, rows), {}, &small_ws, &big_res) == ProjectionStatus::kBadInput);
+  CHECK(big_res.ac == au);
+  ProjectionWorkspace big_ws(65);
+  ProjectionResult small_res(64);
+  CHECK(gauss6::project(make_problem(M, au, rows), {}, &big_ws, &small_res) == ProjectionStatus::kBadInput);
+  CHECK(gauss6::project(make_problem(M, au, rows), {}, &big_ws, &big_res) == ProjectionStatus::kOptimal);
+}
+
 TEST_CASE("redundant rows: duplicates, scaled copies and averages", "[qp]") {
   // With b = 0, exact duplicates, positive multiples and averages of rows leave
   // the feasible cone unchanged: the answer must equal the brute-force answer of
   // the distinct rows alone (1e-9 relative in the M-norm).
   std::mt19937_64 rng(7);
-  std::uniform_real_distribution<double> u01(0, 1);
   const ProjectionSettings settings;
   for (double cond : {1.0, 1e3, 1e6}) {
     for (int base_m : {1, 2, 3, 5, 7}) {
@@ -354,15 +418,7 @@ TEST_CASE("redundant rows: duplicates, scaled copies and averages", "[qp]") {
         const Mat6 M = random_spd(rng, cond);
         const Vec6 au = random_vec(rng);
         const Rows base = random_rows(rng, base_m, au, Push::kSome);
-        Rows rows = base;
-        std::uniform_int_distribution<int> pick(0, base_m - 1);
-        while (rows.m() < total) {
-          const int kind = rows.m() % 3;
-          const Vec6 r = base.row(pick(rng));
-          if (kind == 0) rows.add(r);                                           // exact duplicate
-          if (kind == 1) rows.add(std::pow(10.0, -1 + 2 * u01(rng)) * r);       // scaled copy
-          if (kind == 2) rows.add(0.5 * (r + base.row(pick(rng))));             // average of two
-        }
+        const Rows rows = with_copies(rng, base, total);
         // Shuffle the rows (so that copies may come before their originals).
         std::vector<int> order(total);
         for (int i = 0; i < total; ++i) order[i] = i;
@@ -541,7 +597,7 @@ TEST_CASE("bad input gives kBadInput and a finite zero-force ac", "[qp]") {
 
   auto expect_bad = [&](const ProjectionProblem& pb, const ProjectionSettings& s) {
     ProjectionResult res;
-    res.lambda.fill(42.0);
+    std::fill(res.lambda.begin(), res.lambda.end(), 42.0);
     CHECK(gauss6::project(pb, s, &ws, &res) == ProjectionStatus::kBadInput);
     CHECK(res.status == ProjectionStatus::kBadInput);
     CHECK(res.ac.allFinite());

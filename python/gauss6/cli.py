@@ -3,9 +3,9 @@
     gauss6 --version
     gauss6 scene info SCENE [--json]
     gauss6 datasets generate | check
-    gauss6 crosscheck qp [--family NAME] [--json]
+    gauss6 crosscheck qp [--family NAME] [--json] [--seeded N [--seed S] [--workers N] [--scheduler ADDR] [--out DIR]]
     gauss6 ccd queries FILE.csv|DIR [--kind vf|ee] [--impl optimized|reference] [--json]
-    gauss6 crosscheck ccd [--set NAME] [--json] [--peers]
+    gauss6 crosscheck ccd [--set NAME] [--json] [--peers] [--seeded N [--seed S] [--family F] [--workers N] ...]
     gauss6 report qp --out DIR
     gauss6 report peers [--out DIR] [--repeats N] [--ccd-only | --qp-only]
     gauss6 reproduce peg|bunny|all --out DIR [--threaded]
@@ -75,12 +75,48 @@ def cmd_datasets(args: argparse.Namespace) -> int:
 def cmd_crosscheck_qp(args: argparse.Namespace) -> int:
     from .crosscheck_qp import crosscheck, format_table
 
-    result, failures, reports = crosscheck([args.family] if args.family else None, tolerance=args.tolerance,
+    if args.seeded is not None:
+        return run_seeded_campaign(args, "qp")
+    result, failures, reports = crosscheck(args.family or None, tolerance=args.tolerance,
                                   with_osqp=not args.no_osqp, show_progress=not args.json)
     if args.json:
         print(json.dumps(result))
     else:
         print(format_table(result, reports))
+    for f in failures[:50]:
+        print(f"FAIL {f}", file=sys.stderr)
+    return 0 if result["ok"] else 1
+
+
+def run_seeded_campaign(args: argparse.Namespace, what: str) -> int:
+    """`crosscheck qp|ccd --seeded N`: the seeded campaign on the campaign module."""
+    from .campaign import CampaignError, run_campaign
+
+    if what == "qp":
+        from .crosscheck_qp import format_table, seeded_campaign
+
+        families = args.family or None
+        make = lambda: seeded_campaign(args.seeded, args.seed, families, with_osqp=args.osqp,  # noqa: E731
+                                       tolerance=args.tolerance, chunk_size=args.chunk_size)
+    else:
+        from .crosscheck_ccd import format_seeded_table as format_table, seeded_campaign
+
+        make = lambda: seeded_campaign(args.seeded, args.seed, args.family)  # noqa: E731
+    try:
+        campaign = make()
+        run = run_campaign(campaign, out=args.out, workers=args.workers, scheduler=args.scheduler,
+                           show_progress=not args.json)
+    except (ValueError, CampaignError) as e:
+        return _error(str(e))
+    result, failures, reports = run.summary
+    result = {**result, "seed": args.seed, "chunks": len(campaign.chunks), "chunks_run": run.chunks_run,
+              "chunks_resumed": run.chunks_resumed, "workers": run.workers, "seconds": run.seconds}
+    if args.json:
+        print(json.dumps(result))
+    else:
+        print(format_table(result, reports))
+        print(f"{len(campaign.chunks)} chunks ({run.chunks_resumed} resumed from {args.out}), "
+              f"{run.workers or 'serial, no'} workers, {run.seconds:.1f} s")
     for f in failures[:50]:
         print(f"FAIL {f}", file=sys.stderr)
     return 0 if result["ok"] else 1
@@ -111,6 +147,8 @@ def cmd_ccd_queries(args: argparse.Namespace) -> int:
 def cmd_crosscheck_ccd(args: argparse.Namespace) -> int:
     from .crosscheck_ccd import run_cli
 
+    if args.seeded is not None:
+        return run_seeded_campaign(args, "ccd")
     return run_cli(args)
 
 
@@ -124,6 +162,8 @@ def cmd_device_list(args: argparse.Namespace) -> int:
 
 def build_parser() -> argparse.ArgumentParser:
     from . import __version__, defaults  # the C++ settings' defaults, for the options that share them
+
+    from .campaign import add_arguments as add_campaign_arguments
 
     p = argparse.ArgumentParser(prog="gauss6", description=__doc__.splitlines()[0])
     p.add_argument("--version", action="version", version=f"gauss6 {__version__}")
@@ -147,15 +187,32 @@ def build_parser() -> argparse.ArgumentParser:
     cc = sub.add_parser("crosscheck", help="optimized against exact (and peers)").add_subparsers(
         dest="what", required=True)
     ccq = cc.add_parser("qp", help="the projection: certificate on every instance, exact solve on a sample, OSQP")
-    ccq.add_argument("--family", help="one instance family (default: all)")
+    ccq.add_argument("--family", action="append",
+                     help="an instance family (repeatable with --seeded; default: all the stored ones; with "
+                          "--seeded also m200, m1000, redundant_m200, redundant_m1000)")
     ccq.add_argument("--json", action="store_true", help="machine-readable output")
     ccq.add_argument("--tolerance", type=float, default=1e-9, help="max relative error in the M-norm (default 1e-9)")
     ccq.add_argument("--no-osqp", action="store_true", help="skip the OSQP cross-check")
+    ccq.add_argument("--seeded", type=int, metavar="N",
+                     help="instead of the stored families: a campaign of at least N instances generated from "
+                          "--seed on the fly (qp_seeded.py), on Dask (--workers, --scheduler, --out)")
+    ccq.add_argument("--seed", type=int, default=1, help="with --seeded: the campaign's seed (default 1)")
+    ccq.add_argument("--osqp", action="store_true", help="with --seeded: add the OSQP cross-check (off by default)")
+    ccq.add_argument("--chunk-size", type=int, default=None,
+                     help="with --seeded: instances a chunk (default 360, a multiple of every family's cycle)")
+    add_campaign_arguments(ccq)
     ccq.set_defaults(func=cmd_crosscheck_qp)
     ccc = cc.add_parser("ccd", help="mesh CCD steps: optimized ccd_step against the exact first contact (and FCL)")
     ccc.add_argument("--set", dest="set_name", help="one step set of datasets_generated/ccd/ (default: all)")
     ccc.add_argument("--json", action="store_true", help="machine-readable output")
     ccc.add_argument("--peers", action="store_true", help="print FCL's misses and time (JSON) instead")
+    ccc.add_argument("--seeded", type=int, metavar="N",
+                     help="instead of the stored sets: a campaign of N steps generated from --seed on the fly "
+                          "(ccd_seeded.py), on Dask (--workers, --scheduler, --out)")
+    ccc.add_argument("--seed", type=int, default=1, help="with --seeded: the campaign's seed (default 1)")
+    ccc.add_argument("--family", action="append",
+                     help="with --seeded: only these step families (repeatable; default all)")
+    add_campaign_arguments(ccc)
     ccc.set_defaults(func=cmd_crosscheck_ccd)
 
     ccd = sub.add_parser("ccd", help="continuous collision detection").add_subparsers(dest="action", required=True)

@@ -27,6 +27,7 @@ projection is defined:
 from __future__ import annotations
 
 import contextlib
+import functools
 import math
 import os
 import sys
@@ -102,6 +103,22 @@ class FamilyReport:
                 "max_rel_err_force": self.max_rel_err_force, "max_kkt_residual": self.max_kkt_residual,
                 "certificate_failures": self.certificate_failures,
                 "osqp_max_rel_err_ac": self.osqp_max_rel_err_ac, "statuses": dict(sorted(self.statuses.items()))}
+
+    # A campaign chunk's report travels as JSON (state) and chunks add up (absorb).
+    MAX_FAILURES_KEPT = 20
+
+    def state(self) -> dict:
+        return {**self.as_json(), "exact_solves": self.exact_solves, "near_degenerate": self.near_degenerate,
+                "osqp_failures": self.osqp_failures, "failures": self.failures[:self.MAX_FAILURES_KEPT],
+                "num_failures": len(self.failures)}
+
+    def absorb(self, st: dict) -> None:
+        for k in ("count", "certificate_failures", "exact_solves", "near_degenerate", "osqp_failures"):
+            setattr(self, k, getattr(self, k) + st[k])
+        for k in ("max_rel_err_ac", "max_rel_err_force", "max_kkt_residual", "osqp_max_rel_err_ac"):
+            setattr(self, k, max(getattr(self, k), st[k]))
+        self.statuses.update(st["statuses"])
+        self.failures += st["failures"][:max(self.MAX_FAILURES_KEPT - len(self.failures), 0)]
 
 
 def certified_optimum(M, au, J, b, active) -> tuple[np.ndarray | None, str, str]:
@@ -213,10 +230,14 @@ def check_instance(rep: FamilyReport, inst, res, index: int, with_osqp: bool) ->
 
 
 def crosscheck_family(name: str, with_osqp: bool = True, progress=None) -> FamilyReport:
+    return check_instances(name, qp_instances.load_family(name), with_osqp, progress)
+
+
+def check_instances(name: str, instances: list, with_osqp: bool = True, progress=None) -> FamilyReport:
+    """One family's instances checked (the warm family with warm starts along its sequences)."""
     from . import project, Projector
 
     rep = FamilyReport(name)
-    instances = qp_instances.load_family(name)
     if name == "warm":
         # Warm starts along each sequence, in step order, one projector per sequence.
         projectors: dict[int, Projector] = {}
@@ -256,14 +277,73 @@ def crosscheck(families: list[str] | None = None, tolerance: float = DEFAULT_TOL
 
 
 def format_table(result: dict, reports: list[FamilyReport]) -> str:
-    head = (f"{'family':<10} {'count':>6} {'err ac':>10} {'err force':>10} {'kkt':>10} {'cert fail':>9} "
+    head = (f"{'family':<15} {'count':>6} {'err ac':>10} {'err force':>10} {'kkt':>10} {'cert fail':>9} "
             f"{'near-deg':>8} {'exact':>6} {'osqp err':>10} {'osqp x':>6}  statuses")
     lines = [head, "-" * len(head)]
     for f, r in zip(result["families"], reports):
         f = dict(f, near_degenerate=r.near_degenerate, exact_solves=r.exact_solves, osqp_failures=r.osqp_failures)
         st = ", ".join(f"{k} {v}" for k, v in f["statuses"].items())
-        lines.append(f"{f['name']:<10} {f['count']:>6} {f['max_rel_err_ac']:>10.2e} {f['max_rel_err_force']:>10.2e} "
+        lines.append(f"{f['name']:<15} {f['count']:>6} {f['max_rel_err_ac']:>10.2e} {f['max_rel_err_force']:>10.2e} "
                      f"{f['max_kkt_residual']:>10.2e} {f['certificate_failures']:>9} {f['near_degenerate']:>8} "
                      f"{f['exact_solves']:>6} {f['osqp_max_rel_err_ac']:>10.2e} {f['osqp_failures']:>6}  {st}")
     lines.append(f"tolerance {result['tolerance']:g}: {'OK' if result['ok'] else 'FAILED'}")
     return "\n".join(lines)
+
+
+# --------------------------------------------------------------------------------------
+# Seeded campaigns: instances generated on the fly (qp_seeded.py), chunks as tasks (campaign.py)
+# --------------------------------------------------------------------------------------
+
+def seeded_campaign(count: int, seed: int = 1, families: list[str] | None = None, with_osqp: bool = False,
+                    tolerance: float = DEFAULT_TOLERANCE, chunk_size: int | None = None):
+    """The campaign of at least `count` seeded instances: whole chunks of chunk_size
+    (default qp_seeded.CHUNK_SIZE), the families in turn (chunk j is family j mod F,
+    its chunk j // F)."""
+    from . import qp_seeded
+    from .campaign import Campaign
+
+    names = families or qp_seeded.default_family_names()
+    size = chunk_size or qp_seeded.CHUNK_SIZE
+    if count < 1 or size < 1:
+        raise ValueError(f"a campaign of {count} instances in chunks of {size}: both must be >= 1")
+    for n in names:
+        if n not in qp_seeded.family_names():
+            raise ValueError(f"no QP family {n!r} (families: {', '.join(qp_seeded.family_names())})")
+    chunks, total, j = [], 0, 0
+    while total < count:
+        fam = names[j % len(names)]
+        chunks.append({"family": fam, "seed": seed, "index": j // len(names), "size": size, "osqp": with_osqp})
+        total += qp_seeded.chunk_size(fam, size)
+        j += 1
+    params = {"count": count, "seed": seed, "families": names, "osqp": with_osqp,
+              "chunk_size": size}
+    merge = functools.partial(merge_seeded, names=names, tolerance=tolerance)
+    return Campaign("crosscheck-qp", chunks, run_seeded_chunk, merge, params)
+
+
+def run_seeded_chunk(chunk: dict) -> dict:
+    """One chunk: its instances generated and checked; the family report's state."""
+    from . import qp_seeded
+
+    instances = qp_seeded.chunk_instances(chunk["family"], chunk["seed"], chunk["index"], chunk["size"])
+    return check_instances(chunk["family"], instances, chunk["osqp"]).state()
+
+
+def merge_seeded(results: list[dict], names: list[str], tolerance: float) -> tuple[dict, list[str], list]:
+    """The chunks' reports added up per family: (result JSON, failures, reports), as crosscheck()."""
+    reports = {n: FamilyReport(n) for n in names}
+    for st in results:
+        reports[st["name"]].absorb(st)
+    reports = [r for r in reports.values() if r.count]
+    failures = [f for r in reports for f in r.failures]
+    not_kept = sum(st["num_failures"] for st in results) - len(failures)
+    if not_kept:
+        failures.append(f"... and {not_kept} more failures (not kept)")
+    for r in reports:
+        if r.max_rel_err_ac > tolerance:
+            failures.append(f"{r.name}: max_rel_err_ac {r.max_rel_err_ac:.3g} > {tolerance:g}")
+        if r.max_rel_err_force > tolerance:
+            failures.append(f"{r.name}: max_rel_err_force {r.max_rel_err_force:.3g} > {tolerance:g}")
+    result = {"ok": not failures, "tolerance": tolerance, "families": [r.as_json() for r in reports],
+              "instances": sum(r.count for r in reports)}
+    return result, failures, reports

@@ -93,28 +93,31 @@ def load_family(name_or_path: str | Path) -> list[Instance]:
         raise ValueError(f"{path}: not a {FORMAT} file")
     if doc.get("version") != FORMAT_VERSION:
         raise ValueError(f"{path}: format version {doc.get('version')!r}, this reader knows {FORMAT_VERSION}")
-    out = []
-    for k, rec in enumerate(doc.get("instances", [])):
-        iid = str(rec.get("id", f"#{k}"))
-        try:
-            J = _array(path, iid, "J", rec["J"], (-1, 6))
-            inst = Instance(
-                id=iid,
-                M=_array(path, iid, "M", rec["M"], (6, 6)),
-                au=_array(path, iid, "au", rec["au"], (6,)),
-                J=J,
-                b=_array(path, iid, "b", rec["b"], (len(J),)),
-                push=rec["push"],
-                sequence=_int(path, iid, "sequence", rec["sequence"]),
-                step=_int(path, iid, "step", rec["step"]),
-                tags=rec.get("tags", {}),
-            )
-        except KeyError as e:
-            raise ValueError(f"{path}: instance {iid}: missing key {e}") from None
-        if inst.push not in PUSH_LABELS:
-            raise ValueError(f"{path}: instance {iid}: push {inst.push!r} is not one of {PUSH_LABELS}")
-        out.append(inst)
-    return out
+    return [from_record(path, k, rec) for k, rec in enumerate(doc.get("instances", []))]
+
+
+def from_record(path: Path | str, k: int, rec: dict) -> Instance:
+    """One instance record (the generator's dict, as in a family file) as an Instance;
+    ValueError naming `path` and the instance for a malformed record."""
+    iid = str(rec.get("id", f"#{k}"))
+    try:
+        J = _array(path, iid, "J", rec["J"], (-1, 6))
+        inst = Instance(
+            id=iid,
+            M=_array(path, iid, "M", rec["M"], (6, 6)),
+            au=_array(path, iid, "au", rec["au"], (6,)),
+            J=J,
+            b=_array(path, iid, "b", rec["b"], (len(J),)),
+            push=rec["push"],
+            sequence=_int(path, iid, "sequence", rec["sequence"]),
+            step=_int(path, iid, "step", rec["step"]),
+            tags=rec.get("tags", {}),
+        )
+    except KeyError as e:
+        raise ValueError(f"{path}: instance {iid}: missing key {e}") from None
+    if inst.push not in PUSH_LABELS:
+        raise ValueError(f"{path}: instance {iid}: push {inst.push!r} is not one of {PUSH_LABELS}")
+    return inst
 
 
 def _sha256(path: Path) -> str:

@@ -8,6 +8,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <limits>
 #include <optional>
 #include <string>
 
@@ -33,9 +34,11 @@ struct PyProjection {
 };
 
 // Checks shapes at the edge (the C++ solver takes raw row-major pointers).
+// Any number of rows: the workspaces are sized for J here, at the edge.
 void check_shapes(const RowsX6& J, const std::optional<Eigen::VectorXd>& b) {
-  if (J.rows() > kMaxContacts)
-    throw py::value_error("J has " + std::to_string(J.rows()) + " rows; at most " + std::to_string(kMaxContacts));
+  if (J.rows() > std::numeric_limits<int>::max() / 6)
+    throw py::value_error("J has " + std::to_string(J.rows()) + " rows; at most " +
+                          std::to_string(std::numeric_limits<int>::max() / 6));
   if (b && b->size() != J.rows())
     throw py::value_error("b has " + std::to_string(b->size()) + " entries; J has " + std::to_string(J.rows()) +
                           " rows");
@@ -57,7 +60,7 @@ ProjectionProblem make_problem(const Mat6& M, const Vec6& au, const RowsX6& J,
 PyProjection run(const Mat6& M, const Vec6& au, const RowsX6& J, const std::optional<Eigen::VectorXd>& b,
                  const ProjectionSettings& settings, ProjectionWorkspace* ws) {
   const ProjectionProblem problem = make_problem(M, au, J, b);
-  ProjectionResult r;
+  ProjectionResult r(std::max(problem.num_rows, 1));
   project(problem, settings, ws, &r);
   PyProjection out;
   out.ac = r.ac;
@@ -79,6 +82,7 @@ class Projector {
  public:
   explicit Projector(const ProjectionSettings& s) : settings_(s) {}
   PyProjection project(const Mat6& M, const Vec6& au, const RowsX6& J, const std::optional<Eigen::VectorXd>& b) {
+    if (J.rows() > ws_.max_rows()) ws_ = ProjectionWorkspace(static_cast<int>(J.rows()));  // grows; warm start lost
     return run(M, au, J, b, settings_, &ws_);
   }
   void reset() { ws_.reset(); }
@@ -127,7 +131,7 @@ void bind_quasistatics(py::module_& m) {
   m.def("project",
         [](const Mat6& M, const Vec6& au, const RowsX6& J, const std::optional<Eigen::VectorXd>& b,
            std::optional<ProjectionSettings> settings) {
-          ProjectionWorkspace ws;
+          ProjectionWorkspace ws(std::max(static_cast<int>(J.rows()), 1));
           ProjectionSettings s = settings.value_or(ProjectionSettings{});
           s.warm_start = false;
           return run(M, au, J, b, s, &ws);
@@ -151,12 +155,13 @@ void bind_quasistatics(py::module_& m) {
           ProjectionSettings settings;
           settings.warm_start = warm;
           settings.compute_residuals = false;
-          ProjectionResult r;
-          ProjectionWorkspace primed;
+          const int rows = std::max(problem.num_rows, 1);
+          ProjectionResult r(rows);
+          ProjectionWorkspace primed(rows);
           project(problem, settings, &primed, &r);
           std::vector<double> t(std::max(repeats, 1));
           for (double& ti : t) {
-            ProjectionWorkspace fresh;
+            ProjectionWorkspace fresh(rows);
             ProjectionWorkspace* ws = warm ? &primed : &fresh;
             const auto t0 = std::chrono::steady_clock::now();
             project(problem, settings, ws, &r);
@@ -171,7 +176,7 @@ void bind_quasistatics(py::module_& m) {
 
   m.def("coupling_force",
         [](const Mat6& M, const Vec6& au, const RowsX6& J, double kh, const std::optional<Eigen::VectorXd>& b) {
-          ProjectionWorkspace ws;
+          ProjectionWorkspace ws(std::max(static_cast<int>(J.rows()), 1));
           ProjectionSettings s;
           s.warm_start = false;
           const PyProjection p = run(M, au, J, b, s, &ws);

@@ -99,7 +99,8 @@ def test_first_steps_pass_the_crosscheck(name):
     assert out["steps"] == count and out["false_negatives"] == out["late_hits"] == out["intersecting_stop_poses"] == 0
     assert out["max_gap_u"] >= out["p99_gap_u"] >= 0
     # Which pair stopped each step: compared on every step where both hit, none wrong.
-    assert out["pair_steps"] == out["pair_matches"] + out["pair_within_tolerance"] and out["pair_violations"] == 0
+    assert out["pair_steps"] == out["pair_matches"] + out["pair_within_tolerance"] + out["pair_within_delta"]
+    assert out["pair_violations"] == 0
 
 
 class _Tampered:
@@ -205,7 +206,7 @@ def test_cli_json_schema(capsys):
     assert list(out["sets"][0]) == ["name", "steps", "false_negatives", "late_hits", "max_gap_u", "p99_gap_u",
                                     "intersecting_stop_poses", "max_stop_separation", "optimized_us_per_step",
                                     "reference_s_per_step", "pair_steps", "pair_matches", "pair_within_tolerance",
-                                    "pair_violations"]
+                                    "pair_violations", "pair_within_delta"]
     # Stop poses keep about delta: the exact separation is at most the window and above 0.
     assert 0 < out["sets"][0]["max_stop_separation"] <= cc.STOP_SEPARATION_WINDOW * cc.load_set("parallel")["delta"]
 

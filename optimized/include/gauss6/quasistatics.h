@@ -18,18 +18,27 @@
 // previous call's working set (warm start).
 //
 // Real-time contract: project() allocates nothing, takes no lock, throws
-// nothing; every buffer lives in the caller-owned ProjectionWorkspace. Sizes
-// are fixed at compile time (kMaxContacts rows).
+// nothing; every buffer lives in the caller-owned ProjectionWorkspace and
+// ProjectionResult, sized for max_rows rows when they are built (any number;
+// kDefaultMaxContacts unless the model says otherwise). A problem with more
+// rows than either holds is refused (kBadInput), never truncated.
 #pragma once
 
 #include <array>
+#include <vector>
 
 #include "gauss6/pose.h"
 
 namespace gauss6 {
 
-// Most constraint rows one projection accepts (the contact set's size cap).
-inline constexpr int kMaxContacts = 64;
+// The default capacity in rows of a workspace, a result and the runtime's
+// contact set (RuntimeSettings::max_contacts); any capacity >= 1 may be chosen
+// when they are built.
+inline constexpr int kDefaultMaxContacts = 64;
+// The runtime's contact capacity today: its loops' buffers and the published
+// snapshot (runtime_channels.h) are arrays of this size; a larger contact set
+// is truncated and reported (kContactOverflow).
+inline constexpr int kMaxContacts = kDefaultMaxContacts;
 // Size of a working set: at most 6 linearly independent rows in R^6.
 inline constexpr int kMaxActive = 6;
 
@@ -67,7 +76,8 @@ enum class ProjectionStatus {
                        // set rows whose offsets contradict it by more than
                        // feasibility_tol (only possible with b != 0):
                        // ac = au (zero force), lambda = 0.
-  kBadInput,           // non-finite data, M not SPD, num_rows out of [0, cap],
+  kBadInput,           // non-finite data, M not SPD, num_rows out of [0, the
+                       // workspace's and the result's max_rows],
                        // J null with rows, or settings out of range.
 };
 const char* to_string(ProjectionStatus status) noexcept;
@@ -79,15 +89,19 @@ struct ProjectionProblem {
   const double* J = nullptr; // num_rows x 6, row-major (contact k = J[6k..6k+5]);
                              // may be null when num_rows == 0.
   const double* b = nullptr; // num_rows right-hand sides; null means b = 0.
-  int num_rows = 0;          // m, in [0, kMaxContacts].
+  int num_rows = 0;          // m, in [0, max_rows of the workspace and result].
 };
 
 struct ProjectionResult {
+  // Room for max_rows multipliers (allocated here, once).
+  explicit ProjectionResult(int max_rows = kDefaultMaxContacts);
+  int max_rows() const noexcept { return static_cast<int>(lambda.size()); }
+
   Vec6 ac = Vec6::Zero();  // constrained acceleration; on kBadInput ac = au when
                            // au is finite (zero force), else ac = 0.
   // Multipliers (units of M * a): entries [0, num_rows) are valid, zero off the
   // working set.
-  std::array<double, kMaxContacts> lambda{};
+  std::vector<double> lambda;  // size max_rows
   // Rows of the final working set, in the order they entered it.
   std::array<int, kMaxActive> active{};
   int num_active = 0;
@@ -108,9 +122,13 @@ struct ProjectionResult {
 // for the next warm start. The members are internal: callers only construct
 // it and may call reset().
 struct ProjectionWorkspace {
+  // Buffers for problems of up to max_rows rows (allocated here, once).
+  explicit ProjectionWorkspace(int max_rows = kDefaultMaxContacts);
+  int max_rows() const noexcept { return capacity; }
   // Forget the caches and the warm start.
   void reset() noexcept;
 
+  int capacity = 0;  // rows the buffers below hold
   // Cache of M: its copy, lower Cholesky factor L (M = L L^T) and L^-1.
   bool has_M = false;
   Mat6 M = Mat6::Zero();
@@ -118,11 +136,11 @@ struct ProjectionWorkspace {
   Mat6 L_inv = Mat6::Identity();
   // Cache of J (valid for has_M and M): its copy, A = J L^-T, 1/|A_k|.
   int num_rows = -1;
-  std::array<double, kMaxContacts * 6> J{};
-  std::array<double, kMaxContacts * 6> A{};   // row-major: row k at 6 k
-  std::array<double, kMaxContacts * 6> A_t{};  // column-major: column j at kMaxContacts j
-  std::array<double, kMaxContacts> row_norm{};
-  std::array<double, kMaxContacts> inv_row_norm{};
+  std::vector<double> J;         // capacity x 6
+  std::vector<double> A;         // row-major: row k at 6 k
+  std::vector<double> A_t;       // column-major: column j at capacity j
+  std::vector<double> row_norm;  // capacity
+  std::vector<double> inv_row_norm;
   // Working set: A_W^T = Q(:, 0:q) R(0:q, 0:q), q = num_active, Q orthogonal.
   bool factor_matches_cache = false;  // Q, R are for the cached A
   int num_active = 0;
@@ -134,8 +152,8 @@ struct ProjectionWorkspace {
   long rotations_since_rebuild = 0;
   // Scratch.
   std::array<double, kMaxActive> lambda_active{};
-  std::array<double, kMaxContacts> slack{};
-  std::array<unsigned char, kMaxContacts> in_active{};
+  std::vector<double> slack;               // capacity
+  std::vector<unsigned char> in_active;    // capacity
 };
 
 // Solves the projection (see the top of this file). Fills *result (always: ac
