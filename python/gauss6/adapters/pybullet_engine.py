@@ -125,7 +125,7 @@ class PyBulletEngine:
         return EngineStep(p, q, -applied, contacts, seconds)
 
     def close(self) -> None:
-        if self.client is not None:
+        if getattr(self, "client", None) is not None:
             try:
                 self.client.disconnect()
             except Exception:
