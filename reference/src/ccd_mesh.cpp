@@ -611,18 +611,24 @@ int64_t count_intersecting_pairs(const ExactMeshPair& mp, const Pose& X) {
   return count;
 }
 
-ExactSeparation separation_distance(const ExactMeshPair& mp, const Pose& X, double max_distance) {
-  if (!(max_distance >= 0)) throw std::invalid_argument("separation_distance: max_distance must be >= 0");
-  const PosedBody posed(mp.god, X);
+namespace {
+
+// Passes 1 and 2 of separation_distance: the pairs that can still be the minimum, each with a
+// lower bound of its squared distance, and an upper bound of the minimum squared distance
+// (HUGE_VAL when no pair's interval enclosure was finite).
+struct SeparationCandidate {
+  int32_t f, of;
+  double lower;  // <= the pair's exact squared distance
+};
+
+double interval_candidates(const ExactMeshPair& mp, const PosedBody& posed, double max_distance,
+                           std::vector<SeparationCandidate>* close_out) {
   const TriangleMesh& body = mp.god;
   // Pass 1 (boxes): every pair whose boxes are within max_distance, with a
   // lower bound of its squared distance: the squared gap between the boxes
   // (the body's contain the exact triangle), rounded down by a relative 1e-12,
   // far above the few roundings of 2^-53 in it.
-  struct Candidate {
-    int32_t f, of;
-    double lower;  // <= the pair's exact squared distance
-  };
+  using Candidate = SeparationCandidate;
   std::vector<Candidate> candidates;
   candidate_pairs(mp, posed, max_distance, [&](int32_t f, int32_t of) {
     const CGAL::Bbox_3 a = posed.box(body.F(f, 0)) + posed.box(body.F(f, 1)) + posed.box(body.F(f, 2));
@@ -641,7 +647,7 @@ ExactSeparation separation_distance(const ExactMeshPair& mp, const Pose& X, doub
   // triangle/triangle squared_distance in interval arithmetic; the box bound
   // when the interval signs are uncertain or a vertex has no enclosure).
   double best_upper = HUGE_VAL;  // >= the minimum squared distance
-  std::vector<Candidate> close;
+  std::vector<Candidate>& close = *close_out;
   const ToInterval to_interval;
   for (const Candidate& c : candidates) {
     if (c.lower > best_upper) break;
@@ -658,6 +664,33 @@ ExactSeparation separation_distance(const ExactMeshPair& mp, const Pose& X, doub
     }
     close.push_back(refined);
   }
+  return best_upper;
+}
+
+}  // namespace
+
+SeparationBracket separation_bracket(const ExactMeshPair& mp, const Pose& X, double max_distance) {
+  if (!(max_distance >= 0)) throw std::invalid_argument("separation_bracket: max_distance must be >= 0");
+  const PosedBody posed(mp.god, X);
+  std::vector<SeparationCandidate> close;
+  const double best_upper = interval_candidates(mp, posed, max_distance, &close);
+  SeparationBracket out;
+  // Every pair left out is farther than max_distance (its boxes are); the candidates' lower
+  // bounds hold for them; the minimum's square is at most best_upper.
+  double lower2 = HUGE_VAL;
+  for (const SeparationCandidate& c : close) lower2 = std::min(lower2, c.lower);
+  out.lower = lower2 == HUGE_VAL ? max_distance : std::min(max_distance, std::nextafter(std::sqrt(lower2), 0.0));
+  out.upper = best_upper == HUGE_VAL ? HUGE_VAL : std::nextafter(std::sqrt(best_upper), HUGE_VAL);
+  out.lower = std::min(out.lower, out.upper);
+  return out;
+}
+
+ExactSeparation separation_distance(const ExactMeshPair& mp, const Pose& X, double max_distance) {
+  if (!(max_distance >= 0)) throw std::invalid_argument("separation_distance: max_distance must be >= 0");
+  const PosedBody posed(mp.god, X);
+  using Candidate = SeparationCandidate;
+  std::vector<Candidate> close;
+  const double best_upper = interval_candidates(mp, posed, max_distance, &close);
   // Pass 3 (exact): by increasing lower bound, while a pair can still win.
   std::sort(close.begin(), close.end(), [](const Candidate& a, const Candidate& b) { return a.lower < b.lower; });
   const ToExact to_exact;
