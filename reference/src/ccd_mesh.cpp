@@ -613,6 +613,74 @@ int64_t count_intersecting_pairs(const ExactMeshPair& mp, const Pose& X) {
 
 namespace {
 
+// An upper bound of the squared distance between two triangles given by interval enclosures
+// of their vertices, for the pairs whose interval squared_distance cannot decide (near-parallel
+// triangles, where CGAL's comparisons are uncertain): the squared distance between two points
+// of the triangles. The points are chosen in doubles on the enclosures' midpoints (each vertex
+// of one triangle against the other: its projection inside the triangle, else the nearest
+// point of an edge), as barycentric weights, and evaluated in interval arithmetic from the
+// enclosures: a convex combination of the true vertices lies on the true triangle whatever
+// the rounding of its weights, so the bound holds. HUGE_VAL when no bound is finite.
+double witness_upper_bound(const IntervalKernel::Triangle_3& A, const IntervalKernel::Triangle_3& B) {
+  using I = IntervalKernel::FT;
+  auto mid = [](const IntervalKernel::Point_3& p) {
+    return Vec3(CGAL::to_double(p.x()), CGAL::to_double(p.y()), CGAL::to_double(p.z()));
+  };
+  struct Witness {
+    double d2 = HUGE_VAL;
+    double wa[3] = {0, 0, 0}, wb[3] = {0, 0, 0};
+  } best;
+  // The vertex v (weights wv on its triangle) against triangle T (midpoints t[3]).
+  auto against = [&](const Vec3& x, const double wv[3], const Vec3 t[3], bool v_in_a) {
+    auto consider = [&](const double wt[3]) {
+      const Vec3 y = wt[0] * t[0] + wt[1] * t[1] + wt[2] * t[2];
+      const double d2 = (x - y).squaredNorm();
+      if (d2 < best.d2) {
+        best.d2 = d2;
+        for (int k = 0; k < 3; ++k) {
+          best.wa[k] = v_in_a ? wv[k] : wt[k];
+          best.wb[k] = v_in_a ? wt[k] : wv[k];
+        }
+      }
+    };
+    const Vec3 e1 = t[1] - t[0], e2 = t[2] - t[0], n = e1.cross(e2);
+    const double nn = n.squaredNorm();
+    if (nn > 0) {  // the projection's barycentric coordinates
+      const Vec3 r = x - t[0];
+      const double v = r.cross(e2).dot(n) / nn, w = e1.cross(r).dot(n) / nn, u = 1 - v - w;
+      if (u >= 0 && v >= 0 && w >= 0) {
+        const double wt[3] = {u, v, w};
+        consider(wt);
+      }
+    }
+    for (int k = 0; k < 3; ++k) {  // the nearest point of each edge
+      const Vec3 &p = t[k], &q = t[(k + 1) % 3];
+      const double len2 = (q - p).squaredNorm();
+      const double s = len2 > 0 ? std::clamp((x - p).dot(q - p) / len2, 0.0, 1.0) : 0.0;
+      double wt[3] = {0, 0, 0};
+      wt[k] = 1 - s;
+      wt[(k + 1) % 3] = s;
+      consider(wt);
+    }
+  };
+  const Vec3 a[3] = {mid(A[0]), mid(A[1]), mid(A[2])}, b[3] = {mid(B[0]), mid(B[1]), mid(B[2])};
+  for (int k = 0; k < 3; ++k) {
+    double wv[3] = {0, 0, 0};
+    wv[k] = 1;
+    against(a[k], wv, b, true);
+    against(b[k], wv, a, false);
+  }
+  if (!(best.d2 < HUGE_VAL)) return HUGE_VAL;
+  CGAL::Protect_FPU_rounding<true> upward;
+  auto point = [](const IntervalKernel::Triangle_3& T, const double w[3], int c) {
+    const I sum = I(w[0]) + I(w[1]) + I(w[2]);
+    return (I(w[0]) * T[0][c] + I(w[1]) * T[1][c] + I(w[2]) * T[2][c]) / sum;
+  };
+  I d2(0);
+  for (int c = 0; c < 3; ++c) d2 += CGAL::square(point(A, best.wa, c) - point(B, best.wb, c));
+  return std::isfinite(d2.sup()) ? d2.sup() : HUGE_VAL;
+}
+
 // Passes 1 and 2 of separation_distance: the pairs that can still be the minimum, each with a
 // lower bound of its squared distance, and an upper bound of the minimum squared distance
 // (HUGE_VAL when no pair's interval enclosure was finite).
@@ -661,6 +729,13 @@ double interval_candidates(const ExactMeshPair& mp, const PosedBody& posed, doub
         best_upper = std::min(best_upper, d2.sup());
       }
     } catch (CGAL::Uncertain_conversion_exception&) {
+      // No interval value: the pair keeps its box bound, and bounds the minimum from above by
+      // two of its points when the body's triangle has an enclosure.
+      try {
+        best_upper = std::min(best_upper, witness_upper_bound(to_interval(BodyFace{&posed, &mp.god, c.f}),
+                                                              to_interval(ObstacleFace{&mp.obstacle, c.of})));
+      } catch (CGAL::Uncertain_conversion_exception&) {
+      }
     }
     close.push_back(refined);
   }
