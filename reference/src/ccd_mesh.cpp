@@ -681,6 +681,36 @@ double witness_upper_bound(const IntervalKernel::Triangle_3& A, const IntervalKe
   return std::isfinite(d2.sup()) ? d2.sup() : HUGE_VAL;
 }
 
+// A lower bound of the squared distance between two triangles (interval enclosures of their
+// vertices), for the pairs whose interval squared_distance cannot decide: the gap between the
+// triangles' projections on each one's face normal (a separating axis), squared over the
+// normal's squared length, in interval arithmetic (rounding upward: the caller's mode). 0 when
+// no axis separates them for sure.
+double separating_axis_lower_bound(const IntervalKernel::Triangle_3& A, const IntervalKernel::Triangle_3& B) {
+  using I = IntervalKernel::FT;
+  double best = 0;
+  for (const IntervalKernel::Triangle_3* T : {&A, &B}) {
+    const IntervalKernel::Vector_3 n = CGAL::cross_product((*T)[1] - (*T)[0], (*T)[2] - (*T)[0]);
+    const I nn = n.squared_length();
+    if (!(nn.inf() > 0) || !std::isfinite(nn.sup())) continue;
+    double lo[2] = {HUGE_VAL, HUGE_VAL}, hi[2] = {-HUGE_VAL, -HUGE_VAL};
+    for (int t = 0; t < 2; ++t) {
+      const IntervalKernel::Triangle_3& U = t == 0 ? A : B;
+      for (int k = 0; k < 3; ++k) {
+        const I d = (U[k] - CGAL::ORIGIN) * n;
+        lo[t] = std::min(lo[t], d.inf());
+        hi[t] = std::max(hi[t], d.sup());
+      }
+    }
+    const double gap = std::max((I(lo[1]) - I(hi[0])).inf(), (I(lo[0]) - I(hi[1])).inf());
+    if (gap > 0 && std::isfinite(gap)) {
+      const I g2 = CGAL::square(I(gap)) / nn;
+      if (std::isfinite(g2.inf())) best = std::max(best, g2.inf());
+    }
+  }
+  return best;
+}
+
 // Passes 1 and 2 of separation_distance: the pairs that can still be the minimum, each with a
 // lower bound of its squared distance, and an upper bound of the minimum squared distance
 // (HUGE_VAL when no pair's interval enclosure was finite).
@@ -729,11 +759,14 @@ double interval_candidates(const ExactMeshPair& mp, const PosedBody& posed, doub
         best_upper = std::min(best_upper, d2.sup());
       }
     } catch (CGAL::Uncertain_conversion_exception&) {
-      // No interval value: the pair keeps its box bound, and bounds the minimum from above by
-      // two of its points when the body's triangle has an enclosure.
+      // No interval value: the pair's lower bound is its box's or a separating axis's, and it
+      // bounds the minimum from above by two of its points (when the body's triangle has an
+      // enclosure).
       try {
-        best_upper = std::min(best_upper, witness_upper_bound(to_interval(BodyFace{&posed, &mp.god, c.f}),
-                                                              to_interval(ObstacleFace{&mp.obstacle, c.of})));
+        const IntervalKernel::Triangle_3 A = to_interval(BodyFace{&posed, &mp.god, c.f});
+        const IntervalKernel::Triangle_3 B = to_interval(ObstacleFace{&mp.obstacle, c.of});
+        best_upper = std::min(best_upper, witness_upper_bound(A, B));
+        refined.lower = std::max(refined.lower, separating_axis_lower_bound(A, B));
       } catch (CGAL::Uncertain_conversion_exception&) {
       }
     }
