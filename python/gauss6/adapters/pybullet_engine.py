@@ -62,7 +62,10 @@ class PyBulletEngine:
         self.cfg = common.parse_config(config, DEFAULTS)
         if self.cfg["max_force"] <= 0 or not 0 < self.cfg["erp"] <= 1:
             raise ValueError("config: max_force must be > 0 and erp in (0, 1]")
-        self.name = f"pybullet {pybullet.getAPIVersion()}"
+        from importlib.metadata import version
+
+        del pybullet  # imported above only to fail here when PyBullet is not installed
+        self.name = f"pybullet {version('pybullet')}"
         self.config = config
         self.client = None
 
