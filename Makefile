@@ -71,11 +71,15 @@ datasets: setup
 
 # Regenerates the datasets in place (byte-identical: `gauss6 datasets check`), then runs
 # the paper's scenarios: out/summary.json, out/report.md, the figures and the traces; then
-# the full-resolution bunnies (issue 20's third scenario, about 20 s): out/bunny_full/.
+# the full-resolution bunnies (issue 20's third scenario, about 20 s): out/bunny_full/; then
+# gauss6, MuJoCo, PyBullet and Drake side by side (out/engines/engines.md, docs/engine-adapters.md)
+# on ENGINES_SLICE (--slice S: the first S seconds of each script; empty: whole scripts).
+ENGINES_SLICE ?= --slice 4
 reproduce: setup
 	$(VENV)/gauss6 datasets generate
 	$(VENV)/gauss6 reproduce all --out out
 	$(VENV)/gauss6 reproduce bunny_full --out out/bunny_full
+	$(VENV)/gauss6 reproduce engines --out out/engines $(ENGINES_SLICE)
 
 clean:
 	rm -rf build build-fuzz out

@@ -9,6 +9,7 @@
     gauss6 report qp --out DIR
     gauss6 report peers [--out DIR] [--repeats N] [--ccd-only | --qp-only]
     gauss6 reproduce peg|bunny|all --out DIR [--threaded]
+    gauss6 reproduce engines --out DIR [--slice S]
     gauss6 trace export TRACE [--csv DIR] [--hapi FILE]
     gauss6 trace import FILE --format hapi|csv --out TRACE
     gauss6 view TRACE [TRACE ...] [--scene SCENE] [--out page.html]

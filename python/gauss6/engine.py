@@ -241,10 +241,16 @@ BUILT_ENGINES = {
 }
 
 
+# The same libraries inside an installed wheel (python/CMakeLists.txt: gauss6 and box-penalty).
+PACKAGED_ENGINES = Path(__file__).resolve().parent / "engines"
+
+
 def engine_library(name_or_path: str) -> Path:
-    """The library of a built engine's short name (gauss6, box-penalty, fault), or a path as given."""
+    """The library of a built engine's short name (gauss6, box-penalty, fault): the wheel's copy
+    when the package has one, else the build tree's; or a path as given."""
     if name_or_path in BUILT_ENGINES:
-        return paths.tool(BUILT_ENGINES[name_or_path])
+        packaged = PACKAGED_ENGINES / Path(BUILT_ENGINES[name_or_path]).name
+        return packaged if packaged.exists() else paths.tool(BUILT_ENGINES[name_or_path])
     path = Path(name_or_path)
     if not path.exists():
         raise EngineError(f"{path}: no such engine library (or one of {', '.join(BUILT_ENGINES)})")

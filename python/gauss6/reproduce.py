@@ -377,6 +377,10 @@ def reproduce(which: str, out: Path, threaded: bool = False, show_progress: bool
 
 
 def cmd_reproduce(args: argparse.Namespace) -> int:
+    if args.scenario == "engines":
+        from .reproduce_engines import cmd
+
+        return cmd(args)
     summary = reproduce(args.scenario, Path(args.out), threaded=args.threaded, show_progress=not args.quiet)
     print(json.dumps(summary, indent=2))
     failed = [n for n, s in summary.items() if n != "surfaces" and s["penetrating_poses"] != 0]
@@ -429,11 +433,14 @@ def cmd_trace_import(args: argparse.Namespace) -> int:
 def register(subparsers) -> None:
     """Adds `reproduce` and `trace export` to the gauss6 command's subparsers."""
     rep = subparsers.add_parser("reproduce", help="run the paper's scenarios and write figures and summaries")
-    rep.add_argument("scenario", choices=["peg", "bunny", "bunny_full", "surfaces", "all"],
-                     help="all: peg, bunny and surfaces; bunny_full (the full-resolution bunnies) runs alone")
+    rep.add_argument("scenario", choices=["peg", "bunny", "bunny_full", "surfaces", "all", "engines"],
+                     help="all: peg, bunny and surfaces; bunny_full (the full-resolution bunnies) and engines (gauss6, MuJoCo, "
+                          "PyBullet, Drake side by side: reproduce_engines.py) run alone")
     rep.add_argument("--out", required=True, help="output directory")
     rep.add_argument("--threaded", action="store_true", help="real threads and the wall clock (default: lockstep)")
     rep.add_argument("--quiet", action="store_true", help="no progress bars")
+    rep.add_argument("--slice", type=float, default=None,
+                     help="engines: run only the first S seconds of each script (default: whole)")
     rep.set_defaults(func=cmd_reproduce)
     tr = subparsers.add_parser("trace", help="run traces").add_subparsers(dest="action", required=True)
     ex = tr.add_parser("export", help="write a trace as CSV files (one per stream) and/or a HAPI device log")

@@ -405,6 +405,12 @@ class CcdMeshPair {
     return d;
   }
 
+  std::pair<double, double> separation_bracket(const Eigen::Vector3d& p, const Eigen::Vector4d& q,
+                                               double max_distance) {
+    const reference::SeparationBracket b = reference::separation_bracket(exact(), pose_from(p, q), max_distance);
+    return {b.lower, b.upper};
+  }
+
  private:
   const reference::ExactMeshPair& exact() {
     if (!exact_) exact_ = std::make_unique<reference::ExactMeshPair>(reference::make_exact_mesh_pair(god_, obstacle_));
@@ -638,7 +644,10 @@ void bind_ccd(py::module_& m) {
            "Whether the exact minimum distance at pose (p, q) is <= max_distance (reference separation_within): "
            "dict with within, upper (a certified upper bound of it when within) and exact (Gmpq was needed).")
       .def("separation", &CcdMeshPair::separation, py::arg("p"), py::arg("q"), py::arg("max_distance"),
-           "Exact minimum distance at pose (p, q) over pairs within max_distance: dict with within, lower, upper.");
+           "Exact minimum distance at pose (p, q) over pairs within max_distance: dict with within, lower, upper.")
+      .def("separation_bracket", &CcdMeshPair::separation_bracket, py::arg("p"), py::arg("q"), py::arg("max_distance"),
+           "Certified bracket (lower, upper) of the minimum distance at pose (p, q), intervals only (no exact "
+           "arithmetic): lower = max_distance, upper = inf when every pair is farther than max_distance.");
 }
 
 }  // namespace gauss6::python

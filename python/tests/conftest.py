@@ -1,4 +1,4 @@
-"""Fixtures shared by the Python tests."""
+"""Fixtures and markers shared by the Python tests (run a marked set alone with -m NAME)."""
 from __future__ import annotations
 
 import numpy as np
@@ -22,3 +22,8 @@ def nudged_projection(monkeypatch):
             return getattr(self._res, name)
 
     monkeypatch.setattr(gauss6, "project", lambda *a, **k: Nudged(real_project(*a, **k)))
+
+
+def pytest_configure(config):
+    config.addinivalue_line("markers", "adapters: the third-party engine adapters' smoke runs (a few hundred ticks "
+                                       "each, about a minute together; the full runs are `gauss6 reproduce engines`)")

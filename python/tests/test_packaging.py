@@ -10,6 +10,7 @@ pinned scikit-build-core and pybind11), so that its objects are the main build's
 GAUSS6_SKIP_WHEEL=1 to leave it out of a quick local run."""
 from __future__ import annotations
 
+import json
 import os
 import re
 import subprocess
@@ -64,3 +65,12 @@ def test_wheel_installs_into_a_fresh_venv_and_runs(tmp_path: Path):
     subprocess.run([venv / "bin" / "gauss6", "view", str(trace), "--scene", str(scene), "--out", str(page)],
                    cwd=tmp_path, check=True, capture_output=True, text=True)
     assert "three" in page.read_text()[:2_000_000].lower() and page.stat().st_size > 100_000
+    # gauss6's engine and the oracle's thresholds come with the wheel: validate loads the engine
+    # by name from the package (not the build tree) and judges a short run (0.3 s, free motion).
+    r = subprocess.run([venv / "bin" / "gauss6", "validate", "--engine", "gauss6", "--scene", str(scene),
+                        "--duration", "0.3", "--quiet", "--json", "--out", str(tmp_path / "validate")],
+                       cwd=tmp_path, capture_output=True, text=True)
+    assert r.returncode == 0, r.stderr
+    doc = json.loads(r.stdout)
+    assert doc["pass"] and "site-packages/gauss6/engines/" in doc["engine"]["library"]
+    assert doc["thresholds"]["file"].endswith("gauss6/data/oracle.toml")

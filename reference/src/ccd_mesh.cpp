@@ -643,18 +643,122 @@ int64_t count_intersecting_pairs(const ExactMeshPair& mp, const Pose& X) {
   return count;
 }
 
-ExactSeparation separation_distance(const ExactMeshPair& mp, const Pose& X, double max_distance) {
-  if (!(max_distance >= 0)) throw std::invalid_argument("separation_distance: max_distance must be >= 0");
-  const PosedBody posed(mp.god, X);
+namespace {
+
+// An upper bound of the squared distance between two triangles given by interval enclosures
+// of their vertices, for the pairs whose interval squared_distance cannot decide (near-parallel
+// triangles, where CGAL's comparisons are uncertain): the squared distance between two points
+// of the triangles. The points are chosen in doubles on the enclosures' midpoints (each vertex
+// of one triangle against the other: its projection inside the triangle, else the nearest
+// point of an edge), as barycentric weights, and evaluated in interval arithmetic from the
+// enclosures: a convex combination of the true vertices lies on the true triangle whatever
+// the rounding of its weights, so the bound holds. HUGE_VAL when no bound is finite.
+double witness_upper_bound(const IntervalKernel::Triangle_3& A, const IntervalKernel::Triangle_3& B) {
+  using I = IntervalKernel::FT;
+  auto mid = [](const IntervalKernel::Point_3& p) {
+    return Vec3(CGAL::to_double(p.x()), CGAL::to_double(p.y()), CGAL::to_double(p.z()));
+  };
+  struct Witness {
+    double d2 = HUGE_VAL;
+    double wa[3] = {0, 0, 0}, wb[3] = {0, 0, 0};
+  } best;
+  // The vertex v (weights wv on its triangle) against triangle T (midpoints t[3]).
+  auto against = [&](const Vec3& x, const double wv[3], const Vec3 t[3], bool v_in_a) {
+    auto consider = [&](const double wt[3]) {
+      const Vec3 y = wt[0] * t[0] + wt[1] * t[1] + wt[2] * t[2];
+      const double d2 = (x - y).squaredNorm();
+      if (d2 < best.d2) {
+        best.d2 = d2;
+        for (int k = 0; k < 3; ++k) {
+          best.wa[k] = v_in_a ? wv[k] : wt[k];
+          best.wb[k] = v_in_a ? wt[k] : wv[k];
+        }
+      }
+    };
+    const Vec3 e1 = t[1] - t[0], e2 = t[2] - t[0], n = e1.cross(e2);
+    const double nn = n.squaredNorm();
+    if (nn > 0) {  // the projection's barycentric coordinates
+      const Vec3 r = x - t[0];
+      const double v = r.cross(e2).dot(n) / nn, w = e1.cross(r).dot(n) / nn, u = 1 - v - w;
+      if (u >= 0 && v >= 0 && w >= 0) {
+        const double wt[3] = {u, v, w};
+        consider(wt);
+      }
+    }
+    for (int k = 0; k < 3; ++k) {  // the nearest point of each edge
+      const Vec3 &p = t[k], &q = t[(k + 1) % 3];
+      const double len2 = (q - p).squaredNorm();
+      const double s = len2 > 0 ? std::clamp((x - p).dot(q - p) / len2, 0.0, 1.0) : 0.0;
+      double wt[3] = {0, 0, 0};
+      wt[k] = 1 - s;
+      wt[(k + 1) % 3] = s;
+      consider(wt);
+    }
+  };
+  const Vec3 a[3] = {mid(A[0]), mid(A[1]), mid(A[2])}, b[3] = {mid(B[0]), mid(B[1]), mid(B[2])};
+  for (int k = 0; k < 3; ++k) {
+    double wv[3] = {0, 0, 0};
+    wv[k] = 1;
+    against(a[k], wv, b, true);
+    against(b[k], wv, a, false);
+  }
+  if (!(best.d2 < HUGE_VAL)) return HUGE_VAL;
+  CGAL::Protect_FPU_rounding<true> upward;
+  auto point = [](const IntervalKernel::Triangle_3& T, const double w[3], int c) {
+    const I sum = I(w[0]) + I(w[1]) + I(w[2]);
+    return (I(w[0]) * T[0][c] + I(w[1]) * T[1][c] + I(w[2]) * T[2][c]) / sum;
+  };
+  I d2(0);
+  for (int c = 0; c < 3; ++c) d2 += CGAL::square(point(A, best.wa, c) - point(B, best.wb, c));
+  return std::isfinite(d2.sup()) ? d2.sup() : HUGE_VAL;
+}
+
+// A lower bound of the squared distance between two triangles (interval enclosures of their
+// vertices), for the pairs whose interval squared_distance cannot decide: the gap between the
+// triangles' projections on each one's face normal (a separating axis), squared over the
+// normal's squared length, in interval arithmetic (rounding upward: the caller's mode). 0 when
+// no axis separates them for sure.
+double separating_axis_lower_bound(const IntervalKernel::Triangle_3& A, const IntervalKernel::Triangle_3& B) {
+  using I = IntervalKernel::FT;
+  double best = 0;
+  for (const IntervalKernel::Triangle_3* T : {&A, &B}) {
+    const IntervalKernel::Vector_3 n = CGAL::cross_product((*T)[1] - (*T)[0], (*T)[2] - (*T)[0]);
+    const I nn = n.squared_length();
+    if (!(nn.inf() > 0) || !std::isfinite(nn.sup())) continue;
+    double lo[2] = {HUGE_VAL, HUGE_VAL}, hi[2] = {-HUGE_VAL, -HUGE_VAL};
+    for (int t = 0; t < 2; ++t) {
+      const IntervalKernel::Triangle_3& U = t == 0 ? A : B;
+      for (int k = 0; k < 3; ++k) {
+        const I d = (U[k] - CGAL::ORIGIN) * n;
+        lo[t] = std::min(lo[t], d.inf());
+        hi[t] = std::max(hi[t], d.sup());
+      }
+    }
+    const double gap = std::max((I(lo[1]) - I(hi[0])).inf(), (I(lo[0]) - I(hi[1])).inf());
+    if (gap > 0 && std::isfinite(gap)) {
+      const I g2 = CGAL::square(I(gap)) / nn;
+      if (std::isfinite(g2.inf())) best = std::max(best, g2.inf());
+    }
+  }
+  return best;
+}
+
+// Passes 1 and 2 of separation_distance: the pairs that can still be the minimum, each with a
+// lower bound of its squared distance, and an upper bound of the minimum squared distance
+// (HUGE_VAL when no pair's interval enclosure was finite).
+struct SeparationCandidate {
+  int32_t f, of;
+  double lower;  // <= the pair's exact squared distance
+};
+
+double interval_candidates(const ExactMeshPair& mp, const PosedBody& posed, double max_distance,
+                           std::vector<SeparationCandidate>* close_out) {
   const TriangleMesh& body = mp.god;
   // Pass 1 (boxes): every pair whose boxes are within max_distance, with a
   // lower bound of its squared distance: the squared gap between the boxes
   // (the body's contain the exact triangle), rounded down by a relative 1e-12,
   // far above the few roundings of 2^-53 in it.
-  struct Candidate {
-    int32_t f, of;
-    double lower;  // <= the pair's exact squared distance
-  };
+  using Candidate = SeparationCandidate;
   std::vector<Candidate> candidates;
   candidate_pairs(mp, posed, max_distance, [&](int32_t f, int32_t of) {
     const CGAL::Bbox_3 a = posed.box(body.F(f, 0)) + posed.box(body.F(f, 1)) + posed.box(body.F(f, 2));
@@ -673,7 +777,7 @@ ExactSeparation separation_distance(const ExactMeshPair& mp, const Pose& X, doub
   // triangle/triangle squared_distance in interval arithmetic; the box bound
   // when the interval signs are uncertain or a vertex has no enclosure).
   double best_upper = HUGE_VAL;  // >= the minimum squared distance
-  std::vector<Candidate> close;
+  std::vector<Candidate>& close = *close_out;
   const ToInterval to_interval;
   for (const Candidate& c : candidates) {
     if (c.lower > best_upper) break;
@@ -687,9 +791,46 @@ ExactSeparation separation_distance(const ExactMeshPair& mp, const Pose& X, doub
         best_upper = std::min(best_upper, d2.sup());
       }
     } catch (CGAL::Uncertain_conversion_exception&) {
+      // No interval value: the pair's lower bound is its box's or a separating axis's, and it
+      // bounds the minimum from above by two of its points (when the body's triangle has an
+      // enclosure).
+      try {
+        const IntervalKernel::Triangle_3 A = to_interval(BodyFace{&posed, &mp.god, c.f});
+        const IntervalKernel::Triangle_3 B = to_interval(ObstacleFace{&mp.obstacle, c.of});
+        best_upper = std::min(best_upper, witness_upper_bound(A, B));
+        refined.lower = std::max(refined.lower, separating_axis_lower_bound(A, B));
+      } catch (CGAL::Uncertain_conversion_exception&) {
+      }
     }
     close.push_back(refined);
   }
+  return best_upper;
+}
+
+}  // namespace
+
+SeparationBracket separation_bracket(const ExactMeshPair& mp, const Pose& X, double max_distance) {
+  if (!(max_distance >= 0)) throw std::invalid_argument("separation_bracket: max_distance must be >= 0");
+  const PosedBody posed(mp.god, X);
+  std::vector<SeparationCandidate> close;
+  const double best_upper = interval_candidates(mp, posed, max_distance, &close);
+  SeparationBracket out;
+  // Every pair left out is farther than max_distance (its boxes are); the candidates' lower
+  // bounds hold for them; the minimum's square is at most best_upper.
+  double lower2 = HUGE_VAL;
+  for (const SeparationCandidate& c : close) lower2 = std::min(lower2, c.lower);
+  out.lower = lower2 == HUGE_VAL ? max_distance : std::min(max_distance, std::nextafter(std::sqrt(lower2), 0.0));
+  out.upper = best_upper == HUGE_VAL ? HUGE_VAL : std::nextafter(std::sqrt(best_upper), HUGE_VAL);
+  out.lower = std::min(out.lower, out.upper);
+  return out;
+}
+
+ExactSeparation separation_distance(const ExactMeshPair& mp, const Pose& X, double max_distance) {
+  if (!(max_distance >= 0)) throw std::invalid_argument("separation_distance: max_distance must be >= 0");
+  const PosedBody posed(mp.god, X);
+  using Candidate = SeparationCandidate;
+  std::vector<Candidate> close;
+  const double best_upper = interval_candidates(mp, posed, max_distance, &close);
   // Pass 3 (exact): by increasing lower bound, while a pair can still win.
   std::sort(close.begin(), close.end(), [](const Candidate& a, const Candidate& b) { return a.lower < b.lower; });
   const ToExact to_exact;

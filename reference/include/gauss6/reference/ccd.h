@@ -244,4 +244,15 @@ struct SeparationBound {
 };
 SeparationBound separation_within(const ExactMeshPair& meshes, const Pose& X, double max_distance);
 
+// A certified bracket lower <= d <= upper of the minimum distance d between the god-object at
+// pose X and the obstacle, from separation_distance's first two passes only (boxes, then
+// interval arithmetic on enclosures of the exact posed vertices; no Gmpq): enough to decide
+// d against a threshold outside the bracket, far cheaper than the exact value. When every
+// pair is farther than max_distance, lower = max_distance and upper = +infinity (upper is
+// also +infinity when no enclosure was finite).
+struct SeparationBracket {
+  double lower = 0, upper = 0;
+};
+SeparationBracket separation_bracket(const ExactMeshPair& meshes, const Pose& X, double max_distance);
+
 }  // namespace gauss6::reference
