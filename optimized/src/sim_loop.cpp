@@ -304,8 +304,17 @@ Vec6 command_motion(const RuntimeModel& model, const SimState& s) {
 
 // Step 4: xt = xs (+) ac; CCD; xs = xt or the stop pose; the new contact set
 // (and the settling leg by au - ac if the previous contacts' surface fell away).
+// The residual is what the contacts withheld from the user's command au, both
+// passes together, not asc - ac: on a shaded facet the shading normal leans
+// against the motion on one side of each vertex, asc then leans off the facet
+// (J asc > 0: pass 2 withholds nothing, asc - ac = 0) and the god-object lifted
+// off with nothing to settle it, so the contact set emptied and the force
+// dropped to zero for one step, every other step (716 of 2950 ticks of the
+// Figure 8 slide). au - ac still presses the god-object back onto the surface
+// it left, by the CCD, so property 7 and the contact hold. Plain surfaces
+// (asc = au) are unchanged, bit for bit.
 void advance_by(const RuntimeModel& model, SimState* s, SimStepInfo* info) {
-  const Vec6 residual = s->contacts.num_contacts > 0 ? Vec6(info->asc - info->ac) : Vec6::Zero();
+  const Vec6 residual = s->contacts.num_contacts > 0 ? Vec6(info->au - info->ac) : Vec6::Zero();
   const Pose x_start = s->xs;  // a copy: the step overwrites s->xs
   advance_god_object(model, x_start, pose_update(x_start, info->ac), residual, s, info);
 }
