@@ -642,6 +642,38 @@ TEST_CASE("ccd_step: a box falling flat onto a slab, and one tipping onto it", "
   }
 }
 
+TEST_CASE("ccd_step: a pair test that refuses its input is a conservative hit, never a miss", "[ccd_step]") {
+  // A box falling onto a triangle of the plane z = 0 whose corners reach 2e30:
+  // the pair tests refuse coordinates beyond 1e30 (ccd.cpp). The step must not
+  // report a free motion through it: kInvalidInput, with a hit no later than
+  // the true contact (u = 1/3).
+  const TriangleMesh god = make_box(1, 1, 1);
+  const TriangleMesh huge = gauss6::test::make_mesh({{-2, -2, 0}, {2e30, -2, 0}, {-2, 2e30, 0}}, {{0, 1, 2}}, "huge");
+  const Bvh gb = build_bvh(god), hb = build_bvh(huge);
+  const CcdBody obstacle{&huge, &hb};
+  const CcdBody body{&god, &gb};
+  CcdStepWorkspace ws;
+  CcdStepResult r;
+  for (const bool cached : {false, true}) {
+    CcdStepSettings settings;
+    if (!cached) settings.cache.margin = 0;
+    ccd_step(&obstacle, 1, body, {Vec3(0.1, 0.2, 1.5), Quat{}}, {Vec3(0.1, 0.2, -1.5), Quat{}}, settings, &ws, &r);
+    INFO("proximity cache " << cached);
+    CHECK(r.status == CcdStatus::kInvalidInput);
+    CHECK(r.hit);
+    CHECK(r.u_hit <= 1.0 / 3);
+  }
+  // Settings that cannot serve a step are refused before any pair test, by name.
+  CcdStepSettings bad;
+  bad.narrow.time_tolerance = 0;
+  REQUIRE(ccd_step_settings_problem(bad) != nullptr);
+  CHECK(std::string(ccd_step_settings_problem(bad)).find("time_tolerance") != std::string::npos);
+  ccd_step(&obstacle, 1, body, {Vec3(0.1, 0.2, 1.5), Quat{}}, {Vec3(0.1, 0.2, -1.5), Quat{}}, bad, &ws, &r);
+  CHECK(r.status == CcdStatus::kInvalidInput);
+  CHECK(r.num_pair_tests == 0);
+  CHECK(ccd_step_settings_problem(CcdStepSettings{}) == nullptr);
+}
+
 TEST_CASE("ccd_step: a bar pivoting about its lowest corner over a slab agrees with the brute force", "[ccd_step]") {
   // A 10 x 2 x 2 bar tilted over a slab, its lowest corner a small gap above
   // it, turned about that corner (G moving by the turn of its offset from the
