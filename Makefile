@@ -5,7 +5,7 @@ SHELL := /bin/bash
 VENV := .venv/bin
 JOBS ?= $(shell nproc)
 
-.PHONY: setup test reproduce bench ctest pytest proofs checks datasets clean wheel-test fuzz fuzz-short
+.PHONY: setup test reproduce bench ctest pytest proofs checks datasets clean wheel-test fuzz fuzz-short soak
 
 setup:
 	@tools/setup.sh
@@ -39,6 +39,16 @@ fuzz: setup
 FUZZ_SHORT_RUNS ?= 20000
 fuzz-short: setup
 	@FUZZ_RUNS=$(FUZZ_SHORT_RUNS) tools/fuzz.sh
+
+# A threaded run of SOAK_SECONDS (10 minutes) of SOAK_SCENE's script played over and
+# over while one busy process a core loads the machine (harness/tools/soak.cpp): every
+# force finite and within the limits, the resident set flat; deadline misses, jitter
+# and events in out/soak.json. Not part of `make test`.
+SOAK_SECONDS ?= 600
+SOAK_SCENE ?= datasets_generated/scenes/peg_in_hole.toml
+soak: setup
+	cmake --build build --target gauss6_soak
+	mkdir -p out && build/harness/gauss6_soak $(SOAK_SCENE) --seconds $(SOAK_SECONDS) --json out/soak.json
 
 # Every suite runs even when an earlier one fails; the target fails if any did.
 test: setup
