@@ -78,7 +78,10 @@ bool haptic_tick(const RuntimeModel& model, double t, Device* device, RuntimeCha
   // 1. Read the device; publish a good xh.
   const DeviceStatus status = device->read(t, &h->device);
   if (status == DeviceStatus::kOk) {
-    if (is_valid_pose(h->device.X_WH)) {
+    // A handle beyond the scene's coordinates (1e12) would make au reach the
+    // range where the projection's rows lose their digits (|au| ~ 1e155 reports
+    // optimal while violating one): refused at the entry, as a non-finite pose.
+    if (is_valid_pose(h->device.X_WH) && h->device.X_WH.p.cwiseAbs().maxCoeff() <= kMaxSceneCoordinate) {
       h->xh = h->device.X_WH;
       h->has_handle = true;
       h->last_good_time = t;

@@ -417,9 +417,13 @@ TEST_CASE("faults: projection failure is reported; the force stays finite and bo
 
 TEST_CASE("faults: invalid handle poses give zero force and an event; invalid settings are refused",
           "[runtime][faults]") {
-  SECTION("a zero quaternion from the device") {
-    ScriptedDevice device([](double t) {
-      if (t >= 0.6 && t < 0.603) return Pose{Vec3(0, 0, 0.04), Quat{0, 0, 0, 0}};
+  for (const Pose& bad : {Pose{Vec3(0, 0, 0.04), Quat{0, 0, 0, 0}}, Pose{Vec3(0, 0, -1e155), Quat{}},
+                          Pose{Vec3(2e12, 0, 0), Quat{}}})
+  DYNAMIC_SECTION("a zero quaternion, or a handle beyond the scene's coordinates: " << bad.p.transpose()) {
+    // A handle at 1e155 would make |au| ~ 1e155, where the projection reports optimal
+    // while violating a row: refused at the entry (kMaxSceneCoordinate, 1e12).
+    ScriptedDevice device([bad](double t) {
+      if (t >= 0.6 && t < 0.603) return bad;
       return Pose{Vec3(0, 0, std::max(0.04, 0.2 - 0.4 * t)), Quat{}};
     });
     Run r;

@@ -19,7 +19,7 @@ namespace gauss6 {
 // ---------------------------------------------------------------------------
 
 enum class RuntimeEventKind {
-  kInvalidHandlePose = 0,  // the device returned a non-finite pose: zero force this tick
+  kInvalidHandlePose = 0,  // the device returned a non-finite pose, or one beyond kMaxSceneCoordinate: zero force
   kDeviceError,            // read() returned a status other than kOk
   kDeviceTimeout,          // watchdog: no good sample for device_timeout: zero force
   kSimStalled,             // watchdog: no sim snapshot for sim_timeout: zero force
