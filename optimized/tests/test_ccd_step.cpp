@@ -194,7 +194,8 @@ TEST_CASE("ccd_step: a hint's pair is not searched twice, and a pair sharing one
       }
     };
     const int num_god = static_cast<int>(god.F.rows()), num_obs = static_cast<int>(obs.F.rows());
-    for (const auto& [gf, of] : bf.hitting_pairs) {
+    for (const auto& pair : bf.hitting_pairs) {
+      const int gf = pair.first, of = pair.second;  // not a structured binding: clang 14 cannot capture one
       add_free(num_obs, [&](int k) { return std::pair<int, int>{gf, (of + k) % num_obs}; });  // the god face's
       add_free(num_god, [&](int k) { return std::pair<int, int>{(gf + k) % num_god, of}; });  // the obstacle face's
     }
