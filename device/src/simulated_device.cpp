@@ -140,8 +140,10 @@ Vec6 SimulatedDevice::handle_velocity() const {
 
 void SimulatedDevice::step(double t, double h) {
   const SimulatedHandleParams& p = params_;
-  Vec3 f = F_.head<3>() - p.damping * v_;
-  Vec3 tau = F_.tail<3>() - p.angular_damping * w_;
+  Vec6 F = F_;
+  if (halted_.load(std::memory_order_acquire)) F.setZero();  // halt_force(), until the next write()
+  Vec3 f = F.head<3>() - p.damping * v_;
+  Vec3 tau = F.tail<3>() - p.angular_damping * w_;
   const bool gripped = script_.let_go_time < 0 || t < script_.let_go_time;
   if (gripped) {
     const HandSample hand = sample_hand(script_, t);
@@ -183,6 +185,12 @@ DeviceStatus SimulatedDevice::read(double t, DeviceState* state) {
 DeviceStatus SimulatedDevice::write(double /*t*/, const Vec6& F) {
   if (!F.allFinite()) return DeviceStatus::kError;
   F_ = F;
+  halted_.store(false, std::memory_order_release);
+  return DeviceStatus::kOk;
+}
+
+DeviceStatus SimulatedDevice::halt_force() noexcept {
+  halted_.store(true, std::memory_order_release);
   return DeviceStatus::kOk;
 }
 

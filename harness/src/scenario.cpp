@@ -45,6 +45,7 @@ struct Recorder {
   std::atomic<long> num_sim_steps{0};    // sim thread
   bool flush_in_run_time = false;        // lockstep: the haptic hook flushes every flush_period of run time
   std::atomic<double>* run_time_out = nullptr;  // ScenarioOptions::run_time_out
+  std::atomic<double> haptic_stalled_at{-1};     // watchdog thread -> haptic thread: kHapticStalled's time
 
   // Haptic thread.
   size_t next_phase = 0;
@@ -101,6 +102,9 @@ void on_haptic_tick(void* user, const HapticTickRecord& rec) {
                                  static_cast<double>(r->next_phase)});
     ++r->next_phase;
   }
+  // The watchdog thread's event goes into the trace from here (one writer a stream).
+  const double stalled_at = r->haptic_stalled_at.exchange(-1, std::memory_order_acq_rel);
+  if (stalled_at >= 0) r->writer->append(TraceEvent{stalled_at, TraceEventCode::kWatchdog, r->model->settings.device_timeout});
   if (!rec.gripped && !r->let_go_reported) {
     r->writer->append(TraceEvent{rec.time, TraceEventCode::kLetGo, 0});
     r->let_go_reported = true;
@@ -147,6 +151,12 @@ void on_event(void* user, const RuntimeEvent& e) {
     case RuntimeEventKind::kCouplingStalled:
       r->writer->append(TraceEvent{e.time, TraceEventCode::kWatchdog, s.coupling_timeout});
       break;
+    case RuntimeEventKind::kDeviceNotConnected:
+      r->writer->append(TraceEvent{e.time, TraceEventCode::kDeviceLost, 0});
+      break;
+    case RuntimeEventKind::kHapticStalled:  // the watchdog's thread: written by the next haptic tick
+      r->haptic_stalled_at.store(e.time, std::memory_order_release);
+      break;
     default: break;  // counted in RuntimeStats
   }
 }
@@ -177,9 +187,10 @@ HandScript load_scene_script(const Scene& scene) {
 
 namespace {
 
-void check_options(const ScenarioOptions& options) {
-  if (options.trace_path.empty()) throw ScenarioError("run_scenario: options.trace_path is empty");
-  if (!(options.progress_period > 0)) throw ScenarioError("run_scenario: progress_period must be > 0");
+// `caller` names the entry point in the message ("run_scenario", "run_replay").
+void check_options(const ScenarioOptions& options, const char* caller) {
+  if (options.trace_path.empty()) throw ScenarioError(std::string(caller) + ": options.trace_path is empty");
+  if (!(options.progress_period > 0)) throw ScenarioError(std::string(caller) + ": progress_period must be > 0");
 }
 
 // The run of the model with `device` for `duration` s of run time, recorded in
@@ -271,7 +282,7 @@ ScenarioResult run_device(const RuntimeModel& model, const Scene& scene, Device*
 
 ScenarioResult run_scenario(const Scene& scene, const HandScript& script, const ScenarioOptions& options) {
   const Clock::time_point wall_start = Clock::now();
-  check_options(options);
+  check_options(options, "run_scenario");
   try {
     validate_hand_script(script);
   } catch (const std::invalid_argument& e) {
@@ -293,7 +304,7 @@ ScenarioResult run_scenario(const Scene& scene, const HandScript& script, const 
 ScenarioResult run_replay(const Scene& scene, const Trace& recording, const std::vector<HandPhase>& phases,
                           const ScenarioOptions& options) {
   const Clock::time_point wall_start = Clock::now();
-  check_options(options);
+  check_options(options, "run_replay");
   const RuntimeModel model(scene, options.runtime);
   std::unique_ptr<ReplayDevice> device;
   try {

@@ -108,6 +108,6 @@ TEST_CASE("crash safety: a lockstep recording killed at random moments loses at 
   kill_at_random_moments(/*threaded=*/false, /*seconds=*/60, /*max_delay=*/0.8, /*num_kills=*/6);
 }
 
-TEST_CASE("crash safety: a threaded recording killed at random moments loses at most 1 s of run", "[scenario][crash]") {
+TEST_CASE("crash safety: a threaded recording killed at random moments loses at most 1 s of run", "[scenario][crash][threaded]") {
   kill_at_random_moments(/*threaded=*/true, /*seconds=*/3, /*max_delay=*/1.5, /*num_kills=*/4);
 }

@@ -140,7 +140,7 @@ TEST_CASE("run_scenario: lockstep runs repeat bit for bit", "[scenario]") {
   CHECK(a.contacts.num_rows() == b.contacts.num_rows());
 }
 
-TEST_CASE("run_scenario: threaded run writes a complete trace", "[scenario]") {
+TEST_CASE("run_scenario: threaded run writes a complete trace", "[scenario][threaded]") {
   const Scene scene = make_slab_scene();
   const HandScript script = make_press_script();
   ScenarioOptions options;
@@ -165,7 +165,9 @@ TEST_CASE("run_scenario: threaded run writes a complete trace", "[scenario]") {
 TEST_CASE("run_scenario: bad options and scripts are refused before the run", "[scenario]") {
   const Scene scene = make_slab_scene();
   ScenarioOptions options;  // no trace path
-  CHECK_THROWS_AS(run_scenario(scene, make_press_script(), options), ScenarioError);
+  CHECK_THROWS_WITH(run_scenario(scene, make_press_script(), options), Catch::StartsWith("run_scenario: "));
+  // Each entry point names itself in the message.
+  CHECK_THROWS_WITH(run_replay(scene, Trace{}, {}, options), Catch::StartsWith("run_replay: "));
   options.trace_path = temp_trace("bad");
   HandScript empty;
   CHECK_THROWS_AS(run_scenario(scene, empty, options), ScenarioError);

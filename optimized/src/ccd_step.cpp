@@ -22,9 +22,7 @@ namespace {
 // Every pointer the step reads is set and the settings are usable.
 bool inputs_valid(const CcdBody* obstacles, int num_obstacles, const CcdBody& god, const CcdStepSettings& settings,
                   const CcdStepWorkspace* ws) {
-  bool ok = god.mesh && god.bvh && ws && (num_obstacles == 0 || obstacles) && settings.max_sub_intervals >= 1 &&
-            settings.sub_interval_angle > 0 && settings.sub_interval_travel > 0 &&
-            valid_proximity_cache_settings(settings.cache);
+  bool ok = god.mesh && god.bvh && ws && (num_obstacles == 0 || obstacles) && !ccd_step_settings_problem(settings);
   for (int o = 0; ok && o < num_obstacles; ++o) ok = obstacles[o].mesh && obstacles[o].bvh;
   return ok;
 }
@@ -36,6 +34,21 @@ int plan_sub_intervals(const CcdMotion& motion, const CcdBody& god, const CcdSte
   const double travel = motion.nominal.dp.norm() / std::max(god.bvh->radius, 1e-300);
   const double want = std::max(angle / settings.sub_interval_angle, travel / settings.sub_interval_travel);
   return static_cast<int>(std::clamp(std::ceil(want), 1.0, static_cast<double>(settings.max_sub_intervals)));
+}
+
+// The time tolerance the step searches with: the settings', lowered so that
+// the back-off it allows (a hit is reported up to time_tolerance before the
+// contact, and the step stops there) moves no point of the god-object by more
+// than kBackOffFraction of min_separation: the stop pose then stays within the
+// contact band whatever the scene's units (a scene in millimetres with delta
+// 1e-9 and steps of 0.4 would stop 4e-7 away, 400 delta, with no contact rows).
+// A point moves by at most |dp| + angle radius over the step; the Cayley
+// parameter's speed in u varies by a factor under 2, within the fraction's margin.
+constexpr double kBackOffFraction = 0.05;
+double step_time_tolerance(const CcdMotion& motion, const CcdBody& god, const CcdStepSettings& settings) {
+  const double travel = motion.nominal.dp.norm() + motion_angle(motion.nominal, 1.0) * god.bvh->radius;
+  const double bound = kBackOffFraction * settings.narrow.min_separation / travel;
+  return bound < settings.narrow.time_tolerance ? bound : settings.narrow.time_tolerance;  // NaN, 0 travel: settings'
 }
 
 // The triangle pair is one of hints[0 .. count).
@@ -202,6 +215,22 @@ void set_near_pairs(StepState* s, int num_cand, double u0) {
 
 }  // namespace detail
 
+const char* ccd_step_settings_problem(const CcdStepSettings& s) {
+  const auto positive = [](double x) { return x > 0 && std::isfinite(x); };
+  const auto non_negative = [](double x) { return x >= 0 && std::isfinite(x); };
+  const CcdSettings& n = s.narrow;
+  if (!(n.time_tolerance > 0 && n.time_tolerance < 1)) return "ccd.narrow.time_tolerance must be in (0, 1)";
+  if (!positive(n.distance_tolerance)) return "ccd.narrow.distance_tolerance must be > 0 and finite";
+  if (!non_negative(n.min_separation)) return "ccd.narrow.min_separation must be >= 0 and finite";
+  if (n.max_iterations < 1) return "ccd.narrow.max_iterations must be >= 1";
+  if (s.max_sub_intervals < 1) return "ccd.max_sub_intervals must be >= 1";
+  if (!positive(s.sub_interval_angle) || !positive(s.sub_interval_travel))
+    return "ccd.sub_interval_angle and ccd.sub_interval_travel must be > 0 and finite";
+  if (!non_negative(s.near_distance)) return "ccd.near_distance must be >= 0 and finite";
+  if (!valid_proximity_cache_settings(s.cache)) return "ccd.cache: the proximity cache's settings are not valid";
+  return nullptr;
+}
+
 void ccd_step(const CcdBody* obstacles, int num_obstacles, const CcdBody& god, const Pose& X0, const Pose& X1,
               const CcdStepSettings& settings, CcdStepWorkspace* ws, CcdStepResult* result, const FeaturePair* hints,
               int num_hints) noexcept {
@@ -217,7 +246,10 @@ void ccd_step(const CcdBody* obstacles, int num_obstacles, const CcdBody& god, c
     result->status = ms == MotionStatus::kHalfTurn ? CcdStatus::kHalfTurn : CcdStatus::kInvalidInput;
     return;
   }
-  StepState s(obstacles, num_obstacles, god, X0, settings, ws, result, hints, num_hints);
+  CcdStepSettings step_settings = settings;
+  step_settings.narrow.time_tolerance = step_time_tolerance(result->motion, god, settings);
+  if (!(step_settings.narrow.time_tolerance > 0)) step_settings.narrow.time_tolerance = settings.narrow.time_tolerance;
+  StepState s(obstacles, num_obstacles, god, X0, step_settings, ws, result, hints, num_hints);
   // Plan the sub-intervals.
   s.n = plan_sub_intervals(s.motion, god, settings);
   result->num_sub_intervals = s.n;

@@ -2,6 +2,8 @@
 // (haptic_loop.h).
 #include "gauss6/haptic_loop.h"
 
+#include <cmath>
+
 #include "runtime_detail.h"
 
 namespace gauss6 {
@@ -23,11 +25,22 @@ Vec6 make_safe_wrench(const Vec6& F, double max_force, double max_torque, uint32
     *events |= bit(RuntimeEventKind::kNonFiniteForce);
     return Vec6::Zero();
   }
-  // Scale each part down to its limit (direction kept).
+  // Scale each part down to its limit (direction kept). A finite part whose
+  // norm overflows (components near 1e154 and above) is divided by its largest
+  // component first, so it is clamped to the limit, not to 0.
   Vec6 out = F;
-  const double f = F.head<3>().norm(), tau = F.tail<3>().norm();
-  if (f > max_force) out.head<3>() *= max_force / f, *events |= bit(RuntimeEventKind::kForceClamped);
-  if (tau > max_torque) out.tail<3>() *= max_torque / tau, *events |= bit(RuntimeEventKind::kForceClamped);
+  const auto clamp_part = [events](auto part, double limit) {
+    const double n = part.norm();
+    if (std::isfinite(n)) {
+      if (n > limit) part *= limit / n, *events |= bit(RuntimeEventKind::kForceClamped);
+      return;
+    }
+    part /= part.cwiseAbs().maxCoeff();
+    part *= limit / part.norm();
+    *events |= bit(RuntimeEventKind::kForceClamped);
+  };
+  clamp_part(out.head<3>(), max_force);
+  clamp_part(out.tail<3>(), max_torque);
   if (!all_finite(out)) {  // only when a limit itself is not finite
     *events |= bit(RuntimeEventKind::kNonFiniteForce);
     return Vec6::Zero();
@@ -40,7 +53,7 @@ namespace {
 constexpr uint32_t kZeroForceEvents =
     bit(RuntimeEventKind::kInvalidHandlePose) | bit(RuntimeEventKind::kDeviceTimeout) |
     bit(RuntimeEventKind::kSimStalled) | bit(RuntimeEventKind::kCouplingStalled) |
-    bit(RuntimeEventKind::kDeviceEnded);
+    bit(RuntimeEventKind::kDeviceEnded) | bit(RuntimeEventKind::kDeviceNotConnected);
 
 // The smaller of the scene's limit and the device's; a device limit that is not a
 // positive number (unset, NaN) leaves the scene's, which the model checked is > 0.
@@ -65,7 +78,10 @@ bool haptic_tick(const RuntimeModel& model, double t, Device* device, RuntimeCha
   // 1. Read the device; publish a good xh.
   const DeviceStatus status = device->read(t, &h->device);
   if (status == DeviceStatus::kOk) {
-    if (is_valid_pose(h->device.X_WH)) {
+    // A handle beyond the scene's coordinates (1e12) would make au reach the
+    // range where the projection's rows lose their digits (|au| ~ 1e155 reports
+    // optimal while violating one): refused at the entry, as a non-finite pose.
+    if (is_valid_pose(h->device.X_WH) && h->device.X_WH.p.cwiseAbs().maxCoeff() <= kMaxSceneCoordinate) {
       h->xh = h->device.X_WH;
       h->has_handle = true;
       h->last_good_time = t;
@@ -80,6 +96,8 @@ bool haptic_tick(const RuntimeModel& model, double t, Device* device, RuntimeCha
   } else if (status == DeviceStatus::kEnded) {
     events |= bit(RuntimeEventKind::kDeviceEnded);
     h->ended = true;
+  } else if (status == DeviceStatus::kNotConnected) {
+    events |= bit(RuntimeEventKind::kDeviceNotConnected);  // zero force now (device_port.h), not after the timeout
   } else {
     events |= bit(RuntimeEventKind::kDeviceError);
   }
@@ -113,11 +131,19 @@ bool haptic_tick(const RuntimeModel& model, double t, Device* device, RuntimeCha
   if (!h->limits.resolved) h->limits = resolve_wrench_limits(model, device->info());
   F = make_safe_wrench(F, h->limits.max_force, h->limits.max_torque, &events);
 
-  // 4. Write the device.
-  device->write(t, F);
+  // 4. Write the device. A failed write may leave the last force rendered: zero
+  // is written at once, and if that fails too the device is asked to halt.
+  DeviceStatus written = device->write(t, F);
+  if (written != DeviceStatus::kOk) {
+    events |= bit(RuntimeEventKind::kDeviceWriteFailed);
+    F.setZero();
+    if (device->write(t, F) != DeviceStatus::kOk) device->halt_force();
+  }
 
-  // Events (onsets), statistics, record.
-  report_onsets(events, &h->active_events, t, h->tick, observer, &stats->haptic, static_cast<int>(status));
+  // Events (onsets), statistics, record. The detail is the read's status, or
+  // the failed write's when the read was good.
+  const int detail = static_cast<int>(status != DeviceStatus::kOk ? status : written);
+  report_onsets(events, &h->events, settings.event_interval, t, h->tick, observer, &stats->haptic, detail);
   stats->haptic.work.add(seconds_since(start));
   HapticTickRecord& rec = h->record;
   rec.tick = h->tick;

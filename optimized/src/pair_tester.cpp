@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <array>
+#include <cmath>
 
 #include "gauss6/distance.h"
 #include "gauss6/feature_pair.h"
@@ -20,6 +21,19 @@ Vec3 vertex(const TriangleMesh& m, int f, int k) { return m.V.row(m.F(f, k)).tra
 void PairTester::consider(const CcdResult& r, const FeaturePair& p) {
   ++result->num_pair_tests;
   result->num_box_iterations += r.iterations;
+  if (r.status == CcdStatus::kInvalidInput) {
+    // The pair test refused its input (a coordinate beyond its bound): nothing
+    // is known of this pair, so it is a hit at the window's start, and the step
+    // says it was refused (never a miss).
+    result->status = CcdStatus::kInvalidInput;
+    if (result->hit && result->u_hit <= u0) return;
+    result->hit = true;
+    result->u_hit = u0;
+    result->pair = p;
+    result->time_tolerance_reached = 0;
+    result->distance_reached = INFINITY;
+    return;
+  }
   if (!r.hit || (result->hit && r.u_hit >= result->u_hit)) return;
   result->hit = true;
   result->u_hit = r.u_hit;

@@ -33,9 +33,16 @@ void run_sim_step(const RuntimeModel& model, double t, const RuntimeObserver& ob
   uint32_t events = data->sim.step_events;
   if (info.ccd != CcdStatus::kOk) events |= bit(RuntimeEventKind::kCcdGaveUp);
   if (projection_failed(info.projection)) events |= bit(RuntimeEventKind::kProjectionFailed);
-  report_onsets(events, &data->sim.active_events, t, info.step, observer, &data->stats.sim,
+  report_onsets(events, &data->sim.events, model.settings.event_interval, t, info.step, observer, &data->stats.sim,
                 static_cast<int>(info.ccd));
   if (observer.on_sim_step) observer.on_sim_step(observer.user, info);
+}
+
+// The run's end: every loop's pending (coalesced) events go out.
+void flush_all_events(double t, const RuntimeObserver& observer, RuntimeData* data) {
+  flush_events(&data->sim.events, t, observer);
+  flush_events(&data->coupling.events, t, observer);
+  flush_events(&data->haptic.events, t, observer);
 }
 
 }  // namespace
@@ -86,6 +93,7 @@ void run_lockstep(const RuntimeModel& model, Device* device, long num_ticks, con
       break;
   }
   device->write(t, Vec6::Zero());  // leave the handle without force
+  flush_all_events(t, observer, data);
   data->stats.run_seconds = t;
 }
 
@@ -122,7 +130,8 @@ void run_threaded(const RuntimeModel& model, Device* device, double seconds, con
         data->stats.coupling.add_start(t);
         data->stats.coupling.work.add(info.force_seconds);
         const uint32_t events = projection_failed(info.projection) ? bit(RuntimeEventKind::kProjectionFailed) : 0;
-        report_onsets(events, &data->coupling.active_events, t, info.god_sequence, observer, &data->stats.coupling);
+        report_onsets(events, &data->coupling.events, settings.event_interval, t, info.god_sequence, observer,
+                      &data->stats.coupling);
         if (observer.on_coupling_step) observer.on_coupling_step(observer.user, info);
         if (settings.coupling_min_period > 0) std::this_thread::sleep_until(at(t + settings.coupling_min_period));
         else std::this_thread::yield();
@@ -131,7 +140,9 @@ void run_threaded(const RuntimeModel& model, Device* device, double seconds, con
   }
 
   // Haptic loop: fixed rate, sleep_until pacing; a late start beyond one period
-  // is an overrun and the schedule resyncs to now.
+  // is an overrun and the schedule resyncs to now. It marks the run time each
+  // tick ends at for the watchdog (haptic_alive).
+  std::atomic<double> haptic_alive{0};
   std::thread haptic([&] {
     LoopStats& hs = data->stats.haptic;
     apply_thread_policy(settings, 0, &hs);
@@ -146,6 +157,7 @@ void run_threaded(const RuntimeModel& model, Device* device, double seconds, con
       if (!haptic_tick(model, t, device, &data->channels, &data->haptic, coupling_thread ? nullptr : &data->coupling,
                        observer, &data->stats))
         break;
+      haptic_alive.store(seconds_since(start), std::memory_order_release);
       if (late > period) {
         ++hs.overruns;
         scheduled = t;  // resync
@@ -156,10 +168,36 @@ void run_threaded(const RuntimeModel& model, Device* device, double seconds, con
     quit.store(true, std::memory_order_release);
   });
 
+  // Watchdog of the haptic loop, in a thread of its own (the device's watchdog in
+  // the haptic tick cannot fire while the tick itself is blocked in read() or
+  // write()): when no tick has ended for device_timeout, the device is asked to
+  // halt its force from here (Device::halt_force; its status is the event's
+  // detail) and kHapticStalled is reported. The tick that finally returns finds
+  // its sample late and zeroes the force itself (kDeviceTimeout) until a good one.
+  std::thread watchdog([&] {
+    EventGate gate;
+    bool stalled = false;
+    const double poll = std::min(settings.device_timeout / 4, period);
+    double t = 0;
+    while (!quit.load(std::memory_order_acquire)) {
+      std::this_thread::sleep_until(at(t + poll));
+      t = seconds_since(start);
+      const bool now_stalled = t - haptic_alive.load(std::memory_order_acquire) > settings.device_timeout;
+      int detail = 0;
+      if (now_stalled && !stalled) detail = static_cast<int>(device->halt_force());
+      stalled = now_stalled;
+      report_onsets(now_stalled ? bit(RuntimeEventKind::kHapticStalled) : 0u, &gate, settings.event_interval, t,
+                    /*tick=*/0, observer, &data->stats.watchdog, detail);
+    }
+    flush_events(&gate, t, observer);
+  });
+
   haptic.join();
   sim.join();
   if (coupling.joinable()) coupling.join();
+  watchdog.join();
   data->stats.run_seconds = seconds_since(start);
+  flush_all_events(data->stats.run_seconds, observer, data);
 }
 
 }  // namespace gauss6

@@ -31,23 +31,58 @@ inline double thread_cpu_seconds() {
 constexpr uint32_t bit(RuntimeEventKind k) { return 1u << static_cast<int>(k); }
 static_assert(kNumRuntimeEventKinds <= 32, "event kinds are bits of a uint32_t");
 
-// Reports the conditions of `events` that did not hold last time (*active), and
-// counts them in stats.
-inline void report_onsets(uint32_t events, uint32_t* active, double t, uint64_t tick,
+// Reports the conditions of `events` that did not hold last time (gate->active),
+// counts each in stats, and hands them to the observer rate-limited by the gate
+// (EventGate, runtime_events.h): a kind reported less than `interval` ago is
+// counted as pending; pending onsets go out as one event (count = their
+// number) once `interval` has passed.
+inline void emit_event(RuntimeEventKind kind, double t, uint64_t tick, int detail, uint32_t count,
+                       const RuntimeObserver& observer) {
+  if (!observer.on_event) return;
+  RuntimeEvent e;
+  e.kind = kind;
+  e.time = t;
+  e.tick = tick;
+  e.detail = detail;
+  e.count = count;
+  observer.on_event(observer.user, e);
+}
+
+inline void report_onsets(uint32_t events, EventGate* gate, double interval, double t, uint64_t tick,
                           const RuntimeObserver& observer, LoopStats* stats, int detail = 0) {
-  const uint32_t onset = events & ~*active;
-  *active = events;
+  const uint32_t onset = events & ~gate->active;
+  gate->active = events;
   for (int k = 0; k < kNumRuntimeEventKinds; ++k) {
-    if (!(onset & (1u << k))) continue;
-    ++stats->event_counts[k];
-    if (observer.on_event) {
-      RuntimeEvent e;
-      e.kind = static_cast<RuntimeEventKind>(k);
-      e.time = t;
-      e.tick = tick;
-      e.detail = detail;
-      observer.on_event(observer.user, e);
+    const bool due = !gate->reported[k] || t - gate->last_report[k] >= interval;
+    if (onset & (1u << k)) {
+      ++stats->event_counts[k];
+      if (!due) {
+        if (gate->pending[k]++ == 0) gate->pending_tick[k] = tick;
+        gate->pending_detail[k] = detail;
+        continue;
+      }
+      emit_event(static_cast<RuntimeEventKind>(k), t, tick, detail, gate->pending[k] + 1, observer);
+    } else if (gate->pending[k] && due) {
+      emit_event(static_cast<RuntimeEventKind>(k), t, gate->pending_tick[k], gate->pending_detail[k],
+                 gate->pending[k], observer);
+    } else {
+      continue;
     }
+    gate->pending[k] = 0;
+    gate->reported[k] = true;
+    gate->last_report[k] = t;
+  }
+}
+
+// At the end of a run: the onsets still pending go out (time t).
+inline void flush_events(EventGate* gate, double t, const RuntimeObserver& observer) {
+  for (int k = 0; k < kNumRuntimeEventKinds; ++k) {
+    if (!gate->pending[k]) continue;
+    emit_event(static_cast<RuntimeEventKind>(k), t, gate->pending_tick[k], gate->pending_detail[k], gate->pending[k],
+               observer);
+    gate->pending[k] = 0;
+    gate->reported[k] = true;
+    gate->last_report[k] = t;
   }
 }
 

@@ -17,6 +17,9 @@ const char* to_string(RuntimeEventKind k) {
     case RuntimeEventKind::kCcdGaveUp: return "ccd_gave_up";
     case RuntimeEventKind::kContactOverflow: return "contact_overflow";
     case RuntimeEventKind::kTextureUndersampled: return "texture_undersampled";
+    case RuntimeEventKind::kDeviceNotConnected: return "device_not_connected";
+    case RuntimeEventKind::kDeviceWriteFailed: return "device_write_failed";
+    case RuntimeEventKind::kHapticStalled: return "haptic_stalled";
   }
   return "unknown";
 }

@@ -51,6 +51,7 @@ RuntimeModel::RuntimeModel(const Scene& scene, const RuntimeSettings& s) : setti
     if (problem) fail(problem.message());
   for (const Body& b : scene.obstacles)
     if (const SettingsProblem p = check_crease_angle(b.crease_angle)) fail(b.name + ": " + p.message());
+  if (const SettingsProblem p = check_delta_scale(scene)) fail(p.message());
   if (num_triangles(scene.god_object.mesh) == 0) fail("the god-object's mesh is empty");
   if (!(s.contact_factor > 0) || !(s.gap_factor > 0 && s.gap_factor < s.contact_factor))
     fail("settings: need 0 < gap_factor < contact_factor");
@@ -60,10 +61,20 @@ RuntimeModel::RuntimeModel(const Scene& scene, const RuntimeSettings& s) : setti
   if (!(s.cache_margin >= 0 && s.cache_margin_max >= 0) || !std::isfinite(s.cache_margin) ||
       !std::isfinite(s.cache_margin_max) || s.cache_fill_budget < 0)
     fail("settings: the cache's margins and fill budget must be >= 0 (and finite)");
-  if (!(s.device_timeout > 0) || !(s.sim_timeout > 0) || !(s.coupling_timeout > 0))
-    fail("settings: timeouts must be > 0");
+  // Watchdogs: a timeout that is infinite, NaN or absurdly long would switch one off.
+  const auto timeout_ok = [](double x) { return x > 0 && x <= kMaxTimeout; };
+  if (!timeout_ok(s.device_timeout) || !timeout_ok(s.sim_timeout) || !timeout_ok(s.coupling_timeout))
+    fail("settings: device_timeout, sim_timeout and coupling_timeout must be in (0, " + std::to_string(kMaxTimeout) +
+         "] s (got " + std::to_string(s.device_timeout) + ", " + std::to_string(s.sim_timeout) + ", " +
+         std::to_string(s.coupling_timeout) + ")");
+  if (!(s.event_interval >= 0 && s.event_interval <= kMaxTimeout))
+    fail("settings: event_interval must be in [0, " + std::to_string(kMaxTimeout) + "] s");
   if (s.lockstep_sim_period < 1) fail("settings: lockstep_sim_period must be >= 1");
-  if (!(s.sim_min_period >= 0) || !(s.coupling_min_period >= 0)) fail("settings: min periods must be >= 0");
+  // A loop paced slower than its own watchdog would trip it on every step.
+  if (!(s.sim_min_period >= 0 && s.sim_min_period < s.sim_timeout) ||
+      !(s.coupling_min_period >= 0 && s.coupling_min_period < s.coupling_timeout))
+    fail("settings: min periods must be >= 0 and below their loop's timeout (sim_min_period < sim_timeout, "
+         "coupling_min_period < coupling_timeout)");
 
   // Obstacles: vertices and normals moved to the world frame once; BVHs built once.
   obstacle_meshes_W.reserve(scene.obstacles.size());
@@ -78,6 +89,16 @@ RuntimeModel::RuntimeModel(const Scene& scene, const RuntimeSettings& s) : setti
     }
     obstacle_meshes_W.push_back(std::move(m));
   }
+  // The scene file's bound on coordinates, in the world frame and for a scene
+  // built in code too: beyond it the CCD's pair tests would refuse the obstacle.
+  for (size_t k = 0; k < obstacle_meshes_W.size(); ++k)
+    if (!(obstacle_meshes_W[k].V.size() == 0 || obstacle_meshes_W[k].V.cwiseAbs().maxCoeff() <= kMaxSceneCoordinate))
+      fail(scene.obstacles[k].name + ": a vertex coordinate (world frame) beyond " +
+           std::to_string(kMaxSceneCoordinate) + " or not finite");
+  if (!(scene.god_object.mesh.V.cwiseAbs().maxCoeff() <= kMaxSceneCoordinate) ||
+      !(scene.god_object.pose.p.cwiseAbs().maxCoeff() <= kMaxSceneCoordinate) || !is_valid_pose(scene.god_object.pose))
+    fail("the god-object's vertices or initial pose are beyond " + std::to_string(kMaxSceneCoordinate) +
+         " or not valid");
   for (TriangleMesh& m : obstacle_meshes_W)
     if (m.adjacency.FE.rows() != m.F.rows()) build_adjacency(&m);
   for (const TriangleMesh& m : obstacle_meshes_W) obstacle_bvhs_W.push_back(build_bvh(m));
@@ -109,6 +130,7 @@ RuntimeModel::RuntimeModel(const Scene& scene, const RuntimeSettings& s) : setti
   device = scene.device;
 
   const EffectiveSettings effective = resolve_runtime_settings(scene, s);
+  if (const char* problem = ccd_step_settings_problem(effective.runtime.ccd)) fail(std::string("settings: ") + problem);
   settings = effective.runtime;
   contact_generation = effective.contact_generation;
   match_distance = settings.match_distance > 0 ? settings.match_distance : 1e-3 * god_radius;

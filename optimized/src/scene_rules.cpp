@@ -2,7 +2,9 @@
 // rules its settings must meet (check_gains() and the others, scene.h), stated
 // once in the core: the scene loader applies them at each key's line, and the
 // runtime model applies the same rules to a scene built in code.
+#include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "gauss6/scene.h"
 
@@ -77,6 +79,28 @@ SettingsProblem check_surface_settings(const SurfaceSettings& s) {
 SettingsProblem check_crease_angle(double degrees) {
   if (!(std::isfinite(degrees) && degrees >= 0 && degrees <= 180))
     return {"obstacle", "crease_angle", "must be in [0, 180] (degrees)"};
+  return {};
+}
+
+double scene_extent(const Scene& scene) {
+  double extent = 0;
+  const auto reach = [&](const Body& b) {
+    const double r = b.mesh.V.rows() ? b.mesh.V.rowwise().norm().maxCoeff() : 0.0;  // rotations keep norms
+    extent = std::max(extent, b.pose.p.norm() + r);
+  };
+  for (const Body& b : scene.obstacles) reach(b);
+  reach(scene.god_object);
+  return extent;
+}
+
+SettingsProblem check_delta_scale(const Scene& scene) {
+  static_assert(kMinDeltaPerExtent == 1e-14, "the message below states it");
+  const double extent = scene_extent(scene), delta = scene.contact.delta;
+  if (!(delta >= std::numeric_limits<double>::min() && delta >= kMinDeltaPerExtent * extent))
+    return {"contact", "delta",
+            "must be at least 1e-14 of the scene's extent (" + std::to_string(extent) +
+                ", the farthest vertex from the origin) and a normal number: smaller, it "
+                "nears the coordinates' rounding and the CCD cannot keep its stop distance inside the contact band"};
   return {};
 }
 

@@ -194,7 +194,8 @@ TEST_CASE("ccd_step: a hint's pair is not searched twice, and a pair sharing one
       }
     };
     const int num_god = static_cast<int>(god.F.rows()), num_obs = static_cast<int>(obs.F.rows());
-    for (const auto& [gf, of] : bf.hitting_pairs) {
+    for (const auto& pair : bf.hitting_pairs) {
+      const int gf = pair.first, of = pair.second;  // not a structured binding: clang 14 cannot capture one
       add_free(num_obs, [&](int k) { return std::pair<int, int>{gf, (of + k) % num_obs}; });  // the god face's
       add_free(num_god, [&](int k) { return std::pair<int, int>{(gf + k) % num_god, of}; });  // the obstacle face's
     }
@@ -640,6 +641,38 @@ TEST_CASE("ccd_step: a box falling flat onto a slab, and one tipping onto it", "
              &r);
     CHECK(r.status == CcdStatus::kHalfTurn);
   }
+}
+
+TEST_CASE("ccd_step: a pair test that refuses its input is a conservative hit, never a miss", "[ccd_step]") {
+  // A box falling onto a triangle of the plane z = 0 whose corners reach 2e30:
+  // the pair tests refuse coordinates beyond 1e30 (ccd.cpp). The step must not
+  // report a free motion through it: kInvalidInput, with a hit no later than
+  // the true contact (u = 1/3).
+  const TriangleMesh god = make_box(1, 1, 1);
+  const TriangleMesh huge = gauss6::test::make_mesh({{-2, -2, 0}, {2e30, -2, 0}, {-2, 2e30, 0}}, {{0, 1, 2}}, "huge");
+  const Bvh gb = build_bvh(god), hb = build_bvh(huge);
+  const CcdBody obstacle{&huge, &hb};
+  const CcdBody body{&god, &gb};
+  CcdStepWorkspace ws;
+  CcdStepResult r;
+  for (const bool cached : {false, true}) {
+    CcdStepSettings settings;
+    if (!cached) settings.cache.margin = 0;
+    ccd_step(&obstacle, 1, body, {Vec3(0.1, 0.2, 1.5), Quat{}}, {Vec3(0.1, 0.2, -1.5), Quat{}}, settings, &ws, &r);
+    INFO("proximity cache " << cached);
+    CHECK(r.status == CcdStatus::kInvalidInput);
+    CHECK(r.hit);
+    CHECK(r.u_hit <= 1.0 / 3);
+  }
+  // Settings that cannot serve a step are refused before any pair test, by name.
+  CcdStepSettings bad;
+  bad.narrow.time_tolerance = 0;
+  REQUIRE(ccd_step_settings_problem(bad) != nullptr);
+  CHECK(std::string(ccd_step_settings_problem(bad)).find("time_tolerance") != std::string::npos);
+  ccd_step(&obstacle, 1, body, {Vec3(0.1, 0.2, 1.5), Quat{}}, {Vec3(0.1, 0.2, -1.5), Quat{}}, bad, &ws, &r);
+  CHECK(r.status == CcdStatus::kInvalidInput);
+  CHECK(r.num_pair_tests == 0);
+  CHECK(ccd_step_settings_problem(CcdStepSettings{}) == nullptr);
 }
 
 TEST_CASE("ccd_step: a bar pivoting about its lowest corner over a slab agrees with the brute force", "[ccd_step]") {

@@ -20,141 +20,15 @@
 #include "gauss6/mass_properties.h"
 #include "gauss6/runtime.h"
 #include "mesh_shapes.h"
+#include "runtime_fixtures.h"
 
 using namespace gauss6;
 using gauss6::test::make_box;
 using Vec2 = Eigen::Vector2d;
 
+using namespace gauss6::test;
+
 namespace {
-
-constexpr double kSide = 0.1;        // god-object: cube of side 10 cm, density 1000: m = 1 kg
-constexpr double kHalf = kSide / 2;  // G rests at z = kHalf above the top face
-constexpr double kDelta = 1e-5;
-constexpr double kKs = 0.5, kKh = 1000;  // felt stiffness kh m ks = 500 N/m
-constexpr double kRate = 1000;
-
-Scene make_scene(double offset_eps = -1e-3, double offset_time = 0.05) {
-  Scene sc;
-  sc.path = "test:box_on_box";
-  sc.name = "box_on_box";
-  Body slab;
-  slab.name = "slab";
-  slab.mesh = make_box(1.0, 1.0, 0.1, Vec3(0, 0, -0.05));  // top face z = 0
-  build_adjacency(&slab.mesh);
-  compute_vertex_normals(&slab.mesh);
-  sc.obstacles.push_back(slab);
-  sc.god_object.name = "cube";
-  sc.god_object.role = BodyRole::kGodObject;
-  sc.god_object.mesh = make_box(kSide, kSide, kSide);  // body frame: origin at G (centre)
-  build_adjacency(&sc.god_object.mesh);
-  compute_vertex_normals(&sc.god_object.mesh);
-  sc.god_object.pose = {Vec3(0, 0, 0.2), Quat{}};
-  std::string error;
-  REQUIRE(compute_mass_properties(sc.god_object.mesh, 1000, &sc.god_mass.mass, &error));
-  sc.gains.ks = kKs;
-  sc.gains.kh = kKh;
-  sc.contact.delta = kDelta;
-  sc.contact.offset_eps = offset_eps;
-  sc.contact.offset_time = offset_time;
-  sc.device.rate_hz = kRate;
-  sc.device.max_force = 20;
-  sc.device.max_torque = 1;
-  return sc;
-}
-
-// Lowest point of the god-object at pose x: the top face is at z = 0.
-double lowest_z(const RuntimeModel& model, const Pose& x) {
-  double z = INFINITY;
-  for (int v = 0; v < model.god_mesh_B.V.rows(); ++v)
-    z = std::min(z, transform_point(x, model.god_mesh_B.V.row(v).transpose()).z());
-  return z;
-}
-
-// A device that plays a scripted handle trajectory, with faults on request,
-// and records every wrench it is sent.
-class ScriptedDevice : public Device {
- public:
-  explicit ScriptedDevice(std::function<Pose(double)> script) : script_(std::move(script)) {
-    info_.name = "scripted test device";
-    info_.rate_hz = kRate;
-    writes.reserve(100000);
-  }
-  const DeviceInfo& info() const override { return info_; }
-  void set_limits(double max_force, double max_torque) { info_.max_force = max_force, info_.max_torque = max_torque; }
-  DeviceStatus read(double t, DeviceState* state) override {
-    state->time = t;
-    if (t >= end_time) return state->status = DeviceStatus::kEnded;
-    if (t >= timeout_from) return state->status = DeviceStatus::kTimeout;
-    state->X_WH = script_(t);
-    if (t >= nan_from && t < nan_to) state->X_WH.p.x() = std::nan("");
-    return state->status = DeviceStatus::kOk;
-  }
-  DeviceStatus write(double t, const Vec6& F) override {
-    writes.push_back({t, F});
-    return DeviceStatus::kOk;
-  }
-  struct Write {
-    double t;
-    Vec6 F;
-  };
-  std::vector<Write> writes;
-  double nan_from = INFINITY, nan_to = INFINITY, timeout_from = INFINITY, end_time = INFINITY;
-
- private:
-  std::function<Pose(double)> script_;
-  DeviceInfo info_;
-};
-
-// Everything the hooks report.
-struct Recorder {
-  std::vector<RuntimeEvent> events;
-  std::mutex events_mutex;
-  std::vector<SimStepInfo> sims;
-  std::vector<CouplingStepInfo> couplings;
-  std::vector<HapticTickRecord> ticks;
-  std::atomic<bool> stop{false};
-  std::function<void(const HapticTickRecord&)> on_tick;  // optional extra check
-  RuntimeObserver observer() {
-    RuntimeObserver o;
-    o.user = this;
-    o.on_event = [](void* u, const RuntimeEvent& e) {
-      auto* rec = static_cast<Recorder*>(u);
-      std::lock_guard<std::mutex> lock(rec->events_mutex);  // threaded runs: several loops report
-      rec->events.push_back(e);
-    };
-    o.on_sim_step = [](void* u, const SimStepInfo& i) { static_cast<Recorder*>(u)->sims.push_back(i); };
-    o.on_coupling_step = [](void* u, const CouplingStepInfo& i) { static_cast<Recorder*>(u)->couplings.push_back(i); };
-    o.on_haptic_tick = [](void* u, const HapticTickRecord& r) {
-      auto* rec = static_cast<Recorder*>(u);
-      rec->ticks.push_back(r);
-      if (rec->on_tick) rec->on_tick(r);
-    };
-    return o;
-  }
-  int count(RuntimeEventKind k) const {
-    return static_cast<int>(std::count_if(events.begin(), events.end(), [&](const RuntimeEvent& e) { return e.kind == k; }));
-  }
-};
-
-// Handle straight down from G at z0 to z1 at speed v, then held.
-std::function<Pose(double)> press_script(double z0, double z1, double v) {
-  return [=](double t) { return Pose{Vec3(0, 0, std::max(z1, z0 - v * t)), Quat{}}; };
-}
-
-struct Run {
-  std::unique_ptr<RuntimeModel> model;
-  std::unique_ptr<RuntimeData> data;
-  Recorder rec;
-};
-
-void run(Run* r, const Scene& scene, const RuntimeSettings& settings, Device* device, long ticks) {
-  r->model = std::make_unique<RuntimeModel>(scene, settings);
-  r->data = std::make_unique<RuntimeData>(*r->model);
-  r->rec.sims.reserve(ticks + 1);
-  r->rec.couplings.reserve(ticks + 1);
-  r->rec.ticks.reserve(ticks + 1);
-  run_lockstep(*r->model, device, ticks, r->rec.observer(), r->data.get());
-}
 
 // A god-object on its tip over a convex crease. The obstacle's top is flat
 // (z = 0) for x <= 0 and slopes down by kCreaseAngle for x >= 0 (a prism along y
@@ -782,7 +656,7 @@ TEST_CASE("runtime: a run's recorded CCD inputs replay its collision work exactl
   CHECK(num_hits > 0);
 }
 
-TEST_CASE("shared state: a seqlock read under a concurrent writer is never torn", "[runtime]") {
+TEST_CASE("shared state: a seqlock read under a concurrent writer is never torn", "[runtime][threaded]") {
   // Every write fills all words with one counter value; a torn read would mix two.
   struct Payload {
     uint64_t words[300];
@@ -817,7 +691,7 @@ TEST_CASE("shared state: a seqlock read under a concurrent writer is never torn"
   CHECK(backwards == 0);
 }
 
-TEST_CASE("runtime: threaded runs give sane forces (both force sources)", "[runtime]") {
+TEST_CASE("runtime: threaded runs give sane forces (both force sources)", "[runtime][threaded]") {
   for (const ForceSource source : {ForceSource::kHapticTick, ForceSource::kCouplingLoop}) {
     // Pressed 1 cm deep. The run stops once 50 successive ticks sent more than
     // 4 N, or after 5 s of wall time (a loaded machine only makes it slower).
@@ -866,5 +740,44 @@ TEST_CASE("runtime: threaded runs give sane forces (both force sources)", "[runt
                 1e6 * data->stats.haptic.max_jitter, data->stats.haptic.overruns, data->stats.sim.work.count,
                 1e6 * data->stats.sim.work.mean(), 1e6 * data->stats.sim.work.max, data->stats.coupling.work.count,
                 1e6 * data->stats.coupling.work.mean(), 1e6 * data->stats.coupling.work.max);
+  }
+}
+
+TEST_CASE("runtime: a pushing hand gets rows and force at every delta down to the floor", "[runtime][delta]") {
+  // The box pressed 1 cm (times the scene's scale) onto the slab: 5 N (times
+  // the scale; the resting gap adds 1.25 delta) at any delta the model accepts,
+  // in metres and in a scene 1000 times larger (millimetres). The CCD stops the
+  // god-object within its stop distance, which must stay inside the contact
+  // band delta (1 + contact_factor), or the blocked god-object has no rows and
+  // the user feels almost nothing (in millimetres, before the step's time
+  // tolerance was bounded by delta: 400 delta away, 0 N, from delta 1e-8 down).
+  for (const double scale : {1.0, 1000.0}) {
+    for (const double delta : {1e-4, 1e-6, 1e-8, 1e-9, 1e-10, 1e-11, 1e-12}) {
+      Scene sc = make_scene();
+      sc.contact.delta = delta;
+      sc.device.max_force = 1e9;
+      for (Body* b : {&sc.obstacles[0], &sc.god_object}) b->mesh.V *= scale;
+      sc.god_object.pose.p *= scale;
+      std::string error;
+      REQUIRE(compute_mass_properties(sc.god_object.mesh, 1000 / (scale * scale * scale), &sc.god_mass.mass, &error));
+      if (delta < kMinDeltaPerExtent * scene_extent(sc)) {  // 1e-12 in millimetres: refused, by name
+        CHECK_THROWS_WITH(RuntimeModel(sc, RuntimeSettings{}), Catch::Contains("contact.delta"));
+        continue;
+      }
+      ScriptedDevice device([scale](double t) { return Pose{scale * Vec3(0, 0, std::max(0.04, 0.2 - 0.4 * t)), Quat{}}; });
+      device.set_limits(1e9, 1e9);
+      Run r;
+      run(&r, sc, RuntimeSettings{}, &device, 700);
+      INFO("scale " << scale << ", delta " << delta);
+      const SimStepInfo& last = r.rec.sims.back();
+      CHECK(last.num_contacts > 0);
+      const double expected = 500 * (0.01 * scale + 1.25 * delta);  // kh m ks (depth + resting gap)
+      CHECK(r.rec.ticks.back().F_sent[2] == Approx(expected).epsilon(1e-3));
+      double lowest = INFINITY;
+      for (const SimStepInfo& s : r.rec.sims) lowest = std::min(lowest, lowest_z(*r.model, s.xs));
+      CHECK(lowest >= delta * (1 - 1e-3));
+      std::printf("scale %g, delta %.0e: %d contacts, %.6f N (expected %.6f), lowest gap %.3e (%.2f delta)\n", scale,
+                  delta, last.num_contacts, r.rec.ticks.back().F_sent[2], expected, lowest, lowest / delta);
+    }
   }
 }

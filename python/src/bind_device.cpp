@@ -72,7 +72,7 @@ void bind_device(py::module_& parent) {
                d->reset(0);
                return d;
              } catch (const std::invalid_argument& e) {
-               throw py::value_error(e.what());
+               throw LoadError(origin, e.what());  // gauss6.LoadError, as every file's errors
              }
            }),
            py::arg("script_json"), py::arg("rate_hz") = 0.0, py::arg("max_force") = 0.0, py::arg("max_torque") = 0.0,

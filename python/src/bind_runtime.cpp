@@ -152,6 +152,7 @@ py::dict result_dict(const ScenarioResult& r, const std::vector<HandPhase>& phas
   d["haptic"] = loop_dict(r.stats.haptic);
   d["coupling"] = loop_dict(r.stats.coupling);
   d["sim"] = loop_dict(r.stats.sim);
+  d["watchdog"] = loop_dict(r.stats.watchdog);
   py::list l;
   for (const HandPhase& p : phases) l.append(py::make_tuple(p.name, p.start));
   d["phases"] = l;
@@ -171,7 +172,7 @@ py::dict run(const std::string& scene_path, const std::string& trace_path, bool 
   try {
     script = load_scene_script(scene);
   } catch (const ScenarioError& e) {
-    throw py::value_error(e.what());
+    throw LoadError(scene.path, e.what());  // a file the scene names: gauss6.LoadError
   }
   // The hand holds still after its last key until hold_until (s), when later than the script's end.
   if (hold_until > script.end_time) script.end_time = hold_until;

@@ -172,3 +172,17 @@ def test_projection_of_any_spd_scale_is_finite(scale, au):
     J = np.array([[0, 0, 1, 0, 0, 0]], float)
     r = _gauss6.project(M, np.array(au, float), J)
     assert np.all(np.isfinite(r.ac))
+
+
+# ---------------------------------------------------------------------------
+# Hand scripts: their errors are gauss6.LoadError, as every file's
+
+
+@pytest.mark.parametrize("script", [
+    {"keys": []},
+    {"keys": [{"t": 0, "p": [0, 0, 0]}, {"t": 0, "p": [0, 0, 1]}]},
+    {"keys": [{"t": 0, "p": [0, 0, 0], "q": [0, 0, 0, 0]}]},
+])
+def test_hand_script_errors_are_load_errors(script):
+    with pytest.raises(gauss6.LoadError, match="my_script.json: .*hand script"):
+        _gauss6.device.SimulatedDevice(json.dumps(script), origin="my_script.json")

@@ -20,6 +20,7 @@
 // caller gives (time is never read from a clock).
 #pragma once
 
+#include <atomic>
 #include <string>
 #include <vector>
 
@@ -91,6 +92,10 @@ class SimulatedDevice final : public Device {
   // Holds F (world frame, torque about the handle's point) until the next write().
   // kError (F ignored) if F is not finite.
   DeviceStatus write(double t, const Vec6& F) override;
+  // From any thread (the runtime's watchdog): the handle feels no force from now
+  // until the next write(). kOk.
+  DeviceStatus halt_force() noexcept override;
+  bool halted() const { return halted_.load(std::memory_order_acquire); }
 
   // Puts the handle on the hand at time t0, at rest relative to it, with no force.
   void reset(double t0 = 0);
@@ -114,6 +119,7 @@ class SimulatedDevice final : public Device {
   Vec3 v_ = Vec3::Zero();
   Vec3 w_ = Vec3::Zero();
   Vec6 F_ = Vec6::Zero();
+  std::atomic<bool> halted_{false};  // halt_force(): F_ is not applied until the next write()
 };
 
 }  // namespace gauss6

@@ -41,9 +41,20 @@ struct CcdStepSettings {
                                            // min_separation) by the stop pose: the near pairs (CcdStepResult)
 };
 
+// Why the settings cannot serve a step (nullptr when they can): every
+// tolerance positive and finite (time_tolerance below 1, the whole window),
+// min_separation and near_distance finite and >= 0, max_iterations and
+// max_sub_intervals >= 1, the sub-interval bounds positive and finite, the
+// proximity cache's settings valid. ccd_step refuses such a step (kInvalidInput)
+// before any pair test; RuntimeModel refuses them when it is built.
+const char* ccd_step_settings_problem(const CcdStepSettings& settings);
+
 struct CcdStepResult {
   CcdStatus status = CcdStatus::kOk;       // kOk, kHalfTurn (split the step: split_step()),
-                                           // kInvalidInput, or a pair test's give-up (hit kept conservative)
+                                           // kInvalidInput, or a pair test's give-up (hit kept conservative);
+                                           // a pair test that refused its input (a coordinate beyond the
+                                           // narrow phase's bound) makes the step kInvalidInput with a hit
+                                           // at its window's start: never a miss
   bool hit = false;
   double u_hit = 1;                        // first possible contact over all pairs (<= u*); 1 when none
   FeaturePair pair;                        // the pair that gave u_hit (when hit)

@@ -32,7 +32,7 @@ struct CouplingState {
   OffsetState offsets;                 // offsets and identities of the cached rows (offsetting.h)
   ProjectionWorkspace projection_ws;
   ProjectionResult projection;
-  uint32_t active_events = 0;          // conditions of the last step (coupling thread's events)
+  EventGate events;                    // the coupling thread's onsets and their rate limit (runtime_events.h)
   CouplingStepInfo info;
 };
 

@@ -8,6 +8,7 @@
 // Real-time contract: read() and write() are called from the haptic loop at the
 // device's rate; they allocate nothing, take no lock that a non-real-time thread
 // may hold for long, and throw nothing: failures come back as a DeviceStatus.
+// halt_force() alone may be called from another thread (the watchdog's).
 #pragma once
 
 #include <cstdint>
@@ -54,6 +55,14 @@ class Device {
   // Applies the wrench F = (force, torque about the handle's point), world frame,
   // already clamped to info()'s limits and finite. Input-only devices ignore it.
   virtual DeviceStatus write(double t, const Vec6& F) = 0;
+  // The one call that may come from another thread, while read() or write() is
+  // blocked in the haptic thread: the runtime's watchdog (kHapticStalled) asks the
+  // device to stop rendering force now, without waiting for the blocked call
+  // (an amplifier disable, or an atomic flag the driver's rendering checks); the
+  // next write() renders again. Returns kOk when no force is rendered any more.
+  // The default serves input-only devices (nothing rendered: kOk); a device that
+  // renders force and cannot do this returns kError, and the watchdog says so.
+  virtual DeviceStatus halt_force() noexcept { return info().renders_force ? DeviceStatus::kError : DeviceStatus::kOk; }
 };
 
 }  // namespace gauss6

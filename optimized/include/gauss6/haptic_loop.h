@@ -35,7 +35,7 @@ struct HapticState {
   Pose xh;                             // last good handle pose
   bool has_handle = false;
   double last_good_time = 0;           // s, time of the last good sample (the run's start at first)
-  uint32_t active_events = 0;          // conditions that held last tick (events fire on onset)
+  EventGate events;                    // onsets and their rate limit (runtime_events.h)
   bool ended = false;                  // the device ended
   WrenchSample wrench;                 // kCouplingLoop: last Fc read
   WrenchLimits limits;                 // the device's, resolved at the first tick (a state serves one device)
@@ -45,6 +45,9 @@ struct HapticState {
 // t is the run's clock (s): virtual in lockstep runs, steady_clock in threads.
 // One haptic tick: device read, force (the coupling step when coupling != null,
 // else the wrench channel), safety (watchdogs, finiteness, limits), device write.
+// Zero force (and an event) on: an invalid pose, kNotConnected, the device,
+// sim or coupling watchdog, the device's end; a failed write() is followed by a
+// write of zero (Device::halt_force() if that fails too) and reported.
 // The limits are the device's (device->info()) lowered by the scene's (model.device),
 // resolved once, at the state's first tick (h->limits).
 // Writes stats->haptic (and stats->coupling when coupling != null); event onsets

@@ -92,6 +92,10 @@ void run_lockstep(const RuntimeModel& model, Device* device, long num_ticks, con
 // Threaded run: haptic thread (sleep_until at rate_hz), sim thread, and with
 // kCouplingLoop a coupling thread, for `seconds` of wall time or until *stop
 // becomes true (stop may be null) or the device ends. Blocks until all joined.
+// A watchdog thread guards the haptic thread: no tick ended for device_timeout
+// (read() or write() blocked) -> Device::halt_force() and kHapticStalled (the
+// haptic thread watches the sim and coupling threads: kSimStalled, kCouplingStalled).
+// Both runs report their pending coalesced events (EventGate) when they end.
 void run_threaded(const RuntimeModel& model, Device* device, double seconds, const std::atomic<bool>* stop,
                   const RuntimeObserver& observer, RuntimeData* data);
 

@@ -19,7 +19,7 @@ namespace gauss6 {
 // ---------------------------------------------------------------------------
 
 enum class RuntimeEventKind {
-  kInvalidHandlePose = 0,  // the device returned a non-finite pose: zero force this tick
+  kInvalidHandlePose = 0,  // the device returned a non-finite pose, or one beyond kMaxSceneCoordinate: zero force
   kDeviceError,            // read() returned a status other than kOk
   kDeviceTimeout,          // watchdog: no good sample for device_timeout: zero force
   kSimStalled,             // watchdog: no sim snapshot for sim_timeout: zero force
@@ -32,8 +32,12 @@ enum class RuntimeEventKind {
   kContactOverflow,        // more contacts than kMaxContacts: the set was truncated
   kTextureUndersampled,    // a textured contact moved more than half the texture's shortest wavelength in one
                            // sim step: the texture is skipped at this speed (surface.h, max_texture_speed)
+  kDeviceNotConnected,     // read() returned kNotConnected: zero force until a good sample
+  kDeviceWriteFailed,      // write() failed: zero written at once (Device::halt_force() if that fails too)
+  kHapticStalled,          // watchdog thread (threaded runs): no haptic tick finished for device_timeout, a
+                           // read() or write() that blocks: Device::halt_force() from the watchdog's thread
 };
-inline constexpr int kNumRuntimeEventKinds = 12;
+inline constexpr int kNumRuntimeEventKinds = 15;
 const char* to_string(RuntimeEventKind k);
 
 struct RuntimeEvent {
@@ -41,6 +45,24 @@ struct RuntimeEvent {
   double time = 0;                     // s
   uint64_t tick = 0;                   // haptic tick, or sim step for sim events
   int detail = 0;                      // the status's integer value, when one applies
+  uint32_t count = 1;                  // onsets this event stands for (> 1: coalesced, EventGate)
+};
+
+// The event onsets of one loop, rate-limited per kind so that a flaky fault (a
+// device failing every other tick) does not flood the observer: an onset within
+// RuntimeSettings::event_interval of the last reported event of its kind is
+// counted, not reported; the count goes out in RuntimeEvent::count of the next
+// event of that kind, which is reported as soon as event_interval has passed
+// (with or without a new onset) or when the run ends. Nothing is lost: the
+// counts of the reported events add up to the onsets (LoopStats::event_counts).
+// Each loop owns one; no allocation.
+struct EventGate {
+  uint32_t active = 0;                             // conditions that held last time (events fire on onset)
+  double last_report[kNumRuntimeEventKinds] = {};  // s, run time of the kind's last reported event
+  bool reported[kNumRuntimeEventKinds] = {};       // the kind has been reported once
+  uint32_t pending[kNumRuntimeEventKinds] = {};    // onsets counted since then, not yet reported
+  uint64_t pending_tick[kNumRuntimeEventKinds] = {};  // tick of the first of them
+  int pending_detail[kNumRuntimeEventKinds] = {};     // detail of the last of them
 };
 
 // Per-step records, handed to the hooks.

@@ -29,6 +29,11 @@ enum class ForceSource {
   kCouplingLoop,  // a separate coupling thread publishes Fc (the paper's three loops; threaded runs only)
 };
 
+// The longest timeout (s) a watchdog may have, and the longest min period of a
+// loop: past a second, a stalled loop or a silent device is no longer a fault the
+// user should feel the last force through.
+inline constexpr double kMaxTimeout = 1.0;
+
 // Every setting of the runtime, one line each. Defaults suit scenes whose delta
 // is about 1e-4 of their size.
 struct RuntimeSettings {
@@ -52,6 +57,10 @@ struct RuntimeSettings {
   double device_timeout = 0.005;       // s without a good device sample before the watchdog zeroes the force
   double sim_timeout = 0.5;            // s without a new sim snapshot (sim stalled) before the force is zeroed
   double coupling_timeout = 0.005;     // s without a new Fc (kCouplingLoop) before the force is zeroed
+                                       // (the three timeouts: finite, in (0, kMaxTimeout]; a watchdog cannot be
+                                       // switched off)
+  double event_interval = 0.1;         // s: a kind's onsets closer than this to its last reported event are
+                                       // coalesced into the next one (EventGate; in [0, kMaxTimeout])
   int lockstep_sim_period = 1;         // lockstep: haptic ticks per sim step (>= 1)
   double sim_min_period = 0.0005;      // threaded: a sim step starts at most every this many seconds
   double coupling_min_period = 0;      // threaded, kCouplingLoop: same for coupling steps (0: back to back)

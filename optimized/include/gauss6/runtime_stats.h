@@ -42,6 +42,7 @@ struct LoopStats {
 
 struct RuntimeStats {
   LoopStats haptic, coupling, sim;     // coupling: filled by the haptic loop with kHapticTick
+  LoopStats watchdog;                  // threaded runs: the watchdog thread's events (kHapticStalled)
   double run_seconds = 0;              // wall time (threaded) or virtual time (lockstep)
 };
 

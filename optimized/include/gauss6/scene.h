@@ -124,6 +124,10 @@ struct SettingsProblem {
   explicit operator bool() const { return !key.empty(); }
   std::string message() const { return table + "." + key + ": " + problem; }  // "gains.kh: must be > 0"
 };
+// Coordinates (positions, mesh vertices, in the world frame too) beyond this are
+// refused: the CCD's pair tests refuse coordinates beyond 1e30 (src/ccd.cpp);
+// 1e12 leaves room for poses and motions.
+inline constexpr double kMaxSceneCoordinate = 1e12;
 SettingsProblem check_gains(const Gains& gains);                         // 0 < ks <= 1, kh > 0
 SettingsProblem check_contact_parameters(const ContactParameters& contact);  // delta > 0, offset_eps < 0,
                                                                          // offset_time > 0
@@ -133,6 +137,14 @@ SettingsProblem check_surface_settings(const SurfaceSettings& surface);  // text
                                                                          // axis; height map: an image of
                                                                          // >= 2 x 2 values in [0, 1]
 SettingsProblem check_crease_angle(double degrees);                      // [[obstacle]]: 0 <= crease_angle <= 180
+// delta against the scene's size: delta a normal double and at least
+// kMinDeltaPerExtent of scene_extent(scene), the largest distance from the origin
+// any vertex reaches (obstacles where they stand, the god-object at its initial
+// pose). Below it delta nears the rounding of the coordinates (1e-14 is ~45 ulps)
+// and the CCD's stop distance can no longer be kept inside the contact band.
+inline constexpr double kMinDeltaPerExtent = 1e-14;
+double scene_extent(const Scene& scene);
+SettingsProblem check_delta_scale(const Scene& scene);
 SettingsProblem check_device_settings(const DeviceSettings& device);     // 100 <= rate_hz <= 10000,
                                                                          // max_force > 0, max_torque > 0
 

@@ -48,7 +48,7 @@ struct SimState {
   GodObjectSnapshot snapshot;          // what step 5 publishes
   uint64_t step = 0;
   uint32_t step_events = 0;            // conditions found by this step (contact overflow)
-  uint32_t active_events = 0;          // conditions of the last step (events fire on onset)
+  EventGate events;                    // onsets and their rate limit (runtime_events.h)
   SimStepInfo info;
 };
 

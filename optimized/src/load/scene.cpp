@@ -21,11 +21,6 @@ namespace {
 
 namespace fs = std::filesystem;
 
-// Coordinates (positions, mesh vertices) beyond this are refused: the CCD's
-// pair tests refuse coordinates beyond 1e30 (src/ccd.cpp); 1e12 leaves room for
-// poses and motions.
-constexpr double kMaxSceneCoordinate = 1e12;
-
 // Reads typed values out of one TOML table, naming file:line:col and the dotted key in errors.
 class TableReader {
  public:
@@ -377,6 +372,7 @@ Scene load_scene(const std::string& path) {
     gm.mass = mp;
     b.pose = {transform_point(X_WM, G), X_WM.q};
   }
+  require(check_delta_scale(scene), contact);  // delta against the bodies' coordinates
 
   // [surface] (optional)
   {
