@@ -48,12 +48,15 @@ double volume_of(const TriangleMesh& m) {
   return mp.volume;
 }
 
-// Reading `path` must throw a MeshFileError whose message names the file (its
-// base name at least) and contains `what`.
-void require_file_error(const std::string& path, const std::string& what) {
+// Reading `path` (the mesh, or with `normals` its vertex normals) must throw a
+// MeshFileError whose message names the file (its base name at least) and contains `what`.
+void require_file_error(const std::string& path, const std::string& what, bool normals = false) {
   INFO(path);
   try {
-    read_mesh(path);
+    if (normals)
+      read_vertex_normals(path);
+    else
+      read_mesh(path);
     FAIL("no MeshFileError for " << path);
   } catch (const MeshFileError& e) {
     const std::string msg = e.what();
@@ -208,4 +211,66 @@ TEST_CASE("Mesh files whose headers are broken or whose counts lie are refused b
     stl += std::string("\xff\xff\xff\x7f", 4) + std::string(50, '\0');  // 2^31 - 1 facets announced, 1 present
     require_file_error(dir.write("lying.stl", stl), "the file holds 1");
   }
+}
+
+// OBJ `vn` normals reach the vertices through the face corners that reference
+// them; NOFF normals follow each vertex's coordinates. Exact comparisons: the
+// values are short decimals read from text into doubles, copied unchanged.
+TEST_CASE("OBJ vn and NOFF vertex normals are read per vertex", "[meshio]") {
+  TempDir dir;
+  // A tetrahedron; vn records out of vertex order, the last corner by a negative (relative) index.
+  const std::string obj =
+      "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\n"
+      "vn 0 0 -2\nvn 1 0 0\nvn 0 1 0\nvn 0.5 0.5 0.5\n"
+      "f 1//1 3//3 2//2\nf 1/1/1 2//2 4//4\nf 1//1 4//4 3//3\nf 2//2 3//3 4//-1\n";
+  const std::string good = dir.write("tet.obj", obj);
+  REQUIRE(read_mesh(good).V.rows() == 4);
+  MatrixX3d N = read_vertex_normals(good);
+  REQUIRE(N.rows() == 4);
+  CHECK(N.row(0) == Eigen::RowVector3d(0, 0, -2));  // as stored, not normalised
+  CHECK(N.row(1) == Eigen::RowVector3d(1, 0, 0));
+  CHECK(N.row(2) == Eigen::RowVector3d(0, 1, 0));
+  CHECK(N.row(3) == Eigen::RowVector3d(0.5, 0.5, 0.5));
+  // Two vn records with the same numbers on corners of one vertex are one normal.
+  {
+    std::string dup = obj;
+    dup.replace(dup.find("f 2//2 3//3 4//-1"), 17, "f 2//2 3//3 4//5");
+    dup.replace(dup.find("f 1//1"), 0, "vn 0.5 0.5 0.5\n");
+    CHECK(read_vertex_normals(dir.write("dup.obj", dup)).row(3) == Eigen::RowVector3d(0.5, 0.5, 0.5));
+  }
+  // No vn records: none given (the shading computes them).
+  CHECK(read_vertex_normals(dir.write("plain.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n")).rows() == 0);
+  // Malformed.
+  auto with = [&](const std::string& from, const std::string& to) {
+    std::string s = obj;
+    s.replace(s.find(from), from.size(), to);
+    return s;
+  };
+  require_file_error(dir.write("range.obj", with("4//-1", "4//9")), "names no vertex normal (there are 4 so far)", true);
+  require_file_error(dir.write("zero_index.obj", with("4//-1", "4//0")), "names no vertex normal", true);
+  require_file_error(dir.write("vertex_range.obj", with("f 1//1 3//3", "f 7//1 3//3")), "names no vertex", true);
+  require_file_error(dir.write("crease.obj", with("4//-1", "4//3")),
+                     "vertex 3 has different normals on its face corners (vn 4 on face 1, vn 3 on face 3)", true);
+  require_file_error(dir.write("bare.obj", with("4//-1", "4")), "face 3 gives vertex 3 no normal", true);
+  require_file_error(dir.write("short_vn.obj", with("vn 0 1 0\n", "vn 0 1\n")), "line 7: a vn record needs 3 numbers", true);
+  require_file_error(dir.write("word_vn.obj", with("vn 0 1 0\n", "vn 0 one 0\n")), "vn component 'one' is not a finite number", true);
+  require_file_error(dir.write("nan_vn.obj", with("vn 0 1 0\n", "vn 0 nan 0\n")), "is not a finite number", true);
+  require_file_error(dir.write("lonely.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 5 5 5\nvn 0 0 1\nf 1//1 2//1 3//1\n"),
+                     "vertex 3 is on no face corner, so it has no normal", true);
+
+  // NOFF: read_mesh reads the coordinates, read_vertex_normals the normals.
+  const std::string noff = "NOFF\n3 1 0\n0 0 0 0 0 1\n1 0 0 0 0.25 1\n0 1 0 0 0 3\n3 0 1 2\n";
+  const std::string noff_path = dir.write("tri.off", noff);
+  const TriangleMesh m = read_mesh(noff_path);
+  REQUIRE(m.V.rows() == 3);
+  CHECK(m.V.row(1) == Eigen::RowVector3d(1, 0, 0));
+  N = read_vertex_normals(noff_path);
+  REQUIRE(N.rows() == 3);
+  CHECK(N.row(0) == Eigen::RowVector3d(0, 0, 1));
+  CHECK(N.row(1) == Eigen::RowVector3d(0, 0.25, 1));
+  CHECK(N.row(2) == Eigen::RowVector3d(0, 0, 3));
+  CHECK(read_vertex_normals(dir.write("plain.off", "OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n")).rows() == 0);
+  // A NOFF vertex line without its normal is refused before CGAL reads it.
+  require_file_error(dir.write("short.off", "NOFF\n3 1 0\n0 0 0 0 0 1\n1 0 0\n0 1 0 0 0 1\n3 0 1 2\n"),
+                     "line 4: a NOFF vertex needs 3 coordinates and 3 normal components");
 }

@@ -249,6 +249,45 @@ TEST_CASE("vertex normals given in a PLY mesh are loaded for force shading", "[s
   CHECK_THAT(load_error_at(t), Contains("vertex 0's normal is zero or not finite"));
 }
 
+// OBJ vn normals (through the face corners) and NOFF normals reach the scene the
+// same way, normalised; a zero one is refused, naming the vertex.
+TEST_CASE("vertex normals given in an OBJ or NOFF mesh are loaded for force shading", "[scene]") {
+  using Catch::Matchers::Contains;
+  // kBoxObj with vertex i's normal in vn record i (along its outward diagonal), every corner naming it.
+  std::string obj = "v 0 0 0\nv 2 0 0\nv 2 1 0\nv 0 1 0\nv 0 0 0.5\nv 2 0 0.5\nv 2 1 0.5\nv 0 1 0.5\n"
+                    "vn -1 -1 -1\nvn 1 -1 -1\nvn 1 1 -1\nvn -1 1 -1\nvn -1 -1 1\nvn 1 -1 1\nvn 1 1 1\nvn -1 1 1\n";
+  std::string noff = "NOFF\n8 12 0\n0 0 0 -1 -1 -1\n2 0 0 1 -1 -1\n2 1 0 1 1 -1\n0 1 0 -1 1 -1\n"
+                     "0 0 0.5 -1 -1 1\n2 0 0.5 1 -1 1\n2 1 0.5 1 1 1\n0 1 0.5 -1 1 1\n";
+  {
+    std::istringstream faces(std::string(kBoxObj).substr(std::string(kBoxObj).find('f')));
+    for (std::string f; faces >> f;) {
+      int a, b, c;
+      faces >> a >> b >> c;
+      obj += "f " + std::to_string(a) + "//" + std::to_string(a) + " " + std::to_string(b) + "//" + std::to_string(b) +
+             " " + std::to_string(c) + "//" + std::to_string(c) + "\n";
+      noff += "3 " + std::to_string(a - 1) + " " + std::to_string(b - 1) + " " + std::to_string(c - 1) + "\n";
+    }
+  }
+  for (const std::string& name : {"box.obj", "box.off"}) {
+    INFO(name);
+    const std::string& text = name == std::string("box.obj") ? obj : noff;
+    TempScene t(edited("mesh = \"box.obj\"", "mesh = \"" + std::string(name) + "\""));
+    std::ofstream(t.dir / name) << text;
+    const Scene s = load_scene(t.path());
+    const MatrixX3d& N = s.obstacles[0].given_normals;
+    REQUIRE(N.rows() == 8);
+    for (int v = 0; v < 8; ++v) {
+      CHECK(std::abs(N.row(v).norm() - 1) <= 1e-15);
+      CHECK(std::abs(std::abs(N(v, 2)) - 1 / std::sqrt(3.0)) <= 1e-15);  // the diagonal, normalised
+    }
+    std::string zero = text;
+    const std::string first = name == std::string("box.obj") ? "vn -1 -1 -1" : "0 0 0 -1 -1 -1";
+    zero.replace(zero.find(first), first.size(), name == std::string("box.obj") ? "vn 0 0 0" : "0 0 0 0 0 0");
+    std::ofstream(t.dir / name) << zero;
+    CHECK_THAT(load_error_at(t), Contains("vertex 0's normal is zero or not finite"));
+  }
+}
+
 TEST_CASE("given mass properties are validated", "[scene]") {
   using Catch::Matchers::Contains;
   const std::string given = "mass = 1.0\ncenter_of_mass = [1.0, 0.5, 0.25]\n";

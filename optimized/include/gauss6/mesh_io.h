@@ -23,10 +23,14 @@ namespace gauss6 {
 TriangleMesh read_mesh(const std::string& path);
 // The vertex normals a mesh file gives, one row per vertex as stored (not
 // normalised), or an empty matrix when it gives none. PLY: the vertex element's
-// nx, ny, nz properties (all three), read with CGAL's point-set PLY reader. OBJ
-// `vn` lines are not read (CGAL 5.5's OBJ reader discards them, and they belong
-// to face corners, not vertices); OFF and STL carry no vertex normals. Call after
-// read_mesh() succeeded on the same path. Throws MeshFileError.
+// nx, ny, nz properties (all three), read with CGAL's point-set PLY reader. NOFF:
+// the normal after each vertex's coordinates, read with CGAL's OFF reader. OBJ:
+// the `vn` record the vertex's face corners name (CGAL 5.5's OBJ reader discards
+// them, so a strict reader of v, vn and f records, every index bounds-checked);
+// corners of one vertex naming records with different numbers are refused (a
+// crease), and with vn records every corner must name one. Plain OFF, OBJ
+// without vn and STL: none. Call after read_mesh() succeeded on the same path.
+// Throws MeshFileError.
 MatrixX3d read_vertex_normals(const std::string& path);
 // Writes by extension (.obj .off .ply .stl). OBJ/OFF are text with 17 significant
 // digits and PLY is binary (both round-trip doubles exactly); binary STL stores

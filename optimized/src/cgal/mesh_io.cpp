@@ -1,6 +1,7 @@
 // Mesh files (OBJ, OFF, PLY, STL) through CGAL's polygon-soup readers and
-// writers, with every failure turned into a MeshFileError that names the file and
-// the problem. Scene-load time only. Only the four format headers are included,
+// writers (and a strict reader of OBJ vn normals, which CGAL 5.5 discards), with
+// every failure turned into a MeshFileError that names the file and the problem.
+// Scene-load time only. Only the four format headers are included,
 // to keep this translation unit cheap to compile.
 #include "gauss6/mesh_io.h"
 
@@ -150,8 +151,147 @@ TriangleMesh read_mesh(const std::string& path) {
   return m;
 }
 
+namespace {
+
+// One OBJ index token ("7", "-1"): 1-based, or negative counting back from the
+// last record of its kind read so far. Returns the 0-based index, or -1 when the
+// token is not an integer or falls outside [0, count).
+long long obj_index(const std::string& token, long long count) {
+  if (token.empty()) return -1;
+  std::size_t used = 0;
+  long long k = 0;
+  try {
+    k = std::stoll(token, &used);
+  } catch (const std::exception&) {
+    return -1;
+  }
+  if (used != token.size() || k == 0) return -1;
+  const long long i = k > 0 ? k - 1 : count + k;
+  return (i >= 0 && i < count) ? i : -1;
+}
+
+// OBJ vertex normals from `vn` records and the corners of `f` records that
+// reference them ("f v//vn" or "f v/vt/vn"). Only v, vn and f records are
+// looked at; read_mesh() already read the vertices and faces. Rule: a vertex's
+// normal is the one its face corners reference; corners of one vertex may name
+// different vn records only if those hold the same three numbers, otherwise the
+// file is refused (the vertex is on a crease, which per-vertex normals cannot
+// express). With vn records, every vertex must be on a corner that gives one.
+// No vn record: empty matrix (computed normals are used).
+MatrixX3d read_obj_normals(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) fail(path, "cannot open the file for reading");
+  std::vector<Kernel::Vector_3> vn;
+  std::vector<long long> of_vertex;  // vn index per vertex, -1 when none yet
+  std::vector<long long> first_face;  // face that set it, for messages
+  long long nv = 0, nf = 0, line_no = 0;
+  bool corner_without_normal = false;
+  long long bare_face = -1, bare_vertex = -1;
+  for (std::string line; std::getline(in, line);) {
+    ++line_no;
+    std::istringstream words(line);
+    std::string kind;
+    if (!(words >> kind)) continue;
+    const std::string at = "line " + std::to_string(line_no) + ": ";
+    if (kind == "v") {
+      ++nv;
+      of_vertex.push_back(-1);
+      first_face.push_back(-1);
+    } else if (kind == "vn") {
+      std::string word;
+      double c[3];
+      for (double& x : c) {
+        if (!(words >> word)) fail(path, at + "a vn record needs 3 numbers");
+        std::size_t used = 0;
+        try {
+          x = std::stod(word, &used);
+        } catch (const std::exception&) {
+          used = 0;
+        }
+        if (used != word.size() || !std::isfinite(x))
+          fail(path, at + "vn component '" + word + "' is not a finite number");
+      }
+      if (words >> word) fail(path, at + "a vn record has more than 3 numbers");
+      vn.emplace_back(c[0], c[1], c[2]);
+    } else if (kind == "f") {
+      for (std::string corner; words >> corner;) {
+        const std::size_t s1 = corner.find('/');
+        const long long v = obj_index(corner.substr(0, s1), nv);
+        if (v < 0)
+          fail(path, at + "face " + std::to_string(nf) + " corner '" + corner +
+                         "' names no vertex (there are " + std::to_string(nv) + " so far)");
+        const std::size_t s2 = s1 == std::string::npos ? s1 : corner.find('/', s1 + 1);
+        if (s2 == std::string::npos) {
+          if (!corner_without_normal) bare_face = nf, bare_vertex = v;
+          corner_without_normal = true;
+          continue;
+        }
+        const long long n = obj_index(corner.substr(s2 + 1), static_cast<long long>(vn.size()));
+        if (n < 0)
+          fail(path, at + "face " + std::to_string(nf) + " corner '" + corner +
+                         "' names no vertex normal (there are " + std::to_string(vn.size()) + " so far)");
+        long long& mine = of_vertex[static_cast<std::size_t>(v)];
+        if (mine >= 0 && mine != n && vn[static_cast<std::size_t>(mine)] != vn[static_cast<std::size_t>(n)])
+          fail(path, at + "vertex " + std::to_string(v) + " has different normals on its face corners (vn " +
+                         std::to_string(mine + 1) + " on face " + std::to_string(first_face[static_cast<std::size_t>(v)]) +
+                         ", vn " + std::to_string(n + 1) + " on face " + std::to_string(nf) +
+                         "); a vertex takes one normal");
+        if (mine < 0) mine = n, first_face[static_cast<std::size_t>(v)] = nf;
+      }
+      ++nf;
+    }
+  }
+  if (vn.empty()) return {};
+  if (corner_without_normal)
+    fail(path, "face " + std::to_string(bare_face) + " gives vertex " + std::to_string(bare_vertex) +
+                   " no normal, but the file has vn records: every face corner must name one");
+  MatrixX3d N(static_cast<Eigen::Index>(nv), 3);
+  for (long long v = 0; v < nv; ++v) {
+    const long long n = of_vertex[static_cast<std::size_t>(v)];
+    if (n < 0) fail(path, "vertex " + std::to_string(v) + " is on no face corner, so it has no normal");
+    const Kernel::Vector_3& d = vn[static_cast<std::size_t>(n)];
+    N.row(static_cast<Eigen::Index>(v)) << d.x(), d.y(), d.z();
+  }
+  return N;
+}
+
+// NOFF vertex normals (a normal after each vertex's coordinates), through CGAL's
+// OFF reader; empty for plain OFF.
+MatrixX3d read_noff_normals(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) fail(path, "cannot open the file for reading");
+  std::string header;
+  in >> header;
+  if (header != "NOFF") return {};
+  in.clear();
+  in.seekg(0);
+  std::vector<Point> points;
+  std::vector<Polygon> polygons;
+  std::vector<Kernel::Vector_3> normals;
+  bool parsed = false;
+  try {
+    parsed = CGAL::IO::read_OFF(in, points, polygons,
+                                CGAL::parameters::vertex_normal_output_iterator(std::back_inserter(normals))
+                                    .verbose(false));
+  } catch (const std::bad_alloc&) {
+    fail(path, "out of memory while reading the vertex normals");
+  } catch (const std::exception& e) {
+    fail(path, std::string("cannot read the vertex normals: ") + e.what());
+  }
+  if (!parsed) fail(path, "cannot read the vertex normals (NOFF)");
+  MatrixX3d N(static_cast<Eigen::Index>(normals.size()), 3);
+  for (std::size_t i = 0; i < normals.size(); ++i)
+    N.row(static_cast<Eigen::Index>(i)) << normals[i].x(), normals[i].y(), normals[i].z();
+  return N;
+}
+
+}  // namespace
+
 MatrixX3d read_vertex_normals(const std::string& path) {
-  if (format_of(path) != Format::kPly) return {};
+  const Format format = format_of(path);
+  if (format == Format::kObj) return read_obj_normals(path);
+  if (format == Format::kOff) return read_noff_normals(path);
+  if (format != Format::kPly) return {};
   std::ifstream in(path, std::ios::binary);
   if (!in) fail(path, "cannot open the file for reading");
   // The header (checked by read_mesh): does the vertex element have nx, ny and nz?

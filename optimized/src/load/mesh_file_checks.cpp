@@ -75,15 +75,17 @@ class LineCursor {
 
 }  // namespace
 
-// Plain ASCII OFF, one record a line: "OFF", then "nv nf ne", nv vertex lines of at
+// Plain ASCII OFF, one record a line: "OFF" (or "NOFF", 6 numbers a vertex), then "nv nf ne", nv vertex lines of at
 // least 3 numbers, nf face lines "k i1 ... ik" (extra values, e.g. colours, allowed).
 void check_off_structure(const std::string& path, const std::string& bytes) {
   LineCursor lines(bytes);
   std::vector<std::string_view> t;
   if (!lines.next(&t)) fail(path, "cannot parse as OFF: no header");
-  if (t[0] != "OFF") {
+  // NOFF: each vertex line carries its normal after the coordinates (6 numbers).
+  const bool with_normals = t[0] == "NOFF";
+  if (t[0] != "OFF" && !with_normals) {
     if (t[0].size() >= 3 && t[0].substr(t[0].size() - 3) == "OFF")
-      fail(path, "cannot parse as OFF: the variant '" + std::string(t[0]) + "' is not read (only plain OFF)");
+      fail(path, "cannot parse as OFF: the variant '" + std::string(t[0]) + "' is not read (only OFF and NOFF)");
     fail(path, "cannot parse as OFF: the file does not start with 'OFF'");
   }
   // Counts may follow on the same line or come on the next one.
@@ -103,6 +105,8 @@ void check_off_structure(const std::string& path, const std::string& bytes) {
     if (!lines.next(&t))
       fail(path, "cannot parse as OFF: the header states " + std::to_string(nv) + " vertices, the file holds " + std::to_string(v));
     if (t.size() < 3) fail(path, "cannot parse as OFF: line " + std::to_string(lines.line()) + ": a vertex needs 3 coordinates");
+    if (with_normals && t.size() < 6)
+      fail(path, "cannot parse as OFF: line " + std::to_string(lines.line()) + ": a NOFF vertex needs 3 coordinates and 3 normal components");
   }
   for (uint64_t f = 0; f < nf; ++f) {
     if (!lines.next(&t))
