@@ -183,7 +183,7 @@ void read_body_mesh(const TableReader& r, Body* body, std::vector<std::string>* 
   } catch (const MeshFileError& e) {
     r.fail(r.node("mesh")->source(), "mesh", e.what());
   }
-  // Vertex normals the file gives (PLY nx, ny, nz): force shading uses them (surface.h).
+  // Vertex normals the file gives (PLY nx, ny, nz; NOFF; OBJ vn): force shading uses them (surface.h).
   try {
     body->given_normals = read_vertex_normals(body->mesh_path);
   } catch (const MeshFileError& e) {
