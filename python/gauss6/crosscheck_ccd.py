@@ -172,46 +172,39 @@ class SetResult:
         self.failures += st["failures"][:max(self.MAX_FAILURES_KEPT - len(self.failures), 0)]
 
 
-def _closest_on_triangle(P: np.ndarray, A: np.ndarray, B: np.ndarray, C: np.ndarray) -> np.ndarray:
-    """The point of triangle ABC closest to P (Ericson, Real-Time Collision Detection, 5.1.5)."""
-    ab, ac, ap = B - A, C - A, P - A
-    d1, d2 = ab @ ap, ac @ ap
-    if d1 <= 0 and d2 <= 0:
-        return A
-    bp = P - B
-    d3, d4 = ab @ bp, ac @ bp
-    if d3 >= 0 and d4 <= d3:
-        return B
-    vc = d1 * d4 - d3 * d2
-    if vc <= 0 and d1 >= 0 and d3 <= 0:
-        return A + d1 / (d1 - d3) * ab
-    cp = P - C
-    d5, d6 = ab @ cp, ac @ cp
-    if d6 >= 0 and d5 <= d6:
-        return C
-    vb = d5 * d2 - d1 * d6
-    if vb <= 0 and d2 >= 0 and d6 <= 0:
-        return A + d2 / (d2 - d6) * ac
-    va = d3 * d6 - d5 * d4
-    if va <= 0 and d4 - d3 >= 0 and d5 - d6 >= 0:
-        return B + (d4 - d3) / ((d4 - d3) + (d5 - d6)) * (C - B)
-    denom = 1.0 / (va + vb + vc)
-    return A + ab * (vb * denom) + ac * (vc * denom)
+def point_segment_distance(p, a, b) -> float:
+    """Euclidean distance from p to the closed segment ab (a point when a = b)."""
+    d = b - a
+    t = 0.0 if not d.any() else float(np.clip((p - a) @ d / (d @ d), 0, 1))
+    return float(np.linalg.norm(p - (a + t * d)))
 
 
-def _segment_distance(P1, Q1, P2, Q2) -> float:
-    """Distance between segments P1Q1 and P2Q2 (Ericson 5.1.9)."""
-    d1, d2, r = Q1 - P1, Q2 - P2, P1 - P2
-    a, e, f = d1 @ d1, d2 @ d2, d2 @ r
-    c, b = d1 @ r, d1 @ d2
-    denom = a * e - b * b
-    s = float(np.clip((b * f - c * e) / denom, 0, 1)) if denom > 0 else 0.0
-    t = (b * s + f) / e if e > 0 else 0.0
-    if t < 0:
-        t, s = 0.0, float(np.clip(-c / a, 0, 1)) if a > 0 else 0.0
-    elif t > 1:
-        t, s = 1.0, float(np.clip((b - c) / a, 0, 1)) if a > 0 else 0.0
-    return float(np.linalg.norm((P1 + s * d1) - (P2 + t * d2)))
+def point_triangle_distance(p, a, b, c) -> float:
+    """Euclidean distance from p to the closed triangle abc: the plane's foot when it
+    lies inside, else the nearest edge."""
+    n = np.cross(b - a, c - a)
+    nn = n @ n
+    if nn > 0:
+        foot = p - ((p - a) @ n / nn) * n
+        w = [np.cross(y - x, foot - x) @ n for x, y in ((a, b), (b, c), (c, a))]
+        if min(w) >= 0 or max(w) <= 0:
+            return float(abs((p - a) @ n) / math.sqrt(nn))
+    return min(point_segment_distance(p, x, y) for x, y in ((a, b), (b, c), (c, a)))
+
+
+def segment_distance(a0, a1, b0, b1) -> float:
+    """Euclidean distance between the closed segments a0a1 and b0b1: the endpoint
+    distances, and the lines' closest points when both lie inside their segments."""
+    best = min(point_segment_distance(a0, b0, b1), point_segment_distance(a1, b0, b1),
+               point_segment_distance(b0, a0, a1), point_segment_distance(b1, a0, a1))
+    d1, d2, r = a1 - a0, b1 - b0, a0 - b0
+    a, e, b, c, f = d1 @ d1, d2 @ d2, d1 @ d2, d1 @ r, d2 @ r
+    den = a * e - b * b
+    if den > 1e-300:
+        s, t = (b * f - c * e) / den, (a * f - b * c) / den
+        if 0 <= s <= 1 and 0 <= t <= 1:
+            best = min(best, float(np.linalg.norm(a0 + s * d1 - (b0 + t * d2))))
+    return best
 
 
 def pair_distance(ids, meshes: tuple, p: np.ndarray, q: np.ndarray) -> float:
@@ -227,10 +220,10 @@ def pair_distance(ids, meshes: tuple, p: np.ndarray, q: np.ndarray) -> float:
     elif kind == "obstacle_vertex/god_face":
         P, tri = Vo[obs[1]], Xg[Fg[god[1]]]
     elif kind == "edge/edge":
-        return _segment_distance(Xg[god[1]], Xg[god[2]], Vo[obs[1]], Vo[obs[2]])
+        return segment_distance(Xg[god[1]], Xg[god[2]], Vo[obs[1]], Vo[obs[2]])
     else:
         raise ValueError(f"unknown feature pair kind {kind!r}")
-    return float(np.linalg.norm(P - _closest_on_triangle(P, *tri)))
+    return point_triangle_distance(P, *tri)
 
 
 def classify_stop_pair(pair, step: dict, opt: dict, ex, meshes: tuple | None = None,

@@ -8,7 +8,7 @@ Python call and through the exact reference (exact_vertex_face / exact_edge_edge
 - within tolerance: where both hit and the search finished (status "ok"), either
   u* - u_hit <= 2 time_tolerance (ccd.h: the accepted u-interval is at most
   time_tolerance wide and the contact may lie in the next one), or the stop is a
-  near contact: the features' distance at u_hit (computed here in numpy, from
+  near contact: the features' distance at u_hit (computed in numpy by crosscheck_ccd's plain geometry, from
   the interpolated points: closest points by plain geometry, independent of the
   optimized code) is at most distance_reached (+ 1e-12, the rounding of that
   computation on coordinates of size 1), and distance_reached is at most
@@ -27,6 +27,7 @@ import numpy as np
 import pytest
 
 from gauss6 import ccd, paths
+from gauss6.crosscheck_ccd import point_triangle_distance, segment_distance
 
 DATA = paths.SHARED_DATA_DIR / "ccd-sample-queries"
 FILES = ccd.query_files(DATA, None) if DATA.is_dir() else []
@@ -36,40 +37,6 @@ DISTANCE_TOL = 1e-9        # the default distance_tolerance (CcdSettings)
 # The accepted box's feature-parameter widths blur F beyond the u-width's motion:
 # measured at most 1.35 x on the shared sets; 4 leaves room for other settings.
 NEAR_FACTOR = 4.0
-
-
-def point_segment_distance(p, a, b) -> float:
-    d = b - a
-    t = 0.0 if not d.any() else float(np.clip((p - a) @ d / (d @ d), 0, 1))
-    return float(np.linalg.norm(p - (a + t * d)))
-
-
-def point_triangle_distance(p, a, b, c) -> float:
-    """Euclidean distance from p to the closed triangle abc: the plane's foot when it
-    lies inside, else the nearest edge."""
-    n = np.cross(b - a, c - a)
-    nn = n @ n
-    if nn > 0:
-        foot = p - ((p - a) @ n / nn) * n
-        w = [np.cross(y - x, foot - x) @ n for x, y in ((a, b), (b, c), (c, a))]
-        if min(w) >= 0 or max(w) <= 0:
-            return float(abs((p - a) @ n) / math.sqrt(nn))
-    return min(point_segment_distance(p, x, y) for x, y in ((a, b), (b, c), (c, a)))
-
-
-def segment_distance(a0, a1, b0, b1) -> float:
-    """Euclidean distance between the closed segments a0a1 and b0b1: the endpoint
-    distances, and the lines' closest points when both lie inside their segments."""
-    best = min(point_segment_distance(a0, b0, b1), point_segment_distance(a1, b0, b1),
-               point_segment_distance(b0, a0, a1), point_segment_distance(b1, a0, a1))
-    d1, d2, r = a1 - a0, b1 - b0, a0 - b0
-    a, e, b, c, f = d1 @ d1, d2 @ d2, d1 @ d2, d1 @ r, d2 @ r
-    den = a * e - b * b
-    if den > 1e-300:
-        s, t = (b * f - c * e) / den, (a * f - b * c) / den
-        if 0 <= s <= 1 and 0 <= t <= 1:
-            best = min(best, float(np.linalg.norm(a0 + s * d1 - (b0 + t * d2))))
-    return best
 
 
 def distance_at(kind: str, x: np.ndarray, u: float) -> float:
