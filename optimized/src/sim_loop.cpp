@@ -65,30 +65,57 @@ Vec6 shade_command(const RuntimeModel& model, const RuntimeChannels& ch, const V
 // to 0.9 mm in the Figure 9 run), its contact set emptied at the next step and
 // the force dropped to zero for a sim period: 9 of 11 bumps were missed under
 // the speed bound. A texture perturbs the force's direction only, so a true
-// contact the command presses on (J_k au < 0) stays a contact: asc is first
-// M-projected on J_k a <= 0 for those rows (the god-object slides along the
-// true surface, and leaves it only when the user pulls away), then pass 2
-// projects that under J as before (property 7 is the final projection's).
-// Force shading alone keeps the paper's pass 2: there the shaded plane is the
-// smooth surface the facets approximate, which the god-object follows across
-// an edge (Figure 8). Plain surfaces never come here.
+// contact the command presses on (J_k au < 0) stays a contact: asc is
+// M-projected on J_k a <= b_k for those rows (the god-object slides along the
+// true surface at the gap target, b_k as in constrain_motion, and leaves it
+// only when the user pulls away) together with pass 2's own rows J a >= b, so
+// that a held contact keeps J_k a = b_k; pass 2 then projects that under J as
+// before (property 7 is the final projection's; here it changes nothing). The
+// held rows alone, followed by pass 2, were not enough: on the textured Figure
+// 8 cylinder the probe's tip (held) and a second vertex (not pressed by the
+// texture's asc) lay on a facet; holding the tip moved the second vertex into
+// its face, pass 2 pushed it back out and so lifted the tip by 4e-8 m a step,
+// until the tip, which carried the whole force, left the contact band: the
+// force jumped to the second vertex, half a texture wavelength away, by 30
+// degrees. Without room for both (more than kMaxContacts rows) the held rows
+// alone. Force shading alone keeps the paper's pass 2: there the shaded plane
+// is the smooth surface the facets approximate, which the god-object follows
+// across an edge (Figure 8). Plain surfaces never come here. The right-hand
+// sides go in gap_rhs, which constrain_motion fills anew.
 Vec6 hold_pressed_contacts(const RuntimeModel& model, const Vec6& au, const Vec6& asc, SimState* s) {
   if (!model.surface.texture) return asc;
   const int m = std::min(s->contacts.num_contacts, kMaxContacts);
+  const double target = model.contact.delta * (1 + model.settings.gap_factor);
+  int held = 0;
+  for (int k = 0; k < m; ++k) held += Eigen::Map<const Vec6>(s->contacts.J.data() + 6 * k).dot(au) < 0;
+  if (held == 0) return asc;
+  const bool with_pass2_rows = m + held <= kMaxContacts;
   int n = 0;
   for (int k = 0; k < m; ++k) {
     const Eigen::Map<const Vec6> Jk(s->contacts.J.data() + 6 * k);
-    if (!(Jk.dot(au) < 0)) continue;
-    for (int i = 0; i < 6; ++i) s->held_J[6 * n + i] = -Jk[i];
-    ++n;
+    const double b = target - s->contacts.contacts[k].separation;
+    if (Jk.dot(au) < 0) {  // held: -J_k a >= -b_k
+      for (int i = 0; i < 6; ++i) s->held_J[6 * n + i] = -Jk[i];
+      s->gap_rhs[n++] = -b;
+    }
+    if (with_pass2_rows) {  // pass 2's row: J_k a >= b_k
+      for (int i = 0; i < 6; ++i) s->held_J[6 * n + i] = Jk[i];
+      s->gap_rhs[n++] = b;
+    }
   }
-  if (n == 0) return asc;
   ProjectionProblem problem;
   problem.M = &s->M;
   problem.au = asc;
   problem.J = s->held_J.data();
+  problem.b = s->gap_rhs.data();
   problem.num_rows = n;
-  project(problem, model.settings.projection, &s->shading_ws, &s->shading);
+  // A cold start: these rows are new at every step, and a warm start from the
+  // workspace's previous problems (pass 1's, the texture's weights) read unset
+  // memory in project() on the textured Figure 8 run (valgrind; a crash at its
+  // step 3988), which a cold start does not.
+  ProjectionSettings cold = model.settings.projection;
+  cold.warm_start = false;
+  project(problem, cold, &s->shading_ws, &s->shading);
   return s->shading.status == ProjectionStatus::kOptimal && s->shading.ac.allFinite() ? s->shading.ac : asc;
 }
 
@@ -320,13 +347,18 @@ void advance_by(const RuntimeModel& model, SimState* s, SimStepInfo* info) {
 }
 
 // Step 4b on shaded surfaces: the shading rows Js of the new contact set
-// (surface.h), and on textured ones the largest distance a contact point moved
-// in this step: beyond half the texture's shortest wavelength the texture is
-// skipped at this speed (the kTextureUndersampled event).
+// (surface.h; a texture's average weighted by the forces the command at the
+// new pose gives the contacts, in pass 1's buffers), and on textured ones the
+// largest distance a contact point moved in this step: beyond half the
+// texture's shortest wavelength the texture is skipped at this speed (the
+// kTextureUndersampled event).
 void shade_contact_set(const RuntimeModel& model, SimState* s, SimStepInfo* info) {
   if (!model.surface.active()) return;
+  TextureWeighting weighting;
+  if (model.surface.texture)
+    weighting = {&s->M, command_motion(model, *s), &model.settings.projection, &s->shading_ws, &s->shading};
   shade_contacts(model.surface, model.obstacle_meshes_W.data(), s->contacts, s->xs.p, kMaxContacts,
-                 s->shaded_J.data(), s->shaded_normal);
+                 s->shaded_J.data(), s->shaded_normal, model.surface.texture ? &weighting : nullptr);
   if (!model.surface.texture) return;
   const Mat3 R0 = rotation_matrix(info->x_start.q), R1 = rotation_matrix(s->xs.q);
   const Mat3 R01 = R0 * R1.transpose();

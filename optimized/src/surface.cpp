@@ -20,6 +20,16 @@ double corner_angle(const TriangleMesh& m, int f, int k) {
   return std::atan2(u.cross(v).norm(), u.dot(v));
 }
 
+// Row k of Js (normal n at lever r from G) and its normal.
+void write_row(const Vec3& n, const Vec3& r, int k, double* Js, double (*normals)[3]) {
+  const Vec3 t = r.cross(n);
+  for (int i = 0; i < 3; ++i) {
+    normals[k][i] = n[i];
+    Js[6 * k + i] = n[i];
+    Js[6 * k + 3 + i] = t[i];
+  }
+}
+
 Vec3 normalized_or(const Vec3& v, const Vec3& fallback) {
   const double n = v.norm();
   return n > 0 && std::isfinite(n) ? Vec3(v / n) : fallback;
@@ -251,10 +261,10 @@ double shortest_wavelength(const TextureField& t) noexcept {
 }
 
 double shade_contacts(const SurfaceModel& surface, const TriangleMesh* obstacles_W, const ContactSet& set,
-                      const Vec3& G, int capacity, double* Js, double (*normals)[3]) noexcept {
+                      const Vec3& G, int capacity, double* Js, double (*normals)[3],
+                      const TextureWeighting* weighting) noexcept {
   const int m = std::min(set.num_contacts, capacity);
-  // The shading normals (true normals without shading), and the texture's averaged perturbation.
-  Vec3 g = Vec3::Zero();
+  // The untextured rows: shading normals (the true normals without shading).
   for (int k = 0; k < m; ++k) {
     const Contact& c = set.contacts[k];
     Vec3 n = c.normal;
@@ -263,27 +273,41 @@ double shade_contacts(const SurfaceModel& surface, const TriangleMesh* obstacles
       const Vec3 s = contact_shading_normal(surface.obstacles[o], obstacles_W[o], c);
       if (s.allFinite() && s.dot(c.normal) >= kMinShadingCosine) n = s;
     }
-    if (surface.texture) {
-      // The obstacle's point of the contact: I_k less the separation along the true normal.
-      Vec3 grad = texture_gradient(surface.field, c.point - c.separation * c.normal);
-      grad -= grad.dot(n) * n;                 // its part in the tangent plane
-      const double len = grad.norm();
-      if (len > kMaxTextureSlope) grad *= kMaxTextureSlope / len;
-      if (grad.allFinite()) g -= grad;
-    }
-    for (int i = 0; i < 3; ++i) normals[k][i] = n[i];
+    write_row(n, set.contacts[k].point - G, k, Js, normals);
   }
-  if (m > 0) g /= m;
-  for (int k = 0; k < m; ++k) {
-    Vec3 n(normals[k][0], normals[k][1], normals[k][2]);
-    if (surface.texture) n = normalized_or(n + g - g.dot(n) * n, n);
-    const Vec3 r = set.contacts[k].point - G;
-    const Vec3 t = r.cross(n);
-    for (int i = 0; i < 3; ++i) {
-      normals[k][i] = n[i];
-      Js[6 * k + i] = n[i];
-      Js[6 * k + 3 + i] = t[i];
+  if (!surface.texture || m == 0) return 0;
+  // The weights: each contact's share of the force the untextured rows give the command.
+  const double* lambda = nullptr;
+  double total = 0;
+  if (weighting != nullptr && weighting->M != nullptr && weighting->result != nullptr &&
+      weighting->result->max_rows() >= m && weighting->workspace->max_rows() >= m) {
+    ProjectionProblem problem;
+    problem.M = weighting->M;
+    problem.au = weighting->au;
+    problem.J = Js;
+    problem.num_rows = m;
+    if (project(problem, *weighting->settings, weighting->workspace, weighting->result) == ProjectionStatus::kOptimal) {
+      lambda = weighting->result->lambda.data();
+      for (int k = 0; k < m; ++k) total += std::max(lambda[k], 0.0);
+      if (!(total > 0 && std::isfinite(total))) lambda = nullptr;
     }
+  }
+  // The averaged perturbation: each contact's g_k at its obstacle point (I_k less the
+  // separation along the true normal), in its tangent plane, clamped.
+  Vec3 g = Vec3::Zero();
+  for (int k = 0; k < m; ++k) {
+    const Contact& c = set.contacts[k];
+    const Vec3 n(normals[k][0], normals[k][1], normals[k][2]);
+    Vec3 grad = texture_gradient(surface.field, c.point - c.separation * c.normal);
+    grad -= grad.dot(n) * n;
+    const double len = grad.norm();
+    if (len > kMaxTextureSlope) grad *= kMaxTextureSlope / len;
+    const double w = lambda != nullptr ? std::max(lambda[k], 0.0) / total : 1.0 / m;
+    if (grad.allFinite()) g -= w * grad;
+  }
+  for (int k = 0; k < m; ++k) {
+    const Vec3 n(normals[k][0], normals[k][1], normals[k][2]);
+    write_row(normalized_or(n + g - g.dot(n) * n, n), set.contacts[k].point - G, k, Js, normals);
   }
   return g.norm();
 }

@@ -109,6 +109,51 @@ TEST_CASE("surface: a contact's shading row interpolates the face's corner norma
   CHECK(Vec3(normals[0][0], normals[0][1], normals[0][2]) == c.normal);
 }
 
+TEST_CASE("surface: a texture's average is weighted by the forces the contacts carry", "[surface]") {
+  // Two contacts on the plane z = 0 half a sine wavelength apart (opposite
+  // perturbations: their plain average is zero). The command presses on the
+  // first (at G) and, turning about y, lifts the second off: only the first
+  // carries force, so its perturbation alone tilts every row.
+  const double A = 1e-3, L = 0.02;
+  SurfaceModel surface;
+  surface.texture = true;
+  surface.field.kind = TextureKind::kSine;
+  surface.field.amplitude = A;
+  surface.field.wavelength = L;
+  ContactSet set(4);
+  set.num_contacts = 2;
+  for (int k = 0; k < 2; ++k) {
+    Contact& c = set.contacts[k];
+    c.normal = Vec3::UnitZ();
+    c.separation = 1e-6;
+    c.point = Vec3(k * L / 2, 0, c.separation);
+    c.features.kind = PairKind::kGodVertexObstacleFace;
+    c.features.obstacle = 0;
+  }
+  const Vec3 G = set.contacts[0].point;
+  const Mat6 M = Mat6::Identity();
+  ProjectionSettings settings;
+  ProjectionWorkspace ws(4);
+  ProjectionResult result(4);
+  TextureWeighting weighting{&M, Vec6::Zero(), &settings, &ws, &result};
+  weighting.au << 0, 0, -1, 0, -4 / L, 0;  // the second point moves by (0, 0, -1 + 2): away
+  double Js[4 * 6], normals[4][3];
+  const double slope = 2 * M_PI * A / L;  // |grad h| at the first contact (x = 0), -grad h = -slope x
+  CHECK(std::abs(shade_contacts(surface, nullptr, set, G, 4, Js, normals, &weighting) - slope) <= 1e-12);
+  CHECK(result.lambda[0] > 0);
+  CHECK(result.lambda[1] == 0);
+  const Vec3 tilted = Vec3(-slope, 0, 1).normalized();
+  for (int k = 0; k < 2; ++k) {
+    CHECK((Vec3(normals[k][0], normals[k][1], normals[k][2]) - tilted).norm() <= 1e-12);
+    CHECK(Js[6 * k + 2] == normals[k][2]);
+  }
+  // The plain average (no command, or one that presses on neither): zero, the true normals.
+  CHECK(shade_contacts(surface, nullptr, set, G, 4, Js, normals) <= 1e-12);
+  CHECK((Vec3(normals[1][0], normals[1][1], normals[1][2]) - Vec3::UnitZ()).norm() <= 1e-12);
+  weighting.au << 0, 0, 1, 0, 0, 0;  // pulling away: no contact carries force
+  CHECK(shade_contacts(surface, nullptr, set, G, 4, Js, normals, &weighting) <= 1e-12);
+}
+
 TEST_CASE("surface: textures' gradients match their height fields; the sampling bound", "[surface]") {
   TextureField t;
   t.amplitude = 0.0008;  // scene units: 0.8 mm bumps of 1 cm

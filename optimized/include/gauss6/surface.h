@@ -38,6 +38,21 @@
 // 6.2), and every row's normal becomes normalize(n_k + g - (g . n_k) n_k).
 // Shading and texture combine: the texture perturbs the shading normals.
 //
+// The average is weighted by the force each contact carries: w_k = lambda_k /
+// sum lambda, the multipliers of the command au projected under the untextured
+// rows (the shading rows, or the true ones), at the pose the rows are built
+// for (TextureWeighting). A plain average let contacts that carry no force
+// tilt it: on the textured Figure 8 cylinder the probe lies on a facet with its
+// tip and a second vertex half a wavelength apart (opposite perturbations,
+// average 0); when it rolls off the second vertex, that contact (no force: the
+// probe moves away from it) left the set and the average jumped to the tip's
+// own perturbation, turning the force by 25 degrees in one tick. A contact
+// leaves the set or joins it with a multiplier near zero (it carries no force
+// when the god-object moves away from it, and little when the command has
+// only just reached it), so the weighted average moves as continuously as the
+// force does; with equal forces it is the plain average. Without a command
+// (weighting null), or when no contact carries force, the plain average.
+//
 // Real time: shade_contacts() and the texture functions allocate nothing, lock
 // nothing and throw nothing.
 #pragma once
@@ -47,6 +62,7 @@
 
 #include "gauss6/contacts.h"
 #include "gauss6/pose.h"
+#include "gauss6/quasistatics.h"
 #include "gauss6/scene.h"
 
 namespace gauss6 {
@@ -118,12 +134,26 @@ inline double max_texture_speed(double shortest_wavelength, double update_hz) {
 }
 inline double shortest_felt_wavelength(double speed, double update_hz) { return 2 * speed / update_hz; }
 
+// What weights a texture's average (the top of this file): the command au at
+// the pose the rows are built for, the mass matrix there, and the projection's
+// settings and buffers (at least the set's rows; their warm start is reused).
+struct TextureWeighting {
+  const Mat6* M = nullptr;
+  Vec6 au = Vec6::Zero();
+  const ProjectionSettings* settings = nullptr;
+  ProjectionWorkspace* workspace = nullptr;
+  ProjectionResult* result = nullptr;
+};
+
 // The shading rows of a contact set at the god-object's reference point G:
 // Js (m x 6 row-major, m = set.num_contacts <= capacity) and the shaded unit
 // normals (m). obstacles_W: the world-frame meshes the set's features index.
 // Without shading the normals are the true ones; with a texture they are
-// perturbed. Returns the averaged texture perturbation's norm (0 without one).
+// perturbed by the average of the contacts' perturbations, weighted as
+// `weighting` says (null: the plain average). Returns the averaged texture
+// perturbation's norm (0 without one).
 double shade_contacts(const SurfaceModel& surface, const TriangleMesh* obstacles_W, const ContactSet& set,
-                      const Vec3& G, int capacity, double* Js, double (*normals)[3]) noexcept;
+                      const Vec3& G, int capacity, double* Js, double (*normals)[3],
+                      const TextureWeighting* weighting = nullptr) noexcept;
 
 }  // namespace gauss6
