@@ -10,6 +10,14 @@ meshes and hand scripts.
   put its reference point G at its lowest vertex (the tip that explores).
 - cylinder_slide.json: the tip pressed 4 mm past the cylinder's flats, slid over the
   top half around the axis (15 to 165 degrees) across five edges, then lifted.
+- bumps.png, bumps.json: the height map of the height-map scene (heightmap.toml): a 16-bit
+  grey PNG of round raised-cosine bumps, h = a (1 + cos(pi r / R)) / 2 within r < R, in a
+  row along the image's middle line, their radii (log-uniform 0.75 to 6 mm), steepest
+  slopes (0.3 to 0.5) and gaps (2 to 5 mm) drawn from numpy's PCG64 with a fixed seed;
+  pixel pitch 0.25 mm, values scaled so that the highest bump is 1 (the scene's amplitude
+  is its height). bumps.json lists each bump's centre, radius, height and steepest slope
+  (scene units, the tile's first pixel at the origin) for the analysis. Written with
+  Pillow at a fixed compression level (the same bytes on a rerun with the pinned Pillow).
 - texture_slow.json / texture_fast.json: the tip pressed 6 mm into the slab and slid
   along +X over 12 cm at 0.1 m/s and at 0.4 m/s. The press is deep against the
   hand's lead over the god-object (2 to 4 mm along X at a 50 Hz sim step and
@@ -32,7 +40,7 @@ from pathlib import Path
 
 import numpy as np
 
-GENERATOR_VERSION = "2"  # 2: the texture scripts press 6 mm (1: 3 mm)
+GENERATOR_VERSION = "3"  # 3: the height map bumps.png, bumps.json; 2: the texture scripts press 6 mm (1: 3 mm)
 
 
 def _peg_module():
@@ -64,6 +72,12 @@ class SurfacesParams:
     texture_start_x: float = -0.06
     texture_length: float = 0.12
     texture_speeds: tuple = (0.1, 0.4)
+    heightmap_pixels: tuple = (512, 64)  # width (along X), height (along Y)
+    heightmap_pitch: float = 0.00025
+    heightmap_seed: int = 1
+    heightmap_radii: tuple = (0.00075, 0.006)
+    heightmap_slopes: tuple = (0.15, 0.3)
+    heightmap_gaps: tuple = (0.002, 0.005)
 
     def to_json(self) -> dict:
         d = asdict(self)
@@ -139,6 +153,45 @@ def texture_script(p: SurfacesParams, speed: float) -> dict:
             "end_time": round(2.0 + t_slide, 9)}
 
 
+def height_map(p: SurfacesParams) -> tuple[np.ndarray, list[dict]]:
+    """(image in [0, 1] as uint16, rows along Y; the bumps) of bumps.png: raised-cosine bumps on the
+    image's middle row, drawn left to right until the next would not fit with a margin of one gap."""
+    width, height = p.heightmap_pixels
+    pitch = p.heightmap_pitch
+    rng = np.random.Generator(np.random.PCG64(p.heightmap_seed))
+    bumps = []
+    x = p.heightmap_gaps[1]
+    while True:
+        r = float(np.exp(rng.uniform(np.log(p.heightmap_radii[0]), np.log(p.heightmap_radii[1]))))
+        slope = float(rng.uniform(*p.heightmap_slopes))
+        gap = float(rng.uniform(*p.heightmap_gaps))
+        if x + 2 * r + p.heightmap_gaps[1] > width * pitch or r > 0.5 * height * pitch:
+            break
+        # Steepest slope of a (1 + cos(pi r / R)) / 2 is a pi / (2 R).
+        bumps.append({"x": x + r, "y": 0.5 * height * pitch, "radius": r, "height": slope * 2 * r / np.pi,
+                      "slope": slope})
+        x += 2 * r + gap
+    X, Y = np.meshgrid(np.arange(width) * pitch, np.arange(height) * pitch)
+    h = np.zeros((height, width))
+    for b in bumps:
+        d = np.hypot(X - b["x"], Y - b["y"])
+        h = np.maximum(h, np.where(d < b["radius"], 0.5 * b["height"] * (1 + np.cos(np.pi * d / b["radius"])), 0))
+    top = max(b["height"] for b in bumps)
+    image = np.rint(h / top * 65535).astype(np.uint16)
+    return image, [{k: round(v, 12) for k, v in b.items()} for b in bumps]
+
+
+def png_bytes(image: np.ndarray) -> bytes:
+    """A 16-bit grey PNG of `image` (uint16), Pillow at compression level 9."""
+    import io
+
+    from PIL import Image
+
+    buf = io.BytesIO()
+    Image.fromarray(image).save(buf, format="PNG", compress_level=9)
+    return buf.getvalue()
+
+
 def generate(out_dir: Path, params: SurfacesParams | None = None) -> dict[str, str]:
     """Writes the meshes and scripts into out_dir; returns {filename: text}."""
     p = params or SurfacesParams()
@@ -158,13 +211,20 @@ def generate(out_dir: Path, params: SurfacesParams | None = None) -> dict[str, s
     scripts = {"cylinder_slide.json": cylinder_script(p)}
     for speed, label in zip(p.texture_speeds, ("slow", "fast")):
         scripts[f"texture_{label}.json"] = texture_script(p, speed)
+    image, bumps = height_map(p)
+    scripts["bumps.json"] = {"description": "The round bumps of bumps.png (generators/surfaces.py, height_map): "
+                                            "centre x, y, radius, height and steepest slope, metres, in the "
+                                            "image's tile (its first pixel at 0, 0).",
+                             "pitch": p.heightmap_pitch, "pixels": list(p.heightmap_pixels),
+                             "amplitude": max(b["height"] for b in bumps), "bumps": bumps}
     for name, s in scripts.items():
         out[name] = json.dumps(s, indent=1) + "\n"
     out_dir = Path(out_dir)
     out_dir.mkdir(parents=True, exist_ok=True)
     for name, text in out.items():
         (out_dir / name).write_text(text, encoding="ascii")
-    return out
+    (out_dir / "bumps.png").write_bytes(png_bytes(image))
+    return {**out, "bumps.png": "(binary)"}
 
 
 if __name__ == "__main__":

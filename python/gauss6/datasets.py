@@ -18,8 +18,9 @@ Generation is deterministic: the same parameters give byte-identical files, so
   glmark2-data's bunny.obj by the CGAL program gauss6_make_bunny
   (datasets_generated/generators/make_bunny.cpp, built by CMake).
 - surfaces: faceted_cylinder.off, slab.off, probe.off and the hand scripts of the
-  Figure 8 and 9 analogues (cylinder_slide.json, texture_slow.json, texture_fast.json),
-  from datasets_generated/generators/surfaces.py (Python, numpy; reuses the peg generator).
+  Figure 8 and 9 analogues (cylinder_slide.json, texture_slow.json, texture_fast.json), the
+  height map bumps.png with its bump list bumps.json, from
+  datasets_generated/generators/surfaces.py (Python, numpy, Pillow; reuses the peg generator).
 """
 from __future__ import annotations
 

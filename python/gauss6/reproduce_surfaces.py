@@ -27,6 +27,20 @@ for summary.json and their report.md section.
     speed_bound              v_max (m/s) at the run's update rate
     max_direction_jump_deg, max_direction_step_deg   as for Figure 8 (the texture sampled at
                              each sim step turns the force between two steps by design)
+- Height map (`heightmap`): the bumps of datasets_generated/surfaces/bumps.png (14 round
+  bumps of radius 0.8 to 5.5 mm, bumps.json lists them) on the slab (heightmap.toml),
+  explored by the Figure 9 slow slide (0.1 m/s along the bump row) with a sim step every
+  tick (1 kHz: bound 0.25 m/s) and every 20 ticks (50 Hz: bound 12.5 mm/s for the image's
+  two-pixel wavelength; a bump of radius R is about a period of 2 R, felt while the contact
+  moves less than R per update). Numbers, per run:
+    bumps_traversed, bumps_missed   bumps whose whole extent the god-object crossed during
+                             the slide, and those over which the force's tilt along X (ticks
+                             with |Fz| > 0.5 N) did not reach half the bump's steepest slope
+                             both ways (the rise tilts it back, the fall forward)
+    missed_radii             the missed bumps' radii (m)
+    max_god_object_step      the god-object's largest move between two ticks of the slide (m)
+    texture_events, speed_bound, update_hz   as for Figure 9
+    port_energy_max, port_energy_final, shading_work_*   the energy figures below
 - For every run: property 7 (max_rel_constraint_violation over every sim step), the
   shaded orthogonality (max_rel_force_dot_asc over the coupling steps), penetrating
   poses (exact check), and the energy figures: the constraint stage's (energy_injected,
@@ -48,6 +62,8 @@ SHADING_RUNS = {"plain": "cylinder_plain.toml", "shaded": "cylinder_shaded.toml"
                 "textured": "cylinder_textured.toml"}  # textured: shading and a texture combined
 TEXTURE_RUNS = {"slow": "texture_slow.toml", "fast": "texture_fast.toml"}
 TEXTURE_SIM_PERIOD = 20          # haptic ticks per sim step in the texture runs (50 Hz)
+HEIGHTMAP_SCENE = "heightmap.toml"
+HEIGHTMAP_RUNS = {"1khz": 1, "50hz": TEXTURE_SIM_PERIOD}  # label: haptic ticks per sim step
 MIN_FORCE = 0.5                  # N: ticks with a weaker force have no meaningful direction
 
 
@@ -153,10 +169,62 @@ def bumps(trace, texture: dict) -> tuple[int, int]:
     return len(crossed), missed
 
 
+def height_map_texture(scene: Path) -> dict:
+    """The scene's height map: its [surface] table (origin, amplitude, pitch = wavelength / the
+    image's width) and the bump list the generator wrote beside the image (bumps.json)."""
+    import tomllib
+
+    scene = Path(scene)
+    s = tomllib.loads(scene.read_text())["surface"]
+    if s.get("texture") != "height_map" or s.get("axis", "x") != "x":
+        raise ValueError(f"{scene}: the height-map analysis needs a height map along x")
+    listing = json.loads((scene.parent / s["image"]).resolve().with_name("bumps.json").read_text())
+    return {"origin": [float(v) for v in s.get("origin", [0.0, 0.0, 0.0])], "amplitude": float(s["amplitude"]),
+            "pitch": float(s["wavelength"]) / listing["pixels"][0], "bumps": listing["bumps"]}
+
+
+def height_profile(texture: dict, x: np.ndarray) -> np.ndarray:
+    """The bumps' height along their row at world x (the generator's raised cosines)."""
+    h = np.zeros_like(x)
+    for b in texture["bumps"]:
+        d = np.abs(x - texture["origin"][0] - b["x"])
+        h = np.maximum(h, np.where(d < b["radius"], 0.5 * b["height"] * (1 + np.cos(np.pi * d / b["radius"])), 0))
+    return h
+
+
+def height_map_bumps(trace, texture: dict) -> tuple[int, list[float]]:
+    """(bumps whose extent the god-object crossed during the slide, the radii of those over which
+    the force's tilt did not reach half the bump's steepest slope both ways)."""
+    F = trace.ticks["wrench"][:, :3]
+    x = trace.ticks["xs_p"][:, 0]
+    slide = _slide_mask(trace)
+    ok = slide & (np.abs(F[:, 2]) > MIN_FORCE)
+    tilt = np.where(ok, F[:, 0] / np.where(ok, F[:, 2], 1.0), 0.0)
+    x0 = texture["origin"][0]
+    crossed, missed = 0, []
+    for b in texture["bumps"]:
+        lo, hi = x0 + b["x"] - b["radius"], x0 + b["x"] + b["radius"]
+        if not (x[slide].min() < lo and x[slide].max() > hi):
+            continue
+        crossed += 1
+        t = tilt[ok & (x >= lo) & (x <= hi)]
+        if not (t.size and t.min() < -0.5 * b["slope"] and t.max() > 0.5 * b["slope"]):
+            missed.append(float(b["radius"]))
+    return crossed, missed
+
+
+def max_slide_step(trace) -> float:
+    """The god-object's largest move between two ticks of the slide (m)."""
+    idx = np.flatnonzero(_slide_mask(trace))
+    if idx.size < 2:
+        return 0.0
+    return float(np.linalg.norm(np.diff(trace.ticks["xs_p"][idx], axis=0), axis=1).max())
+
+
 def reproduce_surfaces(out: Path, show_progress: bool = True) -> tuple[dict, dict]:
-    """Runs the four surface runs; writes their traces and figures; returns (summary, details)."""
+    """Runs the surface runs; writes their traces and figures; returns (summary, details)."""
     out.mkdir(parents=True, exist_ok=True)
-    summary: dict = {"shading": {}, "texture": {}}
+    summary: dict = {"shading": {}, "texture": {}, "heightmap": {}}
     traces = {}
     for label, scene in SHADING_RUNS.items():
         numbers, trace = _run(SCENES / scene, out, f"cylinder_{label}", 1, show_progress)
@@ -175,7 +243,19 @@ def reproduce_surfaces(out: Path, show_progress: bool = True) -> tuple[dict, dic
         numbers["max_direction_jump_deg"], numbers["max_direction_step_deg"] = direction_jumps(trace)
         summary["texture"][label] = numbers
         traces[f"texture_{label}"] = trace
+    hm = height_map_texture(SCENES / HEIGHTMAP_SCENE)
+    for label, period in HEIGHTMAP_RUNS.items():
+        numbers, trace = _run(SCENES / HEIGHTMAP_SCENE, out, f"heightmap_{label}", period, show_progress)
+        numbers["bumps_traversed"], missed = height_map_bumps(trace, hm)
+        numbers["bumps_missed"], numbers["missed_radii"] = len(missed), sorted(missed)
+        numbers["max_god_object_step"] = max_slide_step(trace)
+        numbers["texture_events"] = int(numbers["events"].get("texture_undersampled", 0))
+        numbers["update_hz"] = 1000.0 / period
+        numbers["speed_bound"] = 0.5 * 2 * hm["pitch"] * numbers["update_hz"]  # two pixels: L_min f / 2
+        summary["heightmap"][label] = numbers
+        traces[f"heightmap_{label}"] = trace
     figures = plot_surfaces(traces, out, sine_texture(SCENES / TEXTURE_RUNS["slow"]))
+    figures += plot_height_map(traces, out, hm)
     return summary, {"figures": figures}
 
 
@@ -189,6 +269,18 @@ def _save(fig, out: Path, stem: str) -> list[str]:
         names.append(f"{stem}.{ext}")
     plt.close(fig)
     return names
+
+
+def _tilt_panel(ax, trace, x_ref: np.ndarray, tilt_ref: np.ndarray, ref_label: str, title: str) -> None:
+    """One axis: the surface's tilt against x (dotted) and the force's tilt Fx/Fz at the god-object's x
+    over the slide's ticks with a force."""
+    F, x = trace.ticks["wrench"][:, :3], trace.ticks["xs_p"][:, 0]
+    ok = _slide_mask(trace) & (np.abs(F[:, 2]) > MIN_FORCE)
+    ax.plot(x_ref * 100, tilt_ref, "k:", lw=0.8, label=ref_label)
+    ax.plot(x[ok] * 100, F[ok, 0] / F[ok, 2], ".", ms=2, label="force tilt Fx/Fz")
+    ax.set_ylabel("tilt")
+    ax.set_title(title)
+    ax.legend(fontsize=7, loc="upper right")
 
 
 def plot_surfaces(traces: dict, out: Path, texture: dict) -> list[str]:
@@ -232,20 +324,36 @@ def plot_surfaces(traces: dict, out: Path, texture: dict) -> list[str]:
     fig, ax = plt.subplots(2, 1, figsize=(9, 6), sharex=True)
     x = np.linspace(-0.06, 0.06, 1200)
     for i, label in enumerate(("slow", "fast")):
-        tr = traces[f"texture_{label}"]
-        F, xs = tr.ticks["wrench"][:, :3], tr.ticks["xs_p"]
-        ok = _slide_mask(tr) & (np.abs(F[:, 2]) > MIN_FORCE)
         phase = 2 * np.pi * (x - texture["origin_x"]) / texture["wavelength"]
-        ax[i].plot(x * 100, -texture["slope"] * np.cos(phase), "k:", lw=0.8, label="texture's tilt (-dh/dx)")
-        ax[i].plot(xs[ok, 0] * 100, F[ok, 0] / F[ok, 2], ".", ms=2, label="force tilt Fx/Fz")
-        ax[i].set_ylabel("tilt")
-        ax[i].set_title(f"{label}: {'0.1' if label == 'slow' else '0.4'} m/s (bound 0.25 m/s at 50 Hz)")
-        ax[i].legend(fontsize=7, loc="upper right")
+        _tilt_panel(ax[i], traces[f"texture_{label}"], x, -texture["slope"] * np.cos(phase), "texture's tilt (-dh/dx)",
+                    f"{label}: {'0.1' if label == 'slow' else '0.4'} m/s (bound 0.25 m/s at 50 Hz)")
     ax[1].set_xlabel("x (cm)")
     fig.suptitle("Bump-and-hole texture at two speeds (Figure 9 analogue)")
     fig.tight_layout()
     written += _save(fig, out, "figure_texture")
     return written
+
+
+def plot_height_map(traces: dict, out: Path, texture: dict) -> list[str]:
+    """figure_heightmap.png/svg: the bump row's height and the force's tilt against x at both rates."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    xs = np.linspace(-0.064, 0.064, 4001)
+    row = height_profile(texture, xs)
+    fig, ax = plt.subplots(3, 1, figsize=(9, 7.5), sharex=True)
+    ax[0].plot(xs * 100, row * 1000, "k-", lw=0.8)
+    ax[0].set_ylabel("height (mm)")
+    ax[0].set_title("the bumps of bumps.png along the slide (y = 0)")
+    for i, label in enumerate(HEIGHTMAP_RUNS, start=1):
+        _tilt_panel(ax[i], traces[f"heightmap_{label}"], xs, -np.gradient(row, xs), "bumps' tilt (-dh/dx)",
+                    f"0.1 m/s, constraints updated at {1000 // HEIGHTMAP_RUNS[label]} Hz")
+    ax[2].set_xlabel("x (cm)")
+    fig.suptitle("Height-map texture: bumps felt and skipped")
+    fig.tight_layout()
+    return _save(fig, out, "figure_heightmap")
 
 
 def report_lines(summary: dict) -> list[str]:
@@ -305,6 +413,33 @@ def report_lines(summary: dict) -> list[str]:
         if slow["bumps_missed"] > 0 or fast["bumps_missed"] == 0:
             lines += ["", "**Not the paper's Figure 9:** every bump should be felt under the bound and some "
                       "missed over it."]
+    hm = summary.get("heightmap", {})
+    if hm:
+        lines += ["", "![height map](figure_heightmap.png)", "",
+                  "| run | update rate (Hz) | speed bound (m/s) | bumps crossed | bumps missed (radii, mm) | "
+                  "texture events | property 7 | shading work in / out (J) | port energy max / final (J) "
+                  "| penetrating poses |",
+                  "| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |"]
+        for label, n in hm.items():
+            radii = ", ".join(f"{r * 1000:.2g}" for r in n["missed_radii"])
+            lines.append(f"| height map, {label} | {n['update_hz']:.3g} | {n['speed_bound']:.3g} | "
+                         f"{n['bumps_traversed']} | {n['bumps_missed']}{f' ({radii})' if radii else ''} | "
+                         f"{n['texture_events']} | {n['max_rel_constraint_violation']:.3g} | "
+                         f"{n['shading_work_injected']:.3g} / {n['shading_work_removed']:.3g} | "
+                         f"{n['port_energy_max']:.3g} / {n['port_energy_final']:.3g} | {n['penetrating_poses']} |")
+        fast, slow = hm.get("1khz"), hm.get("50hz")
+        lines += ["", "The height map's bound counts its finest detail, two pixels (0.5 mm): 0.25 m/s at 1 kHz, "
+                  "12.5 mm/s at 50 Hz, so the 50 Hz run is over it and says so (`texture_undersampled`). Its "
+                  "bumps are coarser than that: a bump of radius R is about a period of 2 R, which the same bound "
+                  "asks to sample in steps under R."]
+        if fast and slow:
+            lines += ["", f"At 50 Hz the god-object moves up to {slow['max_god_object_step'] * 1000:.2g} mm between "
+                      f"updates and misses {slow['bumps_missed']} of {slow['bumps_traversed']} bumps; at 1 kHz "
+                      f"{fast['bumps_missed']} of {fast['bumps_traversed']}: there the hand moves 0.1 mm a tick, but "
+                      "the god-object, held back on a bump's rise by the tilted rows (pass 2 follows asc along the "
+                      f"surface) and released on its fall, slips by up to {fast['max_god_object_step'] * 1000:.2g} "
+                      f"mm a step, past the bound on the narrowest bumps ({fast['texture_events']} "
+                      "`texture_undersampled` onsets)."]
     lines += ["", "Shading and textures can inject energy: the shaded force is orthogonal to the shaded motion asc, "
               "not to the motion ac the god-object takes, and its work on it is Fs . (ac - asc) (Coq: "
               "`shading_work`). That work is bounded per step by |Fs| |ac - asc|, which grows with the angle "
