@@ -14,9 +14,11 @@
 // Surface properties (surface.h), each next to the same geometry plain, on the
 // Figure 8 and 9 scenes with their own hand scripts (datasets_generated/scenes/),
 // warmed up into the slide, 1000 timed ticks within it:
-//   CouplingStep/cylinder/{plain,shaded}, CouplingStep/slab/{plain,texture}:
+//   CouplingStep/cylinder/{plain,shaded,shaded_texture}, CouplingStep/slab/{plain,texture}:
 //                 the coupling step (shaded: projection under Js, asc published);
-//   SimStep/cylinder/{plain,shaded}, SimStep/slab/{plain,texture}: one sim step
+//                 shaded_texture: the cylinder shaded under a sine texture
+//                 (cylinder_textured.toml, shading and texture combined);
+//   SimStep/cylinder/{plain,shaded,shaded_texture}, SimStep/slab/{plain,texture}: one sim step
 //                 (shaded: pass 2 from the coupling's asc, the new set's Js;
 //                 texture: the held contacts, the texture's perturbation), a
 //                 haptic tick after each (not timed), as lockstep runs them.
@@ -136,6 +138,7 @@ std::unique_ptr<PegRun> make_surface_run(const std::string& scene_name, bool pla
 std::unique_ptr<PegRun> make_surface_run(const std::string& which) {
   if (which == "cylinder/plain") return make_surface_run("cylinder_plain", false, 2.0);
   if (which == "cylinder/shaded") return make_surface_run("cylinder_shaded", false, 2.0);
+  if (which == "cylinder/shaded_texture") return make_surface_run("cylinder_textured", false, 2.0);
   if (which == "slab/plain") return make_surface_run("texture_slow", true, 1.1);
   return make_surface_run("texture_slow", false, 1.1);  // slab/texture
 }
@@ -186,7 +189,8 @@ void register_all() {
       ->UseManualTime()->Iterations(kTimedTicks);
   benchmark::RegisterBenchmark("LockstepTick/peg/pressing_sliding", BM_LockstepTick)
       ->UseManualTime()->Iterations(kTimedTicks)->Unit(benchmark::kMicrosecond);
-  for (const char* which : {"cylinder/plain", "cylinder/shaded", "slab/plain", "slab/texture"}) {
+  for (const char* which :
+       {"cylinder/plain", "cylinder/shaded", "cylinder/shaded_texture", "slab/plain", "slab/texture"}) {
     benchmark::RegisterBenchmark((std::string("CouplingStep/") + which).c_str(), BM_SurfaceCouplingStep,
                                  std::string(which))
         ->UseManualTime()->Iterations(1000);

@@ -46,7 +46,8 @@ for summary.json and their report.md section.
   poses (exact check), and the energy figures: the constraint stage's (energy_injected,
   <= 0 up to rounding), the shading's work on the god-object's motion
   (shading_work_injected / _removed, J) and the device-port passivity observer's maximum
-  (port_energy_max, J).
+  (port_energy_max, J); offset_steps, the coupling steps with an offset row running (on a
+  shaded run the offsets apply to the shading rows).
 """
 from __future__ import annotations
 
@@ -86,6 +87,7 @@ def _run(scene: Path, out: Path, label: str, sim_period: int, show_progress: boo
         "constraint_checks": run["num_constraint_checks"],
         "max_rel_force_dot_asc": run["max_rel_force_dot_ac"],
         "shaded_coupling_steps": run["num_shaded_steps"],
+        "offset_steps": run["num_offset_steps"],
         "energy_injected": run["constraint_energy_injected"],
         "shading_work_injected": run["shading_work_injected"],
         "shading_work_removed": run["shading_work_removed"],

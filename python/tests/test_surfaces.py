@@ -122,6 +122,7 @@ def test_shaded_slide_keeps_contact_and_a_smooth_force(cylinder_runs):
     assert jump_plain > 25 and jump_shaded < 10
     run, trace = cylinder_runs["shaded"]
     assert run["max_rel_force_dot_ac"] <= 1e-9
+    assert run["num_offset_steps"] > 0  # new contacts' offsets on the shading rows (measured 258 steps)
     scene = rs.SCENES / "cylinder_shaded.toml"
     assert count_penetrating(scene, distinct_poses(trace), False, "shaded")[0] == 0
 
