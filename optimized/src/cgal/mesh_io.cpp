@@ -178,6 +178,11 @@ long long obj_index(const std::string& token, long long count) {
 // file is refused (the vertex is on a crease, which per-vertex normals cannot
 // express). With vn records, every vertex must be on a corner that gives one.
 // No vn record: empty matrix (computed normals are used).
+// Not tinyobjloader (Debian's libtinyobjloader-dev 2.0.0~rc10, tried): it
+// accepted, with no error or warning, "vn 0 abc 1" (read as 0 0 1), "vn 0 0 1
+// 5", a corner "1x//1" (atoi: read as 1) and corners naming vertex 7 or -9 of 3
+// (returned as indices 6 and -6); the refusals below would need a second pass
+// over the text anyway.
 MatrixX3d read_obj_normals(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
   if (!in) fail(path, "cannot open the file for reading");
