@@ -279,14 +279,17 @@ double shade_contacts(const SurfaceModel& surface, const TriangleMesh* obstacles
   // The weights: each contact's share of the force the untextured rows give the command.
   const double* lambda = nullptr;
   double total = 0;
-  if (weighting != nullptr && weighting->M != nullptr && weighting->result != nullptr &&
-      weighting->result->max_rows() >= m && weighting->workspace->max_rows() >= m) {
+  if (weighting != nullptr && weighting->M != nullptr && weighting->settings != nullptr &&
+      weighting->workspace != nullptr && weighting->result != nullptr && weighting->result->max_rows() >= m &&
+      weighting->workspace->max_rows() >= m) {
     ProjectionProblem problem;
     problem.M = weighting->M;
     problem.au = weighting->au;
     problem.J = Js;
     problem.num_rows = m;
-    if (project(problem, *weighting->settings, weighting->workspace, weighting->result) == ProjectionStatus::kOptimal) {
+    ProjectionSettings cold = *weighting->settings;  // the rows are new with each contact set
+    cold.warm_start = false;
+    if (project(problem, cold, weighting->workspace, weighting->result) == ProjectionStatus::kOptimal) {
       lambda = weighting->result->lambda.data();
       for (int k = 0; k < m; ++k) total += std::max(lambda[k], 0.0);
       if (!(total > 0 && std::isfinite(total))) lambda = nullptr;

@@ -92,7 +92,7 @@ def test_textured_cylinder_force_turns_without_a_jump(cylinder_runs):
     """The combined scene's force keeps its direction from one tick to the next when the contact
     set changes (the probe's tip and a second vertex, half a texture wavelength apart, on one
     facet): the texture's average weighted by the forces the contacts carry, and a pressed
-    contact held at its gap by pass 2. Measured: 3.8 degrees at most between successive ticks
+    contact held at its gap by pass 2. Measured: 3.7 degrees at most between successive ticks
     (24.9 with the plain average and the tip lifted out of the contact band; the shaded run
     without texture 1.0). The bound 8: about twice the measured value (room for a change of the
     scene's sampling), a third of the jump it replaces."""

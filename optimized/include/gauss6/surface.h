@@ -136,7 +136,8 @@ inline double shortest_felt_wavelength(double speed, double update_hz) { return 
 
 // What weights a texture's average (the top of this file): the command au at
 // the pose the rows are built for, the mass matrix there, and the projection's
-// settings and buffers (at least the set's rows; their warm start is reused).
+// settings and buffers (at least the set's rows; a cold start: the rows are new
+// with each contact set).
 struct TextureWeighting {
   const Mat6* M = nullptr;
   Vec6 au = Vec6::Zero();
