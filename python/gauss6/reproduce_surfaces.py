@@ -424,7 +424,7 @@ def report_lines(summary: dict) -> list[str]:
                   "| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |"]
         for label, n in hm.items():
             radii = ", ".join(f"{r * 1000:.2g}" for r in n["missed_radii"])
-            lines.append(f"| height map, {label} | {n['update_hz']:.3g} | {n['speed_bound']:.3g} | "
+            lines.append(f"| height map, {label} | {n['update_hz']:.0f} | {n['speed_bound']:.3g} | "
                          f"{n['bumps_traversed']} | {n['bumps_missed']}{f' ({radii})' if radii else ''} | "
                          f"{n['texture_events']} | {n['max_rel_constraint_violation']:.3g} | "
                          f"{n['shading_work_injected']:.3g} / {n['shading_work_removed']:.3g} | "
