@@ -278,7 +278,33 @@ class Oracle:
         return M
 
     # -- the judgement --------------------------------------------------------------------------
-    def judge(self, trace, progress=None) -> OracleResult:
+    def nearest_rows(self, p, q, clearance: float) -> np.ndarray:
+        """The contact wrenches J (k, 6) of the features nearest to the tool at pose (p, q), for Fig.
+        13's measure (oracle.toml [direction] nearest_band): gauss6's contact generation within
+        clearance + nearest_band delta, clearance being the pose's own separation (free) or
+        penetration depth (estimate)."""
+        band = self.thresholds["direction"]["nearest_band"] * self.delta
+        return np.asarray(self.contacts.contacts(p, q, max(clearance, 0.0) + band)["J"], float)
+
+    def tangential_share(self, q, wrench, J) -> tuple[float, int]:
+        """The wrench's share outside the span of the rows J, in the metric M^-1 at orientation q, and
+        the rank of the rows. Sign-free (a span, not the cone): the crossing edges of a penetrating
+        pose count either way. NaN without rows or force, and when the rows span every wrench (rank
+        6: no tangential part can show)."""
+        if len(J) == 0 or not np.linalg.norm(wrench) > 0:
+            return math.nan, 0
+        L = np.linalg.cholesky(self.mass_matrix(q))
+        b = np.linalg.solve(L, wrench)
+        A = np.linalg.solve(L, J.T)
+        coef, _, rank, _ = np.linalg.lstsq(A, b, rcond=1e-9)
+        if rank >= 6:
+            return math.nan, int(rank)
+        return float(np.linalg.norm(b - A @ coef) / np.linalg.norm(b)), int(rank)
+
+    def judge(self, trace, progress=None, nearest_window=None) -> OracleResult:
+        """Every check on a run. nearest_window (t0, t1): also the Fig. 13 series nearest_tangential
+        (nearest_tangential_share at every tick with force there, penetrating poses included); off by
+        default (a penetration depth estimate costs seconds a pose on the bunnies)."""
         th = self.thresholds
         delta = self.delta
         ticks = trace.ticks
@@ -463,6 +489,27 @@ class Oracle:
              "max_wrong_side_share": float(np.nanmax(wrong)) if np.any(in_band) else 0.0,
              "ticks_without_contacts": no_contacts}))
 
+        # Fig. 13's measure at every tick with force in the window, penetrating or free (up to free_space).
+        nearest = np.full(n, np.nan)
+        nearest_rank = np.zeros(n, np.int64)
+        if nearest_window is not None:
+            rows_of: dict = {}
+            chosen = forced & finite_pose & (t >= nearest_window[0]) & (t <= nearest_window[1])
+            for c, k in enumerate(np.flatnonzero(chosen)):
+                j = pose_id[k]
+                if j not in rows_of:
+                    if pen_tick[k]:
+                        clearance = depth[j] if depth[j] > 0 else self.depth_estimate(xs_p[k], xs_q[k])
+                    elif np.isfinite(sep[k]):
+                        clearance = sep[k]
+                    else:
+                        clearance = None  # beyond free_space: no nearest features to speak of
+                    rows_of[j] = None if clearance is None else self.nearest_rows(xs_p[k], xs_q[k], clearance)
+                if rows_of[j] is not None:
+                    nearest[k], nearest_rank[k] = self.tangential_share(xs_q[k], W[k], rows_of[j])
+                if c % 500 == 0:
+                    say("nearest features", c, int(chosen.sum()))
+
         free_bad = in_free_space | away
         fb = np.flatnonzero(free_bad)
         verdicts.append(Verdict(
@@ -556,6 +603,8 @@ class Oracle:
              "sustained_hz": 1 / med if med > 0 else None, "steps_over_period": len(over_period)}))
 
         signed = np.where(pen_tick, -depth[pose_id], sep)
-        series = {"t": t, "separation": signed / delta, "cone_distance": cone, "energy": energy,
+        series = {"t": t, "separation": signed / delta, "cone_distance": cone, "nearest_tangential": nearest,
+                  "nearest_rank": nearest_rank,
+                  "energy": energy,
                   "force": f_norm, "penetrating": pen_tick, "step_seconds": st}
         return OracleResult(verdicts, series, phases)
