@@ -33,6 +33,7 @@ from pathlib import Path
 import numpy as np
 
 from . import paths
+from .crosscheck_ccd import point_triangle_distance
 
 # The checkout's thresholds; an installed wheel carries a copy (python/CMakeLists.txt).
 THRESHOLDS = paths.REPO_ROOT / "harness" / "oracle.toml"
@@ -146,32 +147,13 @@ def pose_difference(pa, qa, pb, qb) -> np.ndarray:
     return np.concatenate([pa - pb, r[..., 1:] * scale[..., None]], axis=-1)
 
 
-def _segment_distance(P, A, B):
-    """Distance from points P (n, 1, 3) to segments AB (1, m, 3): (n, m)."""
-    AB = B - A
-    t = np.clip(np.einsum("nmk,nmk->nm", P - A, np.broadcast_to(AB, np.broadcast_shapes(P.shape, AB.shape)))
-                / np.maximum(np.einsum("nmk,nmk->nm", AB, AB), 1e-300), 0, 1)
-    return np.linalg.norm(P - (A + t[..., None] * AB), axis=-1)
-
-
 def point_mesh_distance(P: np.ndarray, V: np.ndarray, F: np.ndarray) -> np.ndarray:
     """Unsigned distance from points (n, 3) to a triangle mesh's surface (floating point)."""
     out = np.full(len(P), np.inf)
-    A, B, C = V[F[:, 0]][None], V[F[:, 1]][None], V[F[:, 2]][None]
-    N = np.cross(B - A, C - A)
-    N = N / np.maximum(np.linalg.norm(N, axis=-1, keepdims=True), 1e-300)
+    A, B, C = V[F[:, 0]], V[F[:, 1]], V[F[:, 2]]
     chunk = max(1, 2_000_000 // max(len(F), 1))
     for i in range(0, len(P), chunk):
-        X = P[i:i + chunk, None, :]
-        h = np.einsum("nmk,nmk->nm", X - A, np.broadcast_to(N, (len(X),) + N.shape[1:]))
-        foot = X - h[..., None] * N
-        inside = np.ones(h.shape, bool)
-        for U, W in ((A, B), (B, C), (C, A)):
-            inside &= np.einsum("nmk,nmk->nm", np.cross(W - U, foot - U), np.broadcast_to(N, foot.shape)) >= 0
-        d = np.where(inside, np.abs(h), np.inf)
-        for U, W in ((A, B), (B, C), (C, A)):
-            d = np.minimum(d, _segment_distance(X, U, W))
-        out[i:i + chunk] = d.min(axis=1)
+        out[i:i + chunk] = np.asarray(point_triangle_distance(P[i:i + chunk, None, :], A, B, C)).min(axis=1)
     return out
 
 
