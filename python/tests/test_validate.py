@@ -80,23 +80,20 @@ def test_gauss6_engine_raises_no_alarm_on_the_peg(tmp_path, peg_oracle):
     assert result.verdict("penetration").details["poses"] > 500
 
 
-def test_gauss6_engine_on_the_bunny_only_its_known_findings(tmp_path):
-    """No false alarm on the bunny; one true finding, characterised here so that a change of the runtime
-    that fixes (or worsens) it shows. A graze in the approach: from 0.191 s the god-object rests on an
-    edge/edge contact at 1.001-1.015 delta, inside the CCD's distance-tolerance band (delta to 1.1 delta),
-    so every sim step's first leg stops at u_hit 6e-4 to 5e-3 (the gap rows then recover 2e-4 delta a
-    step); it creeps, held 5 mm behind the hand (the hand leaves the bunny at 0.236 s, the force still
-    grows), until at 0.257 s a new contact changes the projection, the 2.5 mm leg runs free, the settled
-    end is refused three times (property 5) and the step ends at the first leg's eighth, out of contact:
-    the force falls from 0.84 N to 0 in a tick. (There were also three steps whose direct in-between
-    motion touched the bunny, u* = 0.057, 0.0087, 0.00086, though each leg of the step was free: a
-    settling step displayed only its end. Since the sim loop keeps a settled end only when the CCD proves
-    the direct motion to it free, METHOD.md property 5 holds: none is left.)"""
+def test_gauss6_engine_raises_no_alarm_on_the_bunny(tmp_path):
+    """No alarm on the bunny either. Two true findings were fixed in the runtime and stay checked here.
+    Three steps whose direct in-between motion touched the bunny though each leg was free (the settled
+    end is now kept only when the CCD proves the direct motion free: METHOD.md property 5). And a graze
+    in the approach: from 0.191 s the god-object rested on an edge/edge contact at 1.001-1.015 delta,
+    inside the CCD's distance-tolerance band (delta to 1.1 delta), so every sim step's leg stopped at
+    u_hit 6e-4 to 5e-3; it crept, held 5 mm behind the hand (out of the bunny from 0.236 s), until at
+    0.257 s it slid off and the force fell from 0.84 N to 0 in a tick (the leg now runs again from a
+    waypoint that lifts the contacts out of the band: sim_loop.cpp lift_out_of_graze)."""
     result = Oracle(BUNNY).judge(_run(tmp_path, load_engine("gauss6"), scene=BUNNY, duration=BUNNY_SLICE))
-    assert result.failed() == ["force_jumps"], [v.to_json() for v in result.verdicts if not v.passed]
+    assert result.failed() == [], [v.to_json() for v in result.verdicts if not v.passed]
     tunnels, jumps = result.verdict("tunnelling"), result.verdict("force_jumps")
     assert tunnels.count == 0 and tunnels.details["undecided"] == 0 and tunnels.details["near"] > 1000
-    assert jumps.count == 1 and 0.5 < jumps.worst < 1.0 and jumps.first_time < 0.3
+    assert jumps.details["max_force_step"] < 0.3  # the graze's release was 0.84 N
     assert result.verdict("force_direction").details["ticks"] > 100
 
 
