@@ -205,6 +205,66 @@ bool motion_free(const RuntimeModel& model, const Pose& x0, const Pose& x1, int 
   return s->check.status == CcdStatus::kOk && !s->check.hit;
 }
 
+// A graze: the leg just run (s->ccd) was stopped by a pair of the last contact
+// set (still s->contacts, at the leg's start) that had not come closer than where
+// it started, by half the CCD's distance tolerance. The CCD may stop wherever a
+// pair is within min_separation + distance_tolerance, and a contact the last
+// step left in that band (delta to 1.1 delta) stops the next leg at once, even
+// when the leg moves away from it: the god-object then crept by u_hit 1e-5 to
+// 5e-3 of its leg a step (the gap rows, cut with the leg, lift the contact 2e-4
+// delta a step), held behind the hand for 65 ms on the bunny (an edge/edge
+// contact at 1.001 delta; released at 0.257 s by a 0.84 N drop) and 330 ms in
+// the peg's hole (1.003 delta, at 11.6 s; 2.7 mJ of port energy when it broke free).
+bool grazed(const RuntimeModel& model, const SimState& s) {
+  const CcdStepResult& r = s.ccd;
+  if (!r.hit || r.status != CcdStatus::kOk) return false;
+  const int m = std::min(s.contacts.num_contacts, kMaxContacts);
+  for (int k = 0; k < m; ++k) {
+    const Contact& c = s.contacts.contacts[k];
+    const FeaturePair& a = c.features;
+    const FeaturePair& b = r.pair;
+    if (a.kind == b.kind && a.obstacle == b.obstacle && a.god_face == b.god_face && a.god_corner == b.god_corner &&
+        a.obstacle_face == b.obstacle_face && a.obstacle_corner == b.obstacle_corner)
+      return r.distance_reached >= c.separation - 0.5 * model.settings.ccd.narrow.distance_tolerance;
+  }
+  return false;
+}
+
+// Out of a graze: the leg again, from x_lift = x_start (+) a_lift, a_lift the
+// M-smallest motion that lifts every contact of the set to delta (1 +
+// gap_factor) to first order (the gap rows alone: a fraction of delta), out of
+// the CCD's band; its end is kept only when the CCD proves the direct motion
+// x_start -> end free of contact (the published motion, property 5). x_lift is a
+// waypoint, never published; every pose of the second leg keeps the CCD's
+// min_separation. Returns false, with s->xs, s->ccd and s->stop_deviation as the
+// grazed leg left them, when the gap rows conflict or either CCD refuses.
+bool lift_out_of_graze(const RuntimeModel& model, const Pose& x_start, const Pose& target, int num_hints,
+                       SimState* s, int* num_halves) {
+  const int m = std::min(s->contacts.num_contacts, kMaxContacts);
+  const double gap = model.contact.delta * (1 + model.settings.gap_factor);
+  for (int k = 0; k < m; ++k) s->gap_rhs[k] = gap - s->contacts.contacts[k].separation;
+  ProjectionProblem problem;
+  problem.M = &s->M;
+  problem.J = s->contacts.J.data();
+  problem.b = s->gap_rhs.data();
+  problem.num_rows = m;
+  project(problem, model.settings.projection, &s->shading_ws, &s->shading);
+  if (s->shading.status != ProjectionStatus::kOptimal || !s->shading.ac.allFinite()) return false;
+  const Pose grazed_xs = s->xs;
+  const CcdStepResult grazed_leg = s->ccd;  // to restore on a refusal (plain data: no allocation)
+  const double grazed_deviation = s->stop_deviation;
+  int halves = 1;
+  if (ccd_leg(model, pose_update(x_start, s->shading.ac), target, num_hints, s, &halves) &&
+      motion_free(model, x_start, s->xs, num_hints, s)) {
+    *num_halves = std::max(*num_halves, halves);
+    return true;
+  }
+  s->xs = grazed_xs;
+  s->ccd = grazed_leg;
+  s->stop_deviation = grazed_deviation;
+  return false;
+}
+
 // The contact set at s->xs: every pair within delta (1 + contact_factor), and
 // at least the pair that stopped the last leg (s->ccd). Sets the overflow event.
 void update_contacts(const RuntimeModel& model, SimState* s) {
@@ -249,6 +309,8 @@ void advance_god_object(const RuntimeModel& model, const Pose& x_start, const Po
   for (;;) {
     s->xs = x_start;
     const bool moved = ccd_leg(model, x_start, target, num_hints, s, &info->num_halves);
+    if (moved && info->num_shortenings == 0 && grazed(model, *s))
+      lift_out_of_graze(model, x_start, target, num_hints, s, &info->num_halves);
     info->ccd = s->ccd.status;
     info->u_hit = s->ccd.u_hit;
     info->status = !moved ? SimStepStatus::kInvalidStep

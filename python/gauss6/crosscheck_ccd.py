@@ -172,24 +172,38 @@ class SetResult:
         self.failures += st["failures"][:max(self.MAX_FAILURES_KEPT - len(self.failures), 0)]
 
 
-def point_segment_distance(p, a, b) -> float:
-    """Euclidean distance from p to the closed segment ab (a point when a = b)."""
+def _dot(x, y):
+    return np.einsum("...k,...k->...", x, y)
+
+
+def _scalar(x):
+    return float(x) if np.ndim(x) == 0 else x
+
+
+def point_segment_distance(p, a, b):
+    """Euclidean distance from p to the closed segment ab (a point when a = b). Points (..., 3),
+    broadcast against each other (the oracle's point_mesh_distance: points x triangles' edges): a
+    float for single points, else an array."""
+    p, a, b = (np.asarray(x, float) for x in (p, a, b))
     d = b - a
-    t = 0.0 if not d.any() else float(np.clip((p - a) @ d / (d @ d), 0, 1))
-    return float(np.linalg.norm(p - (a + t * d)))
+    dd = _dot(d, d)
+    t = np.where(dd > 0, np.clip(_dot(p - a, d) / np.where(dd > 0, dd, 1.0), 0, 1), 0.0)
+    return _scalar(np.linalg.norm(p - (a + t[..., None] * d), axis=-1))
 
 
-def point_triangle_distance(p, a, b, c) -> float:
+def point_triangle_distance(p, a, b, c):
     """Euclidean distance from p to the closed triangle abc: the plane's foot when it
-    lies inside, else the nearest edge."""
+    lies inside, else the nearest edge. Broadcast as point_segment_distance."""
+    p, a, b, c = (np.asarray(x, float) for x in (p, a, b, c))
     n = np.cross(b - a, c - a)
-    nn = n @ n
-    if nn > 0:
-        foot = p - ((p - a) @ n / nn) * n
-        w = [np.cross(y - x, foot - x) @ n for x, y in ((a, b), (b, c), (c, a))]
-        if min(w) >= 0 or max(w) <= 0:
-            return float(abs((p - a) @ n) / math.sqrt(nn))
-    return min(point_segment_distance(p, x, y) for x, y in ((a, b), (b, c), (c, a)))
+    nn = _dot(n, n)
+    safe = np.where(nn > 0, nn, 1.0)
+    h = _dot(p - a, n)
+    foot = p - (h / safe)[..., None] * n
+    w = [_dot(np.cross(y - x, foot - x), n) for x, y in ((a, b), (b, c), (c, a))]
+    inside = (nn > 0) & ((np.minimum.reduce(w) >= 0) | (np.maximum.reduce(w) <= 0))
+    edges = np.minimum.reduce([point_segment_distance(p, x, y) for x, y in ((a, b), (b, c), (c, a))])
+    return _scalar(np.where(inside, np.abs(h) / np.sqrt(safe), edges))
 
 
 def segment_distance(a0, a1, b0, b1) -> float:

@@ -33,6 +33,7 @@ from pathlib import Path
 import numpy as np
 
 from . import paths
+from .crosscheck_ccd import point_triangle_distance
 
 # The checkout's thresholds; an installed wheel carries a copy (python/CMakeLists.txt).
 THRESHOLDS = paths.REPO_ROOT / "harness" / "oracle.toml"
@@ -146,32 +147,13 @@ def pose_difference(pa, qa, pb, qb) -> np.ndarray:
     return np.concatenate([pa - pb, r[..., 1:] * scale[..., None]], axis=-1)
 
 
-def _segment_distance(P, A, B):
-    """Distance from points P (n, 1, 3) to segments AB (1, m, 3): (n, m)."""
-    AB = B - A
-    t = np.clip(np.einsum("nmk,nmk->nm", P - A, np.broadcast_to(AB, np.broadcast_shapes(P.shape, AB.shape)))
-                / np.maximum(np.einsum("nmk,nmk->nm", AB, AB), 1e-300), 0, 1)
-    return np.linalg.norm(P - (A + t[..., None] * AB), axis=-1)
-
-
 def point_mesh_distance(P: np.ndarray, V: np.ndarray, F: np.ndarray) -> np.ndarray:
     """Unsigned distance from points (n, 3) to a triangle mesh's surface (floating point)."""
     out = np.full(len(P), np.inf)
-    A, B, C = V[F[:, 0]][None], V[F[:, 1]][None], V[F[:, 2]][None]
-    N = np.cross(B - A, C - A)
-    N = N / np.maximum(np.linalg.norm(N, axis=-1, keepdims=True), 1e-300)
+    A, B, C = V[F[:, 0]], V[F[:, 1]], V[F[:, 2]]
     chunk = max(1, 2_000_000 // max(len(F), 1))
     for i in range(0, len(P), chunk):
-        X = P[i:i + chunk, None, :]
-        h = np.einsum("nmk,nmk->nm", X - A, np.broadcast_to(N, (len(X),) + N.shape[1:]))
-        foot = X - h[..., None] * N
-        inside = np.ones(h.shape, bool)
-        for U, W in ((A, B), (B, C), (C, A)):
-            inside &= np.einsum("nmk,nmk->nm", np.cross(W - U, foot - U), np.broadcast_to(N, foot.shape)) >= 0
-        d = np.where(inside, np.abs(h), np.inf)
-        for U, W in ((A, B), (B, C), (C, A)):
-            d = np.minimum(d, _segment_distance(X, U, W))
-        out[i:i + chunk] = d.min(axis=1)
+        out[i:i + chunk] = np.asarray(point_triangle_distance(P[i:i + chunk, None, :], A, B, C)).min(axis=1)
     return out
 
 
@@ -278,7 +260,33 @@ class Oracle:
         return M
 
     # -- the judgement --------------------------------------------------------------------------
-    def judge(self, trace, progress=None) -> OracleResult:
+    def nearest_rows(self, p, q, clearance: float) -> np.ndarray:
+        """The contact wrenches J (k, 6) of the features nearest to the tool at pose (p, q), for Fig.
+        13's measure (oracle.toml [direction] nearest_band): gauss6's contact generation within
+        clearance + nearest_band delta, clearance being the pose's own separation (free) or
+        penetration depth (estimate)."""
+        band = self.thresholds["direction"]["nearest_band"] * self.delta
+        return np.asarray(self.contacts.contacts(p, q, max(clearance, 0.0) + band)["J"], float)
+
+    def tangential_share(self, q, wrench, J) -> tuple[float, int]:
+        """The wrench's share outside the span of the rows J, in the metric M^-1 at orientation q, and
+        the rank of the rows. Sign-free (a span, not the cone): the crossing edges of a penetrating
+        pose count either way. NaN without rows or force, and when the rows span every wrench (rank
+        6: no tangential part can show)."""
+        if len(J) == 0 or not np.linalg.norm(wrench) > 0:
+            return math.nan, 0
+        L = np.linalg.cholesky(self.mass_matrix(q))
+        b = np.linalg.solve(L, wrench)
+        A = np.linalg.solve(L, J.T)
+        coef, _, rank, _ = np.linalg.lstsq(A, b, rcond=1e-9)
+        if rank >= 6:
+            return math.nan, int(rank)
+        return float(np.linalg.norm(b - A @ coef) / np.linalg.norm(b)), int(rank)
+
+    def judge(self, trace, progress=None, nearest_window=None) -> OracleResult:
+        """Every check on a run. nearest_window (t0, t1): also the Fig. 13 series nearest_tangential
+        (nearest_tangential_share at every tick with force there, penetrating poses included); off by
+        default (a penetration depth estimate costs seconds a pose on the bunnies)."""
         th = self.thresholds
         delta = self.delta
         ticks = trace.ticks
@@ -463,6 +471,27 @@ class Oracle:
              "max_wrong_side_share": float(np.nanmax(wrong)) if np.any(in_band) else 0.0,
              "ticks_without_contacts": no_contacts}))
 
+        # Fig. 13's measure at every tick with force in the window, penetrating or free (up to free_space).
+        nearest = np.full(n, np.nan)
+        nearest_rank = np.zeros(n, np.int64)
+        if nearest_window is not None:
+            rows_of: dict = {}
+            chosen = forced & finite_pose & (t >= nearest_window[0]) & (t <= nearest_window[1])
+            for c, k in enumerate(np.flatnonzero(chosen)):
+                j = pose_id[k]
+                if j not in rows_of:
+                    if pen_tick[k]:
+                        clearance = depth[j] if depth[j] > 0 else self.depth_estimate(xs_p[k], xs_q[k])
+                    elif np.isfinite(sep[k]):
+                        clearance = sep[k]
+                    else:
+                        clearance = None  # beyond free_space: no nearest features to speak of
+                    rows_of[j] = None if clearance is None else self.nearest_rows(xs_p[k], xs_q[k], clearance)
+                if rows_of[j] is not None:
+                    nearest[k], nearest_rank[k] = self.tangential_share(xs_q[k], W[k], rows_of[j])
+                if c % 500 == 0:
+                    say("nearest features", c, int(chosen.sum()))
+
         free_bad = in_free_space | away
         fb = np.flatnonzero(free_bad)
         verdicts.append(Verdict(
@@ -556,6 +585,8 @@ class Oracle:
              "sustained_hz": 1 / med if med > 0 else None, "steps_over_period": len(over_period)}))
 
         signed = np.where(pen_tick, -depth[pose_id], sep)
-        series = {"t": t, "separation": signed / delta, "cone_distance": cone, "energy": energy,
+        series = {"t": t, "separation": signed / delta, "cone_distance": cone, "nearest_tangential": nearest,
+                  "nearest_rank": nearest_rank,
+                  "energy": energy,
                   "force": f_norm, "penetrating": pen_tick, "step_seconds": st}
         return OracleResult(verdicts, series, phases)

@@ -80,20 +80,37 @@ def test_gauss6_engine_raises_no_alarm_on_the_peg(tmp_path, peg_oracle):
     assert result.verdict("penetration").details["poses"] > 500
 
 
-def test_gauss6_engine_on_the_bunny_only_its_known_findings(tmp_path):
-    """No false alarm on the bunny; one true finding, characterised here so that a change of the runtime
-    that fixes (or worsens) it shows. In the approach (t < 0.3 s) the god-object, catching up with the
-    hand from the scene's initial pose in mm steps, brushes the static bunny, and at one step it leaves
-    the contact by 3.2 mm and the force drops by 0.84 N in a tick. (There were also three steps whose
-    direct in-between motion touched the bunny, u* = 0.057, 0.0087, 0.00086, though each leg of the
-    step was free: a settling step displayed only its end. Since the sim loop keeps a settled end only
-    when the CCD proves the direct motion to it free, METHOD.md property 5 holds: none is left.)"""
+def test_gauss6_engine_raises_no_alarm_on_the_bunny(tmp_path):
+    """No alarm on the bunny either. Two true findings were fixed in the runtime and stay checked here.
+    Three steps whose direct in-between motion touched the bunny though each leg was free (the settled
+    end is now kept only when the CCD proves the direct motion free: METHOD.md property 5). And a graze
+    in the approach: from 0.191 s the god-object rested on an edge/edge contact at 1.001-1.015 delta,
+    inside the CCD's distance-tolerance band (delta to 1.1 delta), so every sim step's leg stopped at
+    u_hit 6e-4 to 5e-3; it crept, held 5 mm behind the hand (out of the bunny from 0.236 s), until at
+    0.257 s it slid off and the force fell from 0.84 N to 0 in a tick (the leg now runs again from a
+    waypoint that lifts the contacts out of the band: sim_loop.cpp lift_out_of_graze)."""
     result = Oracle(BUNNY).judge(_run(tmp_path, load_engine("gauss6"), scene=BUNNY, duration=BUNNY_SLICE))
-    assert result.failed() == ["force_jumps"], [v.to_json() for v in result.verdicts if not v.passed]
+    assert result.failed() == [], [v.to_json() for v in result.verdicts if not v.passed]
     tunnels, jumps = result.verdict("tunnelling"), result.verdict("force_jumps")
     assert tunnels.count == 0 and tunnels.details["undecided"] == 0 and tunnels.details["near"] > 1000
-    assert jumps.count == 1 and 0.5 < jumps.worst < 1.0 and jumps.first_time < 0.3
+    assert jumps.details["max_force_step"] < 0.3  # the graze's release was 0.84 N
     assert result.verdict("force_direction").details["ticks"] > 100
+
+
+def test_fig13_tangential_share_against_the_nearest_features(tmp_path, peg_oracle):
+    """Fig. 13's measure (Oracle.nearest_rows, tangential_share): gauss6's force lies in the span of
+    the nearest features' contact wrenches to rounding; the planted 5% tangential part shows on every
+    tick with force after it, at 1-10% (the M^-1 metric weighs it against the torque)."""
+    window = (1.0, PEG_SLICE)
+    plain = peg_oracle.judge(_run(tmp_path, load_engine("gauss6"), name="plain"), nearest_window=window)
+    engine = load_engine("fault", f"inner={engine_library('gauss6')};fault=tangential;at=1.0")
+    fault = peg_oracle.judge(_run(tmp_path, engine, name="fault"), nearest_window=window)
+    for result, low, high in ((plain, 0.0, 1e-9), (fault, 0.01, 0.1)):
+        share = result.series["nearest_tangential"]
+        measured = share[np.isfinite(share)]
+        assert len(measured) > 400
+        assert low <= measured.min() and measured.max() <= high, (measured.min(), measured.max())
+    assert np.all(np.isnan(plain.series["nearest_tangential"][plain.series["t"] < window[0]]))
 
 
 FAULTS = [

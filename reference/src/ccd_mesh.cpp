@@ -864,46 +864,32 @@ SeparationBound separation_within(const ExactMeshPair& mp, const Pose& X, double
   if (!(max_distance >= 0 && std::isfinite(max_distance)))
     throw std::invalid_argument("separation_within: max_distance must be finite and >= 0");
   const PosedBody posed(mp.god, X);
-  const ToInterval to_interval;
+  std::vector<SeparationCandidate> close;
+  const double best_upper = interval_candidates(mp, posed, max_distance, &close);  // separation_bracket's passes
   SeparationBound out;
-  std::vector<std::pair<int32_t, int32_t>> undecided;
-  {
-    CGAL::Protect_FPU_rounding<true> upward;  // Interval_nt_advanced needs it
-    const IntervalKernel::FT m2 = CGAL::square(IntervalKernel::FT(max_distance));
-    double best_sup = HUGE_VAL;  // the least upper bound of a pair's squared distance
-    candidate_pairs(mp, posed, max_distance, [&](int32_t f, int32_t of) {
-      try {
-        const IntervalKernel::FT d2 = CGAL::squared_distance(to_interval(BodyFace{&posed, &mp.god, f}),
-                                                             to_interval(ObstacleFace{&mp.obstacle, of}));
-        if (std::isfinite(d2.sup()) && d2.inf() > m2.sup()) return;  // farther than max_distance
-        if (std::isfinite(d2.sup()) && d2.sup() <= m2.inf()) {
-          best_sup = std::min(best_sup, d2.sup());
-          return;
-        }
-      } catch (CGAL::Uncertain_conversion_exception&) {
-      }
-      undecided.emplace_back(f, of);
-    });
-    if (best_sup < HUGE_VAL) {
-      out.within = true;
-      out.upper = std::nextafter(std::sqrt(best_sup), HUGE_VAL);  // rounded upward, one more step for safety
-      return out;
-    }
-  }
-  // The intervals proved no pair within: exactly, the pairs they could not rule out.
-  const ToExact to_exact;
   const CGAL::Gmpq max2 = CGAL::Gmpq(max_distance) * CGAL::Gmpq(max_distance);
-  for (const auto& [f, of] : undecided) {
+  if (best_upper < HUGE_VAL && CGAL::Gmpq(best_upper) <= max2) {  // a pair's enclosure proves it
+    out.within = true;
+    out.upper = std::nextafter(std::sqrt(best_upper), HUGE_VAL);  // best_upper >= d^2; one more step for safety
+    return out;
+  }
+  // The intervals proved no pair within: exactly, by increasing lower bound, the pairs they could
+  // not rule out.
+  std::sort(close.begin(), close.end(),
+            [](const SeparationCandidate& a, const SeparationCandidate& b) { return a.lower < b.lower; });
+  const ToExact to_exact;
+  for (const SeparationCandidate& c : close) {
+    if (CGAL::Gmpq(c.lower) > max2) break;
+    out.exact = true;
     const CGAL::Gmpq d2 =
-        CGAL::squared_distance(to_exact(BodyFace{&posed, &mp.god, f}), to_exact(ObstacleFace{&mp.obstacle, of}));
+        CGAL::squared_distance(to_exact(BodyFace{&posed, &mp.god, c.f}), to_exact(ObstacleFace{&mp.obstacle, c.of}));
     if (d2 <= max2) {
-      out.within = out.exact = true;
+      out.within = true;
       const double x = CGAL::to_interval(d2).second;  // >= d2
       out.upper = std::nextafter(std::sqrt(x), HUGE_VAL);
       return out;
     }
   }
-  out.exact = !undecided.empty();
   return out;
 }
 

@@ -60,7 +60,12 @@ const SimStepInfo& sim_step(const RuntimeModel& model, double t, RuntimeChannels
 // Step 4 of a sim step alone, from its recorded inputs (SimStepInfo::x_start,
 // x_target, residual): the CCD along the Cayley motion x_start -> x_target (split
 // in halves on a half turn), s->xs = its end or its stop pose (delta before the
-// first contact), s->M at s->xs, and s->contacts, the contact set at s->xs. If
+// first contact), s->M at s->xs, and s->contacts, the contact set at s->xs. A
+// first leg stopped by a graze (a contact of the last set, left inside the CCD's
+// distance-tolerance band, stops it though it has not come closer) runs again
+// from a waypoint that lifts the contacts to delta (1 + gap_factor), its end kept
+// only when the CCD proves the direct motion x_start -> end free of contact
+// (sim_loop.cpp, lift_out_of_graze). If
 // that leg ends free with an empty contact set while residual != 0 (the previous
 // contacts withheld part of the command, and their surface fell away under the
 // linearised constraints: a convex crease or a curved surface), a settling leg
@@ -76,7 +81,8 @@ const SimStepInfo& sim_step(const RuntimeModel& model, double t, RuntimeChannels
 // x_target, residual, settled, num_shortenings, ccd (the first status other
 // than kOk over the legs of the last try), u_hit, num_halves, status and
 // num_contacts. Real time: no allocation; at most 5 ccd_step calls a try (two a
-// leg, one check), 20 over the 1 + kMaxSettleShortenings tries.
+// leg, one check), 20 over the 1 + kMaxSettleShortenings tries, and 3 more (a
+// leg, a check) out of a graze.
 constexpr int kMaxSettleShortenings = 3;
 void advance_god_object(const RuntimeModel& model, const Pose& x_start, const Pose& x_target, const Vec6& residual,
                         SimState* s, SimStepInfo* info) noexcept;

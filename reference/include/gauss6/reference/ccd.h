@@ -231,12 +231,13 @@ struct ExactSeparation {
 ExactSeparation separation_distance(const ExactMeshPair& meshes, const Pose& X, double max_distance);
 
 // Whether the exact minimum triangle/triangle distance between the god-object at
-// pose X and the obstacle is <= max_distance (>= 0), the question of property 6,
-// without computing the minimum: each candidate pair's squared distance is
-// enclosed in interval arithmetic, and any enclosure below max_distance^2 proves
-// it; only when none does are the pairs the intervals could not rule out
-// evaluated in Gmpq. Far faster than separation_distance where faces slide
-// parallel at the contact distance (its exact pass then visits every such pair).
+// pose X and the obstacle is <= max_distance (>= 0, finite), the question of
+// property 6, without computing the minimum: separation_bracket's two passes
+// (boxes, then each candidate pair's squared distance enclosed in interval
+// arithmetic) decide it when an enclosure lies below max_distance^2; only when
+// none does are the pairs whose lower bound does not rule them out evaluated in
+// Gmpq. Far faster than separation_distance where faces slide parallel at the
+// contact distance (its exact pass then visits every such pair).
 struct SeparationBound {
   bool within = false;  // the exact minimum distance is <= max_distance
   double upper = 0;     // when within: a certified upper bound of that minimum
