@@ -164,8 +164,9 @@ bool ccd_leg(const RuntimeModel& model, const Pose& x0, const Pose& x1, int num_
 // Whether the CCD proves the Cayley motion x0 -> x1 free of contact with every
 // obstacle (it never misses one: u_hit <= u*). Searched for contact itself
 // (min_separation 0, so a motion that ends delta from a surface is not
-// refused for reaching delta), without the proximity cache or near pairs, in
-// its own workspace (s->check_ws, s->check: the legs' state is left as it
+// refused for reaching delta), without a proximity cache of its own (the legs'
+// list serves it read-only when it covers the motion) or near pairs, in its
+// own workspace (s->check_ws, s->check: the legs' state is left as it
 // was). A hit, a give-up, invalid input or a half turn answer false.
 bool motion_free(const RuntimeModel& model, const Pose& x0, const Pose& x1, int num_hints, SimState* s) {
   CcdStepSettings settings = model.settings.ccd;
@@ -173,6 +174,10 @@ bool motion_free(const RuntimeModel& model, const Pose& x0, const Pose& x1, int 
   settings.near_distance = 0;
   settings.cache.margin = settings.cache.margin_max = 0;
   settings.cache.fill_budget = 0;
+  // The legs' proximity list serves it read-only when the direct motion stays
+  // within its margin (ccd_step.h, CcdStepWorkspace::borrowed): the same
+  // candidates a descent would find, without descending the trees.
+  s->check_ws.borrowed = &s->ccd_ws.cache;
   ccd_step(model.obstacles.data(), static_cast<int>(model.obstacles.size()), model.god, x0, x1, settings,
            &s->check_ws, &s->check, s->ccd_hints.data(), num_hints);
   return s->check.status == CcdStatus::kOk && !s->check.hit;
