@@ -7,7 +7,8 @@
 // (datasets_generated/scenes/). Two kinds of step sets:
 //   - scenario: the steps of the scene's scripted scenario (what `gauss6
 //     reproduce` runs), recorded once in lockstep at setup (bench_data.h
-//     scenario_steps: about 17,500 peg steps, 7,400 bunny steps); one
+//     scenario_steps: about 17,500 peg steps, 7,400 bunny steps, and 7,400
+//     steps of the full-resolution bunnies, 69,664 triangles each); one
 //     benchmark iteration replays every recorded step once, in order, from its
 //     recorded inputs (settling legs included). These decide issue 4's floors:
 //     p99 <= 0.2 ms per step for the peg, <= 1 ms for the bunnies;
@@ -219,7 +220,8 @@ void time_steps(benchmark::State& state, const RuntimeModel& model, const std::v
   LatencyRecorder rec(capacity), cpu(capacity);
   PerCallCounters counters;
   // The slowest step (CPU time) and what it did; GAUSS6_BENCH_STEP_LOG=<file>
-  // writes one line per step (index, CPU ns and the same counts) for profiles.
+  // writes one line per step (index, CPU ns and the same counts, then the
+  // settling step's shortenings) for profiles.
   double slowest_ns = -1, over_1ms = 0, over_100us = 0;
   std::FILE* log = std::getenv("GAUSS6_BENCH_STEP_LOG") ? std::fopen(std::getenv("GAUSS6_BENCH_STEP_LOG"), "w") : nullptr;
   size_t i = 0;
@@ -247,9 +249,10 @@ void time_steps(benchmark::State& state, const RuntimeModel& model, const std::v
         state.counters["slowest_settled"] = info.settled;
       }
       if (log != nullptr)
-        std::fprintf(log, "%zu %.0f %d %ld %d %d %d %d %d %d\n", index, cpu_ns, r.num_pair_tests, r.num_box_iterations,
+        std::fprintf(log, "%zu %.0f %d %ld %d %d %d %d %d %d %d\n", index, cpu_ns, r.num_pair_tests, r.num_box_iterations,
                      r.num_node_pairs, r.num_fill_node_pairs, r.num_triangle_pairs, static_cast<int>(info.settled),
-                     static_cast<int>(info.status == SimStepStatus::kContact), r.num_sub_intervals);
+                     static_cast<int>(info.status == SimStepStatus::kContact), r.num_sub_intervals,
+                     info.num_shortenings);
       counters.add("hits", info.status == SimStepStatus::kContact);
       counters.add("settling_legs", info.settled);
       counters.add("gave_up", info.ccd != CcdStatus::kOk);
@@ -283,12 +286,13 @@ void BM_CcdStep(benchmark::State& state, const std::string& scene_name, const st
 void register_all() {
   struct Case { const char* scene; const char* script; int iterations; };
   // The scenario cases: one iteration = one pass over every recorded step
-  // (peg: ~20 s to record, ~10 s a pass; bunnies: ~4 s and ~2 s).
+  // (peg: ~20 s to record, ~10 s a pass; bunnies: ~4 s and ~2 s; the
+  // full-resolution bunnies, issue 20's third scenario: ~25 s and ~3 s).
   for (Case c : {Case{"peg_in_hole", "scenario", 1}, Case{"peg_in_hole", "sliding", 600},
                  Case{"peg_in_hole", "descending", 600}, Case{"peg_in_hole", "in_hole", 600},
                  Case{"peg_in_hole", "in_hole_pressing", 600}, Case{"bunnies", "scenario", 1},
                  Case{"bunnies", "near_1mm", 300}, Case{"bunnies", "near_0.2mm", 300},
-                 Case{"bunnies", "ears_pressing", 300}})
+                 Case{"bunnies", "ears_pressing", 300}, Case{"bunnies_full", "scenario", 1}})
     register_latency(std::string("CcdStep/") + c.scene + "/" + c.script, BM_CcdStep, std::string(c.scene),
                      std::string(c.script))
         ->Iterations(c.iterations);

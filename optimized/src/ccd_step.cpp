@@ -255,11 +255,14 @@ void ccd_step(const CcdBody* obstacles, int num_obstacles, const CcdBody& god, c
   result->num_sub_intervals = s.n;
   // The hints and the proximity cache both start from the god-object at u = 0.
   const bool cached = settings.cache.margin > 0;
-  if ((hints && num_hints > 0) || cached) s.start.set(s.motion, 0.0, god.bvh->radius);
+  const bool borrowing = !cached && ws->borrowed != nullptr;
+  if ((hints && num_hints > 0) || cached || borrowing) s.start.set(s.motion, 0.0, god.bvh->radius);
   // Search the hints over the whole step.
   search_hints(&s);
-  // Serve the step's start from the proximity cache, refilled first if worth it.
+  // Serve the step's start from the proximity cache, refilled first if worth it
+  // (or from another workspace's list, read-only).
   if (cached) serve_proximity_cache(&s);
+  if (borrowing) serve_borrowed_list(&s);
   // Descend the trees per sub-interval past the cached range, and test the
   // candidate pairs earliest-first (a full stack stops the step there).
   if (!search_sub_intervals(&s)) return;

@@ -123,5 +123,8 @@ void serve_proximity_cache(StepState* s);
 // After the step's searches: start or go on with the background fill of the
 // next list, and note the step's start for the next step.
 void fill_cache_in_background(StepState* s);
+// Without a cache of its own (settings.cache.margin 0): [0, u_cached] from
+// ws->borrowed, read-only, when that list covers the rest of the step.
+void serve_borrowed_list(StepState* s);
 
 }  // namespace gauss6::detail

@@ -241,8 +241,7 @@ void refill_if_worth(StepState* s, const CacheRanges& r, Displacement* since) {
 // gap at the cache's pose less how far its points can move from there by
 // u_cached: a few flops); the time bound only for the pairs it does not keep
 // beyond the reach; then the candidates' tests.
-void search_cached_pairs(StepState* s, const Displacement& since) {
-  const ProximityCache& pc = s->ws->cache;
+void search_cached_pairs(StepState* s, const ProximityCache& pc, const Displacement& since) {
   CcdStepResult* result = s->result;
   PairTester& tester = s->tester;
   CcdStepWorkspace::Candidate* const cand = s->ws->candidates.data();
@@ -308,7 +307,33 @@ void serve_proximity_cache(StepState* s) {
   refill_if_worth(s, r, &since);
   s->u_cached = r.window(s->u_cached);
   s->result->u_cached = s->u_cached;
-  if (s->u_cached > 0) search_cached_pairs(s, since);
+  if (s->u_cached > 0) search_cached_pairs(s, pc, since);
+}
+
+// The borrowed list (CcdStepWorkspace::borrowed) serves the step when it
+// holds what this step needs: the same god-object and obstacles, filled for a
+// reach at least this step's (it holds every pair not proven farther than
+// its reach plus its margin apart at its pose, so every pair that can come
+// within the smaller reach while no point has moved farther than the margin
+// from there), room for its pairs among the candidates, and a range over which no
+// point leaves its margin that covers the rest of the step (up to a hint's
+// hit). Nothing of the list changes: no use counted, no fill.
+void serve_borrowed_list(StepState* s) {
+  const ProximityCache* pc = s->ws->borrowed;
+  if (s->tester.done() || pc == nullptr || pc->num_pairs < 0) return;
+  bool usable = same_body(pc->god, s->god) && static_cast<int>(pc->obstacles.size()) == s->num_obstacles &&
+                pc->reach >= s->reach && pc->num_pairs <= static_cast<int>(s->ws->candidates.size());
+  for (int o = 0; usable && o < s->num_obstacles; ++o)
+    usable = same_body(pc->obstacles[static_cast<size_t>(o)], s->obstacles[o]);
+  if (!usable) return;
+  const Displacement since(pc->ref, s->X0);
+  const double speed = s->start.speed;  // start: at u = 0 (ccd_step)
+  const double u_rest = s->result->hit ? s->result->u_hit : 1.0;
+  const double u = speed > 0 ? ((Lower{pc->margin} - Upper{since.bound(s->rho)}) / Upper{speed}).v : 1.0;
+  if (!(u > 0 && u >= u_rest)) return;  // also NaN
+  s->u_cached = std::min(u, 1.0);
+  s->result->u_cached = s->u_cached;
+  search_cached_pairs(s, *pc, since);
 }
 
 // The background fill (ProximityCacheSettings::fill_budget node pairs per

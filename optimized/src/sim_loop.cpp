@@ -191,8 +191,9 @@ bool ccd_leg(const RuntimeModel& model, const Pose& x0, const Pose& x1, int num_
 // Whether the CCD proves the Cayley motion x0 -> x1 free of contact with every
 // obstacle (it never misses one: u_hit <= u*). Searched for contact itself
 // (min_separation 0, so a motion that ends delta from a surface is not
-// refused for reaching delta), without the proximity cache or near pairs, in
-// its own workspace (s->check_ws, s->check: the legs' state is left as it
+// refused for reaching delta), without a proximity cache of its own (the legs'
+// list serves it read-only when it covers the motion) or near pairs, in its
+// own workspace (s->check_ws, s->check: the legs' state is left as it
 // was). A hit, a give-up, invalid input or a half turn answer false.
 bool motion_free(const RuntimeModel& model, const Pose& x0, const Pose& x1, int num_hints, SimState* s) {
   CcdStepSettings settings = model.settings.ccd;
@@ -200,6 +201,10 @@ bool motion_free(const RuntimeModel& model, const Pose& x0, const Pose& x1, int 
   settings.near_distance = 0;
   settings.cache.margin = settings.cache.margin_max = 0;
   settings.cache.fill_budget = 0;
+  // The legs' proximity list serves it read-only when the direct motion stays
+  // within its margin (ccd_step.h, CcdStepWorkspace::borrowed): the same
+  // candidates a descent would find, without descending the trees.
+  s->check_ws.borrowed = &s->ccd_ws.cache;
   ccd_step(model.obstacles.data(), static_cast<int>(model.obstacles.size()), model.god, x0, x1, settings,
            &s->check_ws, &s->check, s->ccd_hints.data(), num_hints);
   return s->check.status == CcdStatus::kOk && !s->check.hit;
@@ -306,11 +311,27 @@ void advance_god_object(const RuntimeModel& model, const Pose& x_start, const Po
   const int num_hints = std::min(s->contacts.num_contacts, kMaxContacts);
   for (int k = 0; k < num_hints; ++k) s->ccd_hints[k] = s->contacts.contacts[k].features;
   Pose target = x_target;
+  // After a refused settle the first leg is shortened to its own motion's pose
+  // at u = 1/2 (then 1/4, 1/8): the first part of a path its CCD has just
+  // proven free at delta, so the shortened leg is served from that result (the
+  // stop pose at u, as for a hit there) instead of being searched again.
+  double shortened_u = 1;
+  CcdStepResult proven;  // the whole first leg, free (set when shortened_u < 1)
   for (;;) {
     s->xs = x_start;
-    const bool moved = ccd_leg(model, x_start, target, num_hints, s, &info->num_halves);
-    if (moved && info->num_shortenings == 0 && grazed(model, *s))
-      lift_out_of_graze(model, x_start, target, num_hints, s, &info->num_halves);
+    bool moved = true;
+    bool lifted = false;  // this try's first leg ran from a graze's lift waypoint
+    if (shortened_u < 1) {
+      s->ccd = proven;
+      s->ccd.num_near_pairs = -1;  // its near pairs hold at the leg's end, not at u
+      const StopPose stop = make_stop_pose(proven.motion, shortened_u, model.god_radius);
+      s->xs = stop.pose;
+      s->stop_deviation = stop.deviation;
+    } else {
+      moved = ccd_leg(model, x_start, target, num_hints, s, &info->num_halves);
+      if (moved && info->num_shortenings == 0 && grazed(model, *s))
+        lifted = lift_out_of_graze(model, x_start, target, num_hints, s, &info->num_halves);
+    }
     info->ccd = s->ccd.status;
     info->u_hit = s->ccd.u_hit;
     info->status = !moved ? SimStepStatus::kInvalidStep
@@ -344,16 +365,24 @@ void advance_god_object(const RuntimeModel& model, const Pose& x_start, const Po
     }
     // Refused: back to the first leg's end (free; its contact set, empty, is
     // still s->contacts) and, while shortenings are left, the whole step again
-    // with the first leg halved (split_step: half the travel, half the
-    // rotation): a shorter slide sags less under the crease, and one that stays
-    // in the contact band needs no settling.
+    // with the first leg halved (its motion's pose at half the parameter, or
+    // split_step's when the leg was split at a half turn: half the travel,
+    // half the rotation): a shorter slide sags less under the crease, and one
+    // that stays in the contact band needs no settling.
     s->xs = from;
     s->ccd = first_leg;
     s->stop_deviation = first_deviation;
     info->u_hit = first_leg.u_hit;
     if (info->num_shortenings == kMaxSettleShortenings) break;
     ++info->num_shortenings;
-    target = split_step(x_start, target);
+    // A leg run from a graze's lift waypoint is not a part of x_start -> target:
+    // its parts are not served, the step is split instead.
+    if (info->num_halves == 1 && !lifted) {  // one leg, x_start -> x_target, proven free: serve its parts
+      if (shortened_u == 1) proven = first_leg;
+      shortened_u *= 0.5;
+    } else {
+      target = split_step(x_start, target);
+    }
   }
   s->M = mass_matrix_at(model, s->xs.q);
   info->num_contacts = s->contacts.num_contacts;

@@ -464,6 +464,99 @@ TEST_CASE("ccd_step: a ball wandering among blocks, lists filled ahead of it in 
   CHECK(hits >= 5);
 }
 
+TEST_CASE("ccd_step: a step served read-only from another workspace's list agrees with the brute force", "[ccd_step]") {
+  // The runtime's check of a settling step's direct motion (sim_loop.cpp,
+  // motion_free): min_separation 0, no cache of its own, the legs' list
+  // borrowed (CcdStepWorkspace::borrowed). A ball kept near a slab with a
+  // block on it by the legs' chain of steps (cached, as the runtime's), and
+  // after each leg a check step from the leg's start to a pose nearby (in
+  // the list's margin or, every fifth step, far beyond it) that must agree
+  // with the brute force at min_separation 0 and with a check on a workspace
+  // of its own, and must leave the borrowed list as it was. Served: when
+  // the list is for the same bodies, a reach at least the check's, and a
+  // margin that covers the check's motion; a list for another reach or
+  // another mesh is never served.
+  const TriangleMesh god = make_icosphere(1, 0.5);
+  const TriangleMesh slab = concatenate(make_box(3, 3, 1, Vec3(0, 0, -0.5)), make_box(0.4, 0.4, 0.6, Vec3(0.6, 0, 0.3)));
+  const TriangleMesh other = make_box(3, 3, 1, Vec3(0, 0, -0.5));
+  const Bvh gb = build_bvh(god, 2), sb = build_bvh(slab, 2), ob = build_bvh(other, 2);
+  std::mt19937 rng(31);
+  std::uniform_real_distribution<double> U(-1, 1);
+  CcdStepSettings legs, check;
+  legs.narrow.min_separation = 1e-4;
+  legs.near_distance = 1.7e-4;
+  legs.cache.margin = 0.02;
+  legs.cache.margin_max = 0.06;
+  legs.cache.fill_budget = 12;
+  check.narrow.min_separation = 0;
+  CcdStepWorkspace ws, ws_check, ws_alone;
+  ws_check.borrowed = &ws.cache;
+  const CcdBody obstacle{&slab, &sb};
+  Pose x{Vec3(0.1, 0, 0.5 + 2e-4), Quat{}};
+  std::vector<FeaturePair> hints = {in_contact_hint()};
+  int served = 0, checks_hit = 0;
+  for (int k = 0; k < 150; ++k) {
+    Vec3 dp = 0.003 * Vec3(U(rng), U(rng), U(rng));
+    const Vec3 turn = 0.004 * Vec3(U(rng), U(rng), U(rng));
+    if (k % 3 == 2) dp += Vec3(0.01 * U(rng), 0.01 * U(rng), -0.02);  // press down
+    Pose target{x.p + dp, normalized(quat_exp(turn) * x.q)};
+    target.p.x() = std::clamp(target.p.x(), -0.3, 0.3);
+    target.p.y() = std::clamp(target.p.y(), -1.0, 1.0);
+    CcdStepResult leg;
+    ccd_step(&obstacle, 1, {&god, &gb}, x, target, legs, &ws, &leg, hints.data(), static_cast<int>(hints.size()));
+    // The check: from the leg's start to its end moved a little further
+    // down (into the slab on some steps), or far away on every fifth.
+    const Pose end = make_stop_pose(leg.motion, leg.u_hit, gb.radius).pose;
+    Pose to{end.p + Vec3(0.002 * U(rng), 0.002 * U(rng), -0.002 * (k % 2)), normalized(quat_exp(0.5 * turn) * end.q)};
+    if (k % 5 == 4) to.p += Vec3(0.2, 0.1, 0.05);
+    const int listed = ws.cache.num_pairs;
+    const Pose list_pose = ws.cache.ref;
+    const int list_uses = ws.cache.uses;
+    CcdStepResult r, r_alone;
+    ccd_step(&obstacle, 1, {&god, &gb}, x, to, check, &ws_check, &r, hints.data(), static_cast<int>(hints.size()));
+    ccd_step(&obstacle, 1, {&god, &gb}, x, to, check, &ws_alone, &r_alone, hints.data(), static_cast<int>(hints.size()));
+    INFO("step " << k);
+    CHECK(ws.cache.num_pairs == listed);
+    CHECK(ws.cache.uses == list_uses);
+    CHECK((ws.cache.ref.p == list_pose.p));
+    CcdMotion m;
+    REQUIRE(make_ccd_motion(x, to, &m) == MotionStatus::kOk);
+    const BruteForce bf = brute_force(god, gb, slab, sb, m, check.narrow);
+    if (r.status == CcdStatus::kMaxIterations || r_alone.status == CcdStatus::kMaxIterations) {
+      // A pair sliding at about 0 exhausts the bisection: a conservative hit,
+      // never later than the brute force's.
+      CHECK(r.hit);
+      CHECK(r.u_hit <= bf.u_hit + 1e-5);
+    } else {
+      REQUIRE(r.status == CcdStatus::kOk);
+      REQUIRE(r.hit == bf.hit);
+      REQUIRE(r.hit == r_alone.hit);
+      if (r.hit) CHECK(std::abs(r.u_hit - bf.u_hit) <= 1e-5);
+    }
+    served += r.u_cached > 0;
+    checks_hit += r.hit;
+    if (k % 5 == 4) CHECK(r.u_cached == 0);  // beyond the list's margin: descended
+    // Another reach (the legs' list holds pairs within its own reach only)
+    // or another mesh behind the obstacle: not served.
+    CcdStepSettings wider = check;
+    wider.narrow.min_separation = 2 * legs.near_distance;
+    CcdStepResult r_wide;
+    ccd_step(&obstacle, 1, {&god, &gb}, x, to, wider, &ws_check, &r_wide);
+    CHECK(r_wide.u_cached == 0);
+    const CcdBody swapped{&other, &ob};
+    CcdStepResult r_other;
+    ccd_step(&swapped, 1, {&god, &gb}, x, to, check, &ws_check, &r_other);
+    CHECK(r_other.u_cached == 0);
+    x = make_stop_pose(leg.motion, leg.u_hit, gb.radius).pose;
+    x.p.z() += 3e-4;
+    hints = {in_contact_hint()};
+    if (leg.hit) hints.push_back(leg.pair);
+  }
+  std::printf("borrowed list: %d of 150 checks served from the legs' list, %d hit\n", served, checks_hit);
+  CHECK(served >= 50);
+  CHECK(checks_hit >= 20);
+}
+
 TEST_CASE("ccd_step: a workspace without room to descend is never served an empty cache", "[ccd_step]") {
   // A ball pressed into a slab, in contact (a hint given), on a workspace whose
   // traversal stack holds nothing: every descent, the cache's fill included,

@@ -112,6 +112,13 @@ struct CcdStepWorkspace {
   }
   SweptBoxCache swept;                // god boxes of the current sub-interval
   ProximityCache cache;               // coherence between steps (proximity_cache.h)
+  // Another workspace's list, served read-only to the steps run here with
+  // their own cache off (settings.cache.margin 0): a step that stays within
+  // that list's margin of its pose, and searches no farther than the list's
+  // reach, takes its candidates from it instead of descending the trees; it
+  // never fills, refills or otherwise changes it (the runtime's check of a
+  // settling step's direct motion borrows the legs' list). nullptr: none.
+  const ProximityCache* borrowed = nullptr;
 };
 
 // The first contact of the god-object moving from X0 to X1 (the Cayley motion)
@@ -142,6 +149,8 @@ struct CcdStepWorkspace {
 // With settings.cache.fill_budget > 0 as well, the next list is filled that
 // many node pairs per step, at the pose the god-object is heading for, while
 // the list in use serves.
+// With settings.cache.margin = 0 and ws->borrowed set, that list serves the
+// step read-only under the same rule (the whole rest of the step or nothing).
 void ccd_step(const CcdBody* obstacles, int num_obstacles, const CcdBody& god, const Pose& X0, const Pose& X1,
               const CcdStepSettings& settings, CcdStepWorkspace* ws, CcdStepResult* result,
               const FeaturePair* hints = nullptr, int num_hints = 0) noexcept;

@@ -76,7 +76,9 @@ const SimStepInfo& sim_step(const RuntimeModel& model, double t, RuntimeChannels
 // poses the step goes from and to: the settling leg's end is kept only when a
 // CCD with min_separation 0 proves the direct Cayley motion x_start -> end free
 // of contact. Otherwise the step is done again with the first leg halved
-// (split_step: half the travel, half the rotation), at most kMaxSettleShortenings times; after the last,
+// (its own motion's pose at half the parameter, served from the first leg's
+// CCD, which proved the whole motion free; split_step's when the leg was split
+// at a half turn), at most kMaxSettleShortenings times; after the last,
 // s->xs is the first leg's end (free, out of contact). Sets info's x_start,
 // x_target, residual, settled, num_shortenings, ccd (the first status other
 // than kOk over the legs of the last try), u_hit, num_halves, status and
