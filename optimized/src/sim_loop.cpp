@@ -15,11 +15,22 @@ namespace gauss6 {
 using namespace detail;  // the loops' shared machinery (runtime_detail.h)
 
 SimState::SimState(const RuntimeModel& model)
-    : contacts(kMaxContacts),
+    : capacity(model.settings.max_contacts),
+      contacts(capacity),
+      gap_rhs(static_cast<size_t>(capacity)),
+      projection_ws(capacity),
+      projection(capacity),
+      shaded_J(6 * static_cast<size_t>(capacity)),
+      shaded_normal(3 * static_cast<size_t>(capacity)),
+      shading_ws(capacity),
+      shading(capacity),
+      held_J(6 * static_cast<size_t>(capacity)),
       // The proximity cache keyed by every obstacle of the model (allocated here, not in a step).
       ccd_ws(CcdStepWorkspace::kBoxCapacity, CcdStepWorkspace::kStackCapacity, CcdStepWorkspace::kCandidateCapacity,
              std::max(static_cast<int>(model.obstacles.size()), CcdStepWorkspace::kObstacleCapacity)),
-      contact_ws(model.god_mesh_B) {
+      ccd_hints(static_cast<size_t>(capacity)),
+      contact_ws(model.god_mesh_B),
+      snapshot(capacity) {
   xs = model.initial_pose;
   M = mass_matrix_at(model, xs.q);
   contacts.num_contacts = 0;
@@ -74,7 +85,7 @@ Vec6 shade_command(const RuntimeModel& model, const RuntimeChannels& ch, const V
 // an edge (Figure 8). Plain surfaces never come here.
 Vec6 hold_pressed_contacts(const RuntimeModel& model, const Vec6& au, const Vec6& asc, SimState* s) {
   if (!model.surface.texture) return asc;
-  const int m = std::min(s->contacts.num_contacts, kMaxContacts);
+  const int m = std::min(s->contacts.num_contacts, s->capacity);
   int n = 0;
   for (int k = 0; k < m; ++k) {
     const Eigen::Map<const Vec6> Jk(s->contacts.J.data() + 6 * k);
@@ -216,7 +227,7 @@ void advance_god_object(const RuntimeModel& model, const Pose& x_start, const Po
   info->num_halves = 1;
   // The contacts at x_start (the set of the last step, at s->xs) are the pairs
   // most likely to stop either leg: ccd_step tests them first.
-  const int num_hints = std::min(s->contacts.num_contacts, kMaxContacts);
+  const int num_hints = std::min(s->contacts.num_contacts, s->capacity);
   for (int k = 0; k < num_hints; ++k) s->ccd_hints[k] = s->contacts.contacts[k].features;
   Pose target = x_target;
   for (;;) {
@@ -280,17 +291,17 @@ void publish_god_object(double t, bool shaded, SimState* s, RuntimeChannels* ch)
   store_pose(s->xs, g.p, g.q);
   for (int i = 0; i < 6; ++i)
     for (int j = 0; j < 6; ++j) g.M[6 * i + j] = s->M(i, j);
-  const int m = std::min(s->contacts.num_contacts, kMaxContacts);
+  const int m = std::min(s->contacts.num_contacts, s->capacity);
   g.num_contacts = m;
-  std::memcpy(g.J, s->contacts.J.data(), sizeof(double) * 6 * static_cast<size_t>(m));
+  std::memcpy(g.J.data(), s->contacts.J.data(), sizeof(double) * 6 * static_cast<size_t>(m));
   g.shaded = shaded ? 1 : 0;
   if (shaded) {
-    std::memcpy(g.Js, s->shaded_J.data(), sizeof(double) * 6 * static_cast<size_t>(m));
-    std::memcpy(g.shaded_normal, s->shaded_normal, sizeof(double) * 3 * static_cast<size_t>(m));
+    std::memcpy(g.Js.data(), s->shaded_J.data(), sizeof(double) * 6 * static_cast<size_t>(m));
+    std::memcpy(g.shaded_normal.data(), s->shaded_normal.data(), sizeof(double) * 3 * static_cast<size_t>(m));
   }
   for (int k = 0; k < m; ++k) {
     const Contact& c = s->contacts.contacts[k];
-    for (int i = 0; i < 3; ++i) g.point[k][i] = c.point[i], g.normal[k][i] = c.normal[i];
+    for (int i = 0; i < 3; ++i) g.point[3 * k + i] = c.point[i], g.normal[3 * k + i] = c.normal[i];
     g.separation[k] = c.separation;
   }
   ch->god_object.write(g);
@@ -325,13 +336,13 @@ void advance_by(const RuntimeModel& model, SimState* s, SimStepInfo* info) {
 // skipped at this speed (the kTextureUndersampled event).
 void shade_contact_set(const RuntimeModel& model, SimState* s, SimStepInfo* info) {
   if (!model.surface.active()) return;
-  shade_contacts(model.surface, model.obstacle_meshes_W.data(), s->contacts, s->xs.p, kMaxContacts,
-                 s->shaded_J.data(), s->shaded_normal);
+  shade_contacts(model.surface, model.obstacle_meshes_W.data(), s->contacts, s->xs.p, s->capacity,
+                 s->shaded_J.data(), rows3(s->shaded_normal));
   if (!model.surface.texture) return;
   const Mat3 R0 = rotation_matrix(info->x_start.q), R1 = rotation_matrix(s->xs.q);
   const Mat3 R01 = R0 * R1.transpose();
   double step = 0;
-  for (int k = 0; k < std::min(s->contacts.num_contacts, kMaxContacts); ++k) {
+  for (int k = 0; k < std::min(s->contacts.num_contacts, s->capacity); ++k) {
     const Vec3& I = s->contacts.contacts[k].point;
     const Vec3 before = info->x_start.p + R01 * (I - s->xs.p);  // the same body point at x_start
     step = std::max(step, (I - before).norm());

@@ -35,7 +35,6 @@
 
 namespace {
 
-using gauss6::kMaxContacts;
 using gauss6::Mat6;
 using gauss6::ProjectionProblem;
 using gauss6::ProjectionResult;
@@ -645,7 +644,7 @@ TEST_CASE("bad input gives kBadInput and a finite zero-force ac", "[qp]") {
   expect_bad(make_problem(M, au_good, rows_good), settings);
   // Row counts out of range, missing pointers.
   Rows many;
-  for (int k = 0; k <= kMaxContacts; ++k) many.add(random_contact_row(rng));
+  for (int k = 0; k <= gauss6::kDefaultMaxContacts; ++k) many.add(random_contact_row(rng));
   expect_bad(make_problem(M_good, au_good, many), settings);
   ProjectionProblem pb = make_problem(M_good, au_good, rows_good);
   pb.num_rows = -1;

@@ -35,10 +35,6 @@ namespace gauss6 {
 // contact set (RuntimeSettings::max_contacts); any capacity >= 1 may be chosen
 // when they are built.
 inline constexpr int kDefaultMaxContacts = 64;
-// The runtime's contact capacity today: its loops' buffers and the published
-// snapshot (runtime_channels.h) are arrays of this size; a larger contact set
-// is truncated and reported (kContactOverflow).
-inline constexpr int kMaxContacts = kDefaultMaxContacts;
 // Size of a working set: at most 6 linearly independent rows in R^6.
 inline constexpr int kMaxActive = 6;
 
