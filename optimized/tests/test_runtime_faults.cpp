@@ -439,6 +439,12 @@ TEST_CASE("more than 64 contacts: a capacity of 256 carries them all to the coup
   REQUIRE(project(pb, cold, &ws, &res) == ProjectionStatus::kOptimal);
   const Vec6 F = coupling_force(cs.M, c.au, res.ac, r.model->gains.kh);
   CHECK((F - c.Fc).norm() <= 1e-12 * F.norm());
+  // A capacity out of [1, kMaxContactCapacity] is refused when the model is built.
+  for (const int bad : {0, -1, kMaxContactCapacity + 1}) {
+    RuntimeSettings s;
+    s.max_contacts = bad;
+    CHECK_THROWS_AS(RuntimeModel(sc, s), RuntimeError);
+  }
 }
 
 TEST_CASE("faults: CCD give-up keeps the hit conservatively, reported", "[runtime][faults]") {
