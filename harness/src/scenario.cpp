@@ -86,7 +86,7 @@ void on_sim_step(void* user, const SimStepInfo& info) {
   row.status = static_cast<int>(info.status);
   r->writer->append(row);
   if (!info.contacts) return;
-  const int m = std::min(info.contacts->num_contacts, kMaxContacts);
+  const int m = std::min(info.contacts->num_contacts, info.contacts->capacity());
   for (int k = 0; k < m; ++k) {
     const Contact& c = info.contacts->contacts[static_cast<size_t>(k)];
     r->writer->append(TraceContact{row.step, row.t, c.point, c.normal, c.separation});

@@ -66,13 +66,13 @@ const CouplingStepInfo& coupling_step(const RuntimeModel& model, double t, Runti
     // The rows: J, or on a shaded surface the shading rows Js (pass 1 of the
     // two, surface.h); offsets apply to whichever rows the force comes from.
     info.shaded = s->god.shaded != 0;
-    const double* J = info.shaded ? s->god.Js : s->god.J;
+    const double* J = info.shaded ? s->god.Js.data() : s->god.J.data();
     // 2. au = ks (xh (-) xs); offsets for the new rows of a new set.
     info.au = model.gains.ks * pose_difference(to_pose(s->handle.p, s->handle.q), s->xs);
     if (info.new_set) {
       const OffsetRule rule{model.offsets, model.match_distance, model.settings.match_cosine,
                             model.settings.projection};
-      const OffsetRows rows{m, J, s->god.point, info.shaded ? s->god.shaded_normal : s->god.normal};
+      const OffsetRows rows{m, J, rows3(s->god.point), rows3(info.shaded ? s->god.shaded_normal : s->god.normal)};
       info.num_new_offsets = start_offsets(rule, t, info.au, s->M, s->xs, rows, &s->offsets);
     }
     // 3. ac = projection (warm-started), b(t) while offsets run; Fc = kh M (ac - au).

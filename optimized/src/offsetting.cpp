@@ -35,7 +35,9 @@ double offset_rhs(double d_k, double t, const OffsetSettings& s) noexcept {
 int start_offsets(const OffsetRule& rule, double t, const Vec6& au, const Mat6& M, const Pose& xs,
                   const OffsetRows& rows, OffsetState* s) noexcept {
   const OffsetSettings& offsets = rule.offsets;
-  const int m = rows.num_rows;
+  // The runtime sizes the state for its contact capacity, so m never exceeds it;
+  // rows beyond it would have no room and are not cached (nor offset).
+  const int m = std::min(rows.num_rows, s->capacity());
   const Mat3 Rt = rotation_matrix(xs.q).transpose();
   // The previous set's rows and their right-hand sides now: the "before" problem.
   // After an empty set, the last non-empty one (arrived or emptied less than
@@ -107,6 +109,23 @@ int start_offsets(const OffsetRule& rule, double t, const Vec6& au, const Mat6& 
   s->num_rows = m;
   return started;
 }
+
+OffsetState::OffsetState(int max_rows)
+    : start(static_cast<size_t>(std::max(max_rows, 0))),
+      t0(start.size()),
+      rhs(start.size()),
+      point_B(start.size(), Vec3::Zero()),
+      normal_W(start.size(), Vec3::Zero()),
+      cached_J(6 * start.size()),
+      new_start(start.size()),
+      new_t0(start.size()),
+      new_point_B(start.size(), Vec3::Zero()),
+      new_normal_W(start.size(), Vec3::Zero()),
+      matched(start.size()),
+      kept_J(6 * start.size()),
+      kept_b(start.size()),
+      arrival_ws(std::max(max_rows, 1)),
+      arrival(std::max(max_rows, 1)) {}
 
 int fill_offsets(const OffsetSettings& settings, double t, OffsetState* s) noexcept {
   int running = 0;

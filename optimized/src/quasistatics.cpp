@@ -20,18 +20,29 @@
 //   backward error), apart from skipped dependent rows (below). It must be
 //   this small: a row nearly parallel to an active one (sine theta) accepted
 //   with violation v moves the answer by about v / theta.
-// - dependence_tol = 1e-10: the guard against a numerically singular R. The
-//   computed sine of a row's angle to span(W) has a rounding of about eps
-//   cond(R) (1e-11 for a body jammed between planes 1e-5 from opposite), so
-//   rows below 1e-10 cannot be told from dependent ones. A violated dependent
+// - dependence_tol = 1e-13: the floor of the dependence test. The computed
+//   sine of a row's angle to span(W) has a rounding of about eps cond(R) (Q's
+//   span is that far from the span of W's rows), so a row counts as dependent
+//   below max(dependence_tol, 64 eps cond(R)) (dependence_threshold), with
+//   cond(R) estimated by max |A_i| / |R_ii|: rows nearly parallel to a
+//   well-conditioned W (a copy perturbed by 1e-10, a body jammed between
+//   nearly opposite planes) join W and are resolved, instead of being skipped
+//   with a violation of up to their sine. A violated dependent
 //   row n = A_W^T r + z is handled as in Goldfarb-Idnani: when some r_j > 0,
 //   the multipliers move by -t r, t = min lambda_j / r_j over r_j > 0, and
 //   that row j leaves W (n then usually joins); when r <= 0, its slack on W's
 //   face is r^T b_W - b_p + z^T y: the offsets are inconsistent when
 //   b_p - r^T b_W exceeds the feasibility tolerance, else the row (violated by
-//   at most dependence_tol |A_k| |y| plus rounding) is skipped until a partial
-//   step changes the face. Always so for b = 0, whose feasible set is never
-//   empty.
+//   at most that threshold times |A_k| |y| plus rounding) is skipped until a
+//   partial step changes the face. Always so for b = 0, whose feasible set is
+//   never empty. Components of r at rounding level (kRoundoff cond(R) max|r|)
+//   count as zero: exchanges on noise could cycle (seen on rows perturbed by
+//   1e-10 until the iteration cap).
+// - Refinement: with rows at a sine s of each other in W, the final solve has
+//   an error of about eps / s (1e-6 for s = 1e-10). When cond(R) > 1e3 the
+//   final KKT point gets two passes of iterative refinement with residuals in
+//   twice the working precision on the given M, J, b (refine_kkt_point): the
+//   answer is then the KKT point of W to about eps.
 #include "gauss6/quasistatics.h"
 
 #include <Eigen/Cholesky>
@@ -62,6 +73,13 @@ constexpr long kMaxRotationsBeforeRebuild = 1000;
 // in_active[k] of a row that is dependent on the working set and consistent
 // with it to rounding (see the main loop): not a candidate until the next drop.
 constexpr unsigned char kSkipped = 2;
+// The final KKT point is refined (refine_kkt_point) when the working set's
+// condition estimate exceeds this: below it, eps cond(R) is already under
+// 1e-12 and the plain solve is as accurate as the refinement.
+constexpr double kRefinementCondition = 1e3;
+constexpr int kRefinementPasses = 2;
+// Rounding of a computed sine per unit of cond(R) (see dependence_threshold).
+constexpr double kSineRounding = 64 * std::numeric_limits<double>::epsilon();
 
 bool all_finite(const double* p, int n) noexcept {
   double acc = 0;
@@ -195,6 +213,22 @@ void factor_drop(ProjectionWorkspace& ws, int pos) noexcept {
   ws.num_active = q - 1;
 }
 
+// The largest |A_i| / |R_ii| over the working set: 1 / the smallest sine of a
+// row's angle to the span of the rows before it, an estimate of cond(R) (>= 1).
+double working_set_condition(const ProjectionWorkspace& ws) noexcept {
+  double cond = 1;
+  for (int i = 0; i < ws.num_active; ++i)
+    cond = std::max(cond, ws.row_norm[ws.active[i]] / std::abs(ws.R(i, i)));
+  return cond;
+}
+
+// The sine below which a row counts as dependent on the working set: the
+// setting, or the rounding of the computed sine when that is larger. The sine
+// comes from Q, whose span is off from that of W's rows by about eps cond(R).
+inline double dependence_threshold(const ProjectionWorkspace& ws, double dependence_tol) noexcept {
+  return std::max(dependence_tol, kSineRounding * working_set_condition(ws));
+}
+
 // Adds each row of ws.active[0:count) to empty factors when it is independent of
 // those already added (rows >= m are dropped).
 void rebuild_factors(ProjectionWorkspace& ws, int count, int m, double dependence_tol) noexcept {
@@ -207,7 +241,7 @@ void rebuild_factors(ProjectionWorkspace& ws, int count, int m, double dependenc
     const int p = rows[i];
     if (p < 0 || p >= m || ws.in_active[p]) continue;
     const Vec6 d = ws.Q.transpose() * row(ws, p);
-    if (std::sqrt(tail_squared_norm(d, ws.num_active)) > dependence_tol * ws.row_norm[p])
+    if (std::sqrt(tail_squared_norm(d, ws.num_active)) > dependence_threshold(ws, dependence_tol) * ws.row_norm[p])
       factor_add(ws, d, p);
   }
 }
@@ -259,6 +293,73 @@ int drop_until_dual_feasible(ProjectionWorkspace& ws, const Vec6& yu, double yu_
     }
     if (worst < 0) return drops;
     factor_drop(ws, worst);
+  }
+}
+
+// Error-free transformations (Ogita, Rump, Oishi, "Accurate sum and dot
+// product", SIAM J. Sci. Comput. 26(6), 2005): Dot2 accumulates a dot product
+// as if in twice the working precision, then rounds once.
+struct CompensatedSum {
+  double sum = 0, error = 0;
+  // sum + error += x y (the product exactly, by fma; the sum by TwoSum).
+  void add_product(double x, double y) noexcept {
+    const double p = x * y;
+    const double p_err = std::fma(x, y, -p);
+    const double s = sum + p;
+    const double z = s - sum;
+    error += ((sum - (s - z)) + (p - z)) + p_err;
+    sum = s;
+  }
+  double value() const noexcept { return sum + error; }
+};
+
+// Iterative refinement of the working set's KKT point in a-space, on the data
+// as given (not the rounded A = J L^-T):
+//   M (ac - au) = J_W^T lambda_W,   J_W ac = b_W.
+// The residuals are computed in twice the working precision (CompensatedSum) and
+// the correction solved with the current factors (as solve_working_set):
+//   h = L^-1 g, c = R^-T r - Q1^T h, dlambda = R^-1 c, dy = h + Q1 c, da = L^-T dy,
+// with g = J_W^T lambda_W - M (ac - au), r = b_W - J_W ac. Each pass shrinks the
+// error by about eps cond(R), so a working set with rows at a sine s of each
+// other gets ac to about eps |au| instead of eps / s |au|.
+void refine_kkt_point(const ProjectionProblem& pb, ProjectionWorkspace& ws, Vec6* ac) noexcept {
+  const int q = ws.num_active;
+  const Mat6& M = *pb.M;
+  for (int pass = 0; pass < kRefinementPasses; ++pass) {
+    Vec6 g;
+    for (int i = 0; i < 6; ++i) {
+      CompensatedSum acc;
+      for (int j = 0; j < 6; ++j) {
+        acc.add_product(-M(i, j), (*ac)[j]);
+        acc.add_product(M(i, j), pb.au[j]);
+      }
+      for (int t = 0; t < q; ++t) acc.add_product(pb.J[6 * ws.active[t] + i], ws.lambda_active[t]);
+      g[i] = acc.value();
+    }
+    const Vec6 h = ws.L_inv * g;
+    std::array<double, kMaxActive> c{};
+    for (int i = 0; i < q; ++i) {
+      const int k = ws.active[i];
+      CompensatedSum acc;
+      acc.add_product(pb.b ? pb.b[k] : 0.0, 1.0);
+      for (int j = 0; j < 6; ++j) acc.add_product(-pb.J[6 * k + j], (*ac)[j]);
+      double w = acc.value();
+      for (int j = 0; j < i; ++j) w -= ws.R(j, i) * c[j];
+      c[i] = w / ws.R(i, i);
+    }
+    Vec6 dy = h;
+    for (int i = 0; i < q; ++i) {
+      c[i] -= ws.Q.col(i).dot(h);
+      dy += c[i] * ws.Q.col(i);
+    }
+    // dlambda = R^-1 c (back substitution, into c).
+    for (int i = q - 1; i >= 0; --i) {
+      double v = c[i];
+      for (int j = i + 1; j < q; ++j) v -= ws.R(i, j) * c[j];
+      c[i] = v / ws.R(i, i);
+    }
+    for (int i = 0; i < q; ++i) ws.lambda_active[i] += c[i];
+    ac->noalias() += ws.L_inv.transpose() * dy;
   }
 }
 
@@ -421,7 +522,7 @@ ProjectionStatus project(const ProjectionProblem& pb, const ProjectionSettings& 
       const int q = ws.num_active;
       const Vec6 d = ws.Q.transpose() * n;
       const double z2 = tail_squared_norm(d, q);
-      const bool dependent = std::sqrt(z2) <= dep_tol * ws.row_norm[p];
+      const bool dependent = std::sqrt(z2) <= dependence_threshold(ws, dep_tol) * ws.row_norm[p];
       // r = R^-1 d(0:q): how n is spanned by W's rows; multipliers fall as t r.
       std::array<double, kMaxActive> r{};
       for (int i = q - 1; i >= 0; --i) {
@@ -429,10 +530,16 @@ ProjectionStatus project(const ProjectionProblem& pb, const ProjectionSettings& 
         for (int j = i + 1; j < q; ++j) v -= ws.R(i, j) * r[j];
         r[i] = v / ws.R(i, i);
       }
+      // Components of r at the rounding of the solve with R (about eps cond(R)
+      // of its largest) have no sign: a partial step on one would exchange a row
+      // for p on noise, and such exchanges can cycle.
+      double r_max = 0;
+      for (int i = 0; i < q; ++i) r_max = std::max(r_max, std::abs(r[i]));
+      const double r_noise = kRoundoff * working_set_condition(ws) * r_max;
       double t1 = kInf;
       int block = -1;
       for (int i = 0; i < q; ++i) {
-        if (r[i] <= 0) continue;
+        if (r[i] <= r_noise) continue;
         const double ratio = ws.lambda_active[i] / r[i];
         if (ratio < t1 || (ratio == t1 && ws.active[i] < ws.active[block])) {
           t1 = ratio;
@@ -504,6 +611,7 @@ ProjectionStatus project(const ProjectionProblem& pb, const ProjectionSettings& 
   } else {
     if (iterations > 0) solve_working_set(ws, yu, b, &y);  // else y is already fresh
     res->ac.noalias() = ws.L_inv.transpose() * y;  // ac = L^-T y
+    if (working_set_condition(ws) > kRefinementCondition) refine_kkt_point(pb, ws, &res->ac);
   }
   std::fill_n(res->lambda.begin(), m, 0.0);
   for (int i = 0; i < q; ++i) {

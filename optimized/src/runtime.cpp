@@ -14,7 +14,8 @@ namespace gauss6 {
 
 using namespace detail;  // the loops' shared machinery (runtime_detail.h)
 
-RuntimeData::RuntimeData(const RuntimeModel& model) : sim(model) {
+RuntimeData::RuntimeData(const RuntimeModel& model)
+    : channels(model.settings.max_contacts), sim(model), coupling(model.settings.max_contacts) {
   coupling.xs = model.initial_pose;
   haptic.xh = model.initial_pose;
 }

@@ -70,6 +70,8 @@ RuntimeModel::RuntimeModel(const Scene& scene, const RuntimeSettings& s) : setti
   if (!(s.event_interval >= 0 && s.event_interval <= kMaxTimeout))
     fail("settings: event_interval must be in [0, " + std::to_string(kMaxTimeout) + "] s");
   if (s.lockstep_sim_period < 1) fail("settings: lockstep_sim_period must be >= 1");
+  if (s.max_contacts < 1 || s.max_contacts > kMaxContactCapacity)
+    fail("settings: max_contacts must be in [1, " + std::to_string(kMaxContactCapacity) + "]");
   // A loop paced slower than its own watchdog would trip it on every step.
   if (!(s.sim_min_period >= 0 && s.sim_min_period < s.sim_timeout) ||
       !(s.coupling_min_period >= 0 && s.coupling_min_period < s.coupling_timeout))

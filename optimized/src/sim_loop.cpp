@@ -15,11 +15,22 @@ namespace gauss6 {
 using namespace detail;  // the loops' shared machinery (runtime_detail.h)
 
 SimState::SimState(const RuntimeModel& model)
-    : contacts(kMaxContacts),
+    : capacity(model.settings.max_contacts),
+      contacts(capacity),
+      gap_rhs(static_cast<size_t>(capacity)),
+      projection_ws(capacity),
+      projection(capacity),
+      shaded_J(6 * static_cast<size_t>(capacity)),
+      shaded_normal(3 * static_cast<size_t>(capacity)),
+      shading_ws(capacity),
+      shading(capacity),
+      held_J(6 * static_cast<size_t>(capacity)),
       // The proximity cache keyed by every obstacle of the model (allocated here, not in a step).
       ccd_ws(CcdStepWorkspace::kBoxCapacity, CcdStepWorkspace::kStackCapacity, CcdStepWorkspace::kCandidateCapacity,
              std::max(static_cast<int>(model.obstacles.size()), CcdStepWorkspace::kObstacleCapacity)),
-      contact_ws(model.god_mesh_B) {
+      ccd_hints(static_cast<size_t>(capacity)),
+      contact_ws(model.god_mesh_B),
+      snapshot(capacity) {
   xs = model.initial_pose;
   M = mass_matrix_at(model, xs.q);
   contacts.num_contacts = 0;
@@ -77,19 +88,19 @@ Vec6 shade_command(const RuntimeModel& model, const RuntimeChannels& ch, const V
 // its face, pass 2 pushed it back out and so lifted the tip by 4e-8 m a step,
 // until the tip, which carried the whole force, left the contact band: the
 // force jumped to the second vertex, half a texture wavelength away, by 30
-// degrees. Without room for both (more than kMaxContacts rows) the held rows
+// degrees. Without room for both (more than the set's capacity of rows) the held rows
 // alone. Force shading alone keeps the paper's pass 2: there the shaded plane
 // is the smooth surface the facets approximate, which the god-object follows
 // across an edge (Figure 8). Plain surfaces never come here. The right-hand
 // sides go in gap_rhs, which constrain_motion fills anew.
 Vec6 hold_pressed_contacts(const RuntimeModel& model, const Vec6& au, const Vec6& asc, SimState* s) {
   if (!model.surface.texture) return asc;
-  const int m = std::min(s->contacts.num_contacts, kMaxContacts);
+  const int m = std::min(s->contacts.num_contacts, s->capacity);
   const double target = model.contact.delta * (1 + model.settings.gap_factor);
   int held = 0;
   for (int k = 0; k < m; ++k) held += Eigen::Map<const Vec6>(s->contacts.J.data() + 6 * k).dot(au) < 0;
   if (held == 0) return asc;
-  const bool with_pass2_rows = m + held <= kMaxContacts;
+  const bool with_pass2_rows = m + held <= s->capacity;
   int n = 0;
   for (int k = 0; k < m; ++k) {
     const Eigen::Map<const Vec6> Jk(s->contacts.J.data() + 6 * k);
@@ -223,7 +234,7 @@ bool motion_free(const RuntimeModel& model, const Pose& x0, const Pose& x1, int 
 bool grazed(const RuntimeModel& model, const SimState& s) {
   const CcdStepResult& r = s.ccd;
   if (!r.hit || r.status != CcdStatus::kOk) return false;
-  const int m = std::min(s.contacts.num_contacts, kMaxContacts);
+  const int m = std::min(s.contacts.num_contacts, s.capacity);
   for (int k = 0; k < m; ++k) {
     const Contact& c = s.contacts.contacts[k];
     const FeaturePair& a = c.features;
@@ -245,7 +256,7 @@ bool grazed(const RuntimeModel& model, const SimState& s) {
 // grazed leg left them, when the gap rows conflict or either CCD refuses.
 bool lift_out_of_graze(const RuntimeModel& model, const Pose& x_start, const Pose& target, int num_hints,
                        SimState* s, int* num_halves) {
-  const int m = std::min(s->contacts.num_contacts, kMaxContacts);
+  const int m = std::min(s->contacts.num_contacts, s->capacity);
   const double gap = model.contact.delta * (1 + model.settings.gap_factor);
   for (int k = 0; k < m; ++k) s->gap_rhs[k] = gap - s->contacts.contacts[k].separation;
   ProjectionProblem problem;
@@ -308,7 +319,7 @@ void advance_god_object(const RuntimeModel& model, const Pose& x_start, const Po
   info->num_halves = 1;
   // The contacts at x_start (the set of the last step, at s->xs) are the pairs
   // most likely to stop either leg: ccd_step tests them first.
-  const int num_hints = std::min(s->contacts.num_contacts, kMaxContacts);
+  const int num_hints = std::min(s->contacts.num_contacts, s->capacity);
   for (int k = 0; k < num_hints; ++k) s->ccd_hints[k] = s->contacts.contacts[k].features;
   Pose target = x_target;
   // After a refused settle the first leg is shortened to its own motion's pose
@@ -398,17 +409,17 @@ void publish_god_object(double t, bool shaded, SimState* s, RuntimeChannels* ch)
   store_pose(s->xs, g.p, g.q);
   for (int i = 0; i < 6; ++i)
     for (int j = 0; j < 6; ++j) g.M[6 * i + j] = s->M(i, j);
-  const int m = std::min(s->contacts.num_contacts, kMaxContacts);
+  const int m = std::min(s->contacts.num_contacts, s->capacity);
   g.num_contacts = m;
-  std::memcpy(g.J, s->contacts.J.data(), sizeof(double) * 6 * static_cast<size_t>(m));
+  std::memcpy(g.J.data(), s->contacts.J.data(), sizeof(double) * 6 * static_cast<size_t>(m));
   g.shaded = shaded ? 1 : 0;
   if (shaded) {
-    std::memcpy(g.Js, s->shaded_J.data(), sizeof(double) * 6 * static_cast<size_t>(m));
-    std::memcpy(g.shaded_normal, s->shaded_normal, sizeof(double) * 3 * static_cast<size_t>(m));
+    std::memcpy(g.Js.data(), s->shaded_J.data(), sizeof(double) * 6 * static_cast<size_t>(m));
+    std::memcpy(g.shaded_normal.data(), s->shaded_normal.data(), sizeof(double) * 3 * static_cast<size_t>(m));
   }
   for (int k = 0; k < m; ++k) {
     const Contact& c = s->contacts.contacts[k];
-    for (int i = 0; i < 3; ++i) g.point[k][i] = c.point[i], g.normal[k][i] = c.normal[i];
+    for (int i = 0; i < 3; ++i) g.point[3 * k + i] = c.point[i], g.normal[3 * k + i] = c.normal[i];
     g.separation[k] = c.separation;
   }
   ch->god_object.write(g);
@@ -448,13 +459,13 @@ void shade_contact_set(const RuntimeModel& model, SimState* s, SimStepInfo* info
   TextureWeighting weighting;
   if (model.surface.texture)
     weighting = {&s->M, command_motion(model, *s), &model.settings.projection, &s->shading_ws, &s->shading};
-  shade_contacts(model.surface, model.obstacle_meshes_W.data(), s->contacts, s->xs.p, kMaxContacts,
-                 s->shaded_J.data(), s->shaded_normal, model.surface.texture ? &weighting : nullptr);
+  shade_contacts(model.surface, model.obstacle_meshes_W.data(), s->contacts, s->xs.p, s->capacity,
+                 s->shaded_J.data(), rows3(s->shaded_normal), model.surface.texture ? &weighting : nullptr);
   if (!model.surface.texture) return;
   const Mat3 R0 = rotation_matrix(info->x_start.q), R1 = rotation_matrix(s->xs.q);
   const Mat3 R01 = R0 * R1.transpose();
   double step = 0;
-  for (int k = 0; k < std::min(s->contacts.num_contacts, kMaxContacts); ++k) {
+  for (int k = 0; k < std::min(s->contacts.num_contacts, s->capacity); ++k) {
     const Vec3& I = s->contacts.contacts[k].point;
     const Vec3 before = info->x_start.p + R01 * (I - s->xs.p);  // the same body point at x_start
     step = std::max(step, (I - before).norm());

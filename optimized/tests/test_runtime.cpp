@@ -691,6 +691,59 @@ TEST_CASE("shared state: a seqlock read under a concurrent writer is never torn"
   CHECK(backwards == 0);
 }
 
+TEST_CASE("shared state: the god-object channel of a runtime capacity, whole and never torn", "[runtime][threaded]") {
+  // A channel for 300 contacts (SeqLockBuffer underneath): writes of 0 to 300
+  // rows, plain and shaded, each filled with its write number; a reader sees
+  // whole snapshots only (every value one number, the row count the one written
+  // with it), in order. A reader with less room than the channel is refused.
+  constexpr int kCap = 300;
+  static GodObjectChannel channel(kCap);
+  GodObjectSnapshot small(kCap - 1);
+  GodObjectSnapshot got(kCap);
+  CHECK(!channel.try_read(&got));  // nothing written yet
+  std::atomic<bool> done{false};
+  constexpr uint64_t kWrites = 20000;
+  std::thread writer([&] {
+    static GodObjectSnapshot g(kCap);
+    for (uint64_t i = 1; i <= kWrites; ++i) {
+      const double v = static_cast<double>(i);
+      g.sequence = i;
+      g.time = v;
+      g.num_contacts = static_cast<int32_t>(i % (kCap + 1));
+      g.shaded = static_cast<int32_t>(i % 2);
+      std::fill(std::begin(g.M), std::end(g.M), v);
+      for (auto* a : {&g.J, &g.point, &g.normal, &g.separation, &g.Js, &g.shaded_normal})
+        std::fill(a->begin(), a->end(), v);
+      channel.write(g);
+    }
+    done.store(true);
+  });
+  long reads = 0, torn = 0, backwards = 0;
+  uint64_t last = 0;
+  while (!done.load() || reads == 0) {
+    if (!channel.try_read(&got)) continue;
+    ++reads;
+    const double v = static_cast<double>(got.sequence);
+    const int m = got.num_contacts;
+    torn += got.time != v || got.M[35] != v || m != static_cast<int>(got.sequence % (kCap + 1)) ||
+            got.shaded != static_cast<int>(got.sequence % 2);
+    for (int k = 0; k < m; ++k)
+      torn += got.J[6 * k + 5] != v || got.point[3 * k] != v || got.normal[3 * k + 2] != v ||
+              got.separation[k] != v || (got.shaded && (got.Js[6 * k] != v || got.shaded_normal[3 * k + 1] != v));
+    backwards += got.sequence < last;
+    last = got.sequence;
+  }
+  writer.join();
+  REQUIRE(channel.try_read(&got));
+  CHECK(got.sequence == kWrites);
+  CHECK(got.num_contacts == static_cast<int>(kWrites % (kCap + 1)));
+  CHECK(channel.num_writes() == kWrites);
+  CHECK(reads > 0);
+  CHECK(torn == 0);
+  CHECK(backwards == 0);
+  CHECK(!channel.try_read(&small));
+}
+
 TEST_CASE("runtime: threaded runs give sane forces (both force sources)", "[runtime][threaded]") {
   for (const ForceSource source : {ForceSource::kHapticTick, ForceSource::kCouplingLoop}) {
     // Pressed 1 cm deep. The run stops once 50 successive ticks sent more than

@@ -21,6 +21,7 @@
 
 #include "gauss6/runtime.h"
 #include "mesh_shapes.h"
+#include "gauss6/coupling.h"
 #include "runtime_fixtures.h"
 
 using namespace gauss6;
@@ -369,18 +370,81 @@ TEST_CASE("faults: a non-finite force from inside the pipeline is zeroed and rep
 }
 
 TEST_CASE("faults: contact overflow truncates the set, reported; the god-object stays out", "[runtime][faults]") {
-  // 121 bottom vertices rest on the slab: more than kMaxContacts (64) contacts.
+  // 121 bottom vertices rest on the slab: more than the default capacity (64) contacts.
   const Scene sc = make_grid_bottom_scene(10);
   ScriptedDevice device(press_script(0.2, 0.04, 0.4));
   Run r;
   run(&r, sc, RuntimeSettings{}, &device, 700);
   CHECK(r.rec.count(RuntimeEventKind::kContactOverflow) >= 1);
   for (const SimStepInfo& s : r.rec.sims) {
-    CHECK(s.num_contacts <= kMaxContacts);
+    CHECK(s.num_contacts <= kDefaultMaxContacts);
     CHECK(lowest_z(*r.model, s.xs) >= kDelta * (1 - 1e-3));
   }
   check_bounded(device);
   CHECK(r.rec.ticks.back().F_sent[2] > 0);  // still pushed back up
+}
+
+TEST_CASE("more than 64 contacts: a capacity of 256 carries them all to the coupling", "[runtime][faults]") {
+  // The same 121-vertex grid bottom pressed 1 cm into the slab, with
+  // RuntimeSettings::max_contacts = 256: no overflow, sets of more than 64
+  // contacts reach the coupling whole (its rows are the snapshot's), and the
+  // force is that of a fully blocked body, -kh M au, to 1e-9 relative (rounding
+  // of a projection over 121 rows; a wrong or missing row would let the body
+  // tip or sink and change it at the 1e-2 level). The
+  // coupling's force is also that of a cold projection of the cached snapshot's
+  // rows (same answer to 1e-12 relative: warm and cold starts end on the same
+  // optimum). Lockstep, so the run is repeatable.
+  const Scene sc = make_grid_bottom_scene(10);
+  ScriptedDevice device(press_script(0.2, 0.04, 0.4));
+  RuntimeSettings settings;
+  settings.max_contacts = 256;
+  Run r;
+  run(&r, sc, settings, &device, 700);
+  CHECK(r.rec.count(RuntimeEventKind::kContactOverflow) == 0);
+  int most = 0;
+  for (const SimStepInfo& s : r.rec.sims) {
+    most = std::max(most, s.num_contacts);
+    CHECK(lowest_z(*r.model, s.xs) >= kDelta * (1 - 1e-3));
+  }
+  CHECK(most > 64);
+  int most_rows = 0;
+  for (const CouplingStepInfo& c : r.rec.couplings) {
+    most_rows = std::max(most_rows, c.num_rows);
+    if (!c.has_god_object) continue;
+    const SimStepInfo& published = r.rec.sims[static_cast<size_t>(c.god_sequence - 1)];
+    CHECK(c.num_rows == published.num_contacts);
+  }
+  CHECK(most_rows > 64);
+  check_bounded(device);
+  // Pressed straight down on its flat bottom, the god-object is fully blocked:
+  // ac = 0, Fc = -kh M au (straight up: the handle is below G), to rounding.
+  const CouplingState& cs = r.data->coupling;
+  const CouplingStepInfo& c = r.rec.couplings.back();
+  const Vec6 blocked = -r.model->gains.kh * (cs.M * c.au);
+  CHECK(c.Fc[2] > 1.0);
+  CHECK((c.Fc - blocked).norm() <= 1e-9 * blocked.norm());
+  CHECK(c.Fc.head<2>().norm() <= 1e-9 * c.Fc[2]);
+  CHECK(r.rec.ticks.back().F_sent == c.Fc);
+  // The last coupling step again, cold, from the cached snapshot.
+  REQUIRE(cs.god.num_contacts > 64);
+  ProjectionWorkspace ws(cs.god.num_contacts);
+  ProjectionResult res(cs.god.num_contacts);
+  ProjectionSettings cold = r.model->settings.projection;
+  cold.warm_start = false;
+  ProjectionProblem pb;
+  pb.M = &cs.M;
+  pb.au = c.au;
+  pb.J = cs.god.J.data();
+  pb.num_rows = cs.god.num_contacts;
+  REQUIRE(project(pb, cold, &ws, &res) == ProjectionStatus::kOptimal);
+  const Vec6 F = coupling_force(cs.M, c.au, res.ac, r.model->gains.kh);
+  CHECK((F - c.Fc).norm() <= 1e-12 * F.norm());
+  // A capacity out of [1, kMaxContactCapacity] is refused when the model is built.
+  for (const int bad : {0, -1, kMaxContactCapacity + 1}) {
+    RuntimeSettings s;
+    s.max_contacts = bad;
+    CHECK_THROWS_AS(RuntimeModel(sc, s), RuntimeError);
+  }
 }
 
 TEST_CASE("faults: CCD give-up keeps the hit conservatively, reported", "[runtime][faults]") {

@@ -91,8 +91,12 @@ py::dict loop_dict(const LoopStats& s) {
 // The options of a run from Python: lockstep runs produce rows faster than real
 // time (larger rings, frequent flushes); progress(run_time_s) under the GIL.
 ScenarioOptions run_options(const std::string& trace_path, bool threaded, double duration, int lockstep_sim_period,
-                            const std::string& extra_json, const std::function<void(double)>& progress) {
+                            const std::string& extra_json, const std::function<void(double)>& progress,
+                            int max_contacts) {
+  if (max_contacts < 1 || max_contacts > kMaxContactCapacity)
+    throw py::value_error("max_contacts must be in [1, " + std::to_string(kMaxContactCapacity) + "]");
   ScenarioOptions options;
+  options.runtime.max_contacts = max_contacts;
   options.trace_path = trace_path;
   options.threaded = threaded;
   options.duration = duration;
@@ -161,7 +165,7 @@ py::dict result_dict(const ScenarioResult& r, const std::vector<HandPhase>& phas
 
 py::dict run(const std::string& scene_path, const std::string& trace_path, bool threaded, double duration,
              int lockstep_sim_period, const std::string& extra_json, const std::function<void(double)>& progress,
-             double rate_hz, int realtime_priority, bool pin_threads, double hold_until) {
+             double rate_hz, int realtime_priority, bool pin_threads, double hold_until, int max_contacts) {
   Scene scene = load(scene_path);
   if (rate_hz != 0) {
     if (!(rate_hz >= 1 && rate_hz <= 1e5)) throw py::value_error("rate_hz must be in [1, 1e5] (0: the scene's)");
@@ -176,7 +180,8 @@ py::dict run(const std::string& scene_path, const std::string& trace_path, bool 
   }
   // The hand holds still after its last key until hold_until (s), when later than the script's end.
   if (hold_until > script.end_time) script.end_time = hold_until;
-  ScenarioOptions options = run_options(trace_path, threaded, duration, lockstep_sim_period, extra_json, progress);
+  ScenarioOptions options =
+      run_options(trace_path, threaded, duration, lockstep_sim_period, extra_json, progress, max_contacts);
   options.runtime.realtime_priority = realtime_priority;
   options.runtime.pin_threads = pin_threads;
   const ScenarioResult r = run_released([&] { return run_scenario(scene, script, options); });
@@ -188,12 +193,14 @@ py::dict run(const std::string& scene_path, const std::string& trace_path, bool 
 
 py::dict replay(const std::string& scene_path, const std::string& recording_path, const std::string& trace_path,
                 const std::vector<std::pair<std::string, double>>& phase_list, bool threaded, double duration,
-                int lockstep_sim_period, const std::string& extra_json, const std::function<void(double)>& progress) {
+                int lockstep_sim_period, const std::string& extra_json, const std::function<void(double)>& progress,
+                int max_contacts) {
   const Scene scene = load(scene_path);
   const Trace recording = read_trace(recording_path);  // TraceError: a gauss6.LoadError
   std::vector<HandPhase> phases;
   for (const auto& [name, start] : phase_list) phases.push_back({name, start});
-  const ScenarioOptions options = run_options(trace_path, threaded, duration, lockstep_sim_period, extra_json, progress);
+  const ScenarioOptions options =
+      run_options(trace_path, threaded, duration, lockstep_sim_period, extra_json, progress, max_contacts);
   return result_dict(run_released([&] { return run_replay(scene, recording, phases, options); }), phases);
 }
 
@@ -281,16 +288,18 @@ void bind_runtime(py::module_& parent) {
         py::arg("duration") = -1.0, py::arg("lockstep_sim_period") = 1, py::arg("extra_json") = "{}",
         py::arg("progress") = nullptr, py::arg("rate_hz") = 0.0, py::arg("realtime_priority") = 0,
         py::arg("pin_threads") = false, py::arg("hold_until") = -1.0,
+        py::arg("max_contacts") = kDefaultMaxContacts,
         "Runs the scene with its hand script (lockstep by default, or threaded) and writes the trace. Returns a dict "
         "of run statistics and property checks (orthogonality, constraint energy, passivity observer). "
         "progress(run_time_s) is called about every 0.2 s of wall time. rate_hz overrides the scene's haptic rate "
         "(0: the scene's); realtime_priority and pin_threads are RuntimeSettings' (threaded runs; each loop's "
         "outcome in its dict: realtime 1 applied / 0 not asked / -errno, pinned_cpu, pin_error); hold_until (s): "
-        "the hand holds still after the script until then.");
+        "the hand holds still after the script until then. max_contacts: RuntimeSettings::max_contacts, the "
+        "contact capacity of the loops (a larger set is truncated and reported as contact_overflow).");
   m.def("replay", &replay, py::arg("scene"), py::arg("recording"), py::arg("trace"),
         py::arg("phases") = std::vector<std::pair<std::string, double>>{}, py::arg("threaded") = false,
         py::arg("duration") = -1.0, py::arg("lockstep_sim_period") = 1, py::arg("extra_json") = "{}",
-        py::arg("progress") = nullptr,
+        py::arg("progress") = nullptr, py::arg("max_contacts") = kDefaultMaxContacts,
         "Replays a recorded session: the handle poses of the trace `recording` drive the scene's runtime through "
         "the replay device, and the run is written to `trace`. phases: (name, start) pairs to mark. Returns the "
         "dict of run_scenario.");

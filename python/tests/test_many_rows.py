@@ -44,3 +44,22 @@ def test_projector_grows_for_more_rows_and_keeps_answering():
         cold = gauss6.project(inst.M, inst.au, inst.J, inst.b)
         assert r.status == "optimal" and len(r.lam) == inst.num_rows
         assert crosscheck_qp.m_norm(inst.M, r.ac - cold.ac) <= 1e-12 * crosscheck_qp.m_norm(inst.M, inst.au)
+
+
+def test_runtime_contact_capacity_from_python(tmp_path):
+    """run_scenario's max_contacts is the runtime's contact capacity (RuntimeSettings::max_contacts):
+    the peg's first 8 s hold sets of up to 3 contacts; at capacity 1 they are truncated and
+    reported (contact_overflow), at the default (64) they are not; a capacity out of
+    [1, 100000] is refused by name. (More than 64 contacts through the loops: the C++
+    test "more than 64 contacts: a capacity of 256 carries them all to the coupling".)"""
+    from gauss6 import reproduce
+
+    runtime = _gauss6.runtime
+    peg = str(reproduce.SCENES["peg"])
+    full = runtime.run_scenario(peg, str(tmp_path / "full.g6trace"), duration=8.0)
+    one = runtime.run_scenario(peg, str(tmp_path / "one.g6trace"), duration=8.0, max_contacts=1)
+    assert "contact_overflow" not in full["sim"]["events"]
+    assert one["sim"]["events"].get("contact_overflow", 0) >= 1
+    assert one["rows_written"][2] < full["rows_written"][2]  # fewer contact rows traced
+    with pytest.raises(ValueError, match="max_contacts"):
+        runtime.run_scenario(peg, str(tmp_path / "x.g6trace"), duration=0.1, max_contacts=0)

@@ -13,6 +13,11 @@
 #include <CGAL/QP_functions.h>
 #include <CGAL/QP_models.h>
 
+#include <Eigen/Cholesky>
+
+#include <algorithm>
+#include <cmath>
+
 #include "exact_linear_algebra.h"
 #include "gauss6/reference/quasistatics.h"
 
@@ -39,7 +44,74 @@ Rational to_rational(const CGAL::Quotient<ET>& x) {
 
 }  // namespace
 
+namespace {
+
+// A floating-point guess of the optimal active set by Hildreth's row-action
+// method (C. Hildreth, Naval Res. Logist. Q. 4, 1957: coordinate descent on the
+// dual, one row at a time, lambda_k >= 0; not the optimized solver's
+// Goldfarb-Idnani method): the rows with a positive multiplier or a slack
+// within 1e-9 of the row's scale after at most kHildrethSweeps sweeps, or until
+// no row moves its multiplier by more than 1e-15 of the largest. Only a guess:
+// project() keeps it only when the exact certificate passes.
+constexpr int kHildrethSweeps = 2000;
+
+std::vector<int> hildreth_active_set(const ProjectionProblem& pb) {
+  const int m = static_cast<int>(pb.J.rows());
+  const Mat6 Ms = 0.5 * (pb.M + pb.M.transpose());
+  const Eigen::LLT<Mat6> llt(Ms);
+  const Eigen::MatrixXd MinvJt = llt.solve(pb.J.transpose());  // 6 x m
+  Eigen::VectorXd diag(m), lambda = Eigen::VectorXd::Zero(m);
+  for (int k = 0; k < m; ++k) diag[k] = pb.J.row(k).dot(MinvJt.col(k));
+  Vec6 a = pb.au;
+  auto rhs = [&](int k) { return pb.b.size() == 0 ? 0.0 : pb.b[k]; };
+  for (int sweep = 0; sweep < kHildrethSweeps; ++sweep) {
+    double largest = 0, moved = 0;
+    for (int k = 0; k < m; ++k) {
+      if (!(diag[k] > 0)) continue;
+      const double step = std::max(-lambda[k], (rhs(k) - pb.J.row(k).dot(a)) / diag[k]);
+      lambda[k] += step;
+      a += step * MinvJt.col(k);
+      largest = std::max(largest, lambda[k]);
+      moved = std::max(moved, std::abs(step));
+    }
+    if (!std::isfinite(largest) || moved <= 1e-15 * largest) break;
+  }
+  std::vector<int> active;
+  const double a_norm = std::max(a.norm(), pb.au.norm());
+  for (int k = 0; k < m; ++k) {
+    const double slack = pb.J.row(k).dot(a) - rhs(k);
+    if (lambda[k] > 0 || std::abs(slack) <= 1e-9 * (pb.J.row(k).norm() * a_norm + std::abs(rhs(k))))
+      active.push_back(k);
+  }
+  return active;
+}
+
+}  // namespace
+
 ProjectionResult project(const ProjectionProblem& problem) {
+  ProjectionResult out;  // status = kBadInput until the inputs are checked
+  if (!internal::valid_inputs(problem.M, problem.au, problem.J, problem.b)) return out;
+  if (!internal::positive_definite(internal::symmetric_part(problem.M))) return out;
+  // A guessed active set whose exact KKT point passes the exact certificate is
+  // the exact optimum (check_certificate); CGAL's solver decides the rest.
+  const CertificateReport cert = check_certificate(problem, hildreth_active_set(problem));
+  if (!cert.pass) return project_by_qp_solver(problem);
+  const int m = static_cast<int>(problem.J.rows());
+  out.status = ProjectionStatus::kOptimal;
+  out.ac = cert.ac_exact;
+  out.lambda = cert.lambda_exact;
+  out.ac_double = cert.ac_rounded;
+  out.lambda_double = cert.lambda_rounded;
+  for (int k = 0; k < m; ++k) {
+    Rational s = -Rational(problem.b.size() == 0 ? 0.0 : problem.b[k]);
+    for (int j = 0; j < 6; ++j)
+      if (problem.J(k, j) != 0) s += Rational(problem.J(k, j)) * out.ac[j];
+    if (sgn(s) == 0) out.active_set.push_back(k);
+  }
+  return out;
+}
+
+ProjectionResult project_by_qp_solver(const ProjectionProblem& problem) {
   const Mat6& M = problem.M;
   const Vec6& au = problem.au;
   const Eigen::MatrixXd& J = problem.J;

@@ -19,9 +19,11 @@
 
 namespace gauss6 {
 
-// Every buffer of the coupling loop.
+// Every buffer of the coupling loop, for up to max_contacts rows
+// (RuntimeSettings::max_contacts), allocated when built.
 struct CouplingState {
-  CouplingState() = default;
+  explicit CouplingState(int max_contacts = kDefaultMaxContacts)
+      : god(max_contacts), offsets(max_contacts), projection_ws(max_contacts), projection(max_contacts) {}
   HandleSample handle;
   bool has_handle = false;
   GodObjectSnapshot god;               // cached snapshot (xs, M, J)

@@ -13,6 +13,7 @@
 #pragma once
 
 #include <array>
+#include <vector>
 
 #include "gauss6/pose.h"
 #include "gauss6/quasistatics.h"
@@ -52,34 +53,37 @@ struct OffsetRule {
 // A newly published contact set (a view; world frame): m rows J (m x 6
 // row-major), their contact points I_k and normals n_k.
 struct OffsetRows {
-  int num_rows = 0;                    // m <= kMaxContacts
+  int num_rows = 0;                    // m (rows beyond the state's capacity are not offset: see start_offsets)
   const double* J = nullptr;
   const double (*point)[3] = nullptr;
   const double (*normal)[3] = nullptr;
 };
 
 // Per-row offsets and identities of the cached set, the stand-in set, and the
-// scratch of the matching. Construct once; the members are internal.
+// scratch of the matching, for up to max_rows rows (allocated when built).
+// Construct once; the members are internal.
 struct OffsetState {
+  explicit OffsetState(int max_rows = kDefaultMaxContacts);
+  int capacity() const noexcept { return static_cast<int>(start.size()); }
   // One per cached row: start value d_k (0: none), start time, right-hand side
   // of the current step, and the row's identity for matching across sets.
   int num_rows = 0;                    // rows whose identities are in point_B / normal_W
-  std::array<double, kMaxContacts> start{};
-  std::array<double, kMaxContacts> t0{};
-  std::array<double, kMaxContacts> rhs{};
-  std::array<Vec3, kMaxContacts> point_B{};   // I_k in the god-object's frame
-  std::array<Vec3, kMaxContacts> normal_W{};
-  std::array<double, kMaxContacts * 6> cached_J{};  // the last non-empty set's rows (m x 6 row-major)
+  std::vector<double> start;
+  std::vector<double> t0;
+  std::vector<double> rhs;
+  std::vector<Vec3> point_B;           // I_k in the god-object's frame
+  std::vector<Vec3> normal_W;
+  std::vector<double> cached_J;        // the last non-empty set's rows (m x 6 row-major)
   int num_last_rows = 0;               // rows in cached_J (kept through empty sets)
   double last_rows_time = -1;          // s, when that set arrived or was last replaced by an empty one
   // Scratch for the matching of a new set's rows.
-  std::array<double, kMaxContacts> new_start{}, new_t0{};
-  std::array<Vec3, kMaxContacts> new_point_B{}, new_normal_W{};
-  std::array<unsigned char, kMaxContacts> matched{};
+  std::vector<double> new_start, new_t0;
+  std::vector<Vec3> new_point_B, new_normal_W;
+  std::vector<unsigned char> matched;
   // The previous set's rows and their right-hand sides at the new set's
   // arrival, projected once per new set to measure the new rows.
-  std::array<double, kMaxContacts * 6> kept_J{};
-  std::array<double, kMaxContacts> kept_b{};
+  std::vector<double> kept_J;
+  std::vector<double> kept_b;
   ProjectionWorkspace arrival_ws;
   ProjectionResult arrival;
 };

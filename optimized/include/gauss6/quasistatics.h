@@ -35,10 +35,6 @@ namespace gauss6 {
 // contact set (RuntimeSettings::max_contacts); any capacity >= 1 may be chosen
 // when they are built.
 inline constexpr int kDefaultMaxContacts = 64;
-// The runtime's contact capacity today: its loops' buffers and the published
-// snapshot (runtime_channels.h) are arrays of this size; a larger contact set
-// is truncated and reported (kContactOverflow).
-inline constexpr int kMaxContacts = kDefaultMaxContacts;
 // Size of a working set: at most 6 linearly independent rows in R^6.
 inline constexpr int kMaxActive = 6;
 
@@ -48,11 +44,13 @@ inline constexpr int kMaxActive = 6;
 // "Tolerances" at the top of quasistatics.cpp.
 struct ProjectionSettings {
   // Row k is dependent on the working set W when the sine of its angle to the
-  // span of W's rows (y-space) is <= dependence_tol: it never joins W; a
-  // violated one is exchanged for a row of W that spans it. 1e-10: keeps
-  // cond(R) below 1e10, and stays above the rounding of that sine (eps cond(R)
-  // for ill-conditioned W, e.g. a body jammed between nearly opposite planes).
-  double dependence_tol = 1e-10;
+  // span of W's rows (y-space) is <= max(dependence_tol, 64 eps cond(R)): it
+  // never joins W; a violated one is exchanged for a row of W that spans it.
+  // The second term is the rounding of that computed sine for an
+  // ill-conditioned W; 1e-13 (~450 eps) is the floor for a well-conditioned
+  // one, and keeps cond(R) below 1e13 (the final answer is refined when W is
+  // ill-conditioned: see quasistatics.cpp).
+  double dependence_tol = 1e-13;
   // Row k is violated when J_k a - b_k < -feasibility_tol * scale_k, with
   // scale_k = |A_k| max(|y|, |y_u|) + |b_k|. 1e-13 (~450 eps): above the
   // rounding of a slack, and small because a nearly parallel row left violated

@@ -29,7 +29,7 @@ enum class RuntimeEventKind {
   kDeviceEnded,            // the device's script or replay ended: the run stops
   kProjectionFailed,       // a projection returned kBadInput or kIterationCap
   kCcdGaveUp,              // the sim step's CCD gave up (hit kept conservatively) or refused its input
-  kContactOverflow,        // more contacts than kMaxContacts: the set was truncated
+  kContactOverflow,        // more contacts than RuntimeSettings::max_contacts: the set was truncated
   kTextureUndersampled,    // a textured contact moved more than half the texture's shortest wavelength in one
                            // sim step: the texture is skipped at this speed (surface.h, max_texture_speed)
   kDeviceNotConnected,     // read() returned kNotConnected: zero force until a good sample

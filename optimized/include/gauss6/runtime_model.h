@@ -34,10 +34,17 @@ enum class ForceSource {
 // user should feel the last force through.
 inline constexpr double kMaxTimeout = 1.0;
 
+// The largest RuntimeSettings::max_contacts accepted (the buffers take about
+// 1 KB per contact).
+inline constexpr int kMaxContactCapacity = 100000;
+
 // Every setting of the runtime, one line each. Defaults suit scenes whose delta
 // is about 1e-4 of their size.
 struct RuntimeSettings {
   ProjectionSettings projection;       // both loops' projections
+  int max_contacts = kDefaultMaxContacts;  // contact capacity of the loops' buffers and the published snapshot,
+                                       // fixed when the runtime is built (in [1, kMaxContactCapacity]); a larger
+                                       // contact set is truncated to it and reported (kContactOverflow)
   CcdStepSettings ccd;                 // the sim loop's CCD; its distances and the cache's margins and budget are
                                        // resolved from the settings below (resolve_runtime_settings): the values
                                        // given in these six fields are not used

@@ -10,6 +10,7 @@
 
 #include <array>
 #include <cstdint>
+#include <vector>
 
 #include "gauss6/ccd_step.h"
 #include "gauss6/contacts.h"
@@ -21,27 +22,29 @@
 
 namespace gauss6 {
 
-// Every buffer of the sim loop, allocated when built.
+// Every buffer of the sim loop, allocated when built, for up to
+// capacity = model.settings.max_contacts contacts.
 struct SimState {
   explicit SimState(const RuntimeModel& model);
+  int capacity = 0;                    // contacts the buffers below hold
   Pose xs;                             // god-object pose
   Mat6 M = Mat6::Identity();           // at xs's orientation
-  ContactSet contacts;                 // the current set (capacity kMaxContacts)
-  std::array<double, kMaxContacts> gap_rhs{};  // b_k = delta (1 + gap_factor) - separation_k
+  ContactSet contacts;                 // the current set (capacity contacts)
+  std::vector<double> gap_rhs;         // capacity: b_k = delta (1 + gap_factor) - separation_k
   ProjectionWorkspace projection_ws;
   ProjectionResult projection;
   // Shaded surfaces: the shading rows of the current set (published with J)
   // and pass 1's own projection, used when the coupling's asc is not for the last snapshot.
-  std::array<double, kMaxContacts * 6> shaded_J{};
-  double shaded_normal[kMaxContacts][3] = {};
+  std::vector<double> shaded_J;        // capacity x 6
+  std::vector<double> shaded_normal;   // capacity x 3 (rows3())
   ProjectionWorkspace shading_ws;
   ProjectionResult shading;
-  std::array<double, kMaxContacts * 6> held_J{};  // textures: -J_k of the contacts the command presses on
+  std::vector<double> held_J;          // capacity x 6; textures: -J_k of the contacts the command presses on
   CcdStepWorkspace ccd_ws;
   CcdStepResult ccd;
   CcdStepWorkspace check_ws;           // the settling step's check of its direct motion (advance_god_object)
   CcdStepResult check;
-  std::array<FeaturePair, kMaxContacts> ccd_hints{};  // the contacts at a leg's start, tested first (ccd_step)
+  std::vector<FeaturePair> ccd_hints;  // capacity: the contacts at a leg's start, tested first (ccd_step)
   double stop_deviation = 0;           // of xs from the motion's exact pose (make_stop_pose)
   ContactWorkspace contact_ws;
   HandleSample handle;                 // last sample read

@@ -85,10 +85,20 @@ struct ProjectionResult {
 // (1e12 and more) and can differ by O(|au|) from a floating-point solver's
 // answer, which violates some row exactly by about 1e-20. Both are right: such
 // an instance is ill-conditioned (test "[refqp-illposed]").
+// Two exact paths, the same answer: first a floating-point guess of the active
+// set (Hildreth's row-action method, not the optimized solver's algorithm),
+// kept when its exact KKT point passes the exact certificate (check_certificate
+// below: then it is the exact optimum); otherwise CGAL's exact QP solver
+// (project_by_qp_solver), whose pivoting can take minutes on degenerate sets of
+// 50 rows (a seeded m50 instance: unfinished after 4 minutes of CPU; this
+// path, 6 ms).
+// Test "[refqp-paths]": both paths agree exactly.
 // Not real-time: allocates; about 0.4 ms CPU for m = 3, 1.3 ms for m = 12,
 // 5 ms for m = 50 (test "[refqp-timing]", random contacts), the exact
 // verification included (about a sixth of it).
 ProjectionResult project(const ProjectionProblem& problem);
+// CGAL's exact QP solver alone (the fallback of project()).
+ProjectionResult project_by_qp_solver(const ProjectionProblem& problem);
 
 // ---------------------------------------------------------------------------
 // Exact certificate check of a claimed active set.
