@@ -172,7 +172,7 @@ void factor_add(ProjectionWorkspace& ws, Vec6 d, int p) noexcept {
   // Rotate d(q+1:6) into d(q), bottom up, carrying Q along.
   for (int i = 5; i > q; --i) {
     if (d[i] == 0) continue;
-    const double h = std::sqrt(d[i - 1] * d[i - 1] + d[i] * d[i]);
+    const double h = std::hypot(d[i - 1], d[i]);
     const double c = d[i - 1] / h, s = d[i] / h;
     d[i - 1] = h;
     d[i] = 0;
@@ -198,7 +198,7 @@ void factor_drop(ProjectionWorkspace& ws, int pos) noexcept {
   for (int k = pos; k + 1 < q; ++k) {
     const double x = ws.R(k, k), y = ws.R(k + 1, k);
     if (y == 0) continue;
-    const double h = std::sqrt(x * x + y * y);
+    const double h = std::hypot(x, y);
     const double c = x / h, s = y / h;
     for (int j = k; j + 1 < q; ++j) {
       const double u = ws.R(k, j), v = ws.R(k + 1, j);
@@ -547,7 +547,10 @@ ProjectionStatus project(const ProjectionProblem& pb, const ProjectionSettings& 
         }
       }
       const double t2 = dependent ? kInf : -s_p / z2;
-      if (t1 == kInf && t2 == kInf) {
+      // No row of W blocks (block < 0) and no full step (t2 infinite, or NaN
+      // when rounding leaves z2 = 0 on a row not counted dependent): p cannot
+      // be satisfied by a step; never a drop at block -1.
+      if (block < 0 && !(t2 < kInf)) {
         // n = A_W^T r + z, |z| <= dependence_tol |n|, with r <= 0: no step
         // can satisfy row p. On W's face its slack is r^T b_W - b_p + z^T y,
         // so the offsets are inconsistent when b_p - r^T b_W exceeds the

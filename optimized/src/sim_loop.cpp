@@ -120,10 +120,8 @@ Vec6 hold_pressed_contacts(const RuntimeModel& model, const Vec6& au, const Vec6
   problem.J = s->held_J.data();
   problem.b = s->gap_rhs.data();
   problem.num_rows = n;
-  // A cold start: these rows are new at every step, and a warm start from the
-  // workspace's previous problems (pass 1's, the texture's weights) read unset
-  // memory in project() on the textured Figure 8 run (valgrind; a crash at its
-  // step 3988), which a cold start does not.
+  // A cold start: these rows are new at every step, and the workspace's last
+  // working set is another problem's (pass 1's, the texture's weights).
   ProjectionSettings cold = model.settings.projection;
   cold.warm_start = false;
   project(problem, cold, &s->shading_ws, &s->shading);

@@ -408,6 +408,30 @@ TEST_CASE("more rows than the workspace or the result holds is refused, not trun
   CHECK(gauss6::project(make_problem(M, au, rows), {}, &big_ws, &big_res) == ProjectionStatus::kOptimal);
 }
 
+TEST_CASE("a row whose tail components are below the square root of the smallest double", "[qp]") {
+  // Joining W, row 1's d = Q^T A_1 = (0, 1, 1e-170, 1e-170, 0, 0) is rotated
+  // into d(1) by Givens rotations; with h = sqrt(x^2 + y^2) the squares of
+  // 1e-170 underflow to 0, h = 0 and the rotation is 0/0: Q turned NaN, a later
+  // step found no blocking row and dropped position -1 (the textured Figure 8
+  // run, warm-started, crashed at its step 3988). h = hypot(x, y) does not
+  // underflow. Expected: both rows active, ac = (0, 0, 0, 0, 0, 0) to within
+  // 1e-15 (the rows' own cross terms, 1e-170, are far below it).
+  const Mat6 M = Mat6::Identity();
+  double J[12] = {1, 0, 0, 0, 0, 0, 0, 1, 1e-170, 1e-170, 0, 0};
+  ProjectionProblem pb;
+  pb.M = &M;
+  pb.au << -1, -2, 0, 0, 0, 0;
+  pb.J = J;
+  pb.num_rows = 2;
+  ProjectionWorkspace ws;
+  ProjectionResult res;
+  REQUIRE(gauss6::project(pb, {}, &ws, &res) == ProjectionStatus::kOptimal);
+  CHECK(res.ac.allFinite());
+  CHECK(res.ac.norm() <= 1e-15);
+  CHECK(res.num_active == 2);
+  CHECK(ws.Q.allFinite());
+}
+
 TEST_CASE("redundant rows: duplicates, scaled copies and averages", "[qp]") {
   // With b = 0, exact duplicates, positive multiples and averages of rows leave
   // the feasible cone unchanged: the answer must equal the brute-force answer of
