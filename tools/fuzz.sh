@@ -10,6 +10,7 @@
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
 cd "$root"
+. tools/ccache.env
 seconds=${1:-${FUZZ_SECONDS:-180}}
 # FUZZ_RUNS=N: a fixed number of inputs per target from a fixed seed instead of a time
 # budget, so that the same build explores the same inputs on any machine (make test's
@@ -21,7 +22,8 @@ else
   budget=(-max_total_time="$seconds")
   what="${seconds}s"
 fi
-targets=(scene obj off ply stl trace ccd_queries qp_instances hand_script height_map)
+# FUZZ_TARGETS="a b": only these targets (default all).
+targets=(${FUZZ_TARGETS:-scene obj off ply stl trace ccd_queries qp_instances hand_script height_map})
 
 if ! command -v clang++ >/dev/null; then
   echo "gauss6 fuzz: clang++ not found (tools/debian-packages.txt: clang, libclang-rt-14-dev)" >&2

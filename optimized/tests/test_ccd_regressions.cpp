@@ -146,11 +146,11 @@ MeshCertificate certify_step(const RuntimeModel& model, const CayleyMotion& m, d
         return (y - closest_point_on_triangle(y, a, b, d)).norm();
       });
   const auto god_edges = edges_of(god), obs_edges = edges_of(obs);
-  for (const auto& [ga, gb] : god_edges)
-    for (const auto& [oa, ob] : obs_edges)
+  for (const std::pair<int, int>& ge : god_edges)
+    for (const std::pair<int, int>& oe : obs_edges)  // not structured bindings: clang 14 cannot capture one
       check([&](double u) {
-        const Vec3 p0 = motion_point(m, u, gv(ga)), p1 = motion_point(m, u, gv(gb));
-        const Vec3 q0 = ov(oa), q1 = ov(ob);
+        const Vec3 p0 = motion_point(m, u, gv(ge.first)), p1 = motion_point(m, u, gv(ge.second));
+        const Vec3 q0 = ov(oe.first), q1 = ov(oe.second);
         double s = 0, t = 0;
         closest_segment_parameters(p0, p1, q0, q1, &s, &t);
         return ((p0 + s * (p1 - p0)) - (q0 + t * (q1 - q0))).norm();

@@ -164,15 +164,17 @@ std::optional<Vec6> brute_force(const Mat6& M, const Vec6& au, const Rows& rows)
   const Mat6L Minv = Ml.ldlt().solve(Mat6L::Identity());
   const Vec6L aul = au.cast<long double>();
   MatL J(m, 6);
-  VecL b(m), tol(m);
+  VecL b(m), row_M(m);
   for (int k = 0; k < m; ++k) {
     J.row(k) = rows.row(k).transpose().cast<long double>();
     b[k] = rows.bk(k);
+    row_M[k] = std::sqrt(J.row(k).dot(Minv * J.row(k).transpose()));
   }
-  // Feasibility of a candidate, relative to the row's scale (see check_kkt).
+  // Feasibility of a candidate a, relative to the row's scale (see check_kkt) at
+  // the larger of |au|_M and |a|_M: with offsets b > 0 a thin feasible cone puts
+  // the answer up to 1e6 |au|_M away (cond(M) 1e6), where the rounding of J a
+  // grows with |a|_M (a tolerance at |au|_M alone called such problems infeasible).
   const long double au_M = std::sqrt(aul.dot(Ml * aul));
-  for (int k = 0; k < m; ++k)
-    tol[k] = 1e-12L * (std::sqrt(J.row(k).dot(Minv * J.row(k).transpose())) * au_M + std::abs(b[k]));
   std::optional<Vec6> best;
   long double best_f = std::numeric_limits<long double>::infinity();
   std::vector<int> S;
@@ -197,7 +199,9 @@ std::optional<Vec6> brute_force(const Mat6& M, const Vec6& au, const Rows& rows)
     }
     if (independent) {
       bool feasible = true;
-      for (int k = 0; k < m && feasible; ++k) feasible = J.row(k).dot(a) - b[k] >= -tol[k];
+      const long double scale = std::max(au_M, std::sqrt(a.dot(Ml * a)));
+      for (int k = 0; k < m && feasible; ++k)
+        feasible = J.row(k).dot(a) - b[k] >= -1e-12L * (row_M[k] * scale + std::abs(b[k]));
       const Vec6L d = a - aul;
       const long double f = 0.5L * d.dot(Ml * d);
       if (feasible && f < best_f) {
@@ -572,7 +576,10 @@ TEST_CASE("offsets: b != 0 meets KKT and matches brute force", "[qp]") {
           }
           ++feasible;
           check_kkt(M, au, rows, res, settings);
-          check_same(M, au, res.ac, *truth);
+          // 1e-9 of the larger of |au|_M and the answer's distance from it: a thin
+          // feasible cone puts the answer up to 1e6 |au|_M away, and the rounding
+          // of both solutions grows with that distance.
+          check_same(M, au, res.ac, *truth, 1e-9 * std::max(1.0, m_norm(M, *truth - au) / m_norm(M, au)));
         }
       }
     }

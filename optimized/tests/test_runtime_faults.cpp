@@ -160,6 +160,47 @@ TEST_CASE("faults: kNotConnected zeroes the force at once, as device_port.h prom
   check_bounded(device);
 }
 
+TEST_CASE("faults: a device that ends stops the run, zero force sent, reported", "[runtime][faults][threaded]") {
+  // The device's script ends at 0.6 s (kEnded) while the box is pressed (5 N):
+  // the tick that reads kEnded sends zero, reports device_ended once and is the
+  // run's last, lockstep or threaded (which must not run on to its 5 s).
+  for (const bool threaded : {false, true}) {
+    DYNAMIC_SECTION((threaded ? "threaded" : "lockstep")) {
+      ScriptedDevice device(press_script(0.2, 0.04, 0.4));
+      device.end_time = 0.6;
+      Run r;
+      if (threaded) {
+        r.model = std::make_unique<RuntimeModel>(make_scene(), RuntimeSettings{});
+        r.data = std::make_unique<RuntimeData>(*r.model);
+        r.rec.ticks.reserve(10000);
+        r.rec.sims.reserve(20000);
+        RuntimeObserver observer = r.rec.observer();
+        observer.on_coupling_step = nullptr;
+        const auto start = std::chrono::steady_clock::now();
+        run_threaded(*r.model, &device, 5.0, nullptr, observer, r.data.get());
+        CHECK(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count() < 4.0);
+      } else {
+        run(&r, make_scene(), RuntimeSettings{}, &device, 5000);
+        CHECK(r.rec.ticks.size() == 601);  // t = 0, 1 ms, ..., 0.6 s: not the 5000 asked for
+      }
+      REQUIRE(!r.rec.ticks.empty());
+      const HapticTickRecord& last = r.rec.ticks.back();
+      CHECK(last.device_status == DeviceStatus::kEnded);
+      CHECK(last.time >= 0.6);
+      CHECK(last.F_sent.norm() == 0.0);
+      CHECK(r.rec.count(RuntimeEventKind::kDeviceEnded) == 1);
+      int pressed = 0;  // the force was on until then
+      for (const HapticTickRecord& t : r.rec.ticks) {
+        if (&t != &last) CHECK(t.device_status == DeviceStatus::kOk);
+        if (t.time > 0.5 && t.time < 0.599) pressed += t.F_sent[2] > kPressed ? 1 : 0;
+      }
+      CHECK(pressed > (threaded ? 5 : 90));  // threaded: as many ticks as the machine schedules
+      CHECK(device.felt().norm() == 0.0);
+      check_bounded(device);
+    }
+  }
+}
+
 TEST_CASE("faults: a failing write() is reported and zero is written at once", "[runtime][faults]") {
   SECTION("zero is accepted: the device renders nothing while its writes fail") {
     ScriptedDevice device(press_script(0.2, 0.04, 0.4));
