@@ -300,6 +300,51 @@ void update_contacts(const RuntimeModel& model, SimState* s) {
     s->step_events |= bit(RuntimeEventKind::kContactOverflow);
 }
 
+// The god-object stays at x_start this step, with the contact set there (the
+// last step's pairs, which withheld part of the command). Staying put is always
+// a free motion (property 5); the hand's next sample gives the next step another
+// leg. keep_a_contact's last resort.
+void stay_at_start(const RuntimeModel& model, const Pose& x_start, SimState* s, SimStepInfo* info) {
+  s->xs = x_start;
+  s->stop_deviation = 0;
+  s->ccd.hit = false;
+  s->ccd.num_near_pairs = -1;  // the near pairs are the legs', not x_start's: a full search
+  update_contacts(model, s);
+  info->u_hit = 0;
+  info->status = s->contacts.num_contacts > 0 ? SimStepStatus::kContact : SimStepStatus::kFree;
+}
+
+// Every settle refused, the shortenings spent and the first leg's end still out
+// of contact: its motion's pose at u / 2, u / 4, ... (served from the leg's proven
+// CCD result, no settling) until the pose keeps a contact, at most
+// kMaxKeepHalvings times; x_start itself (stay_at_start) when none does or the
+// leg cannot be served (split, or run from a graze's lift waypoint). The first
+// leg's end, kept before, had lifted off every contact that held the user's
+// push: in the peg's hole at 11.473 s of the whole script (a wedge of 2-6 edge
+// contacts) the ends at 1/2 to 1/8 of a 160 um slide were all beyond
+// delta (1 + contact_factor) of them, so that one step published an empty set
+// while the hand was 3 mm behind: the force fell from 1.47 N to 0 for one tick
+// and came back at once (1.47 and 1.38 N jumps). Staying at x_start alone
+// instead stalled the god-object there (167 ticks from 11.472 s, then a 1.15 N
+// release): each step repeated the same refusals.
+void keep_a_contact(const RuntimeModel& model, const Pose& x_start, bool served, double u, SimState* s,
+                    SimStepInfo* info) {
+  if (served) {
+    const CcdStepResult proven = s->ccd;  // the first leg, free: its end was refused
+    for (int i = 0; i < kMaxKeepHalvings && s->contacts.num_contacts == 0; ++i) {
+      u *= 0.5;
+      s->ccd = proven;
+      s->ccd.num_near_pairs = -1;  // its near pairs hold at the leg's end, not at u
+      const StopPose stop = make_stop_pose(proven.motion, u, model.god_radius);
+      s->xs = stop.pose;
+      s->stop_deviation = stop.deviation;
+      update_contacts(model, s);
+    }
+    if (s->contacts.num_contacts > 0) return;
+  }
+  stay_at_start(model, x_start, s, info);
+}
+
 }  // namespace
 
 // Step 4: CCD along x_start -> x_target, then xs = its end or the stop pose and
@@ -382,7 +427,10 @@ void advance_god_object(const RuntimeModel& model, const Pose& x_start, const Po
     s->ccd = first_leg;
     s->stop_deviation = first_deviation;
     info->u_hit = first_leg.u_hit;
-    if (info->num_shortenings == kMaxSettleShortenings) break;
+    if (info->num_shortenings == kMaxSettleShortenings) {
+      keep_a_contact(model, x_start, info->num_halves == 1 && !lifted, shortened_u, s, info);
+      break;
+    }
     ++info->num_shortenings;
     // A leg run from a graze's lift waypoint is not a part of x_start -> target:
     // its parts are not served, the step is split instead.

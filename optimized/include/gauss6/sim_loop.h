@@ -89,6 +89,8 @@ const SimStepInfo& sim_step(const RuntimeModel& model, double t, RuntimeChannels
 // leg, one check), 20 over the 1 + kMaxSettleShortenings tries, and 3 more (a
 // leg, a check) out of a graze.
 constexpr int kMaxSettleShortenings = 3;
+// After them, the first leg halved on (without settling) until its end keeps a contact.
+constexpr int kMaxKeepHalvings = 8;
 void advance_god_object(const RuntimeModel& model, const Pose& x_start, const Pose& x_target, const Vec6& residual,
                         SimState* s, SimStepInfo* info) noexcept;
 
