@@ -22,6 +22,7 @@ from __future__ import annotations
 
 import functools
 import importlib.util
+import os
 import sys
 
 import numpy as np
@@ -40,7 +41,20 @@ def generator():
     spec = importlib.util.spec_from_file_location("gauss6_qp_generate", FAMILIES_DIR / "generate.py")
     gen = importlib.util.module_from_spec(spec)
     sys.modules[spec.name] = gen  # dataclasses look their module up by name
-    spec.loader.exec_module(gen)
+    # The generator pins numpy's OpenBLAS kernels for the stored files (OPENBLAS_CORETYPE,
+    # read when numpy loads: no effect here, numpy is loaded). Left set, it would reach the
+    # worker processes a campaign spawns later, whose numpy would then run other kernels
+    # than this process's (AVX2 against AVX-512 where the CPU has it) and round the last
+    # bits of the same products differently: a campaign's summary would then differ,
+    # serial and distributed. So this process's environment is left as it was.
+    before = os.environ.get("OPENBLAS_CORETYPE")
+    try:
+        spec.loader.exec_module(gen)
+    finally:
+        if before is None:
+            os.environ.pop("OPENBLAS_CORETYPE", None)
+        else:
+            os.environ["OPENBLAS_CORETYPE"] = before
     gen.mesh_body = functools.cache(gen.mesh_body)
     return gen
 
