@@ -18,14 +18,19 @@ Violations (any one makes the command exit 1):
   alone over [0, 1]) is earlier than u_hit (impossible for a sound step: u_hit <=
   u* <= the pair's own contact), never comes, or comes later than u* by more than
   the step's time_tolerance_reached plus PAIR_SLACK_U (below). A different pair
-  within that window is reported as agreement within tolerance. A pair that never
-  touches but is itself within the CCD's acceptance band at the stop pose (its
-  distance <= STOP_BAND delta, computed in doubles: rounding is ~1e-17 m against a
-  band of 0.1 delta = 1e-7 m) is a stop within delta (counted apart, not a
-  violation): the step's contract is to stop where a pair may come within delta, and a
-  contact sliding at about delta (the seeded `sliding` family) has pairs that come
-  within delta without ever touching, while another pair touches later. Measured:
-  such stops are at 1.00001-1.00002 delta (the time tolerance's worth of motion).
+  within that window is reported as agreement within tolerance. A pair that is
+  itself within the CCD's acceptance band at the stop pose (its distance <= STOP_BAND
+  delta, computed in doubles: rounding is ~1e-17 m against a band of 0.1 delta =
+  1e-7 m) is a stop within delta (counted apart, not a violation), whether it touches
+  later or never: the step's contract is to stop where a pair may come within delta.
+  A contact sliding at about delta (the seeded `sliding` family) has pairs that come
+  within delta without ever touching, while another pair touches later; and a step
+  whose start pose is already within delta of a pair stays at u = 0 on that pair,
+  which may touch after another pair's contact, outside the window below (the
+  100,000-step campaign of seed 1 has 37 such steps, starting 0.28-1.0 delta from their
+  stop pair, in the random, zero_rotation and peg_scenario families). Measured: the
+  other stops within delta are at 1.00001-1.00002 delta (the time tolerance's worth of
+  motion).
 
 Why the slack: the step stops where a pair may come within delta (min_separation),
 not where one touches, and tests each pair only up to (best u so far) minus the
@@ -134,7 +139,7 @@ class SetResult:
     pair_steps: int = 0             # both hit, the optimized step on a feature pair: its pair compared
     pair_matches: int = 0           # ... stopped on a pair the reference says touches at u*
     pair_within_tolerance: int = 0  # ... on another pair whose own contact is within the window
-    pair_within_delta: int = 0      # ... on a pair that never touches, itself within delta at the stop (see the top)
+    pair_within_delta: int = 0      # ... on a pair itself within delta at the stop, touching later or never (see the top)
     pair_violations: int = 0        # ... on a pair whose own contact is before u_hit, none, or past the window
     failures: list[str] = field(default_factory=list)
 
@@ -251,14 +256,14 @@ def classify_stop_pair(pair, step: dict, opt: dict, ex, meshes: tuple | None = N
         return "match", ""
     own = pair.pair_first_contact(ids, *poses(step))
     u_hit = opt["u_hit"]
-    if not own.hit and meshes is not None and pair_distance(
+    if own.hit and own.compare(u_hit) > 0:
+        return "violation", f"stopped on {ids} at u_hit = {u_hit!r}, after its own contact in [{own.lower!r}, " \
+                            f"{own.upper!r}]"
+    if meshes is not None and pair_distance(
             ids, meshes, np.asarray(opt["stop_p"]), np.asarray(opt["stop_q"])) <= STOP_BAND * delta:
         return "within_delta", ""
     if not own.hit:
         return "violation", f"stopped on {ids}, which never touches (u* in [{ex.lower!r}, {ex.upper!r}])"
-    if own.compare(u_hit) > 0:
-        return "violation", f"stopped on {ids} at u_hit = {u_hit!r}, after its own contact in [{own.lower!r}, " \
-                            f"{own.upper!r}]"
     window = opt["time_tolerance_reached"] + max(ex.lower - u_hit, 0.0) + PAIR_SLACK_U
     if own.lower > ex.upper + window:
         return "violation", f"stopped on {ids}, whose own contact in [{own.lower!r}, {own.upper!r}] is past " \
@@ -452,7 +457,7 @@ def format_table(result: dict, ours: dict[str, SetResult], peers: list[PeerResul
     lines.append("hits*: exact contacts; FN: false negatives; late: u_hit > u* (exact); isect: stop poses "
                  "that intersect (exact); stop sep in scene units")
     lines.append("pairs =/~/d/x: hit steps stopped on a pair touching at u* / on another pair within the window / "
-                 "on a pair that never touches, itself within delta at the stop / on a wrong pair (violation)")
+                 "on a pair itself within delta at the stop (touching later or never) / on a wrong pair (violation)")
     if peers is None:
         lines.append("FCL: python-fcl not installed (pip install -r requirements.txt): peers skipped")
     else:

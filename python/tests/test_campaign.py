@@ -252,3 +252,32 @@ def test_a_failing_chunk_is_named():
         campaign.run_campaign(campaign.Campaign("bad", [{"family": "nope", "seed": 1, "index": 0, "size": 1,
                                                          "osqp": False}], crosscheck_qp.run_seeded_chunk,
                                                 lambda r: r), workers=0, show_progress=False)
+
+
+def test_a_step_starting_within_delta_of_a_pair_is_within_delta_though_it_touches_later():
+    """Seeded zero_rotation step 12 of chunk 37 (seed 1), one of the 37 stops that the
+    100,000-step campaign once called wrong pairs: the step starts 0.88 delta from a
+    vertex/face pair, so it stays at u = 0 on that pair, which touches only at 3.5 u*
+    (after another pair's contact, outside the pair window). It is within delta at the
+    stop pose, so the step kept its contract. Fed with a u_hit past the pair's own
+    contact, the same pair is still a violation."""
+    from gauss6 import ccd_seeded
+
+    cc = crosscheck_ccd
+    steps, delta = ccd_seeded.chunk_steps("zero_rotation", 1, 37, 25)
+    st = steps[12]
+    assert st["id"] == "zero_rotation-s1-c37-012"
+    key, pair = cc._MESHES.get(st)
+    meshes = cc._MESHES.features(key)
+    p0, q0, p1, q1 = cc.poses(st)
+    opt = pair.step(p0, q0, p1, q1, delta, time_tolerance=cc.TIME_TOLERANCE, repeats=1)
+    ex = pair.exact_first_contact(p0, q0, p1, q1)
+    assert opt["hit"] and ex.hit and opt["pair_ids"] not in ex.pairs
+    own = pair.pair_first_contact(opt["pair_ids"], p0, q0, p1, q1)
+    assert own.hit and own.lower > 2 * ex.upper
+    assert cc.classify_stop_pair(pair, st, opt, ex)[0] == "violation"  # without the meshes: strict
+    assert cc.classify_stop_pair(pair, st, opt, ex, meshes, delta) == ("within_delta", "")
+    d = cc.pair_distance(opt["pair_ids"], meshes, np.asarray(opt["stop_p"]), np.asarray(opt["stop_q"]))
+    assert opt["u_hit"] == 0.0 and 0.0 < d <= cc.STOP_BAND * delta
+    late = {**opt, "u_hit": min(1.0, own.upper * 1.5)}
+    assert cc.classify_stop_pair(pair, st, late, ex, meshes, delta)[0] == "violation"
