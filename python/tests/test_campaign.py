@@ -216,19 +216,26 @@ def test_ccd_campaign_fails_on_a_planted_miss(monkeypatch):
     assert not result["ok"] and any("false negative" in f for f in failures)
 
 
-def test_a_stop_pair_sliding_at_delta_is_within_delta_and_a_far_one_a_violation():
-    """Seeded sliding step 5 of chunk 0 (seed 1): the step stops on a vertex/face pair
-    that comes within delta and never touches, while another pair touches later."""
+def seeded_stop(family: str, chunk: int, count: int, i: int):
+    """Step i of a seeded chunk (seed 1) run both ways: (step, delta, MeshPair, its
+    features, the optimized step's dict, the exact contact)."""
     from gauss6 import ccd_seeded
 
     cc = crosscheck_ccd
-    steps, delta = ccd_seeded.chunk_steps("sliding", 1, 0, 6)
-    st = steps[5]
+    steps, delta = ccd_seeded.chunk_steps(family, 1, chunk, count)
+    st = steps[i]
     key, pair = cc._MESHES.get(st)
-    meshes = cc._MESHES.features(key)
     p0, q0, p1, q1 = cc.poses(st)
     opt = pair.step(p0, q0, p1, q1, delta, time_tolerance=cc.TIME_TOLERANCE, repeats=1)
-    ex = pair.exact_first_contact(p0, q0, p1, q1)
+    return st, delta, pair, cc._MESHES.features(key), opt, pair.exact_first_contact(p0, q0, p1, q1)
+
+
+def test_a_stop_pair_sliding_at_delta_is_within_delta_and_a_far_one_a_violation():
+    """Seeded sliding step 5 of chunk 0 (seed 1): the step stops on a vertex/face pair
+    that comes within delta and never touches, while another pair touches later."""
+    cc = crosscheck_ccd
+    st, delta, pair, meshes, opt, ex = seeded_stop("sliding", 0, 6, 5)
+    p0, q0, p1, q1 = cc.poses(st)
     assert opt["hit"] and ex.hit and opt["pair_ids"] not in ex.pairs
     assert not pair.pair_first_contact(opt["pair_ids"], p0, q0, p1, q1).hit
     assert cc.classify_stop_pair(pair, st, opt, ex)[0] == "violation"  # without the meshes: strict
@@ -261,17 +268,10 @@ def test_a_step_starting_within_delta_of_a_pair_is_within_delta_though_it_touche
     (after another pair's contact, outside the pair window). It is within delta at the
     stop pose, so the step kept its contract. Fed with a u_hit past the pair's own
     contact, the same pair is still a violation."""
-    from gauss6 import ccd_seeded
-
     cc = crosscheck_ccd
-    steps, delta = ccd_seeded.chunk_steps("zero_rotation", 1, 37, 25)
-    st = steps[12]
+    st, delta, pair, meshes, opt, ex = seeded_stop("zero_rotation", 37, 25, 12)
     assert st["id"] == "zero_rotation-s1-c37-012"
-    key, pair = cc._MESHES.get(st)
-    meshes = cc._MESHES.features(key)
     p0, q0, p1, q1 = cc.poses(st)
-    opt = pair.step(p0, q0, p1, q1, delta, time_tolerance=cc.TIME_TOLERANCE, repeats=1)
-    ex = pair.exact_first_contact(p0, q0, p1, q1)
     assert opt["hit"] and ex.hit and opt["pair_ids"] not in ex.pairs
     own = pair.pair_first_contact(opt["pair_ids"], p0, q0, p1, q1)
     assert own.hit and own.lower > 2 * ex.upper
