@@ -325,6 +325,21 @@ def make_au(rng: Generator, J: np.ndarray, label: str, S: np.ndarray | None = No
     return None
 
 
+def first_au(rng: Generator, J: np.ndarray, labels: tuple[str, ...], attempts: int = 100) -> np.ndarray:
+    """make_au with the first of `labels` that it can make, tried in turn (rows that
+    allow no au of a label: 'some' for one row, 'all'/'none' without an interior, and
+    'some' by a rejection that can fail). The seeded campaign's offsets family once drew
+    a single row for which the old fallback, 'some' alone, gave no au (an instance
+    without au, chunk 1150 of `crosscheck qp --seeded 1000000`). The first label's
+    success draws exactly what make_au drew before, so the stored files are unchanged."""
+    for _ in range(attempts):
+        for label in labels:
+            au = make_au(rng, J, label)
+            if au is not None:
+                return au
+    raise RuntimeError(f"no au with any of the labels {labels} for {len(J)} rows")
+
+
 def rows_and_au(rng: Generator, pl: Placed, m: int, label: str) -> tuple[np.ndarray, np.ndarray]:
     """Contact rows on pl and an au with the label: for all/none, first try contacts all
     around the body, then one-sided contact sets (which always have an interior)."""
@@ -514,9 +529,8 @@ def family_offsets(rng: Generator, p: dict) -> list[dict]:
                     break
             u = rng.uniform(0.05, 0.9, size=m)
             b = np.where(dw > 0, dw * u, dw * (1.0 + u))  # b <= J w, with a margin
-            au = make_au(rng, J, cycle_label(i, m))
-            if au is None:  # no interior (e.g. a form-closed set): only 'some' is possible
-                au = make_au(rng, J, "some")
+            # No interior (e.g. a form-closed set): only 'some' is possible; one row: no 'some'.
+            au = first_au(rng, J, (cycle_label(i, m), "some", "all", "none"))
             tags.update(kind="positive", feasible=True, witness=w.tolist())
         else:
             k = int(rng.integers(1, 8))
@@ -531,7 +545,7 @@ def family_offsets(rng: Generator, p: dict) -> list[dict]:
             b[at] = loguniform(rng, (1e-5, 1e-3))
             y = np.zeros(k + 1)
             y[j], y[at] = c, 1.0
-            au = make_au(rng, J, "some")
+            au = first_au(rng, J, ("some", "all", "none"))
             tags.update(kind="infeasible", feasible=False, farkas_y=y.tolist())
         out.append(record(f"offsets-{i:04d}", pl.M, au, J, b, tags=tags))
     return out
