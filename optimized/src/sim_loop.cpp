@@ -235,10 +235,7 @@ bool grazed(const RuntimeModel& model, const SimState& s) {
   const int m = std::min(s.contacts.num_contacts, s.capacity);
   for (int k = 0; k < m; ++k) {
     const Contact& c = s.contacts.contacts[k];
-    const FeaturePair& a = c.features;
-    const FeaturePair& b = r.pair;
-    if (a.kind == b.kind && a.obstacle == b.obstacle && a.god_face == b.god_face && a.god_corner == b.god_corner &&
-        a.obstacle_face == b.obstacle_face && a.obstacle_corner == b.obstacle_corner)
+    if (c.features == r.pair)
       return r.distance_reached >= c.separation - 0.5 * model.settings.ccd.narrow.distance_tolerance;
   }
   return false;

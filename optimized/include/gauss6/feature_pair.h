@@ -32,6 +32,7 @@ struct FeaturePair {
   int obstacle = -1;                       // index into the obstacle list
   int god_face = -1, god_corner = -1;
   int obstacle_face = -1, obstacle_corner = -1;
+  friend bool operator==(const FeaturePair&, const FeaturePair&) = default;
 };
 
 // Feature ownership bits of a triangle (Bvh::owned): bit k owns vertex
