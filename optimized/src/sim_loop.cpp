@@ -297,6 +297,17 @@ void update_contacts(const RuntimeModel& model, SimState* s) {
     s->step_events |= bit(RuntimeEventKind::kContactOverflow);
 }
 
+// The pose at u of a leg whose whole motion its CCD result `proven` showed free
+// at delta: the stop pose there (the same deviation bound as a hit's), with that
+// result as s->ccd, without searching again.
+void serve_proven_leg(const RuntimeModel& model, const CcdStepResult& proven, double u, SimState* s) {
+  s->ccd = proven;
+  s->ccd.num_near_pairs = -1;  // its near pairs hold at the leg's end, not at u
+  const StopPose stop = make_stop_pose(proven.motion, u, model.god_radius);
+  s->xs = stop.pose;
+  s->stop_deviation = stop.deviation;
+}
+
 // The god-object stays at x_start this step, with the contact set there (the
 // last step's pairs, which withheld part of the command). Staying put is always
 // a free motion (property 5); the hand's next sample gives the next step another
@@ -330,11 +341,7 @@ void keep_a_contact(const RuntimeModel& model, const Pose& x_start, bool served,
     const CcdStepResult proven = s->ccd;  // the first leg, free: its end was refused
     for (int i = 0; i < kMaxKeepHalvings && s->contacts.num_contacts == 0; ++i) {
       u *= 0.5;
-      s->ccd = proven;
-      s->ccd.num_near_pairs = -1;  // its near pairs hold at the leg's end, not at u
-      const StopPose stop = make_stop_pose(proven.motion, u, model.god_radius);
-      s->xs = stop.pose;
-      s->stop_deviation = stop.deviation;
+      serve_proven_leg(model, proven, u, s);
       update_contacts(model, s);
     }
     if (s->contacts.num_contacts > 0) return;
@@ -373,11 +380,7 @@ void advance_god_object(const RuntimeModel& model, const Pose& x_start, const Po
     bool moved = true;
     bool lifted = false;  // this try's first leg ran from a graze's lift waypoint
     if (shortened_u < 1) {
-      s->ccd = proven;
-      s->ccd.num_near_pairs = -1;  // its near pairs hold at the leg's end, not at u
-      const StopPose stop = make_stop_pose(proven.motion, shortened_u, model.god_radius);
-      s->xs = stop.pose;
-      s->stop_deviation = stop.deviation;
+      serve_proven_leg(model, proven, shortened_u, s);
     } else {
       moved = ccd_leg(model, x_start, target, num_hints, s, &info->num_halves);
       if (moved && info->num_shortenings == 0 && grazed(model, *s))
