@@ -38,6 +38,13 @@ double list_margin(const StepState& s, double v, double margin, double margin_ma
 
 bool same_body(const CcdBody& a, const CcdBody& b) { return a.mesh == b.mesh && a.bvh == b.bvh; }
 
+// The list was filled for this step's god-object and obstacles (meshes and trees).
+bool same_bodies(const ProximityCache& pc, const StepState& s) {
+  bool k = same_body(pc.god, s.god) && static_cast<int>(pc.obstacles.size()) == s.num_obstacles;
+  for (int o = 0; k && o < s.num_obstacles; ++o) k = same_body(pc.obstacles[static_cast<size_t>(o)], s.obstacles[o]);
+  return k;
+}
+
 // The settings' margins, the larger one at least the smaller.
 double step_margin(const StepState& s) { return s.settings.cache.margin; }
 double step_margin_max(const StepState& s) { return std::max(s.settings.cache.margin_max, step_margin(s)); }
@@ -45,10 +52,8 @@ double step_margin_max(const StepState& s) { return std::max(s.settings.cache.ma
 // The list in use was filled for these meshes, trees, reach and margins.
 bool is_keyed(const StepState& s) {
   const ProximityCache& pc = s.ws->cache;
-  bool k = pc.num_pairs >= 0 && s.num_obstacles <= pc.obstacle_capacity && same_body(pc.god, s.god) && pc.reach == s.reach && pc.margin_min == step_margin(s) &&
-           pc.margin_max == step_margin_max(s) && static_cast<int>(pc.obstacles.size()) == s.num_obstacles;
-  for (int o = 0; k && o < s.num_obstacles; ++o) k = same_body(pc.obstacles[static_cast<size_t>(o)], s.obstacles[o]);
-  return k;
+  return pc.num_pairs >= 0 && s.num_obstacles <= pc.obstacle_capacity && pc.reach == s.reach &&
+         pc.margin_min == step_margin(s) && pc.margin_max == step_margin_max(s) && same_bodies(pc, s);
 }
 
 // Fills: every pair not proven apart by reach + pf.margin with the god-object
@@ -321,11 +326,8 @@ void serve_proximity_cache(StepState* s) {
 void serve_borrowed_list(StepState* s) {
   const ProximityCache* pc = s->ws->borrowed;
   if (s->tester.done() || pc == nullptr || pc->num_pairs < 0) return;
-  bool usable = same_body(pc->god, s->god) && static_cast<int>(pc->obstacles.size()) == s->num_obstacles &&
-                pc->reach >= s->reach && pc->num_pairs <= static_cast<int>(s->ws->candidates.size());
-  for (int o = 0; usable && o < s->num_obstacles; ++o)
-    usable = same_body(pc->obstacles[static_cast<size_t>(o)], s->obstacles[o]);
-  if (!usable) return;
+  if (!(pc->reach >= s->reach && pc->num_pairs <= static_cast<int>(s->ws->candidates.size()) && same_bodies(*pc, *s)))
+    return;
   const Displacement since(pc->ref, s->X0);
   const double speed = s->start.speed;  // start: at u = 0 (ccd_step)
   const double u_rest = s->result->hit ? s->result->u_hit : 1.0;
