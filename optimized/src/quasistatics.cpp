@@ -27,7 +27,11 @@
 //   cond(R) estimated by max |A_i| / |R_ii|: rows nearly parallel to a
 //   well-conditioned W (a copy perturbed by 1e-10, a body jammed between
 //   nearly opposite planes) join W and are resolved, instead of being skipped
-//   with a violation of up to their sine. A violated dependent
+//   with a violation of up to their sine. A row that this test calls
+//   dependent only because of the rounding term is measured again on the rows
+//   themselves (refined_sine, good to a few eps) and judged against
+//   dependence_tol: an ill-conditioned W (such a pair in it, cond(R) ~ 1e10)
+//   would otherwise skip rows at sines up to 1e-4. A violated dependent
 //   row n = A_W^T r + z is handled as in Goldfarb-Idnani: when some r_j > 0,
 //   the multipliers move by -t r, t = min lambda_j / r_j over r_j > 0, and
 //   that row j leaves W (n then usually joins); when r <= 0, its slack on W's
@@ -363,6 +367,39 @@ void refine_kkt_point(const ProjectionProblem& pb, ProjectionWorkspace& ws, Vec6
   }
 }
 
+// The sine of row p's angle to the span of W's rows, refined: the residual
+// z = A_p - A_W^T r of its least-squares fit on W's rows, with r from the
+// factors and corrected twice (r += R^-1 Q1^T z), z summed in twice the working
+// precision (CompensatedSum) on the rows themselves. The sine read off Q
+// (|d(q:6)| / |A_p|) is only as good as Q's span, about eps cond(R) off from
+// that of W's rows; this one is good to a few eps for cond(R) up to about
+// 1 / (eps sqrt(eps)), so a row at a sine of 1e-10 to an ill-conditioned W is
+// told from one that W spans (a row skipped as dependent on a wrong sine was
+// left violated by up to 4% of its scale).
+double refined_sine(const ProjectionWorkspace& ws, int p, const Vec6& d) noexcept {
+  const int q = ws.num_active;
+  std::array<double, kMaxActive> r{}, c{};
+  for (int i = 0; i < q; ++i) c[i] = d[i];
+  Vec6 z = Vec6::Zero();
+  for (int pass = 0; pass <= 2; ++pass) {
+    for (int i = q - 1; i >= 0; --i) {  // r += R^-1 c
+      double v = c[i];
+      for (int j = i + 1; j < q; ++j) v -= ws.R(i, j) * c[j];
+      c[i] = v / ws.R(i, i);
+    }
+    for (int i = 0; i < q; ++i) r[i] += c[i];
+    for (int j = 0; j < 6; ++j) {
+      CompensatedSum acc;
+      acc.add_product(ws.A[6 * static_cast<size_t>(p) + j], 1.0);
+      for (int i = 0; i < q; ++i) acc.add_product(-r[i], ws.A[6 * static_cast<size_t>(ws.active[i]) + j]);
+      z[j] = acc.value();
+    }
+    if (pass == 2) break;
+    for (int i = 0; i < q; ++i) c[i] = ws.Q.col(i).dot(z);
+  }
+  return z.norm() * ws.inv_row_norm[p];
+}
+
 bool valid_settings(const ProjectionSettings& s) noexcept {
   return std::isfinite(s.dependence_tol) && s.dependence_tol >= 0 && s.dependence_tol < 1 &&
          std::isfinite(s.feasibility_tol) && s.feasibility_tol >= 0 && s.max_iterations >= 0;
@@ -522,7 +559,9 @@ ProjectionStatus project(const ProjectionProblem& pb, const ProjectionSettings& 
       const int q = ws.num_active;
       const Vec6 d = ws.Q.transpose() * n;
       const double z2 = tail_squared_norm(d, q);
-      const bool dependent = std::sqrt(z2) <= dependence_threshold(ws, dep_tol) * ws.row_norm[p];
+      bool dependent = std::sqrt(z2) <= dependence_threshold(ws, dep_tol) * ws.row_norm[p];
+      // Below the rounding of Q's span, the sine is measured on the rows.
+      if (dependent && std::sqrt(z2) > dep_tol * ws.row_norm[p]) dependent = refined_sine(ws, p, d) <= dep_tol;
       // r = R^-1 d(0:q): how n is spanned by W's rows; multipliers fall as t r.
       std::array<double, kMaxActive> r{};
       for (int i = q - 1; i >= 0; --i) {
@@ -576,7 +615,10 @@ ProjectionStatus project(const ProjectionProblem& pb, const ProjectionSettings& 
         break;
       }
       const double t = std::min(t1, t2);
-      for (int i = 0; i < q; ++i) ws.lambda_active[i] -= t * r[i];
+      // Components at rounding level count as zero here too (as in the ratio
+      // test): moved by t r_i, a small multiplier would go negative.
+      for (int i = 0; i < q; ++i)
+        if (std::abs(r[i]) > r_noise) ws.lambda_active[i] -= t * r[i];
       lambda_p += t;
       if (!dependent) {
         // Primal step along z = Q(:, q:6) d(q:6), the part of n orthogonal to W.

@@ -978,7 +978,14 @@ TEST_CASE("regression: seeded campaign instances with rows perturbed by 1e-10", 
   // scale (c6-0012, c19-0300: skipped as dependent below the old fixed
   // dependence_tol 1e-10), or returned the KKT point of its working set with a
   // forward error of 5e-9..1.1e-6 of |au|_M (c15-0252, c20-0130, c22-0276,
-  // c24-0156: eps over the sine of the rows in W). Now: optimal, and ac the
+  // c24-0156: eps over the sine of the rows in W), or skipped a row as
+  // dependent on a sine read off Q's span, which an ill-conditioned working set
+  // (rows at a sine of 1e-10 of each other) knows only to ~1e-4, leaving it
+  // violated by 1e-12 .. 4e-2 of its scale (c18-0252, c30-0132, c108-0252,
+  // c129-0204, c200-0087 of the 1,000,000-instance campaign; now measured on the
+  // rows, refined_sine). c72-0252 and c148-0108 were right (ac = 0, a jammed
+  // body) but their working set's own multipliers were not all >= 0: the exact
+  // certificate now searches multipliers over every tight row. Now: optimal, and ac the
   // exact KKT point of the working set to 1e-13 of |au|_M (the refinement's
   // eps plus the rounding of the stored point; the old errors were 5e-9 and up).
   // The exact points (.expected, by reference/ check_certificate) are for the

@@ -299,7 +299,7 @@ CertificateReport check_certificate(const ProjectionProblem& problem, const std:
 
   // 3. Primal feasibility of every row: s_k = J_k a - b_k = c_k + J_k d, so
   //    det s_k = det c_k + J_k x is dyadic: no division per row. Remember which
-  //    rows of W are tight.
+  //    rows are tight (of W or not: KKT allows a multiplier on any row tight at a).
   int worst_row = -1;
   Rational worst = 0;  // most negative det_sign * det * s_k
   std::vector<int> tight;
@@ -313,7 +313,7 @@ CertificateReport check_certificate(const ProjectionProblem& problem, const std:
       worst = ts;
       worst_row = k;
     }
-    if (in_w[k] && sgn(ts) == 0) tight.push_back(k);
+    if (sgn(ts) == 0) tight.push_back(k);
   }
   if (worst_row >= 0) {
     const Rational amount = -worst / abs(det_q);
@@ -330,7 +330,7 @@ CertificateReport check_certificate(const ProjectionProblem& problem, const std:
     }
   if (neg_row < 0) return finish(CertificateFailure::none, -1, Rational(0));
 
-  // Otherwise, with more tight rows of W than B, the multipliers are not unique:
+  // Otherwise, with more tight rows than B, the multipliers are not unique:
   // search lambda >= 0 over the tight rows with the same wrench g = J_B^T lambda_B,
   // then verify it here, exactly, whatever found it.
   if (static_cast<int>(tight.size()) > nb) {

@@ -47,9 +47,10 @@ struct ProjectionSettings {
   // span of W's rows (y-space) is <= max(dependence_tol, 64 eps cond(R)): it
   // never joins W; a violated one is exchanged for a row of W that spans it.
   // The second term is the rounding of that computed sine for an
-  // ill-conditioned W; 1e-13 (~450 eps) is the floor for a well-conditioned
-  // one, and keeps cond(R) below 1e13 (the final answer is refined when W is
-  // ill-conditioned: see quasistatics.cpp).
+  // ill-conditioned W; a row under it and above dependence_tol has its sine
+  // measured again on the rows (to a few eps) and is dependent only when that
+  // is <= dependence_tol. 1e-13 (~450 eps) keeps cond(R) below 1e13 (the final
+  // answer is refined when W is ill-conditioned: see quasistatics.cpp).
   double dependence_tol = 1e-13;
   // Row k is violated when J_k a - b_k < -feasibility_tol * scale_k, with
   // scale_k = |A_k| max(|y|, |y_u|) + |b_k|. 1e-13 (~450 eps): above the

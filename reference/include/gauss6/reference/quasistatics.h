@@ -114,9 +114,11 @@ ProjectionResult project_by_qp_solver(const ProjectionProblem& problem);
 // Rows of W that depend linearly on earlier rows of W (duplicated contacts,
 // four coplanar corners) are dropped from the solve; a is unique anyway. If the
 // multipliers of the remaining rows are not all >= 0, a non-negative
-// combination over every row of W that is exactly tight at a is searched with
-// an exact linear program, since multipliers are not unique then. A dependent
-// row of W that turns out not tight at a simply gets lambda 0. The check
+// combination over every row that is exactly tight at a (of W or not: the KKT
+// conditions allow a multiplier on any row tight at the optimum, and a body
+// jammed with b = 0 has every row tight at a = 0, whatever W a solver kept) is
+// searched with an exact linear program, since multipliers are not unique
+// then. A dependent row of W that turns out not tight at a simply gets lambda 0. The check
 // never passes a wrong answer: every condition it reports as met was verified
 // in exact arithmetic on the returned (ac_exact, lambda_exact).
 
