@@ -29,7 +29,7 @@
 //   nearly opposite planes) join W and are resolved, instead of being skipped
 //   with a violation of up to their sine. A row that this test calls
 //   dependent only because of the rounding term is measured again on the rows
-//   themselves (refined_sine, good to a few eps) and judged against
+//   themselves (independent_on_rows, good to the rows' own rounding) and judged against
 //   dependence_tol: an ill-conditioned W (such a pair in it, cond(R) ~ 1e10)
 //   would otherwise skip rows at sines up to 1e-4. A violated dependent
 //   row n = A_W^T r + z is handled as in Goldfarb-Idnani: when some r_j > 0,
@@ -367,16 +367,18 @@ void refine_kkt_point(const ProjectionProblem& pb, ProjectionWorkspace& ws, Vec6
   }
 }
 
-// The sine of row p's angle to the span of W's rows, refined: the residual
-// z = A_p - A_W^T r of its least-squares fit on W's rows, with r from the
-// factors and corrected twice (r += R^-1 Q1^T z), z summed in twice the working
-// precision (CompensatedSum) on the rows themselves. The sine read off Q
-// (|d(q:6)| / |A_p|) is only as good as Q's span, about eps cond(R) off from
-// that of W's rows; this one is good to a few eps for cond(R) up to about
-// 1 / (eps sqrt(eps)), so a row at a sine of 1e-10 to an ill-conditioned W is
-// told from one that W spans (a row skipped as dependent on a wrong sine was
-// left violated by up to 4% of its scale).
-double refined_sine(const ProjectionWorkspace& ws, int p, const Vec6& d) noexcept {
+// Whether row p is independent of W's rows, measured on the rows: the
+// residual z = A_p - A_W^T r of its least-squares fit on W's rows, with r from
+// the factors and corrected twice (r += R^-1 Q1^T z), z summed in twice the
+// working precision (CompensatedSum) on the rows themselves. The sine read off
+// Q (|d(q:6)| / |A_p|) is only as good as Q's span, about eps cond(R) off from
+// that of W's rows; this residual is good to the rounding of the rows A = J L^-T
+// themselves, kRoundoff (|A_p| + sum |r_i| |A_i|) (rows that J holds exactly
+// dependent, four coplanar corners, are that far from dependent in A). So p is
+// independent when |z| exceeds both that and dependence_tol |A_p|: a row at a
+// sine of 1e-10 to an ill-conditioned W is told from one that W spans (a row
+// skipped as dependent on Q's sine was left violated by up to 4% of its scale).
+bool independent_on_rows(const ProjectionWorkspace& ws, int p, const Vec6& d, double dependence_tol) noexcept {
   const int q = ws.num_active;
   std::array<double, kMaxActive> r{}, c{};
   for (int i = 0; i < q; ++i) c[i] = d[i];
@@ -397,7 +399,9 @@ double refined_sine(const ProjectionWorkspace& ws, int p, const Vec6& d) noexcep
     if (pass == 2) break;
     for (int i = 0; i < q; ++i) c[i] = ws.Q.col(i).dot(z);
   }
-  return z.norm() * ws.inv_row_norm[p];
+  double rows_size = ws.row_norm[p];
+  for (int i = 0; i < q; ++i) rows_size += std::abs(r[i]) * ws.row_norm[ws.active[i]];
+  return z.norm() > std::max(dependence_tol * ws.row_norm[p], kRoundoff * rows_size);
 }
 
 bool valid_settings(const ProjectionSettings& s) noexcept {
@@ -561,7 +565,7 @@ ProjectionStatus project(const ProjectionProblem& pb, const ProjectionSettings& 
       const double z2 = tail_squared_norm(d, q);
       bool dependent = std::sqrt(z2) <= dependence_threshold(ws, dep_tol) * ws.row_norm[p];
       // Below the rounding of Q's span, the sine is measured on the rows.
-      if (dependent && std::sqrt(z2) > dep_tol * ws.row_norm[p]) dependent = refined_sine(ws, p, d) <= dep_tol;
+      if (dependent && std::sqrt(z2) > dep_tol * ws.row_norm[p]) dependent = !independent_on_rows(ws, p, d, dep_tol);
       // r = R^-1 d(0:q): how n is spanned by W's rows; multipliers fall as t r.
       std::array<double, kMaxActive> r{};
       for (int i = q - 1; i >= 0; --i) {

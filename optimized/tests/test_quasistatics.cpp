@@ -969,7 +969,7 @@ TEST_CASE("Q stays orthogonal over long warm-started runs", "[qp]") {
   CHECK(worst <= 2e-14);
 }
 
-TEST_CASE("regression: seeded campaign instances with rows perturbed by 1e-10", "[qp]") {
+TEST_CASE("regression: seeded campaign instances with rows perturbed by 1e-10 or exactly dependent", "[qp]") {
   // Instances of the seeded campaign (qp_seeded.chunk_instances("redundant", 1, c),
   // kind perturbed_1e-10; optimized/tests/data/qp_seeded_regressions.json) on
   // which the projection once stopped at the iteration cap (c30-0132, c36-0036:
@@ -983,7 +983,10 @@ TEST_CASE("regression: seeded campaign instances with rows perturbed by 1e-10", 
   // (rows at a sine of 1e-10 of each other) knows only to ~1e-4, leaving it
   // violated by 1e-12 .. 4e-2 of its scale (c18-0252, c30-0132, c108-0252,
   // c129-0204, c200-0087 of the 1,000,000-instance campaign; now measured on the
-  // rows, refined_sine). c72-0252 and c148-0108 were right (ac = 0, a jammed
+  // rows, independent_on_rows; peg-s1-c23-0164 and box-s1-c188-0129, rows that J
+  // holds exactly dependent, guard that measure's allowance for the rounding of
+  // the rows: without it they joined W with multipliers of -1e14). c72-0252 and
+  // c148-0108 were right (ac = 0, a jammed
   // body) but their working set's own multipliers were not all >= 0: the exact
   // certificate now searches multipliers over every tight row. Now: optimal, and ac the
   // exact KKT point of the working set to 1e-13 of |au|_M (the refinement's
