@@ -72,19 +72,30 @@ const CouplingStepInfo& coupling_step(const RuntimeModel& model, double t, Runti
     if (info.new_set) {
       const OffsetRule rule{model.offsets, model.match_distance, model.settings.match_cosine,
                             model.settings.projection};
-      const OffsetRows rows{m, J, rows3(s->god.point), rows3(info.shaded ? s->god.shaded_normal : s->god.normal)};
+      const OffsetRows rows{m, J, rows3(s->god.point), rows3(info.shaded ? s->god.shaded_normal : s->god.normal),
+                            s->god.features.data()};
       info.num_new_offsets = start_offsets(rule, t, info.au, s->M, s->xs, rows, &s->offsets);
     }
-    // 3. ac = projection (warm-started), b(t) while offsets run; Fc = kh M (ac - au).
+    // 3. ac = projection (warm-started), b(t) while offsets run, lowered where
+    // the user backs off with energy lent; Fc = kh M (ac - au); then the
+    // offsets' energy account (offsetting.h: passive offsets).
+    const double energy_scale = model.gains.kh / model.gains.ks;
     info.num_offset_rows = fill_offsets(model.offsets, t, &s->offsets);
+    const Pose xh = to_pose(s->handle.p, s->handle.q);
+    const Vec6 hand = s->has_last_xh ? Vec6(model.gains.ks * pose_difference(xh, s->last_xh)) : Vec6::Zero();
+    s->last_xh = xh;
+    s->has_last_xh = true;
+    const int lowered = release_offsets(energy_scale, info.au, hand, J, &s->offsets);
     ProjectionProblem problem;
     problem.M = &s->M;
     problem.au = info.au;
     problem.J = m > 0 ? J : nullptr;
-    problem.b = info.num_offset_rows > 0 ? s->offsets.rhs.data() : nullptr;
+    problem.b = info.num_offset_rows > 0 || lowered > 0 ? s->offsets.rhs.data() : nullptr;
     problem.num_rows = m;
     info.projection = project(problem, model.settings.projection, &s->projection_ws, &s->projection);
     info.ac = s->projection.ac;
+    account_offsets(model.offsets, energy_scale, t, info.au, info.ac, s->projection.lambda.data(),
+                    info.projection == ProjectionStatus::kOptimal, s->M, J, &s->offsets);
     info.Fc = coupling_force(s->M, info.au, info.ac, model.gains.kh);
     if (info.shaded) publish_shaded_motion(t, info, channels);  // asc, for the sim loop's pass 2
   }
