@@ -189,12 +189,13 @@ int fill_offsets(const OffsetSettings& settings, double t, OffsetState* s) noexc
 // b lowered by c dx, gives back c dR; c = L / P keeps L / P constant, so L
 // and P reach 0 together and the user never gets back more than P.
 int release_offsets(double energy_scale, const Vec6& au, const Vec6& hand, const double* J, OffsetState* s) noexcept {
-  if (!(s->lent > 0) || !(energy_scale > 0)) return 0;
+  const bool lent = s->lent > 0 && energy_scale > 0;
   const double user = s->stored - s->lent;
   const double c = user > 0 ? s->lent / user : std::numeric_limits<double>::infinity();
-  int lowered = 0;
+  int nonzero = 0;
   for (int k = 0; k < s->num_rows; ++k) {
-    if (!(s->last_lambda[k] > 0)) continue;
+    nonzero += s->rhs[k] != 0.0 ? 1 : 0;
+    if (!lent || !(s->last_lambda[k] > 0)) continue;
     const Eigen::Map<const Vec6> Jk(J + 6 * k);
     const double x = Jk.dot(au);
     const double back = Jk.dot(hand);
@@ -203,11 +204,11 @@ int release_offsets(double energy_scale, const Vec6& au, const Vec6& hand, const
     // the row no longer pushes: lowering it further gives nothing back).
     const double lower = std::min(c * back, s->rhs[k] - x);
     if (!(lower > 0)) continue;
+    nonzero += s->rhs[k] == 0.0 ? 1 : 0;
     s->rhs[k] -= lower;
     s->give[k] += lower;
-    ++lowered;
   }
-  return lowered;
+  return nonzero;
 }
 
 void account_offsets(const OffsetSettings& settings, double energy_scale, double t, const Vec6& au, const Vec6& ac,

@@ -145,7 +145,7 @@ int fill_offsets(const OffsetSettings& settings, double t, OffsetState* s) noexc
 // the pushing rows the hand backs off from while energy is lent. hand: the
 // hand's motion since the last step in a-units, ks (xh (-) xh_last); J: the
 // cached rows (num_rows x 6); energy_scale = kh / ks (> 0). Returns the number
-// of rows lowered.
+// of rows with a non-zero right-hand side after it (as fill_offsets).
 int release_offsets(double energy_scale, const Vec6& au, const Vec6& hand, const double* J, OffsetState* s) noexcept;
 
 // After the projection (ac, lambda: its result, optimal): lends the energy
