@@ -14,16 +14,15 @@ void CouplingPropertyObserver::add(const CouplingStepInfo& info) noexcept {
   const double w = info.au.dot(info.Fc);
   if (w > 0) energy_injected += w;
   else energy_removed -= w;
-  // Orthogonality Fc . ac = 0 (not with running offsets: their b != 0).
-  if (info.num_offset_rows > 0) {
-    ++num_offset_steps;
-    return;
-  }
+  // Orthogonality Fc . ac = 0, or with running offsets Fc . ac = kh lambda^T b
+  // (their b != 0; README: force_orthogonal_offset).
+  if (info.num_offset_rows > 0) ++num_offset_steps;
   // With ac at rounding level (pressing straight into a face: ac = 0 exactly),
   // the ratio measures rounding noise, not the solver: skip |ac| <= 1e-6 |au|.
   const double nf = info.Fc.norm(), na = info.ac.norm();
   if (nf > 0 && na > kMinRelativeAc * info.au.norm()) {
-    max_rel_force_dot_ac = std::max(max_rel_force_dot_ac, std::abs(info.Fc.dot(info.ac)) / (nf * na));
+    max_rel_force_dot_ac =
+        std::max(max_rel_force_dot_ac, std::abs(info.Fc.dot(info.ac) - info.offset_power) / (nf * na));
     ++num_orthogonality_checks;
   }
 }

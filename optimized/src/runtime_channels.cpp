@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cstring>
+#include <type_traits>
 
 namespace gauss6 {
 
@@ -17,10 +18,11 @@ Pose to_pose(const double p[3], const double q[4]) {
 namespace {
 
 // The snapshot in words: a header (sequence, time, p, q, M, num_contacts,
-// shaded), then the m rows of J, point, normal, separation and, when shaded,
-// of Js and shaded_normal, each array in turn.
+// shaded), then the m rows of J, point, normal, separation, features and,
+// when shaded, of Js and shaded_normal, each array in turn.
 constexpr size_t kHeaderWords = 1 + 1 + 3 + 4 + 36 + 1 + 1;
-constexpr size_t kWordsPerRow = 6 + 3 + 3 + 1;
+constexpr size_t kFeatureWords = sizeof(FeaturePair) / sizeof(uint64_t);
+constexpr size_t kWordsPerRow = 6 + 3 + 3 + 1 + kFeatureWords;
 constexpr size_t kShadedWordsPerRow = 6 + 3;
 
 size_t max_words(int capacity) {
@@ -28,6 +30,16 @@ size_t max_words(int capacity) {
 }
 
 static_assert(sizeof(double) == sizeof(uint64_t));
+static_assert(sizeof(FeaturePair) % sizeof(uint64_t) == 0 && std::is_trivially_copyable_v<FeaturePair>);
+
+void put(uint64_t*& w, const FeaturePair* x, size_t n) {
+  std::memcpy(w, x, n * sizeof(FeaturePair));
+  w += n * kFeatureWords;
+}
+void get(const uint64_t*& w, FeaturePair* x, size_t n) {
+  std::memcpy(x, w, n * sizeof(FeaturePair));
+  w += n * kFeatureWords;
+}
 
 void put(uint64_t*& w, const double* x, size_t n) {
   std::memcpy(w, x, n * sizeof(double));
@@ -46,6 +58,7 @@ GodObjectSnapshot::GodObjectSnapshot(int max_contacts) {
   point.assign(3 * n, 0.0);
   normal.assign(3 * n, 0.0);
   separation.assign(n, 0.0);
+  features.assign(n, FeaturePair{});
   Js.assign(6 * n, 0.0);
   shaded_normal.assign(3 * n, 0.0);
   wire.assign(max_words(max_contacts), 0);
@@ -68,6 +81,7 @@ void GodObjectChannel::write(const GodObjectSnapshot& g) noexcept {
   put(w, g.point.data(), 3 * m);
   put(w, g.normal.data(), 3 * m);
   put(w, g.separation.data(), m);
+  put(w, g.features.data(), m);
   if (g.shaded) {
     put(w, g.Js.data(), 6 * m);
     put(w, g.shaded_normal.data(), 3 * m);
@@ -100,6 +114,7 @@ bool GodObjectChannel::try_read(GodObjectSnapshot* out) const noexcept {
   get(w, g.point.data(), 3 * m);
   get(w, g.normal.data(), 3 * m);
   get(w, g.separation.data(), m);
+  get(w, g.features.data(), m);
   if (shaded) {
     get(w, g.Js.data(), 6 * m);
     get(w, g.shaded_normal.data(), 3 * m);

@@ -467,6 +467,7 @@ void publish_god_object(double t, bool shaded, SimState* s, RuntimeChannels* ch)
     const Contact& c = s->contacts.contacts[k];
     for (int i = 0; i < 3; ++i) g.point[3 * k + i] = c.point[i], g.normal[3 * k + i] = c.normal[i];
     g.separation[k] = c.separation;
+    g.features[k] = c.features;
   }
   ch->god_object.write(g);
 }

@@ -20,12 +20,12 @@ inline constexpr double kMinRelativeAc = 1e-6;
 // Orthogonality and constraint energy over the coupling steps.
 struct CouplingPropertyObserver {
   // Orthogonality (METHOD.md 5.1), over coupling steps with |Fc| > 0, |ac| > 1e-6 |au|
-  // (below, ac is rounding noise: pressing straight into a face gives ac = 0) and
-  // no running offset (an offset row's right-hand side is not 0, so the identity
-  // does not hold there): max |Fc . ac| / (|Fc| |ac|).
+  // (below, ac is rounding noise: pressing straight into a face gives ac = 0); with
+  // running offsets (b != 0) in its offset form Fc . ac = kh lambda^T b
+  // (CouplingStepInfo::offset_power): max |Fc . ac - kh lambda^T b| / (|Fc| |ac|).
   double max_rel_force_dot_ac = 0;
   long num_orthogonality_checks = 0;
-  long num_offset_steps = 0;           // coupling steps skipped because an offset ran
+  long num_offset_steps = 0;           // coupling steps with a running offset (checked in the offset form)
   // The constraint stage's work on the user's command (METHOD.md 5.4 with Fu = kh M au):
   // per coupling step au . Fc = -kh |ac - au|_M^2 <= 0 (J). Sums of its positive and
   // negative parts; the positive sum must be 0 up to rounding.

@@ -26,6 +26,8 @@ struct CouplingState {
       : god(max_contacts), offsets(max_contacts), projection_ws(max_contacts), projection(max_contacts) {}
   HandleSample handle;
   bool has_handle = false;
+  Pose last_xh;                        // the handle at the last step with a god-object (offsets' release)
+  bool has_last_xh = false;
   GodObjectSnapshot god;               // cached snapshot (xs, M, J)
   bool has_god = false;
   uint64_t god_writes = 0;             // channel writes seen (detects a new snapshot)

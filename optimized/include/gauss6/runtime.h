@@ -28,13 +28,23 @@
 //     each contact's gap near delta (1 + gap_factor) (J_k a >= gap_target -
 //     separation_k), so that sliding is never taken for a new contact; the
 //     coupling loop, hence the force, uses exactly J a >= 0 (or the offsets);
-//   - a row of a new set is "the same constraint" as a cached one when its
-//     body-frame point and its normal match: its offset runs on; a new row's
+//   - a row of a new set is "the same constraint" as a cached one when it
+//     comes from the same feature pair (plain surfaces) (an edge/edge row whose normal turns
+//     with the god-object stays the same), or its body-frame point and its
+//     normal match: its offset runs on; a new row's
 //     d_k is J_k ac_old, ac_old the projection on the previous set's rows (what
 //     the user felt: J_k au without), so that a contact sliding across
 //     triangles, whose rows change identity, is not offset again; after a set
 //     with no rows, the last non-empty set stands in for it for offset_time
-//     (a contact lost for a step, e.g. sliding over a crease, is not ramped again).
+//     (a contact lost for a step, e.g. sliding over a crease, is not ramped again);
+//   - on plain surfaces, offsets are passive: the energy an offset puts in while it relaxes under
+//     a pushing row is lent, and given back when the hand backs off (its
+//     right-hand side goes down, and comes up again only where its row does
+//     not push), so that a release returns no more than the user put in
+//     (offsetting.h; f_k rises from d_k to 0 in T while the user does not
+//     back off with energy lent). Not on shaded surfaces, where the coupling's
+//     projection is also the god-object's motion (coupling_loop.cpp); there,
+//     too, rows are matched by point and normal only.
 //   - force shading and textures are refused (RuntimeError) when the model is built.
 //
 // Real-time rules: sim_step, coupling_step and haptic_tick allocate nothing, lock

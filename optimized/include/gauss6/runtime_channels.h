@@ -8,6 +8,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "gauss6/feature_pair.h"
 #include "gauss6/pose.h"
 #include "gauss6/quasistatics.h"  // kDefaultMaxContacts
 #include "gauss6/shared_state.h"
@@ -49,6 +50,7 @@ struct GodObjectSnapshot {
   std::vector<double> point;           // m x 3: I_k, world frame (rows3() for double[m][3])
   std::vector<double> normal;          // m x 3: n_k, world frame
   std::vector<double> separation;      // m
+  std::vector<FeaturePair> features;   // m: the pair each contact came from (its identity across sets)
   // Shaded surfaces (surface.h): the shading rows Js (m x 6 row-major) and
   // their unit normals (m x 3); shaded = 0 on plain surfaces (then not filled).
   int32_t shaded = 0;

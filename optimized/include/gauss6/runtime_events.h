@@ -130,8 +130,9 @@ struct CouplingStepInfo {
   // and the sim loop takes, surface.h); Fc = kh M (ac - au).
   Vec6 au = Vec6::Zero(), ac = Vec6::Zero(), Fc = Vec6::Zero();
   bool shaded = false;                 // the rows were the shading rows Js
-  int num_rows = 0, num_offset_rows = 0;  // rows, and rows whose offset still runs
+  int num_rows = 0, num_offset_rows = 0;  // rows, and rows with b_k != 0 (an offset runs, or the account lowered it)
   int num_new_offsets = 0;             // rows offset when this snapshot arrived
+  double offset_power = 0;             // kh lambda^T b: what Fc . ac equals with offsets (0 without)
   ProjectionStatus projection = ProjectionStatus::kOptimal;
   double force_seconds = 0;            // wall time of the step (steady_clock)
 };
