@@ -47,6 +47,22 @@
 //   final KKT point gets two passes of iterative refinement with residuals in
 //   twice the working precision on the given M, J, b (refine_kkt_point): the
 //   answer is then the KKT point of W to about eps.
+//
+// Multipliers at a degenerate vertex: a body jammed between nearly opposite
+// rows (ac = 0, more than 6 rows tight) needs multipliers 1e7..1e10 times the
+// force. The incremental multipliers then carry an error of about eps cond(R)
+// |lambda_W| (0.2 for |lambda| = 1e7, cond(R) = 1e8), so a small one can look
+// >= 0 on a working set whose exact multipliers have a negative entry; ac, the
+// vertex, is right all the same (seen on 59 chunks of the million-instance
+// campaign's redundant family: -0.24 against |M au| = 0.0024, which the final
+// solve and refinement report exactly). When a final multiplier is negative
+// beyond rounding (has_negative_multiplier), nonnegative ones are sought over
+// the rows tight at ac with ac kept (recover_multipliers: a nonnegative least
+// squares problem, Lawson-Hanson, in y-space, on the working set's factors,
+// residuals in twice the working precision); they replace the working set's
+// when their residual is no larger or at rounding, else the working set stays
+// and dual_infeasibility reports it. Rare path, at most kMaxRecoverySteps
+// additions and drops, no allocation.
 #include "gauss6/quasistatics.h"
 
 #include <Eigen/Cholesky>
@@ -84,6 +100,9 @@ constexpr double kRefinementCondition = 1e3;
 constexpr int kRefinementPasses = 2;
 // Rounding of a computed sine per unit of cond(R) (see dependence_threshold).
 constexpr double kSineRounding = 64 * std::numeric_limits<double>::epsilon();
+// Cap on the additions and drops of recover_multipliers (each O(6 m) flops):
+// the least-squares active-set method needs about one per row of its answer.
+constexpr int kMaxRecoverySteps = 8 * kMaxActive;
 
 bool all_finite(const double* p, int n) noexcept {
   double acc = 0;
@@ -404,6 +423,162 @@ bool independent_on_rows(const ProjectionWorkspace& ws, int p, const Vec6& d, do
   return z.norm() > std::max(dependence_tol * ws.row_norm[p], kRoundoff * rows_size);
 }
 
+// Whether a multiplier of the working set is negative beyond rounding: its
+// correction lambda_i |A_i| below -kRoundoff of the row's scale (the measure of
+// drop_until_dual_feasible).
+bool has_negative_multiplier(const ProjectionWorkspace& ws, double y_scale, const double* b) noexcept {
+  for (int i = 0; i < ws.num_active; ++i) {
+    const int k = ws.active[i];
+    const double noise = kRoundoff * (y_scale + (b ? std::abs(b[k]) * ws.inv_row_norm[k] : 0.0));
+    if (ws.lambda_active[i] * ws.row_norm[k] < -noise) return true;
+  }
+  return false;
+}
+
+// The multipliers' residual g - A_W^T lambda (y-space), summed in twice the
+// working precision (CompensatedSum): multipliers 1e10 times |g| (a body jammed
+// between nearly opposite rows) would otherwise bury it in their rounding.
+Vec6 multiplier_residual(const ProjectionWorkspace& ws, const Vec6& g, const double* lambda) noexcept {
+  Vec6 r;
+  for (int j = 0; j < 6; ++j) {
+    CompensatedSum acc;
+    acc.add_product(g[j], 1.0);
+    for (int i = 0; i < ws.num_active; ++i) acc.add_product(-lambda[i], ws.A[6 * static_cast<size_t>(ws.active[i]) + j]);
+    r[j] = acc.value();
+  }
+  return r;
+}
+
+// lambda += R^-1 Q1^T r: the least-squares correction on the working set's rows.
+void add_least_squares_correction(const ProjectionWorkspace& ws, const Vec6& r, double* lambda) noexcept {
+  const int q = ws.num_active;
+  std::array<double, kMaxActive> c{};
+  for (int i = 0; i < q; ++i) c[i] = ws.Q.col(i).dot(r);
+  for (int i = q - 1; i >= 0; --i) {
+    double v = c[i];
+    for (int j = i + 1; j < q; ++j) v -= ws.R(i, j) * c[j];
+    c[i] = v / ws.R(i, i);
+  }
+  for (int i = 0; i < q; ++i) lambda[i] += c[i];
+}
+
+// Nonnegative multipliers over the rows tight at the answer, for an answer
+// whose working set's own multipliers are not all >= 0 (see "Multipliers at a
+// degenerate vertex" at the top of this file). With y fixed and g = y - y_u, it
+// solves min |A_T^T lambda - g| over lambda >= 0, T = the rows with
+// |A_k y - b_k| within the feasibility tolerance, by the active-set method of
+// Lawson and Hanson (Solving Least Squares Problems, 1974, ch. 23): the passive
+// set P is the working set's factors (factor_add/factor_drop), its least-squares
+// solution R^-1 Q1^T g, and a row joins P when the residual's component along
+// it is above rounding. P becomes the working set and lambda_P its multipliers
+// when the residual ends no larger than the working set's own (or at rounding);
+// else the working set is restored. At most kMaxRecoverySteps additions and
+// drops: bounded work, no allocation (the tight rows are marked in in_active).
+constexpr unsigned char kNotTight = 3;
+bool recover_multipliers(ProjectionWorkspace& ws, const Vec6& y, const Vec6& yu, const double* b, int m,
+                         double feasibility_tol, double dependence_tol) noexcept {
+  const Vec6 g = y - yu;
+  const double y_scale = std::max(y.norm(), yu.norm());
+  const double residual_before = multiplier_residual(ws, g, ws.lambda_active.data()).norm();
+  // The working set as it is, restored when the search does not do better.
+  const Mat6 Q0 = ws.Q, R0 = ws.R;
+  const std::array<int, kMaxActive> active0 = ws.active;
+  const std::array<double, kMaxActive> lambda0 = ws.lambda_active;
+  const int q0 = ws.num_active;
+  const long rotations0 = ws.rotations_since_rebuild;
+
+  for (int k = 0; k < m; ++k) {
+    const double bk = b ? b[k] : 0.0;
+    const double s = row(ws, k).dot(y) - bk;
+    ws.in_active[k] = std::abs(s) <= feasibility_tol * (ws.row_norm[k] * y_scale + std::abs(bk)) ? 0 : kNotTight;
+  }
+  ws.Q.setIdentity();
+  ws.R.setZero();
+  ws.num_active = 0;
+  ws.rotations_since_rebuild = 0;
+
+  for (int steps = 0; steps < kMaxRecoverySteps;) {
+    // The tight row outside P along which the residual points most (per unit
+    // of |A_k|), above its rounding.
+    const Vec6 residual = multiplier_residual(ws, g, ws.lambda_active.data());
+    int p = -1;
+    double best = kRoundoff * residual.norm();
+    for (int k = 0; k < m; ++k) {
+      if (ws.in_active[k] != 0) continue;
+      const double w = row(ws, k).dot(residual) * ws.inv_row_norm[k];
+      if (w > best) {
+        best = w;
+        p = k;
+      }
+    }
+    if (p < 0) break;
+    const int q = ws.num_active;
+    const Vec6 d = ws.Q.transpose() * row(ws, p);
+    // Dependence on P as in the main loop: below the rounding of Q's span, the
+    // sine is measured on the rows.
+    const double sine_norm = std::sqrt(tail_squared_norm(d, q));
+    bool dependent = q == kMaxActive || sine_norm <= dependence_threshold(ws, dependence_tol) * ws.row_norm[p];
+    if (dependent && q < kMaxActive && sine_norm > dependence_tol * ws.row_norm[p])
+      dependent = !independent_on_rows(ws, p, d, dependence_tol);
+    if (dependent) {
+      ws.in_active[p] = kSkipped;  // spanned by P: examined again after a drop
+      continue;
+    }
+    ++steps;
+    factor_add(ws, d, p);
+    ws.lambda_active[q] = 0;
+    // Least-squares solution on P; while some entry is not positive, move
+    // from lambda towards it until an entry reaches zero and drop that row.
+    while (steps < kMaxRecoverySteps) {
+      const int n = ws.num_active;
+      // Least squares on P, refined on compensated residuals as refine_kkt_point.
+      std::array<double, kMaxActive> z{};
+      add_least_squares_correction(ws, g, z.data());
+      for (int pass = 0; pass < kRefinementPasses; ++pass)
+        add_least_squares_correction(ws, multiplier_residual(ws, g, z.data()), z.data());
+      double alpha = 1;
+      int block = -1;
+      for (int i = 0; i < n; ++i) {
+        if (z[i] > 0) continue;
+        const double ratio = ws.lambda_active[i] / (ws.lambda_active[i] - z[i]);
+        if (block < 0 || ratio < alpha) {
+          alpha = ratio;
+          block = i;
+        }
+      }
+      if (block < 0) {
+        for (int i = 0; i < n; ++i) ws.lambda_active[i] = z[i];
+        break;
+      }
+      ++steps;
+      for (int i = 0; i < n; ++i)
+        ws.lambda_active[i] = std::max(0.0, ws.lambda_active[i] + alpha * (z[i] - ws.lambda_active[i]));
+      // The row that just joined cannot carry a positive multiplier (rounding
+      // of its gradient): leave it out until P changes.
+      const bool was_new = ws.active[block] == p && ws.lambda_active[block] <= 0;
+      ws.lambda_active[block] = 0;
+      factor_drop(ws, block);
+      for (int k = 0; k < m; ++k)
+        if (ws.in_active[k] == kSkipped) ws.in_active[k] = 0;
+      if (was_new) ws.in_active[p] = kSkipped;
+    }
+  }
+  // Every iterate is >= 0; it is kept when its residual is no larger than the
+  // working set's or at the rounding of its own multipliers (ulp(lambda_i) |A_i|
+  // is the floor for multipliers 1e10 times |g|).
+  const Vec6 residual = multiplier_residual(ws, g, ws.lambda_active.data());
+  double rounding = g.norm();
+  for (int i = 0; i < ws.num_active; ++i) rounding += ws.lambda_active[i] * ws.row_norm[ws.active[i]];
+  if (residual.norm() <= std::max(residual_before, kRoundoff * rounding)) return true;
+  ws.Q = Q0;
+  ws.R = R0;
+  ws.active = active0;
+  ws.lambda_active = lambda0;
+  ws.num_active = q0;
+  ws.rotations_since_rebuild = rotations0;
+  return false;
+}
+
 bool valid_settings(const ProjectionSettings& s) noexcept {
   return std::isfinite(s.dependence_tol) && s.dependence_tol >= 0 && s.dependence_tol < 1 &&
          std::isfinite(s.feasibility_tol) && s.feasibility_tol >= 0 && s.max_iterations >= 0;
@@ -661,6 +836,11 @@ ProjectionStatus project(const ProjectionProblem& pb, const ProjectionSettings& 
     if (iterations > 0) solve_working_set(ws, yu, b, &y);  // else y is already fresh
     res->ac.noalias() = ws.L_inv.transpose() * y;  // ac = L^-T y
     if (working_set_condition(ws) > kRefinementCondition) refine_kkt_point(pb, ws, &res->ac);
+    // At a degenerate vertex the working set's own multipliers may be negative
+    // though ac is optimal: nonnegative ones over the tight rows replace them.
+    const Vec6 y_final = ws.L.transpose() * res->ac;
+    if (has_negative_multiplier(ws, std::max(y_final.norm(), yu_norm), b))
+      recover_multipliers(ws, y_final, yu, b, m, feas_tol, dep_tol);
   }
   std::fill_n(res->lambda.begin(), m, 0.0);
   for (int i = 0; i < q; ++i) {

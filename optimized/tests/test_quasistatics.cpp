@@ -988,7 +988,8 @@ TEST_CASE("regression: seeded campaign instances with rows perturbed by 1e-10 or
   // the rows: without it they joined W with multipliers of -1e14). c72-0252 and
   // c148-0108 were right (ac = 0, a jammed
   // body) but their working set's own multipliers were not all >= 0: the exact
-  // certificate now searches multipliers over every tight row. Now: optimal, and ac the
+  // certificate now searches multipliers over every tight row (and the projection
+  // returns such multipliers: see the next test). Now: optimal, and ac the
   // exact KKT point of the working set to 1e-13 of |au|_M (the refinement's
   // eps plus the rounding of the stored point; the old errors were 5e-9 and up).
   // The exact points (.expected, by reference/ check_certificate) are for the
@@ -1023,4 +1024,41 @@ TEST_CASE("regression: seeded campaign instances with rows perturbed by 1e-10 or
     CHECK(active == truth[q.id].first);
     check_same(q.M, q.au, cold.ac, truth[q.id].second, 1e-13);
   }
+}
+
+TEST_CASE("regression: multipliers of a jammed body are dual feasible", "[qp]") {
+  // c72-0252, c148-0108, c200-0087 of qp_seeded_regressions.json: a body jammed
+  // between nearly opposite rows (ac = 0, every row tight, more than 6 of them)
+  // whose answer needs multipliers 1e7..1e8 for |M au| ~ 1e-3. The working set's
+  // incremental multipliers carried an error of eps cond(R) |lambda| ~ 0.2, so a
+  // working set whose exact multipliers are not all >= 0 (exactly -0.236,
+  // -0.0030, -0.00027; the final solve reported them faithfully) looked dual
+  // feasible; the result had dual_infeasibility 98 |M au|. Now nonnegative
+  // multipliers over the tight rows replace them (recover_multipliers).
+  // Tolerances: every multiplier >= -64 eps |M au|_inf (the rounding of a
+  // multiplier of the size of the force; the method returns them >= 0 exactly);
+  // stationarity within 64 eps (|M au|_inf + sum_k lambda_k |J_k|_inf), the
+  // rounding of the sum J^T lambda it measures: multipliers of 1e8 have an ulp
+  // of 1.5e-8, so nothing smaller than that can be asked of |M ac - M au - J^T lambda|.
+  const std::string dir = std::string(GAUSS6_SOURCE_DIR) + "/optimized/tests/data/";
+  const std::vector<gauss6::QpInstance> all = gauss6::read_qp_instances(dir + "qp_seeded_regressions.json");
+  const double eps = std::numeric_limits<double>::epsilon();
+  int checked = 0;
+  for (const gauss6::QpInstance& q : all) {
+    INFO(q.id);
+    const Rows rows = rows_of(q);
+    const ProjectionResult res = solve_cold(q.M, q.au, rows);
+    REQUIRE(res.status == ProjectionStatus::kOptimal);
+    const double force_scale = (q.M * q.au).cwiseAbs().maxCoeff();
+    double sum_scale = force_scale;
+    for (int k = 0; k < rows.m(); ++k) {
+      CHECK(res.lambda[k] >= -64 * eps * force_scale);
+      sum_scale += std::abs(res.lambda[k]) * rows.row(k).cwiseAbs().maxCoeff();
+    }
+    CHECK(res.dual_infeasibility <= 64 * eps * force_scale);
+    CHECK(res.stationarity <= 64 * eps * sum_scale);
+    CHECK(res.primal_infeasibility <= 1e-13 * (q.au.cwiseAbs().maxCoeff() + 1e-300));
+    ++checked;
+  }
+  CHECK(checked == 16);
 }

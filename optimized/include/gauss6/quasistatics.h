@@ -15,7 +15,10 @@
 // independent rows, A_W^T = Q [R; 0] is kept by Givens rotations as rows enter
 // and leave, and every iterate (y, lambda_W >= 0) is optimal for the rows in W,
 // so the method stops as soon as no row is violated. It may start from the
-// previous call's working set (warm start).
+// previous call's working set (warm start). At a degenerate vertex whose
+// working set turns out to have a negative multiplier beyond rounding (a jammed
+// body: see quasistatics.cpp), ac is kept and nonnegative multipliers are
+// sought over the rows tight at ac; their rows become the working set.
 //
 // Real-time contract: project() allocates nothing, takes no lock, throws
 // nothing; every buffer lives in the caller-owned ProjectionWorkspace and
@@ -105,7 +108,9 @@ struct ProjectionResult {
   std::array<int, kMaxActive> active{};
   int num_active = 0;
   ProjectionStatus status = ProjectionStatus::kBadInput;
-  int iterations = 0;  // add/drop steps taken (0 when the warm start was exact)
+  int iterations = 0;  // add/drop steps taken (0 when the warm start was exact;
+                       // the multipliers' recovery at a degenerate vertex is
+                       // not counted: it is bounded on its own)
   // KKT residuals, measured on the input data (a-space), filled when
   // settings.compute_residuals (else left at 0):
   double stationarity = 0;          // max_i |M (ac - au) - J^T lambda|_i
