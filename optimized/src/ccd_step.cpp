@@ -107,7 +107,7 @@ TraversalStatus descend(StepState* s, double u_end, const Visit& visit) {
     int pending = 0;
     if (!start_candidate_pairs(*s->god.bvh, *s->obstacles[o].bvh, &s->ws->stack, &pending))
       return TraversalStatus::kStackFull;
-    const TraversalStatus ts = traverse(*s, s->start, s->e, u_end, s->reach, o, &s->ws->stack, &pending,
+    const TraversalStatus ts = traverse(*s, s->start, s->e, s->ws->swept, u_end, s->reach, o, &s->ws->stack, &pending,
                                         std::numeric_limits<long>::max(), &s->result->num_node_pairs, visit);
     if (ts != TraversalStatus::kDone) return ts;
   }

@@ -86,14 +86,14 @@ void set_near_pairs(StepState* s, int num_cand, double u0);
 // translation up to u_end, grown by what else its points may move, plus dist),
 // and visit(gf, of, o) gets the rest (false: stop). It runs from the node pairs
 // pending on `stack` (resume_candidate_pairs) for at most `budget` node pairs,
-// counted in *num_node_pairs. Call ws->swept.next_interval() first whenever
-// the enclosure changed.
+// counted in *num_node_pairs. The god-object's boxes are cached in `swept`
+// (the step's, ws->swept, or a fill's own): call swept.next_interval() first
+// whenever the enclosure or dist changed.
 template <class Visit>
-TraversalStatus traverse(const StepState& s, const StartFrame& frame, const MotionEnclosure& enc, double u_end,
-                         double dist, int o, BvhStack* stack, int* pending, long budget, int* num_node_pairs,
-                         const Visit& visit) {
+TraversalStatus traverse(const StepState& s, const StartFrame& frame, const MotionEnclosure& enc, SweptBoxCache& swept,
+                         double u_end, double dist, int o, BvhStack* stack, int* pending, long budget,
+                         int* num_node_pairs, const Visit& visit) {
   const CcdBody& god = s.god;
-  SweptBoxCache& swept = s.ws->swept;
   const SweptObbFrame obb_frame = frame.obb_frame(u_end, dist);
   const auto god_node_obb = [&](int node) -> const PosedObb& {
     return swept.get(swept.node_obbs, node, [&] { return obb_frame.pose(god.bvh->nodes[node].obb); });

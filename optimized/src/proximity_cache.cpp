@@ -59,7 +59,7 @@ bool is_keyed(const StepState& s) {
 // Fills: every pair not proven apart by reach + pf.margin with the god-object
 // at pf.ref (X0, or the pose a background fill is started at:
 // fill_cache_in_background), descended into pf.pairs obstacle by obstacle, a
-// budget of node pairs at a time (run_fill: true once complete; a fill that
+// budget of node pairs at a time (fill_some: true once complete; a fill that
 // does not fit, in pf.pairs or on pf.stack, is dropped), then swapped in
 // (put_fill).
 void start_obstacle(StepState* s) {
@@ -84,6 +84,7 @@ void start_fill(StepState* s, const Pose* ahead, double m) {
     }
   }
   pf.cost = 0;
+  pf.swept_dist = -1;  // another pose: the boxes of the last fill are stale
   pf.num_pairs = 0;
   pf.obstacle = 0;
   pf.active = true;
@@ -100,13 +101,16 @@ bool fill_some(StepState* s, long budget) {
   frame.set(pf.motion, 0.0, s->rho);
   MotionEnclosure enc;
   enclose_motion(pf.motion, {0, 0}, &enc);
-  s->ws->swept.next_interval();
   const int capacity = static_cast<int>(pf.pairs.size());
   const double fill_dist = (Upper{s->reach} + Upper{pf.margin}).v;
+  if (pf.swept_dist != fill_dist) {  // (start_fill sets -1)
+    pf.swept.next_interval();
+    pf.swept_dist = fill_dist;
+  }
   while (pf.obstacle < s->num_obstacles) {
     int used = 0;
-    const TraversalStatus ts = traverse(*s, frame, enc, 0.0, fill_dist, pf.obstacle, &pf.stack, &pf.pending, budget,
-                                        &used, [&](int gf, int of, int o) {
+    const TraversalStatus ts = traverse(*s, frame, enc, pf.swept, 0.0, fill_dist, pf.obstacle, &pf.stack, &pf.pending,
+                                        budget, &used, [&](int gf, int of, int o) {
       double radius = 0;
       const double gap = frame.gap(*god.mesh, gf, *s->obstacles[o].mesh, of, fill_dist, &radius);
       if (gap > fill_dist) return true;
@@ -129,12 +133,6 @@ bool fill_some(StepState* s, long budget) {
   pf.complete = true;
   pc.fill_cost = pf.cost;
   return true;
-}
-
-bool run_fill(StepState* s, long budget) {
-  const bool complete = fill_some(s, budget);
-  s->ws->swept.next_interval();  // the boxes cached were the fill's, not e's
-  return complete;
 }
 
 void put_fill(StepState* s) {
@@ -192,7 +190,7 @@ void take_background_fill(StepState* s, const CacheRanges& r, Displacement* sinc
   const bool needed = !r.usable(s->u_cached) && r.usable(r.range(moved_ahead, pf.margin));
   if (!r.usable(s->u_cached) && !needed) {
     pf.active = false;  // the god-object went elsewhere
-  } else if ((better && pf.complete) || (needed && run_fill(s, std::numeric_limits<long>::max()))) {
+  } else if ((better && pf.complete) || (needed && fill_some(s, std::numeric_limits<long>::max()))) {
     put_fill(s);
     s->result->cache_refilled = true;
     *since = ahead;
@@ -228,7 +226,7 @@ void refill_if_worth(StepState* s, const CacheRanges& r, Displacement* since) {
   }
   if (!fill) return;
   start_fill(s, /*ahead=*/nullptr, fresh_margin);
-  const bool filled = run_fill(s, std::numeric_limits<long>::max());
+  const bool filled = fill_some(s, std::numeric_limits<long>::max());
   pc.clear();
   s->u_cached = 0;
   s->cache_keyed = false;
@@ -365,7 +363,7 @@ void fill_cache_in_background(StepState* s) {
         start_fill(s, &ahead, m);
       }
     }
-    if (pf.active && !pf.complete) run_fill(s, settings.cache.fill_budget);
+    if (pf.active && !pf.complete) fill_some(s, settings.cache.fill_budget);
   }
   // The next step's background fill and list margin follow this step's motion.
   pc.last_x0 = X0;

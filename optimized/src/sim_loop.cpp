@@ -175,20 +175,32 @@ Vec6 constrain_motion(const RuntimeModel& model, const Vec6& au, SimState* s, do
 // CCD's guarantee holds for it, up to make_stop_pose's deviation bound) and the
 // function returns true; on invalid input or a half turn left after splitting,
 // s->xs is left as it was and it returns false.
+// Every leg is served from the legs' proximity cache (and may refill it), but
+// only a step's first leg (first_leg; its first half when split) goes on with
+// the cache's background fill: the fill's budget is per sim step, as the
+// fill's plan counts it (proximity_cache.cpp, fill_cache_in_background).
+// Spent by every leg, a settling step (first leg, settling leg) or a graze's
+// lift filled twice or three times the budget, on the steps that already do
+// the most work: in one profiled pass of the bunnies, 68 of the 549 steps over
+// 0.1 ms of CPU ran a background fill in a later leg, 196 node pairs on
+// average (docs/benchmarks.md, issue 20, fourth session).
 bool ccd_leg(const RuntimeModel& model, const Pose& x0, const Pose& x1, int num_hints, SimState* s,
-             int* num_halves) {
+             int* num_halves, bool first_leg) {
   const int num_obstacles = static_cast<int>(model.obstacles.size());
   const CcdBody* obstacles = model.obstacles.data();
   CcdStepResult& r = s->ccd;
-  ccd_step(obstacles, num_obstacles, model.god, x0, x1, model.settings.ccd, &s->ccd_ws, &r, s->ccd_hints.data(),
+  CcdStepSettings settings = model.settings.ccd;
+  if (!first_leg) settings.cache.fill_budget = 0;
+  ccd_step(obstacles, num_obstacles, model.god, x0, x1, settings, &s->ccd_ws, &r, s->ccd_hints.data(),
            num_hints);
   if (r.status == CcdStatus::kHalfTurn) {
     const Pose mid = split_step(x0, x1);
     *num_halves = 2;
-    ccd_step(obstacles, num_obstacles, model.god, x0, mid, model.settings.ccd, &s->ccd_ws, &r, s->ccd_hints.data(),
+    ccd_step(obstacles, num_obstacles, model.god, x0, mid, settings, &s->ccd_ws, &r, s->ccd_hints.data(),
              num_hints);
+    settings.cache.fill_budget = 0;  // spent by the first half
     if (r.status != CcdStatus::kInvalidInput && r.status != CcdStatus::kHalfTurn && !r.hit)
-      ccd_step(obstacles, num_obstacles, model.god, mid, x1, model.settings.ccd, &s->ccd_ws, &r);
+      ccd_step(obstacles, num_obstacles, model.god, mid, x1, settings, &s->ccd_ws, &r);
   }
   if (r.status == CcdStatus::kInvalidInput || r.status == CcdStatus::kHalfTurn) return false;
   const StopPose stop = make_stop_pose(r.motion, r.hit ? r.u_hit : 1.0, model.god_radius);
@@ -265,7 +277,7 @@ bool lift_out_of_graze(const RuntimeModel& model, const Pose& x_start, const Pos
   const CcdStepResult grazed_leg = s->ccd;  // to restore on a refusal (plain data: no allocation)
   const double grazed_deviation = s->stop_deviation;
   int halves = 1;
-  if (ccd_leg(model, pose_update(x_start, s->shading.ac), target, num_hints, s, &halves) &&
+  if (ccd_leg(model, pose_update(x_start, s->shading.ac), target, num_hints, s, &halves, /*first_leg=*/false) &&
       motion_free(model, x_start, s->xs, num_hints, s)) {
     *num_halves = std::max(*num_halves, halves);
     return true;
@@ -382,7 +394,7 @@ void advance_god_object(const RuntimeModel& model, const Pose& x_start, const Po
     if (shortened_u < 1) {
       serve_proven_leg(model, proven, shortened_u, s);
     } else {
-      moved = ccd_leg(model, x_start, target, num_hints, s, &info->num_halves);
+      moved = ccd_leg(model, x_start, target, num_hints, s, &info->num_halves, info->num_shortenings == 0);
       if (moved && info->num_shortenings == 0 && grazed(model, *s))
         lifted = lift_out_of_graze(model, x_start, target, num_hints, s, &info->num_halves);
     }
@@ -404,7 +416,8 @@ void advance_god_object(const RuntimeModel& model, const Pose& x_start, const Po
     const CcdStepResult first_leg = s->ccd;  // to restore on a refusal (plain data: no allocation)
     const double first_deviation = s->stop_deviation;
     int halves = 1;
-    const bool settled = ccd_leg(model, from, pose_update(from, residual), num_hints, s, &halves);
+    const bool settled = ccd_leg(model, from, pose_update(from, residual), num_hints, s, &halves,
+                                 /*first_leg=*/false);
     if (info->ccd == CcdStatus::kOk) info->ccd = s->ccd.status;
     info->u_hit = s->ccd.u_hit;
     if (!settled) break;  // s->xs is still the first leg's end

@@ -625,7 +625,7 @@ TEST_CASE("runtime: a run's recorded CCD inputs replay its collision work exactl
   const RuntimeModel& model = *r.model;
   SimState replay(model);
   SimStepInfo info;
-  int num_replayed = 0, num_settled = 0, num_hits = 0;
+  int num_replayed = 0, num_settled = 0, num_hits = 0, num_settling_legs = 0;
   for (size_t k = 0; k < r.rec.sims.size(); ++k) {
     const SimStepInfo& sim = r.rec.sims[k];
     if (sim.status == SimStepStatus::kNoHandle) {
@@ -647,12 +647,22 @@ TEST_CASE("runtime: a run's recorded CCD inputs replay its collision work exactl
            replay.xs.q.z == sim.xs.q.z));
     CHECK(info.num_contacts == sim.num_contacts);
     CHECK(info.settled == sim.settled);
+    // Only the step's first leg goes on with the proximity cache's background
+    // fill (its budget is per sim step): an accepted settling leg, the last
+    // leg run, filled only if it refilled the list at once or finished a
+    // fill it needed.
+    if (info.settled && info.num_shortenings == 0 && replay.ccd.motion.nominal.p0 != sim.x_start.p &&
+        !replay.ccd.cache_filled && !replay.ccd.cache_refilled) {
+      CHECK(replay.ccd.num_fill_node_pairs == 0);
+      ++num_settling_legs;
+    }
     ++num_replayed;
     num_settled += sim.settled;
     num_hits += sim.status == SimStepStatus::kContact;
   }
   CHECK(num_replayed > 1400);
   CHECK(num_settled > 0);
+  CHECK(num_settling_legs > 0);
   CHECK(num_hits > 0);
 }
 

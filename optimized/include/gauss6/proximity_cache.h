@@ -17,6 +17,7 @@
 
 #include "gauss6/bvh.h"
 #include "gauss6/ccd.h"
+#include "gauss6/motion_bounds.h"
 #include "gauss6/pose.h"
 
 namespace gauss6 {
@@ -95,6 +96,11 @@ struct ProximityCache {
     CcdMotion motion;  // still at ref (or the step it started in, when ref is that step's start)
     BvhStack stack;    // the descent's pending node pairs: stack.items[0 .. pending)
     int pending = 0;
+    // The god-object's boxes at ref grown by swept_dist (the reach plus the
+    // margin), kept over the steps the fill takes: its pose does not move, so
+    // each chunk of the fill reuses the boxes the chunks before it posed.
+    SweptBoxCache swept;
+    double swept_dist = -1;  // the grow of the boxes in swept (-1: none yet)
     int obstacle = 0;  // the obstacle being descended
     long cost = 0;     // node pairs tested so far
     bool active = false, complete = false;

@@ -120,7 +120,8 @@ struct RuntimeModel {
 //   ccd.narrow.distance_tolerance = ccd_distance_tolerance delta   (0.1: a hit is accepted within 1.1 delta)
 //   ccd.cache.margin              = cache_margin delta             (64: proximity cache, at rest)
 //   ccd.cache.margin_max          = cache_margin_max delta         (256: proximity cache, at speed)
-//   ccd.cache.fill_budget         = cache_fill_budget              (300 node pairs a step; not scaled)
+//   ccd.cache.fill_budget         = cache_fill_budget              (300 node pairs a step, spent by its
+//                                                                    first leg only; not scaled)
 //   ccd.near_distance             = delta (1 + contact_factor) + near_slack delta
 // and contact_generation.distance = delta (1 + contact_factor). No validation:
 // RuntimeModel's constructor checks the scene and the settings.
