@@ -67,7 +67,7 @@ def test_seeded_regressions():
 
     path = Path(__file__).resolve().parents[2] / "optimized/tests/data/qp_seeded_regressions.json"
     instances = qp_instances.load_family(path)
-    assert len(instances) == 16
+    assert len(instances) == 26
     for inst in instances:
         res = _gauss6.project(inst.M, inst.au, inst.J, inst.b)
         assert res.status == "optimal", inst.id
