@@ -24,14 +24,25 @@
 // slab bound (no pair test), contacts at the stop pose (of the step's last leg);
 // the slowest step's index and counts (slowest_*), and the steps over 1 ms and
 // over 100 us of CPU time (cpu_steps_over_*).
+// Profiles of the tail: GAUSS6_BENCH_STEP_LOG=<file> writes one line per step;
+// GAUSS6_BENCH_COLLECT=<i,j,...> switches callgrind's collection on around
+// those steps only (run under valgrind --tool=callgrind --collect-atstart=no),
+// so that the instructions of the slowest steps can be read apart from the rest.
 #include <benchmark/benchmark.h>
 
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <memory>
+#include <set>
+#include <sstream>
 #include <string>
 #include <vector>
+#if __has_include(<valgrind/callgrind.h>)
+#include <valgrind/callgrind.h>
+#else
+#define CALLGRIND_TOGGLE_COLLECT
+#endif
 
 #include "bench_data.h"
 #include "gauss6/bvh.h"
@@ -225,13 +236,22 @@ void time_steps(benchmark::State& state, const RuntimeModel& model, const std::v
   double slowest_ns = -1, over_1ms = 0, over_100us = 0;
   std::FILE* log = std::getenv("GAUSS6_BENCH_STEP_LOG") ? std::fopen(std::getenv("GAUSS6_BENCH_STEP_LOG"), "w") : nullptr;
   size_t i = 0;
+  std::set<size_t> collect;  // GAUSS6_BENCH_COLLECT: step indices, comma-separated
+  if (const char* list = std::getenv("GAUSS6_BENCH_COLLECT")) {
+    std::istringstream in(list);
+    for (std::string t; std::getline(in, t, ',');)
+      if (!t.empty()) collect.insert(std::stoul(t));
+  }
   for (auto _ : state) {
     double iteration_ns = 0;
     for (size_t k = 0; k < steps_per_iteration; ++k) {
       const size_t index = i++ % steps.size();
       const ScenarioStep& st = steps[index];
       const double cpu0 = thread_cpu_ns();
+      const bool profiled = collect.count(index) > 0;
+      if (profiled) CALLGRIND_TOGGLE_COLLECT;
       iteration_ns += rec.sample([&] { advance_god_object(model, st.x_start, st.x_target, st.residual, &sim, &info); });
+      if (profiled) CALLGRIND_TOGGLE_COLLECT;
       const double cpu_ns = thread_cpu_ns() - cpu0;
       cpu.add(cpu_ns);
       benchmark::DoNotOptimize(sim.contacts.num_contacts);
