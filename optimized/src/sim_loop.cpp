@@ -222,6 +222,12 @@ bool motion_free(const RuntimeModel& model, const Pose& x0, const Pose& x1, int 
   settings.near_distance = 0;
   settings.cache.margin = settings.cache.margin_max = 0;
   settings.cache.fill_budget = 0;
+  // Only whether it is free counts: the first hit found answers it. A refused
+  // settle's check is stopped by a hint (a contact at x_start) at u 0.002-0.3,
+  // and then descended the trees to confirm that no pair hits earlier (835-1,040
+  // node pairs, 0.15-0.3 ms a try in the peg's heaviest steps: docs/benchmarks.md,
+  // issue 20, fifth session); the answer was "not free" either way.
+  settings.any_hit = true;
   // The legs' proximity list serves it read-only when the direct motion stays
   // within its margin (ccd_step.h, CcdStepWorkspace::borrowed): the same
   // candidates a descent would find, without descending the trees.
