@@ -1475,7 +1475,7 @@ double motion_distance_bound(const Pose& a0, const Pose& a1, const Pose& b0, con
   for (int i = 0; i < 3; ++i)
     pb1[static_cast<size_t>(i)] = b.p0[static_cast<size_t>(i)] + ub * b.dp[static_cast<size_t>(i)];
   const Upper shift = max(difference_norm(a.p0, to_interval(b0.p)), difference_norm(a.p0 + a.dp, pb1));
-  const double bound = (shift + 4.0 * (turn * Upper{body_radius})).v;
+  const double bound = (shift + 2.0 * (turn * Upper{body_radius})).v;
   return std::isfinite(bound) ? bound : kNone;
 }
 

@@ -245,9 +245,9 @@ bool motion_free(const RuntimeModel& model, const Pose& x0, const Pose& x1, int 
 // case: its leg starts a fraction of delta from x_start and the direct motion
 // x_start -> end shares the leg's end. Searched instead, that direct motion
 // descended the same 1,050-1,530 node pairs and tested the same sliding pairs
-// as the lift's leg (0.25-0.65 ms of the peg's heaviest steps; 38 of the 50
-// lifts of the peg's replay are now proven so: docs/benchmarks.md, issue 20,
-// fifth session). The other direct motions, a settling step's, stray farther
+// as the lift's leg (0.25-0.65 ms of the peg's heaviest steps; 20 of the 25
+// lifts of the peg's replay and all 6 of the bunnies' are now proven so:
+// docs/benchmarks.md, issue 20, fifth session). The other direct motions, a settling step's, stray farther
 // from both of their legs: in the peg's and bunnies' replays the bound never
 // served one, and it is not tried there.
 bool leg_proves(const RuntimeModel& model, const Pose& a0, const Pose& a1, const Pose& b0, const CcdStepResult& leg,
