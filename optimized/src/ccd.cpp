@@ -4,7 +4,9 @@
 // guarantee and the rounding argument.
 #include "gauss6/ccd.h"
 
+#include <array>
 #include <cmath>
+#include <limits>
 
 #include "gauss6/distance.h"  // closest points: the separating axes of the u-filter
 #include "gauss6/error_allowances.h"
@@ -1421,6 +1423,60 @@ StopPose make_stop_pose(const CcdMotion& m, double u, double body_radius) {
   }
   out.deviation = sqrt(sum2).v;
   return out;
+}
+
+namespace {
+
+// The unit quaternion q / |q| of a pose, enclosed (false when |q| cannot be
+// bounded away from 0).
+bool unit_quaternion(const Quat& q, std::array<Interval, 4>* out) {
+  const double c[4] = {q.w, q.x, q.y, q.z};
+  Interval n2 = Interval::point(0);
+  for (double v : c) n2 = n2 + sqr(Interval::point(v));
+  if (!(n2.lo > 0) || !std::isfinite(n2.hi)) return false;
+  const Interval n{sqrt(Lower{n2.lo}).v, sqrt(Upper{n2.hi}).v};
+  for (int i = 0; i < 4; ++i) (*out)[static_cast<size_t>(i)] = div_positive(Interval::point(c[i]), n);
+  return true;
+}
+
+// (1, g) (x) q (Hamilton product, w first).
+std::array<Interval, 4> gibbs_times(const IVec3& g, const std::array<Interval, 4>& q) {
+  const Interval w = q[0], x = q[1], y = q[2], z = q[3];
+  return {w - (g[0] * x + g[1] * y + g[2] * z), x + g[0] * w + (g[1] * z - g[2] * y),
+          y + g[1] * w + (g[2] * x - g[0] * z), z + g[2] * w + (g[0] * y - g[1] * x)};
+}
+
+template <size_t N>
+Upper difference_norm(const std::array<Interval, N>& a, const std::array<Interval, N>& b) {
+  Upper s2{0};
+  for (size_t i = 0; i < N; ++i) s2 = s2 + sqr(magnitude(a[i] - b[i]));
+  return sqrt(s2);
+}
+
+}  // namespace
+
+double motion_distance_bound(const Pose& a0, const Pose& a1, const Pose& b0, const CcdMotion& b, double ub,
+                             double body_radius) {
+  constexpr double kNone = std::numeric_limits<double>::infinity();
+  CcdMotion a;
+  std::array<Interval, 4> qa, qb;
+  if (!(ub >= 0 && ub <= 1 && body_radius >= 0) || make_ccd_motion(a0, a1, &a) != MotionStatus::kOk ||
+      !unit_quaternion(a0.q, &qa) || !unit_quaternion(b0.q, &qb))
+    return kNone;
+  // q and -q are the same rotation: b's quaternions taken on a's side.
+  if (a0.q.w * b0.q.w + a0.q.x * b0.q.x + a0.q.y * b0.q.y + a0.q.z * b0.q.z < 0)
+    for (Interval& c : qb) c = -c;
+  // Rotations: max over u = 0, 1 of the affine quaternions' difference.
+  IVec3 gb;
+  for (int i = 0; i < 3; ++i) gb[static_cast<size_t>(i)] = ub * b.g[static_cast<size_t>(i)];
+  const Upper turn = max(difference_norm(qa, qb), difference_norm(gibbs_times(a.g, qa), gibbs_times(gb, qb)));
+  // Positions: max over u = 0, 1 (b's start is b0.p, its position at ub p0 + ub dp).
+  IVec3 pb1;
+  for (int i = 0; i < 3; ++i)
+    pb1[static_cast<size_t>(i)] = b.p0[static_cast<size_t>(i)] + ub * b.dp[static_cast<size_t>(i)];
+  const Upper shift = max(difference_norm(a.p0, to_interval(b0.p)), difference_norm(a.p0 + a.dp, pb1));
+  const double bound = (shift + 2.0 * (turn * Upper{body_radius})).v;
+  return std::isfinite(bound) ? bound : kNone;
 }
 
 }  // namespace gauss6

@@ -85,7 +85,7 @@ void search_hints(StepState* s) {
       break;
     }
   const CcdBody& god = s->god;
-  for (int k = 0; k < num_hints && !tester.done(); ++k) {
+  for (int k = 0; k < num_hints && !tester.done() && !answered(*s); ++k) {
     const int h = k == 0 ? lead : (k <= lead ? k - 1 : k);
     const FeaturePair& f = hints[h];
     // (Every obstacle's mesh and tree were checked with the inputs.)
@@ -124,7 +124,7 @@ bool search_sub_intervals(StepState* s) {
   CcdStepWorkspace::Candidate* const cand = s->ws->candidates.data();
   const int cand_capacity = static_cast<int>(s->ws->candidates.size());
   const int n = s->n;
-  for (int i = 0; i < n; ++i) {
+  for (int i = 0; i < n && !answered(*s); ++i) {
     const double u0 = std::max(static_cast<double>(i) / n, s->u_cached);
     const double u1 = (i + 1 == n) ? 1.0 : static_cast<double>(i + 1) / n;
     if (!(u0 < u1)) continue;  // inside the cached range
@@ -155,7 +155,7 @@ bool search_sub_intervals(StepState* s) {
       listed = false;
       if (!searched(*s, gf, of, o)) tester.test(*god.mesh, *god.bvh, gf, *ob.mesh, *ob.bvh, of, o);
       // A hit at the sub-interval's start cannot be bettered: stop.
-      return !tester.done();
+      return !tester.done() && !answered(*s);
     });
     if (ts == TraversalStatus::kStackFull) {
       // Unknown beyond here: stop conservatively at the sub-interval's start.
@@ -188,6 +188,8 @@ void finish(StepState* s) {
 
 bool searched(const StepState& s, int gf, int of, int o) { return among(s.hints, s.num_searched, gf, of, o); }
 
+bool answered(const StepState& s) { return s.settings.any_hit && s.result->hit; }
+
 // Earliest-first: each hit shortens the windows of the pairs after it, and
 // once a pair's bound passes the best u so far, so do all the rest.
 void test_candidates(StepState* s, int num_cand) {
@@ -196,7 +198,7 @@ void test_candidates(StepState* s, int num_cand) {
   const CcdBody& god = s->god;
   std::sort(cand, cand + num_cand, [](const auto& a, const auto& b) { return a.earliest < b.earliest; });
   for (int c = 0; c < num_cand; ++c) {
-    if (cand[c].earliest > tester.end() || tester.done()) break;
+    if (cand[c].earliest > tester.end() || tester.done() || answered(*s)) break;
     const TrianglePair& p = cand[c].pair;
     if (searched(*s, p.god_face, p.obstacle_face, p.obstacle)) continue;
     const CcdBody& ob = s->obstacles[p.obstacle];
@@ -257,15 +259,18 @@ void ccd_step(const CcdBody* obstacles, int num_obstacles, const CcdBody& god, c
   const bool cached = settings.cache.margin > 0;
   const bool borrowing = !cached && ws->borrowed != nullptr;
   if ((hints && num_hints > 0) || cached || borrowing) s.start.set(s.motion, 0.0, god.bvh->radius);
-  // Search the hints over the whole step.
+  // Search the hints over the whole step (a hit among them answers a yes/no
+  // step: settings.any_hit).
   search_hints(&s);
-  // Serve the step's start from the proximity cache, refilled first if worth it
-  // (or from another workspace's list, read-only).
-  if (cached) serve_proximity_cache(&s);
-  if (borrowing) serve_borrowed_list(&s);
-  // Descend the trees per sub-interval past the cached range, and test the
-  // candidate pairs earliest-first (a full stack stops the step there).
-  if (!search_sub_intervals(&s)) return;
+  if (!answered(s)) {
+    // Serve the step's start from the proximity cache, refilled first if worth it
+    // (or from another workspace's list, read-only).
+    if (cached) serve_proximity_cache(&s);
+    if (borrowing) serve_borrowed_list(&s);
+    // Descend the trees per sub-interval past the cached range, and test the
+    // candidate pairs earliest-first (a full stack stops the step there).
+    if (!search_sub_intervals(&s)) return;
+  }
   // Fill the next list in the background while this one serves.
   if (cached) fill_cache_in_background(&s);
   // Finish: the result less the time tolerance, the pair that stopped the step.

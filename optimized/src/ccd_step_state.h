@@ -73,6 +73,8 @@ struct StepState {
 // The triangle pair was searched over the whole step among the hints (then it
 // needs no second search: ccd_step.cpp, search_hints).
 bool searched(const StepState& s, int gf, int of, int o);
+// A yes/no step (settings.any_hit) has its answer: a hit.
+bool answered(const StepState& s);
 // Tests cand[0 .. num_cand) earliest-first (ws->candidates), skipping the
 // pairs searched with the hints.
 void test_candidates(StepState* s, int num_cand);

@@ -222,6 +222,12 @@ bool motion_free(const RuntimeModel& model, const Pose& x0, const Pose& x1, int 
   settings.near_distance = 0;
   settings.cache.margin = settings.cache.margin_max = 0;
   settings.cache.fill_budget = 0;
+  // Only whether it is free counts: the first hit found answers it. A refused
+  // settle's check is stopped by a hint (a contact at x_start) at u 0.002-0.3,
+  // and then descended the trees to confirm that no pair hits earlier (835-1,040
+  // node pairs, 0.15-0.3 ms a try in the peg's heaviest steps: docs/benchmarks.md,
+  // issue 20, fifth session); the answer was "not free" either way.
+  settings.any_hit = true;
   // The legs' proximity list serves it read-only when the direct motion stays
   // within its margin (ccd_step.h, CcdStepWorkspace::borrowed): the same
   // candidates a descent would find, without descending the trees.
@@ -229,6 +235,25 @@ bool motion_free(const RuntimeModel& model, const Pose& x0, const Pose& x1, int 
   ccd_step(model.obstacles.data(), static_cast<int>(model.obstacles.size()), model.god, x0, x1, settings,
            &s->check_ws, &s->check, s->ccd_hints.data(), num_hints);
   return s->check.status == CcdStatus::kOk && !s->check.hit;
+}
+
+// Whether a CCD leg already run, `leg` (from b0, in one piece; its exact
+// motion keeps every pair at least min_separation apart up to ub: ccd.h),
+// proves the motion a0 -> a1 free of contact without a search of its own: no
+// body point of a0 -> a1 strays by as much as min_separation from where the leg
+// puts it at the same pace (motion_distance_bound). A graze's lift is such a
+// case: its leg starts a fraction of delta from x_start and the direct motion
+// x_start -> end shares the leg's end. Searched instead, that direct motion
+// descended the same 1,050-1,530 node pairs and tested the same sliding pairs
+// as the lift's leg (0.25-0.65 ms of the peg's heaviest steps; 20 of the 25
+// lifts of the peg's replay and all 6 of the bunnies' are now proven so:
+// docs/benchmarks.md, issue 20, fifth session). The other direct motions, a settling step's, stray farther
+// from both of their legs: in the peg's and bunnies' replays the bound never
+// served one, and it is not tried there.
+bool leg_proves(const RuntimeModel& model, const Pose& a0, const Pose& a1, const Pose& b0, const CcdStepResult& leg,
+                double ub) {
+  return leg.status == CcdStatus::kOk &&
+         motion_distance_bound(a0, a1, b0, leg.motion, ub, model.god_radius) < model.settings.ccd.narrow.min_separation;
 }
 
 // A graze: the leg just run (s->ccd) was stopped by a pair of the last contact
@@ -256,8 +281,10 @@ bool grazed(const RuntimeModel& model, const SimState& s) {
 // Out of a graze: the leg again, from x_lift = x_start (+) a_lift, a_lift the
 // M-smallest motion that lifts every contact of the set to delta (1 +
 // gap_factor) to first order (the gap rows alone: a fraction of delta), out of
-// the CCD's band; its end is kept only when the CCD proves the direct motion
-// x_start -> end free of contact (the published motion, property 5). x_lift is a
+// the CCD's band; its end is kept only when the direct motion x_start -> end is
+// proven free of contact (the published motion, property 5): by the lift's leg
+// itself when the two motions stay within min_separation of each other
+// (leg_proves), by the CCD otherwise. x_lift is a
 // waypoint, never published; every pose of the second leg keeps the CCD's
 // min_separation. Returns false, with s->xs, s->ccd and s->stop_deviation as the
 // grazed leg left them, when the gap rows conflict or either CCD refuses.
@@ -277,8 +304,10 @@ bool lift_out_of_graze(const RuntimeModel& model, const Pose& x_start, const Pos
   const CcdStepResult grazed_leg = s->ccd;  // to restore on a refusal (plain data: no allocation)
   const double grazed_deviation = s->stop_deviation;
   int halves = 1;
-  if (ccd_leg(model, pose_update(x_start, s->shading.ac), target, num_hints, s, &halves, /*first_leg=*/false) &&
-      motion_free(model, x_start, s->xs, num_hints, s)) {
+  const Pose x_lift = pose_update(x_start, s->shading.ac);
+  if (ccd_leg(model, x_lift, target, num_hints, s, &halves, /*first_leg=*/false) &&
+      ((halves == 1 && leg_proves(model, x_start, s->xs, x_lift, s->ccd, s->ccd.hit ? s->ccd.u_hit : 1.0)) ||
+       motion_free(model, x_start, s->xs, num_hints, s))) {
     *num_halves = std::max(*num_halves, halves);
     return true;
   }

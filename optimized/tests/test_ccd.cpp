@@ -493,6 +493,59 @@ TEST_CASE("stop pose: deviation from the exact motion is bounded and tiny", "[cc
   }
 }
 
+// motion_distance_bound must hold for the exact motions (ccd_test_util.h's
+// rationals): two motions whose starts differ by a lift-sized step (up to 1e-3
+// of the radius, turns included, the quaternion's sign flipped on some) and
+// whose ends agree up to b's pace (a ends at b's pose at ub, rounded to
+// doubles), and unrelated motions; every sampled body point within the radius
+// at every sampled u lies within the bound of its place under b. It must also
+// be useful: for a shared end and starts 1e-6 apart, far below 1e-3.
+TEST_CASE("motion distance bound: no body point of one motion strays farther from the other", "[ccd]") {
+  std::mt19937 rng(20);
+  std::normal_distribution<double> n(0, 1);
+  std::uniform_real_distribution<double> unit(0, 1);
+  const double radius = 0.05;
+  int checked = 0, tight = 0;
+  for (int i = 0; i < 60; ++i) {
+    const bool related = i % 4 != 3;
+    const double lift = related ? std::pow(10.0, -3.0 - 4.0 * unit(rng)) : 1.0;
+    const Pose b0{{n(rng), n(rng), n(rng)}, normalized(Quat{n(rng), n(rng), n(rng), n(rng)})};
+    const Pose target{b0.p + 0.01 * Vec3(n(rng), n(rng), n(rng)),
+                      normalized(quat_exp(0.3 * unit(rng) * Vec3(n(rng), n(rng), n(rng)).normalized()) * b0.q)};
+    CcdMotion b;
+    REQUIRE(make_ccd_motion(b0, target, &b) == MotionStatus::kOk);
+    const double ub = i % 2 == 0 ? 1.0 : unit(rng);
+    Pose a0{b0.p + lift * radius * Vec3(n(rng), n(rng), n(rng)),
+            normalized(quat_exp(lift * Vec3(n(rng), n(rng), n(rng))) * b0.q)};
+    if (i % 3 == 0) a0.q = Quat{-a0.q.w, -a0.q.x, -a0.q.y, -a0.q.z};  // the same rotation
+    const Pose a1 = related ? make_stop_pose(b, ub, radius).pose
+                            : Pose{b0.p + Vec3(n(rng), n(rng), n(rng)), normalized(Quat{n(rng), n(rng), n(rng), n(rng)})};
+    const double bound = motion_distance_bound(a0, a1, b0, b, ub, radius);
+    if (!std::isfinite(bound)) {  // a1 half a turn or more from a0 (unrelated motions only)
+      CHECK(!related);
+      continue;
+    }
+    if (related && lift <= 2e-5) tight += bound < 1e-3 * radius;
+    const test::ExactMotion ea(a0, a1), eb(b0, target);
+    for (int k = 0; k < 40; ++k) {
+      const mpq_class u = k == 0 ? mpq_class(0) : k == 1 ? mpq_class(1) : Q(unit(rng));
+      const Q3 r = q3(radius * unit(rng) * Vec3(n(rng), n(rng), n(rng)).normalized());
+      const Q3 d = ea.point(u, r) - eb.point(u * Q(ub), r);
+      CHECK(dot(d, d) <= Q(bound) * Q(bound));
+      ++checked;
+    }
+  }
+  CHECK(checked >= 50 * 40);
+  CHECK(tight > 0);
+  // Cannot bound: an invalid pose or a half turn for a.
+  CcdMotion b;
+  const Pose x{{0, 0, 0}, {1, 0, 0, 0}};
+  REQUIRE(make_ccd_motion(x, x, &b) == MotionStatus::kOk);
+  CHECK(std::isinf(motion_distance_bound(x, Pose{{0, 0, 0}, {0, 1, 0, 0}}, x, b, 1.0, 1.0)));
+  CHECK(std::isinf(motion_distance_bound(x, Pose{{0, 0, 0}, {0, 0, 0, 0}}, x, b, 1.0, 1.0)));
+  CHECK(std::isinf(motion_distance_bound(x, x, x, b, 1.5, 1.0)));
+}
+
 TEST_CASE("shared sample queries: no false negative with the linear primitives", "[ccd]") {
   const std::string root = std::string(GAUSS6_SOURCE_DIR) + "/../shared/data/ccd-sample-queries";
   if (!std::filesystem::is_directory(root)) {

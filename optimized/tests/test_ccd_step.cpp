@@ -475,7 +475,8 @@ TEST_CASE("ccd_step: a step served read-only from another workspace's list agree
   // of its own, and must leave the borrowed list as it was. Served: when
   // the list is for the same bodies, a reach at least the check's, and a
   // margin that covers the check's motion; a list for another reach or
-  // another mesh is never served.
+  // another mesh is never served. Asked as a yes/no question (any_hit), the
+  // check gives the same answer with no more work.
   const TriangleMesh god = make_icosphere(1, 0.5);
   const TriangleMesh slab = concatenate(make_box(3, 3, 1, Vec3(0, 0, -0.5)), make_box(0.4, 0.4, 0.6, Vec3(0.6, 0, 0.3)));
   const TriangleMesh other = make_box(3, 3, 1, Vec3(0, 0, -0.5));
@@ -489,12 +490,12 @@ TEST_CASE("ccd_step: a step served read-only from another workspace's list agree
   legs.cache.margin_max = 0.06;
   legs.cache.fill_budget = 12;
   check.narrow.min_separation = 0;
-  CcdStepWorkspace ws, ws_check, ws_alone;
-  ws_check.borrowed = &ws.cache;
+  CcdStepWorkspace ws, ws_check, ws_alone, ws_any;
+  ws_check.borrowed = ws_any.borrowed = &ws.cache;
   const CcdBody obstacle{&slab, &sb};
   Pose x{Vec3(0.1, 0, 0.5 + 2e-4), Quat{}};
   std::vector<FeaturePair> hints = {in_contact_hint()};
-  int served = 0, checks_hit = 0;
+  int served = 0, checks_hit = 0, shorter = 0;
   for (int k = 0; k < 150; ++k) {
     Vec3 dp = 0.003 * Vec3(U(rng), U(rng), U(rng));
     const Vec3 turn = 0.004 * Vec3(U(rng), U(rng), U(rng));
@@ -533,6 +534,16 @@ TEST_CASE("ccd_step: a step served read-only from another workspace's list agree
       REQUIRE(r.hit == r_alone.hit);
       if (r.hit) CHECK(std::abs(r.u_hit - bf.u_hit) <= 1e-5);
     }
+    // The same check as a yes/no question (any_hit, as the runtime asks it):
+    // the same answer, stopped at the first hit it finds.
+    CcdStepSettings yes_no = check;
+    yes_no.any_hit = true;
+    CcdStepResult r_any;
+    ccd_step(&obstacle, 1, {&god, &gb}, x, to, yes_no, &ws_any, &r_any, hints.data(), static_cast<int>(hints.size()));
+    CHECK(r_any.hit == r.hit);
+    CHECK((r_any.status == CcdStatus::kOk) == (r.status == CcdStatus::kOk));
+    CHECK(r_any.num_node_pairs <= r.num_node_pairs);
+    shorter += r_any.num_node_pairs + r_any.num_pair_tests < r.num_node_pairs + r.num_pair_tests;
     served += r.u_cached > 0;
     checks_hit += r.hit;
     if (k % 5 == 4) CHECK(r.u_cached == 0);  // beyond the list's margin: descended
@@ -552,9 +563,11 @@ TEST_CASE("ccd_step: a step served read-only from another workspace's list agree
     hints = {in_contact_hint()};
     if (leg.hit) hints.push_back(leg.pair);
   }
-  std::printf("borrowed list: %d of 150 checks served from the legs' list, %d hit\n", served, checks_hit);
+  std::printf("borrowed list: %d of 150 checks served from the legs' list, %d hit, %d shorter as yes/no\n", served,
+              checks_hit, shorter);
   CHECK(served >= 50);
   CHECK(checks_hit >= 20);
+  CHECK(shorter >= 10);
 }
 
 TEST_CASE("ccd_step: a workspace without room to descend is never served an empty cache", "[ccd_step]") {

@@ -204,4 +204,21 @@ struct StopPose {
 };
 StopPose make_stop_pose(const CcdMotion& motion, double u, double body_radius);
 
+// A bound on how far apart two Cayley motions keep each body point: the exact
+// motion a from a0 to a1, and the exact motion b (from b0, its start pose) over
+// [0, ub] run at the same pace (b at u ub when a is at u); for every u in
+// [0, 1] and |r_B| <= body_radius, |(p_a(u) + R_a(u) r_B) - (p_b(u ub) +
+// R_b(u ub) r_B)| <= the result (infinity when a cannot be made: invalid pose,
+// half turn). Why it holds: b over [0, ub] is the Cayley motion of Gibbs vector
+// ub g_b; each motion's quaternion (1, u g) (x) q0 / |q0| is affine in u and of
+// norm >= 1, and x -> x / |x| is the nearest point of the unit ball for such
+// x (a projection on a convex set: it does not lengthen distances), so the unit
+// quaternions differ by at most the affine ones' difference, largest at u = 0
+// or 1; unit quaternions q, q' turn r_B to within 2 |q - q'| |r_B| of each
+// other; the positions are affine in u too. A
+// CCD run of b at min_separation d that stopped at ub keeps a distance >= d
+// on [0, ub]: when the bound is below d, the motion a is free of contact.
+double motion_distance_bound(const Pose& a0, const Pose& a1, const Pose& b0, const CcdMotion& b, double ub,
+                             double body_radius);
+
 }  // namespace gauss6

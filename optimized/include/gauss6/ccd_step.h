@@ -39,6 +39,9 @@ struct CcdStepSettings {
   ProximityCacheSettings cache;            // coherence between steps (proximity_cache.h; cache.margin 0: off)
   double near_distance = 0;                // also list the triangle pairs that may come within this (>=
                                            // min_separation) by the stop pose: the near pairs (CcdStepResult)
+  bool any_hit = false;                    // a yes/no question, "is the motion free?": the step stops at the
+                                           // first hit it finds (hit and status are the answer; u_hit and pair
+                                           // are then a hit's, not the first contact's: no stop pose)
 };
 
 // Why the settings cannot serve a step (nullptr when they can): every
@@ -151,6 +154,10 @@ struct CcdStepWorkspace {
 // the list in use serves.
 // With settings.cache.margin = 0 and ws->borrowed set, that list serves the
 // step read-only under the same rule (the whole rest of the step or nothing).
+// With settings.any_hit the step answers only whether the motion is free: it
+// stops at the first hit it finds (the hints first), whose u_hit is not the
+// first contact's; hit and status are the same as without it (a hit is never
+// taken back by a later search), so it is for checks, never for a stop pose.
 void ccd_step(const CcdBody* obstacles, int num_obstacles, const CcdBody& god, const Pose& X0, const Pose& X1,
               const CcdStepSettings& settings, CcdStepWorkspace* ws, CcdStepResult* result,
               const FeaturePair* hints = nullptr, int num_hints = 0) noexcept;
