@@ -313,6 +313,7 @@ bool lift_out_of_graze(const RuntimeModel& model, const Pose& x_start, const Pos
   }
   s->xs = grazed_xs;
   s->ccd = grazed_leg;
+  s->ccd.num_near_pairs = -1;  // the lift's leg overwrote the grazed leg's near pairs: a full search
   s->stop_deviation = grazed_deviation;
   return false;
 }
