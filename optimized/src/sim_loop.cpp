@@ -278,6 +278,17 @@ bool grazed(const RuntimeModel& model, const SimState& s) {
   return false;
 }
 
+// Back to a leg run earlier, its stop pose, CCD result and deviation saved
+// before a later leg ran. The legs share one workspace (s->ccd_ws), so the
+// later leg overwrote the candidates that the saved result's near pairs index:
+// the restored result has none, and a contact search at xs is a full one.
+void restore_leg(const Pose& xs, const CcdStepResult& leg, double deviation, SimState* s) {
+  s->xs = xs;
+  s->ccd = leg;
+  s->ccd.num_near_pairs = -1;
+  s->stop_deviation = deviation;
+}
+
 // Out of a graze: the leg again, from x_lift = x_start (+) a_lift, a_lift the
 // M-smallest motion that lifts every contact of the set to delta (1 +
 // gap_factor) to first order (the gap rows alone: a fraction of delta), out of
@@ -311,10 +322,7 @@ bool lift_out_of_graze(const RuntimeModel& model, const Pose& x_start, const Pos
     *num_halves = std::max(*num_halves, halves);
     return true;
   }
-  s->xs = grazed_xs;
-  s->ccd = grazed_leg;
-  s->ccd.num_near_pairs = -1;  // the lift's leg overwrote the grazed leg's near pairs: a full search
-  s->stop_deviation = grazed_deviation;
+  restore_leg(grazed_xs, grazed_leg, grazed_deviation, s);
   return false;
 }
 
@@ -466,9 +474,7 @@ void advance_god_object(const RuntimeModel& model, const Pose& x_start, const Po
     // split_step's when the leg was split at a half turn: half the travel,
     // half the rotation): a shorter slide sags less under the crease, and one
     // that stays in the contact band needs no settling.
-    s->xs = from;
-    s->ccd = first_leg;
-    s->stop_deviation = first_deviation;
+    restore_leg(from, first_leg, first_deviation, s);
     info->u_hit = first_leg.u_hit;
     if (info->num_shortenings == kMaxSettleShortenings) {
       keep_a_contact(model, x_start, info->num_halves == 1 && !lifted, shortened_u, s, info);
