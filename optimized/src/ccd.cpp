@@ -411,6 +411,16 @@ void enclose_linear(const LinearPoints& pts, const LinearDifference& ix, const B
 
 namespace {
 
+// A quaternion (w, x, y, z) with enclosed components.
+using IQuat = std::array<Interval, 4>;
+
+// The Hamilton product a b, each component enclosed.
+IQuat hamilton(const IQuat& a, const IQuat& b) {
+  const Interval aw = a[0], ax = a[1], ay = a[2], az = a[3], bw = b[0], bx = b[1], by = b[2], bz = b[3];
+  return {aw * bw - ax * bx - ay * by - az * bz, aw * bx + ax * bw + ay * bz - az * by,
+          aw * by - ax * bz + ay * bw + az * bx, aw * bz + ax * by - ay * bx + az * bw};
+}
+
 // The rational rotation R(q) of pose.h, every entry enclosed; nullopt-like
 // false when |q|^2 is not safely positive.
 bool rational_rotation(const Quat& q, IMat3* R) {
@@ -445,12 +455,8 @@ MotionStatus make_ccd_motion(const Pose& x0, const Pose& x1, CcdMotion* m) {
   // qr = q1 conj(q0), exactly enclosed (Hamilton product), with the same sign
   // choice as make_cayley_motion (decided on the double value).
   const auto I = [](double v) { return Interval::point(v); };
-  const Interval aw = I(x1.q.w), ax = I(x1.q.x), ay = I(x1.q.y), az = I(x1.q.z);
-  const Interval bw = I(x0.q.w), bx = -I(x0.q.x), by = -I(x0.q.y), bz = -I(x0.q.z);
-  Interval rw = aw * bw - ax * bx - ay * by - az * bz;
-  Interval rx = aw * bx + ax * bw + ay * bz - az * by;
-  Interval ry = aw * by - ax * bz + ay * bw + az * bx;
-  Interval rz = aw * bz + ax * by - ay * bx + az * bw;
+  const IQuat r = hamilton({I(x1.q.w), I(x1.q.x), I(x1.q.y), I(x1.q.z)}, {I(x0.q.w), -I(x0.q.x), -I(x0.q.y), -I(x0.q.z)});
+  Interval rw = r[0], rx = r[1], ry = r[2], rz = r[3];
   const Quat qr_double = x1.q * conjugate(x0.q);
   if (qr_double.w < 0) { rw = -rw; rx = -rx; ry = -ry; rz = -rz; }
   if (!(rw.lo > 0)) return MotionStatus::kHalfTurn;
@@ -633,6 +639,8 @@ struct Cubic {
 // computed from the Taylor coefficients at u0 in outward-rounded intervals, with
 // h enclosed, so the test holds for the exact cubic. The ends (b0, b3: the values
 // at u0 and u1) are checked first: they decide most calls.
+// 1/3, enclosed: div_positive(point(1), point(3)), once.
+const Interval kThird = div_positive(Interval::point(1), Interval::point(3));
 bool positive_on(const Cubic& c, double u0, double u1) {
   const Interval U = Interval::point(u0);
   const Interval a0 = c.k[0] + U * (c.k[1] + U * (c.k[2] + U * c.k[3]));
@@ -644,8 +652,7 @@ bool positive_on(const Cubic& c, double u0, double u1) {
   const Interval A2 = (c.k[2] + u3k3) * h2;                      // p''(u0) / 2 h^2
   const Interval A3 = c.k[3] * (h2 * h);
   if (!((a0 + A1 + A2 + A3).lo > 0)) return false;
-  const Interval third = div_positive(Interval::point(1), Interval::point(3));
-  return (a0 + third * A1).lo > 0 && (a0 + third * (2.0 * A1 + A2)).lo > 0;
+  return (a0 + kThird * A1).lo > 0 && (a0 + kThird * (2.0 * A1 + A2)).lo > 0;
 }
 
 // D(u) (x(u) - f).m for the body point with world-oriented offset w = R0 r_B
@@ -667,6 +674,16 @@ GAUSS6_ALWAYS_INLINE Cubic static_point_along(const CcdMotion& m, const IVec3& y
            -dot(m.dp, cn.c2)}};
 }
 
+// A body corner w = R0 r_B of the moving feature, with the terms of its
+// motion that no axis changes: p0 + w, dp + 2 g x w, g x w, g x (g x w).
+struct MovingCorner {
+  IVec3 at0, rate, gxw, ggw;
+  MovingCorner(const CcdMotion& m, const IVec3& w)
+      : at0(m.p0 + w), gxw(cross(m.g, w)), ggw(cross(m.g, gxw)) {
+    rate = m.dp + 2.0 * gxw;
+  }
+};
+
 // The separating-axis test (2) for one axis n: the moving feature's corners'
 // projection coefficients and the static projection grown by d |n|.
 struct SeparatingAxis {
@@ -674,19 +691,14 @@ struct SeparatingAxis {
   Interval c0[3], c1[3], c2[3], c3[3];
   Interval static_proj;
 
-  // Adds a body corner w = R0 r_B (world-oriented offset from G) for the axis n
-  // (exact doubles: each product is a double times an interval).
-  void add_corner(const CcdMotion& m, const IVec3& w, const Vec3& n) {
-    const IVec3 gxw = cross(m.g, w), ggw = cross(m.g, gxw);
-    add_corner(m, w, gxw, ggw, n);
-  }
-  // The same with g x w and g x (g x w) given (they do not depend on n).
-  void add_corner(const CcdMotion& m, const IVec3& w, const IVec3& gxw, const IVec3& ggw, const Vec3& n) {
+  // Adds a body corner (MovingCorner) for the axis n (exact doubles: each
+  // product is a double times an interval).
+  void add_corner(const MovingCorner& k, const Vec3& n) {
     const int j = num_corners++;
-    c0[j] = along(n, m.p0 + w);
-    c1[j] = along(n, m.dp + 2.0 * gxw);
-    c2[j] = along(n, gxw);
-    c3[j] = along(n, ggw);
+    c0[j] = along(n, k.at0);
+    c1[j] = along(n, k.rate);
+    c2[j] = along(n, k.gxw);
+    c3[j] = along(n, k.ggw);
   }
   void set_static(Interval proj, const IVec3& n, double d) {
     static_proj = widen(proj, d * norm_upper(n));
@@ -736,7 +748,7 @@ struct UFilter {
     joins_previous[num_conditions] = join && num_conditions > 0;
     cond[num_conditions++] = c;
   }
-  void add_corner(const IVec3& w, const Vec3& n) { axis.add_corner(*motion, w, n); }
+  void add_corner(const MovingCorner& k, const Vec3& n) { axis.add_corner(k, n); }
   void set_axis_static(Interval proj, const IVec3& n, double d) { axis.set_static(proj, n, d); }
 
   bool excludes(double u0, double u1) const {
@@ -846,8 +858,10 @@ void filtered_bisect(const Enclose& enclose, bool triangle, const Scales& sc, UF
   // tolerance-wide intervals and left the rest of the window to the bisection.
   // (Not the linear queries': their 64-box bisection runs first, and there the
   // extra guide per interval made the unit tests' edge/edge pass 3.5x slower.)
+  // An interval that starts at the window's start has that axis already: the
+  // filter's own axis test (the same nominal closest points, unnormalised).
   const auto separated_from = [&](double u0, double u1) {
-    if (filter.motion == nullptr) return false;
+    if (filter.motion == nullptr || (u0 == u_begin && filter.axis.num_corners > 0)) return false;
     Guide g = guides.at(u0);
     return unit_axis(&g) && guides.separated(g.axis, u0, u1);
   };
@@ -988,10 +1002,11 @@ void rigid_vertex_face(Moving moving, const VertexFacePair& q, const CcdSettings
   if (vertex_moves) {
     const Vec3 x_begin = motion_point(m.nominal, q.u_begin, q.vertex);  // heuristic only (the axis)
     const IVec3 w = mul(m.R0, v);
+    const MovingCorner corner_w(m, w);
     const Vec3 axis = x_begin - closest_point_on_triangle(x_begin, q.face[0], q.face[1], q.face[2]);
     if (axis != Vec3::Zero() && std::isfinite(axis.squaredNorm())) {
       const IVec3 na = to_interval(axis);
-      filter.add_corner(w, axis);
+      filter.add_corner(corner_w, axis);
       filter.set_axis_static(hull(hull(dot(na, corner[0]), dot(na, corner[1])), dot(na, corner[2])), na, d);
     }
     if (axis_clears(filter, q.u_begin, q.u_end, r)) return;  // before the coplanarity cubic's set-up
@@ -1010,11 +1025,10 @@ void rigid_vertex_face(Moving moving, const VertexFacePair& q, const CcdSettings
       g.valid = true;
       return g;
     };
-    const IVec3 gxw = cross(m.g, w), ggw = cross(m.g, gxw);
     const auto separated = [&](const Vec3& axis_u, double u0, double u1) {
       SeparatingAxis sa;
       const IVec3 na = to_interval(axis_u);
-      sa.add_corner(m, w, gxw, ggw, axis_u);
+      sa.add_corner(corner_w, axis_u);
       sa.set_static(hull(hull(dot(na, corner[0]), dot(na, corner[1])), dot(na, corner[2])), na, d);
       return sa.excludes(m, u0, u1);
     };
@@ -1031,9 +1045,11 @@ void rigid_vertex_face(Moving moving, const VertexFacePair& q, const CcdSettings
   Vec3 moved[3];
   for (int k = 0; k < 3; ++k) moved[k] = motion_point(m.nominal, q.u_begin, q.face[k]);
   const Vec3 axis = q.vertex - closest_point_on_triangle(q.vertex, moved[0], moved[1], moved[2]);
+  const MovingCorner face_corners[3] = {{m, mul(m.R0, corner[0])}, {m, mul(m.R0, corner[1])},
+                                        {m, mul(m.R0, corner[2])}};
   if (axis != Vec3::Zero() && std::isfinite(axis.squaredNorm())) {
     const IVec3 na = to_interval(axis);
-    for (int k = 0; k < 3; ++k) filter.add_corner(mul(m.R0, corner[k]), axis);
+    for (int k = 0; k < 3; ++k) filter.add_corner(face_corners[k], axis);
     filter.set_axis_static(dot(na, v), na, d);
   }
   if (axis_clears(filter, q.u_begin, q.u_end, r)) return;  // before the coplanarity cubic's set-up
@@ -1054,15 +1070,9 @@ void rigid_vertex_face(Moving moving, const VertexFacePair& q, const CcdSettings
     g.valid = true;
     return g;
   };
-  IVec3 cw[3], cgxw[3], cggw[3];
-  for (int k = 0; k < 3; ++k) {
-    cw[k] = mul(m.R0, corner[k]);
-    cgxw[k] = cross(m.g, cw[k]);
-    cggw[k] = cross(m.g, cgxw[k]);
-  }
   const auto separated = [&](const Vec3& axis_u, double u0, double u1) {
     SeparatingAxis sa;
-    for (int k = 0; k < 3; ++k) sa.add_corner(m, cw[k], cgxw[k], cggw[k], axis_u);
+    for (int k = 0; k < 3; ++k) sa.add_corner(face_corners[k], axis_u);
     sa.set_static(along(axis_u, v), to_interval(axis_u), d);
     return sa.excludes(m, u0, u1);
   };
@@ -1126,10 +1136,11 @@ void ccd_rigid_edge_edge(const RigidEdgeEdgeQuery& q, const CcdSettings& s, CcdW
   double sa = 0, tb = 0;
   closest_segment_parameters(A0, A1, q.edge_W[0], q.edge_W[1], &sa, &tb);
   const Vec3 axis = (A0 + sa * (A1 - A0)) - (q.edge_W[0] + tb * (q.edge_W[1] - q.edge_W[0]));
+  const MovingCorner ends[2] = {{m, a0W}, {m, a1W}};
   if (axis != Vec3::Zero() && std::isfinite(axis.squaredNorm())) {
     const IVec3 na = to_interval(axis);
-    filter.add_corner(a0W, axis);
-    filter.add_corner(a1W, axis);
+    filter.add_corner(ends[0], axis);
+    filter.add_corner(ends[1], axis);
     filter.set_axis_static(hull(dot(na, b0), dot(na, b0 + eb)), na, d);
   }
   if (axis_clears(filter, q.u_begin, q.u_end, r)) return;  // before the coplanarity cubic's set-up
@@ -1157,13 +1168,11 @@ void ccd_rigid_edge_edge(const RigidEdgeEdgeQuery& q, const CcdSettings& s, CcdW
     g.axis = (P0 + g.a * (P1 - P0)) - (q.edge_W[0] + g.b * (q.edge_W[1] - q.edge_W[0]));
     return g;
   };
-  const IVec3 ea_gxw[2] = {cross(m.g, a0W), cross(m.g, a1W)};
-  const IVec3 ea_ggw[2] = {cross(m.g, ea_gxw[0]), cross(m.g, ea_gxw[1])};
   const IVec3 b1 = b0 + eb;
   const auto separated = [&](const Vec3& axis_u, double u0, double u1) {
     SeparatingAxis sa;
-    sa.add_corner(m, a0W, ea_gxw[0], ea_ggw[0], axis_u);
-    sa.add_corner(m, a1W, ea_gxw[1], ea_ggw[1], axis_u);
+    sa.add_corner(ends[0], axis_u);
+    sa.add_corner(ends[1], axis_u);
     sa.set_static(hull(along(axis_u, b0), along(axis_u, b1)), to_interval(axis_u), d);
     return sa.excludes(m, u0, u1);
   };
@@ -1429,7 +1438,7 @@ namespace {
 
 // The unit quaternion q / |q| of a pose, enclosed (false when |q| cannot be
 // bounded away from 0).
-bool unit_quaternion(const Quat& q, std::array<Interval, 4>* out) {
+bool unit_quaternion(const Quat& q, IQuat* out) {
   const double c[4] = {q.w, q.x, q.y, q.z};
   Interval n2 = Interval::point(0);
   for (double v : c) n2 = n2 + sqr(Interval::point(v));
@@ -1439,12 +1448,6 @@ bool unit_quaternion(const Quat& q, std::array<Interval, 4>* out) {
   return true;
 }
 
-// (1, g) (x) q (Hamilton product, w first).
-std::array<Interval, 4> gibbs_times(const IVec3& g, const std::array<Interval, 4>& q) {
-  const Interval w = q[0], x = q[1], y = q[2], z = q[3];
-  return {w - (g[0] * x + g[1] * y + g[2] * z), x + g[0] * w + (g[1] * z - g[2] * y),
-          y + g[1] * w + (g[2] * x - g[0] * z), z + g[2] * w + (g[0] * y - g[1] * x)};
-}
 
 template <size_t N>
 Upper difference_norm(const std::array<Interval, N>& a, const std::array<Interval, N>& b) {
@@ -1459,7 +1462,7 @@ double motion_distance_bound(const Pose& a0, const Pose& a1, const Pose& b0, con
                              double body_radius) {
   constexpr double kNone = std::numeric_limits<double>::infinity();
   CcdMotion a;
-  std::array<Interval, 4> qa, qb;
+  IQuat qa, qb;
   if (!(ub >= 0 && ub <= 1 && body_radius >= 0) || make_ccd_motion(a0, a1, &a) != MotionStatus::kOk ||
       !unit_quaternion(a0.q, &qa) || !unit_quaternion(b0.q, &qb))
     return kNone;
@@ -1469,7 +1472,9 @@ double motion_distance_bound(const Pose& a0, const Pose& a1, const Pose& b0, con
   // Rotations: max over u = 0, 1 of the affine quaternions' difference.
   IVec3 gb;
   for (int i = 0; i < 3; ++i) gb[static_cast<size_t>(i)] = ub * b.g[static_cast<size_t>(i)];
-  const Upper turn = max(difference_norm(qa, qb), difference_norm(gibbs_times(a.g, qa), gibbs_times(gb, qb)));
+  // (1, g) q: the affine quaternion at u = 1 of the motion from q with Gibbs vector g.
+  const auto at_end = [](const IVec3& g, const IQuat& q) { return hamilton({Interval::point(1), g[0], g[1], g[2]}, q); };
+  const Upper turn = max(difference_norm(qa, qb), difference_norm(at_end(a.g, qa), at_end(gb, qb)));
   // Positions: max over u = 0, 1 (b's start is b0.p, its position at ub p0 + ub dp).
   IVec3 pb1;
   for (int i = 0; i < 3; ++i)
