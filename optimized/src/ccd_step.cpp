@@ -51,6 +51,36 @@ double step_time_tolerance(const CcdMotion& motion, const CcdBody& god, const Cc
   return bound < settings.narrow.time_tolerance ? bound : settings.narrow.time_tolerance;  // NaN, 0 travel: settings'
 }
 
+// The lead pieces (CcdStepSettings::lead_sweep): k pieces ahead of the first
+// sub-interval's last quarter, each a quarter of the next, k the least that
+// makes the first sweep at most lead_sweep reaches (the nominal motion's travel
+// and turn at the god-object's radius; a heuristic: any partition of [0, 1]
+// is searched alike), at most kMaxLead. A settling leg stops 0.0003-0.06 into
+// its motion (the replays' 5th-95th percentiles on the bunnies), where the
+// swept boxes of its whole motion, a turn of 0.02-0.03 rad, reached 900-2,000
+// node pairs on the full bunnies.
+constexpr int kMaxLead = 6;
+int plan_lead(const CcdMotion& motion, const CcdBody& god, int n, double reach, double lead_sweep) {
+  if (!(lead_sweep > 0)) return 0;
+  const double sweep = (motion.nominal.dp.norm() + motion_angle(motion.nominal, 1.0) * god.bvh->radius) / n;
+  int k = 0;
+  for (double piece = sweep; k < kMaxLead && piece > lead_sweep * reach; piece *= 0.25) ++k;
+  return k;  // 0 for a NaN sweep
+}
+
+// Piece j of a step planned as n sub-intervals with `lead` pieces ahead: the
+// lead's pieces of [0, 1/n] first, then the sub-intervals [i/n, (i+1)/n].
+void plan_piece(int j, int lead, int n, double* u0, double* u1) {
+  if (j <= lead) {
+    *u0 = j == 0 ? 0.0 : std::ldexp(1.0, -2 * (lead - j + 1)) / n;
+    *u1 = j < lead ? std::ldexp(1.0, -2 * (lead - j)) / n : (n == 1 ? 1.0 : 1.0 / n);
+    return;
+  }
+  const int i = j - lead;
+  *u0 = static_cast<double>(i) / n;
+  *u1 = (i + 1 == n) ? 1.0 : static_cast<double>(i + 1) / n;
+}
+
 // The triangle pair is one of hints[0 .. count).
 bool among(const FeaturePair* hints, int count, int gf, int of, int o) {
   for (int h = 0; h < count; ++h)
@@ -114,8 +144,8 @@ TraversalStatus descend(StepState* s, double u_end, const Visit& visit) {
   return TraversalStatus::kDone;
 }
 
-// The sub-intervals past the cached range, each descended and its candidates
-// tested. False when the descent's stack overflowed (the step then stops
+// The sub-intervals (and lead pieces) past the cached range, each descended and
+// its candidates tested. False when the descent's stack overflowed (the step then stops
 // conservatively, result final).
 bool search_sub_intervals(StepState* s) {
   const CcdBody& god = s->god;
@@ -123,10 +153,10 @@ bool search_sub_intervals(StepState* s) {
   PairTester& tester = s->tester;
   CcdStepWorkspace::Candidate* const cand = s->ws->candidates.data();
   const int cand_capacity = static_cast<int>(s->ws->candidates.size());
-  const int n = s->n;
-  for (int i = 0; i < n && !answered(*s); ++i) {
-    const double u0 = std::max(static_cast<double>(i) / n, s->u_cached);
-    const double u1 = (i + 1 == n) ? 1.0 : static_cast<double>(i + 1) / n;
+  for (int j = 0; j < s->n + s->lead && !answered(*s); ++j) {
+    double u0 = 0, u1 = 1;
+    plan_piece(j, s->lead, s->n, &u0, &u1);
+    u0 = std::max(u0, s->u_cached);
     if (!(u0 < u1)) continue;  // inside the cached range
     if (result->hit && result->u_hit - s->settings.narrow.time_tolerance <= u0) break;  // nothing left to search
     enclose_motion(s->motion, {u0, std::min(u1, result->u_hit)}, &s->e);
@@ -229,6 +259,7 @@ const char* ccd_step_settings_problem(const CcdStepSettings& s) {
   if (!positive(s.sub_interval_angle) || !positive(s.sub_interval_travel))
     return "ccd.sub_interval_angle and ccd.sub_interval_travel must be > 0 and finite";
   if (!non_negative(s.near_distance)) return "ccd.near_distance must be >= 0 and finite";
+  if (!non_negative(s.lead_sweep)) return "ccd.lead_sweep must be >= 0 and finite";
   if (!valid_proximity_cache_settings(s.cache)) return "ccd.cache: the proximity cache's settings are not valid";
   return nullptr;
 }
@@ -254,7 +285,8 @@ void ccd_step(const CcdBody* obstacles, int num_obstacles, const CcdBody& god, c
   StepState s(obstacles, num_obstacles, god, X0, step_settings, ws, result, hints, num_hints);
   // Plan the sub-intervals.
   s.n = plan_sub_intervals(s.motion, god, settings);
-  result->num_sub_intervals = s.n;
+  s.lead = plan_lead(s.motion, god, s.n, s.reach, settings.lead_sweep);
+  result->num_sub_intervals = s.n + s.lead;
   // The hints and the proximity cache both start from the god-object at u = 0.
   const bool cached = settings.cache.margin > 0;
   const bool borrowing = !cached && ws->borrowed != nullptr;

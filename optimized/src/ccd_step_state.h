@@ -59,6 +59,7 @@ struct StepState {
   const double reach;       // max(min_separation, near_distance)
   const double rho;         // the god-object's radius (about G)
   int n = 1;                // sub-intervals
+  int lead = 0;             // pieces searched ahead of the first sub-interval's rest (ccd_step.cpp plan_lead)
   MotionEnclosure e;        // the motion over the range being searched
   StartFrame start;         // the god-object at that range's start
   PairTester tester;        // tests on [tester.u0, tester.end()], earliest hit in *result

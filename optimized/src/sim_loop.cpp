@@ -184,13 +184,20 @@ Vec6 constrain_motion(const RuntimeModel& model, const Vec6& au, SimState* s, do
 // the most work: in one profiled pass of the bunnies, 68 of the 549 steps over
 // 0.1 ms of CPU ran a background fill in a later leg, 196 node pairs on
 // average (docs/benchmarks.md, issue 20, fourth session).
+// A settling leg (settling = true) searches its start in lead pieces
+// (CcdStepSettings::lead_sweep, kSettleLeadSweep): it starts just off the
+// surface it lifted from and stops again at u 0.0003-0.06 (the bunnies'
+// replays, 5th-95th percentiles), while the swept boxes of its whole motion,
+// a turn of 0.02-0.03 rad, meant 900-2,000 node pairs of descent in the full
+// bunnies' slowest steps (docs/benchmarks.md, issue 20, seventh session).
 bool ccd_leg(const RuntimeModel& model, const Pose& x0, const Pose& x1, int num_hints, SimState* s,
-             int* num_halves, bool first_leg) {
+             int* num_halves, bool first_leg, bool settling = false) {
   const int num_obstacles = static_cast<int>(model.obstacles.size());
   const CcdBody* obstacles = model.obstacles.data();
   CcdStepResult& r = s->ccd;
   CcdStepSettings settings = model.settings.ccd;
   if (!first_leg) settings.cache.fill_budget = 0;
+  if (settling) settings.lead_sweep = kSettleLeadSweep;
   ccd_step(obstacles, num_obstacles, model.god, x0, x1, settings, &s->ccd_ws, &r, s->ccd_hints.data(),
            num_hints);
   if (r.status == CcdStatus::kHalfTurn) {
@@ -455,7 +462,7 @@ void advance_god_object(const RuntimeModel& model, const Pose& x_start, const Po
     const double first_deviation = s->stop_deviation;
     int halves = 1;
     const bool settled = ccd_leg(model, from, pose_update(from, residual), num_hints, s, &halves,
-                                 /*first_leg=*/false);
+                                 /*first_leg=*/false, /*settling=*/true);
     if (info->ccd == CcdStatus::kOk) info->ccd = s->ccd.status;
     info->u_hit = s->ccd.u_hit;
     if (!settled) break;  // s->xs is still the first leg's end

@@ -39,6 +39,10 @@ struct CcdStepSettings {
   ProximityCacheSettings cache;            // coherence between steps (proximity_cache.h; cache.margin 0: off)
   double near_distance = 0;                // also list the triangle pairs that may come within this (>=
                                            // min_separation) by the stop pose: the near pairs (CcdStepResult)
+  double lead_sweep = 0;                   // > 0: a leg expected to stop early (a settling leg) searches its
+                                           // first sub-interval in pieces, [0, 4^-k/n], [4^-k/n, 4^(1-k)/n],
+                                           // ..., [1/(4n), 1/n], the first sweeping about this many times the
+                                           // reach: a first contact met soon ends the search there (0: off)
   bool any_hit = false;                    // a yes/no question, "is the motion free?": the step stops at the
                                            // first hit it finds (hit and status are the answer; u_hit and pair
                                            // are then a hit's, not the first contact's: no stop pose)
@@ -47,8 +51,8 @@ struct CcdStepSettings {
 // Why the settings cannot serve a step (nullptr when they can): every
 // tolerance positive and finite (time_tolerance below 1, the whole window),
 // min_separation and near_distance finite and >= 0, max_iterations and
-// max_sub_intervals >= 1, the sub-interval bounds positive and finite, the
-// proximity cache's settings valid. ccd_step refuses such a step (kInvalidInput)
+// max_sub_intervals >= 1, the sub-interval bounds positive and finite,
+// lead_sweep finite and >= 0, the proximity cache's settings valid. ccd_step refuses such a step (kInvalidInput)
 // before any pair test; RuntimeModel refuses them when it is built.
 const char* ccd_step_settings_problem(const CcdStepSettings& settings);
 

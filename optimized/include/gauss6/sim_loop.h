@@ -91,6 +91,9 @@ const SimStepInfo& sim_step(const RuntimeModel& model, double t, RuntimeChannels
 constexpr int kMaxSettleShortenings = 3;
 // After them, the first leg halved on (without settling) until its end keeps a contact.
 constexpr int kMaxKeepHalvings = 8;
+// The settling leg's first lead piece sweeps about this many times the CCD's
+// reach (CcdStepSettings::lead_sweep).
+constexpr double kSettleLeadSweep = 16;
 void advance_god_object(const RuntimeModel& model, const Pose& x_start, const Pose& x_target, const Vec6& residual,
                         SimState* s, SimStepInfo* info) noexcept;
 
