@@ -73,7 +73,7 @@ BruteForce brute_force(const TriangleMesh& god, const Bvh& gb, const TriangleMes
 
 }  // namespace
 
-TEST_CASE("BVH: every truly colliding triangle pair is a candidate; ccd_step agrees with brute force", "[ccd_step]") {
+TEST_CASE("BVH: every truly colliding triangle pair is a candidate, ccd_step agrees with brute force", "[ccd_step]") {
   const TriangleMesh god = make_icosphere(1, 0.5);    // 80 triangles, body frame about G
   const TriangleMesh obs = make_box(2, 2, 1, Vec3(0, 0, -0.5));  // world frame, top at z = 0
   const TriangleMesh obs2 = make_icosphere(1, 0.4);

@@ -103,7 +103,7 @@ constexpr double kOrthogonalityTol = 1e-9;
 
 }  // namespace
 
-TEST_CASE("runtime: model built once; refused settings and surfaces", "[runtime]") {
+TEST_CASE("runtime: model built once, refused settings and surfaces", "[runtime]") {
   const Scene sc = make_scene();
   const RuntimeModel model(sc, RuntimeSettings{});
   REQUIRE(model.obstacles.size() == 1);
@@ -189,7 +189,7 @@ TEST_CASE("runtime: delta-scaled settings resolve into the CCD's", "[runtime]") 
   CHECK(e.runtime.ccd.near_distance == e.contact_generation.distance + 0.5 * d);
 }
 
-TEST_CASE("runtime: a box pressed onto a box never penetrates; the force is up, kh m ks deep", "[runtime]") {
+TEST_CASE("runtime: a box pressed onto a box never penetrates, the force is up, kh m ks deep", "[runtime]") {
   // Handle from G = 0.2 down to 0.03 at 0.2 m/s (2 cm deeper than resting, at
   // t = 0.85 s), held until 1.2 s. One sim step per haptic tick.
   ScriptedDevice device(press_script(0.2, 0.03, 0.2));

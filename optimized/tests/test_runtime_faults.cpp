@@ -410,7 +410,7 @@ TEST_CASE("faults: a non-finite force from inside the pipeline is zeroed and rep
   CHECK(device.writes[2].F[2] == 2.0);
 }
 
-TEST_CASE("faults: contact overflow truncates the set, reported; the god-object stays out", "[runtime][faults]") {
+TEST_CASE("faults: contact overflow truncates the set, reported, the god-object stays out", "[runtime][faults]") {
   // 121 bottom vertices rest on the slab: more than the default capacity (64) contacts.
   const Scene sc = make_grid_bottom_scene(10);
   ScriptedDevice device(press_script(0.2, 0.04, 0.4));
@@ -508,7 +508,7 @@ TEST_CASE("faults: CCD give-up keeps the hit conservatively, reported", "[runtim
   check_bounded(device);
 }
 
-TEST_CASE("faults: projection failure is reported; the force stays finite and bounded", "[runtime][faults]") {
+TEST_CASE("faults: projection failure is reported, the force stays finite and bounded", "[runtime][faults]") {
   // An add/drop cap of 0 steps: any active row makes the projection stop at its cap.
   RuntimeSettings settings;
   settings.projection.max_iterations = 0;
@@ -520,7 +520,7 @@ TEST_CASE("faults: projection failure is reported; the force stays finite and bo
   check_bounded(device);
 }
 
-TEST_CASE("faults: invalid handle poses give zero force and an event; invalid settings are refused",
+TEST_CASE("faults: invalid handle poses give zero force and an event, invalid settings are refused",
           "[runtime][faults]") {
   for (const Pose& bad : {Pose{Vec3(0, 0, 0.04), Quat{0, 0, 0, 0}}, Pose{Vec3(0, 0, -1e155), Quat{}},
                           Pose{Vec3(2e12, 0, 0), Quat{}}})

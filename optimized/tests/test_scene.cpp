@@ -171,7 +171,7 @@ TEST_CASE("bad scenes are errors that name the file, line and key", "[scene]") {
 
 // Version 2 states a texture's amplitude in scene units; version 1 stated the
 // height field's steepest slope, converted at load into the same field.
-TEST_CASE("texture amplitudes are in scene units; version 1's slopes are converted", "[scene]") {
+TEST_CASE("texture amplitudes are in scene units, version 1's slopes are converted", "[scene]") {
   using Catch::Matchers::Contains;
   const auto text = [](int version, const char* texture, const char* amplitude) {
     const std::string s = edited("version = 1", "version = " + std::to_string(version));

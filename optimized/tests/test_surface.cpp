@@ -154,7 +154,7 @@ TEST_CASE("surface: a texture's average is weighted by the forces the contacts c
   CHECK(shade_contacts(surface, nullptr, set, G, 4, Js, normals, &weighting) <= 1e-12);
 }
 
-TEST_CASE("surface: textures' gradients match their height fields; the sampling bound", "[surface]") {
+TEST_CASE("surface: textures' gradients match their height fields, the sampling bound", "[surface]") {
   TextureField t;
   t.amplitude = 0.0008;  // scene units: 0.8 mm bumps of 1 cm
   t.wavelength = 0.01;

@@ -654,7 +654,7 @@ const std::vector<StoredInstance>& ill_conditioned_instances() {
 
 }  // namespace
 
-TEST_CASE("jammed instances of the families: the exact optimum is verified; the "
+TEST_CASE("jammed instances of the families: the exact optimum is verified, the "
           "floating-point optimum is infeasible by a rounding-level amount",
           "[refqp][refqp-illposed]") {
   for (const StoredInstance& s : ill_conditioned_instances()) {
