@@ -152,6 +152,26 @@ TEST_CASE("BVH: every truly colliding triangle pair is a candidate, ccd_step agr
     REQUIRE(r_hinted.status == CcdStatus::kOk);
     CHECK(r_hinted.hit == bf.hit);
     if (r_hinted.hit && bf.hit) CHECK(std::abs(r_hinted.u_hit - bf.u_hit) <= 1e-5);
+    // The first sub-interval searched in lead pieces (CcdStepSettings::lead_sweep,
+    // with and without a reach to scale it): other windows, the same first
+    // contact (same 1e-5 bound). Every motion here sweeps far more than the
+    // first piece may, so pieces are planned.
+    CcdStepSettings leading = i % 3 == 0 ? settings : probing;
+    leading.narrow.min_separation = i % 2 ? 0.0 : 1e-4;
+    leading.lead_sweep = i % 3 == 0 ? 1.0 : (i % 3 == 1 ? 4.0 : 16.0);
+    CcdStepResult r_lead;
+    ccd_step(&ob_body, 1, {&god, &gb}, x0, x1, leading, &ws, &r_lead, i % 2 ? hints.data() : nullptr,
+             i % 2 ? static_cast<int>(hints.size()) : 0);
+    REQUIRE(r_lead.status == CcdStatus::kOk);
+    CHECK(r_lead.num_sub_intervals > r.num_sub_intervals);
+    if (leading.narrow.min_separation == 0) {
+      CHECK(r_lead.hit == bf.hit);
+      if (r_lead.hit && bf.hit) CHECK(std::abs(r_lead.u_hit - bf.u_hit) <= 1e-5);
+    } else {
+      // Within 1e-4 no later than the first contact; kept 1e-4 apart, no contact.
+      if (r_lead.hit && bf.hit) CHECK(r_lead.u_hit <= bf.u_hit + 1e-5);
+      if (!r_lead.hit) CHECK_FALSE(bf.hit);
+    }
   }
   CHECK(hits >= 10);
 }
@@ -689,6 +709,42 @@ TEST_CASE("ccd_step: the proximity cache's keys never grow, and its settings are
     CHECK(r.status == CcdStatus::kInvalidInput);
   }
   CHECK(valid_proximity_cache_settings(ProximityCacheSettings{}));
+  for (double lead : {-1.0, std::numeric_limits<double>::infinity(), std::numeric_limits<double>::quiet_NaN()}) {
+    CcdStepSettings bad = settings;
+    bad.lead_sweep = lead;
+    CHECK(ccd_step_settings_problem(bad) != nullptr);
+    CcdStepResult r;
+    ccd_step(obstacles, 1, {&god, &gb}, x0, x1, bad, &roomy, &r, &hint, 1);
+    CHECK(r.status == CcdStatus::kInvalidInput);
+  }
+}
+
+TEST_CASE("ccd_step: lead pieces find a first contact in whichever piece it falls", "[ccd_step]") {
+  // A unit box falling flat by 3 onto a slab: its bottom face (G - 1/2) meets
+  // z = 0 at u* = (z0 - 1/2) / 3, put in each of the pieces [0, 4^-6], ...,
+  // [1/4, 1] (CcdStepSettings::lead_sweep; reach 0: the most pieces) and at
+  // their ends. Every piece must be searched, from its start: the box is
+  // through the slab by the next one.
+  const TriangleMesh god = make_box(1, 1, 1);
+  const TriangleMesh slab = make_box(4, 4, 1, Vec3(0, 0, -0.5));  // top face z = 0
+  const Bvh gb = build_bvh(god), sb = build_bvh(slab);
+  const CcdBody obstacle{&slab, &sb}, body{&god, &gb};
+  CcdStepSettings plain, leading;
+  leading.lead_sweep = 1;
+  CcdStepWorkspace ws;
+  for (double u_star : {1e-4, 0.000244140625, 5e-4, 2e-3, 1e-2, 0.04, 0.0625, 0.1, 0.2, 0.25, 0.3, 0.45, 0.6, 0.9}) {
+    const Pose x0{Vec3(0.1, 0.2, 0.5 + 3 * u_star), Quat{}}, x1{Vec3(0.1, 0.2, 0.5 + 3 * u_star - 3), Quat{}};
+    CcdStepResult r_plain, r_lead;
+    ccd_step(&obstacle, 1, body, x0, x1, plain, &ws, &r_plain);
+    ccd_step(&obstacle, 1, body, x0, x1, leading, &ws, &r_lead);
+    REQUIRE(r_lead.status == CcdStatus::kOk);
+    CHECK(r_lead.num_sub_intervals == r_plain.num_sub_intervals + 6);
+    // (z0 is rounded: u* is within 1e-15 of the value written.)
+    CHECK(r_lead.hit);
+    CHECK(r_lead.u_hit <= u_star + 1e-15);
+    CHECK(u_star - r_lead.u_hit <= 1e-5);  // as the plain step below (time tolerance 1e-6 at speed 3)
+    CHECK(u_star - r_plain.u_hit <= 1e-5);
+  }
 }
 
 TEST_CASE("ccd_step: a box falling flat onto a slab, and one tipping onto it", "[ccd_step]") {
