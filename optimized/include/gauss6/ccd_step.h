@@ -67,7 +67,8 @@ struct CcdStepResult {
   FeaturePair pair;                        // the pair that gave u_hit (when hit)
   double time_tolerance_reached = 0, distance_reached = 0;  // of that pair's test
   CcdMotion motion;                        // the enclosed motion used (for make_stop_pose)
-  int num_sub_intervals = 0, num_node_pairs = 0, num_triangle_pairs = 0, num_pair_tests = 0;
+  int num_sub_intervals = 0;               // the sub-intervals planned, lead pieces included (CcdStepSettings::lead_sweep)
+  int num_node_pairs = 0, num_triangle_pairs = 0, num_pair_tests = 0;
   int num_axis_culls = 0;                  // triangle pairs dropped whole by a separating-axis time bound (no pair test)
   int num_feature_culls = 0;               // feature pairs dropped by their own time bound (no pair test)
   long num_box_iterations = 0;             // narrow-phase boxes, all tests together
