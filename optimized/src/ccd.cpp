@@ -677,11 +677,9 @@ GAUSS6_ALWAYS_INLINE Cubic static_point_along(const CcdMotion& m, const IVec3& y
 // A body corner w = R0 r_B of the moving feature, with the terms of its
 // motion that no axis changes: p0 + w, dp + 2 g x w, g x w, g x (g x w).
 struct MovingCorner {
-  IVec3 at0, rate, gxw, ggw;
+  IVec3 at0, gxw, ggw, rate;
   MovingCorner(const CcdMotion& m, const IVec3& w)
-      : at0(m.p0 + w), gxw(cross(m.g, w)), ggw(cross(m.g, gxw)) {
-    rate = m.dp + 2.0 * gxw;
-  }
+      : at0(m.p0 + w), gxw(cross(m.g, w)), ggw(cross(m.g, gxw)), rate(m.dp + 2.0 * gxw) {}
 };
 
 // The separating-axis test (2) for one axis n: the moving feature's corners'
@@ -1447,7 +1445,6 @@ bool unit_quaternion(const Quat& q, IQuat* out) {
   for (int i = 0; i < 4; ++i) (*out)[static_cast<size_t>(i)] = div_positive(Interval::point(c[i]), n);
   return true;
 }
-
 
 template <size_t N>
 Upper difference_norm(const std::array<Interval, N>& a, const std::array<Interval, N>& b) {

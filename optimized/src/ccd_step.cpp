@@ -36,6 +36,12 @@ int plan_sub_intervals(const CcdMotion& motion, const CcdBody& god, const CcdSte
   return static_cast<int>(std::clamp(std::ceil(want), 1.0, static_cast<double>(settings.max_sub_intervals)));
 }
 
+// How far a point of the god-object moves over the step, nominally (doubles,
+// a heuristic): |dp| + angle radius.
+double nominal_travel(const CcdMotion& motion, const CcdBody& god) {
+  return motion.nominal.dp.norm() + motion_angle(motion.nominal, 1.0) * god.bvh->radius;
+}
+
 // The time tolerance the step searches with: the settings', lowered so that
 // the back-off it allows (a hit is reported up to time_tolerance before the
 // contact, and the step stops there) moves no point of the god-object by more
@@ -46,7 +52,7 @@ int plan_sub_intervals(const CcdMotion& motion, const CcdBody& god, const CcdSte
 // parameter's speed in u varies by a factor under 2, within the fraction's margin.
 constexpr double kBackOffFraction = 0.05;
 double step_time_tolerance(const CcdMotion& motion, const CcdBody& god, const CcdStepSettings& settings) {
-  const double travel = motion.nominal.dp.norm() + motion_angle(motion.nominal, 1.0) * god.bvh->radius;
+  const double travel = nominal_travel(motion, god);
   const double bound = kBackOffFraction * settings.narrow.min_separation / travel;
   return bound < settings.narrow.time_tolerance ? bound : settings.narrow.time_tolerance;  // NaN, 0 travel: settings'
 }
@@ -62,7 +68,7 @@ double step_time_tolerance(const CcdMotion& motion, const CcdBody& god, const Cc
 constexpr int kMaxLead = 6;
 int plan_lead(const CcdMotion& motion, const CcdBody& god, int n, double reach, double lead_sweep) {
   if (!(lead_sweep > 0)) return 0;
-  const double sweep = (motion.nominal.dp.norm() + motion_angle(motion.nominal, 1.0) * god.bvh->radius) / n;
+  const double sweep = nominal_travel(motion, god) / n;
   int k = 0;
   for (double piece = sweep; k < kMaxLead && piece > lead_sweep * reach; piece *= 0.25) ++k;
   return k;  // 0 for a NaN sweep
@@ -71,13 +77,14 @@ int plan_lead(const CcdMotion& motion, const CcdBody& god, int n, double reach, 
 // Piece j of a step planned as n sub-intervals with `lead` pieces ahead: the
 // lead's pieces of [0, 1/n] first, then the sub-intervals [i/n, (i+1)/n].
 void plan_piece(int j, int lead, int n, double* u0, double* u1) {
-  if (j <= lead) {
-    *u0 = j == 0 ? 0.0 : std::ldexp(1.0, -2 * (lead - j + 1)) / n;
-    *u1 = j < lead ? std::ldexp(1.0, -2 * (lead - j)) / n : (n == 1 ? 1.0 : 1.0 / n);
+  const auto quarters = [&](int k) { return std::ldexp(1.0, -2 * k) / n; };  // 4^-k / n
+  if (j < lead) {
+    *u0 = j == 0 ? 0.0 : quarters(lead - j + 1);
+    *u1 = quarters(lead - j);
     return;
   }
-  const int i = j - lead;
-  *u0 = static_cast<double>(i) / n;
+  const int i = j - lead;  // the sub-interval; the first starts after the lead's pieces
+  *u0 = i == 0 && lead > 0 ? quarters(1) : static_cast<double>(i) / n;
   *u1 = (i + 1 == n) ? 1.0 : static_cast<double>(i + 1) / n;
 }
 
