@@ -29,6 +29,7 @@ SimState::SimState(const RuntimeModel& model)
       ccd_ws(CcdStepWorkspace::kBoxCapacity, CcdStepWorkspace::kStackCapacity, CcdStepWorkspace::kCandidateCapacity,
              std::max(static_cast<int>(model.obstacles.size()), CcdStepWorkspace::kObstacleCapacity)),
       ccd_hints(static_cast<size_t>(capacity)),
+      proven_near(ccd_ws.candidates.size()),
       contact_ws(model.god_mesh_B),
       snapshot(capacity) {
   xs = model.initial_pose;
@@ -209,6 +210,7 @@ bool ccd_leg(const RuntimeModel& model, const Pose& x0, const Pose& x1, int num_
     if (r.status != CcdStatus::kInvalidInput && r.status != CcdStatus::kHalfTurn && !r.hit)
       ccd_step(obstacles, num_obstacles, model.god, mid, x1, settings, &s->ccd_ws, &r);
   }
+  s->near_is_proven = false;  // r's near pairs, if any, are ccd_ws's
   if (r.status == CcdStatus::kInvalidInput || r.status == CcdStatus::kHalfTurn) return false;
   const StopPose stop = make_stop_pose(r.motion, r.hit ? r.u_hit : 1.0, model.god_radius);
   s->xs = stop.pose;
@@ -293,6 +295,7 @@ void restore_leg(const Pose& xs, const CcdStepResult& leg, double deviation, Sim
   s->xs = xs;
   s->ccd = leg;
   s->ccd.num_near_pairs = -1;
+  s->near_is_proven = false;
   s->stop_deviation = deviation;
 }
 
@@ -346,20 +349,38 @@ void update_contacts(const RuntimeModel& model, SimState* s) {
   // within that, they are the only pairs to test.
   const double slack = round_up(s->stop_deviation + kPoseRounding * (s->xs.p.cwiseAbs().maxCoeff() + model.god_radius)).v;
   const bool near = r.num_near_pairs >= 0 && (r.hit ? r.u_hit : 1.0) >= r.near_u0 && cs.distance + slack <= r.near_reach;
-  const ContactStatus status =
-      generate_contacts(model.obstacles.data(), static_cast<int>(model.obstacles.size()), model.god, s->xs, cs,
-                        &s->contact_ws, &s->contacts, s->ccd_ws.near_pairs(near ? r.num_near_pairs : -1));
+  const NearPairs list = !near                ? NearPairs{}
+                         : s->near_is_proven ? NearPairs{s->proven_near.data(), r.num_near_pairs}
+                                             : s->ccd_ws.near_pairs(r.num_near_pairs);
+  const ContactStatus status = generate_contacts(model.obstacles.data(), static_cast<int>(model.obstacles.size()),
+                                                 model.god, s->xs, cs, &s->contact_ws, &s->contacts, list);
   if (status == ContactStatus::kInvalidInput) s->contacts.num_contacts = 0;
   if (status == ContactStatus::kOverflow || status == ContactStatus::kStackFull)
     s->step_events |= bit(RuntimeEventKind::kContactOverflow);
 }
 
+// A settling step's first leg's near pairs, kept in s->proven_near before the
+// settling leg reuses s->ccd_ws (its candidates hold them): the poses later
+// served from that leg take their contacts from them (serve_proven_leg).
+void keep_proven_near(SimState* s) {
+  const int n = s->near_is_proven ? -1 : s->ccd.num_near_pairs;
+  s->num_proven_near = n >= 0 && n <= static_cast<int>(s->proven_near.size()) ? n : -1;
+  const NearPairs list = s->ccd_ws.near_pairs(s->num_proven_near);
+  for (int k = 0; k < s->num_proven_near; ++k) s->proven_near[k] = list[k];
+}
+
 // The pose at u of a leg whose whole motion its CCD result `proven` showed free
 // at delta: the stop pose there (the same deviation bound as a hit's), with that
-// result as s->ccd, without searching again.
+// result as s->ccd, without searching again. Its near pairs, kept by
+// keep_proven_near, hold at every u in [near_u0, u_hit] of its motion
+// (CcdStepResult::num_near_pairs), so the contact search there tests them.
+// In a refused settle's shortened tries they were most of the step's contact
+// searches, each a full descent (41-54 us each in the full bunnies' slowest
+// steps, 3 or 4 a step: docs/benchmarks.md, issue 20, eighth session).
 void serve_proven_leg(const RuntimeModel& model, const CcdStepResult& proven, double u, SimState* s) {
   s->ccd = proven;
-  s->ccd.num_near_pairs = -1;  // its near pairs hold at the leg's end, not at u
+  s->near_is_proven = s->num_proven_near >= 0 && u >= proven.near_u0 && u <= (proven.hit ? proven.u_hit : 1.0);
+  s->ccd.num_near_pairs = s->near_is_proven ? s->num_proven_near : -1;
   const StopPose stop = make_stop_pose(proven.motion, u, model.god_radius);
   s->xs = stop.pose;
   s->stop_deviation = stop.deviation;
@@ -374,6 +395,7 @@ void stay_at_start(const RuntimeModel& model, const Pose& x_start, SimState* s, 
   s->stop_deviation = 0;
   s->ccd.hit = false;
   s->ccd.num_near_pairs = -1;  // the near pairs are the legs', not x_start's: a full search
+  s->near_is_proven = false;
   update_contacts(model, s);
   info->u_hit = 0;
   info->status = s->contacts.num_contacts > 0 ? SimStepStatus::kContact : SimStepStatus::kFree;
@@ -421,6 +443,7 @@ void advance_god_object(const RuntimeModel& model, const Pose& x_start, const Po
   info->settled = false;
   info->num_shortenings = 0;
   info->num_halves = 1;
+  s->num_proven_near = -1;
   // The contacts at x_start (the set of the last step, at s->xs) are the pairs
   // most likely to stop either leg: ccd_step tests them first.
   const int num_hints = std::min(s->contacts.num_contacts, s->capacity);
@@ -459,6 +482,7 @@ void advance_god_object(const RuntimeModel& model, const Pose& x_start, const Po
     info->settled = true;
     const Pose from = s->xs;
     const CcdStepResult first_leg = s->ccd;  // to restore on a refusal (plain data: no allocation)
+    if (shortened_u == 1) keep_proven_near(s);  // the leg later tries serve (proven = first_leg)
     const double first_deviation = s->stop_deviation;
     int halves = 1;
     const bool settled = ccd_leg(model, from, pose_update(from, residual), num_hints, s, &halves,

@@ -559,6 +559,23 @@ TEST_CASE("runtime: a step that lifts off a convex crease settles back onto the 
     CHECK(s.xs.p.x() == Approx(x0.p.x() + 0.003 / 4).margin(1e-12));
     // Property 5, the check that failed before the refusal (-23 delta: through the crease).
     CHECK(lowest_over_crease_along(model, x0, s.xs) > 0.5 * kDelta);
+    // The shortened tries' contacts came from the first leg's near pairs, kept
+    // before the settling legs ran (SimState::proven_near): the same set as a
+    // full descent at the published pose.
+    CHECK(s.near_is_proven);
+    CHECK(s.num_proven_near > 0);
+    ContactSet full(s.capacity);
+    ContactWorkspace full_ws(model.god_mesh_B);
+    REQUIRE(generate_contacts(model.obstacles.data(), static_cast<int>(model.obstacles.size()), model.god, s.xs,
+                              model.contact_generation, &full_ws, &full) == ContactStatus::kOk);
+    REQUIRE(full.num_contacts == s.contacts.num_contacts);
+    for (int k = 0; k < full.num_contacts; ++k) {
+      int same = 0;
+      for (int j = 0; j < s.contacts.num_contacts; ++j)
+        same += s.contacts.contacts[j].features == full.contacts[k].features &&
+                s.contacts.contacts[j].separation == full.contacts[k].separation;
+      CHECK(same == 1);
+    }
   }
 }
 

@@ -46,6 +46,13 @@ struct SimState {
   CcdStepResult check;
   std::vector<FeaturePair> ccd_hints;  // capacity: the contacts at a leg's start, tested first (ccd_step)
   double stop_deviation = 0;           // of xs from the motion's exact pose (make_stop_pose)
+  // A settling step's first leg's near pairs (CcdStepResult::num_near_pairs),
+  // copied before later legs reuse ccd_ws: the contact searches at the poses
+  // served from that leg (a refused settle's shortened tries, keep_a_contact)
+  // test them instead of descending the trees. Capacity: ccd_ws's candidates.
+  std::vector<TrianglePair> proven_near;
+  int num_proven_near = -1;            // -1: no list
+  bool near_is_proven = false;         // ccd's near pairs index proven_near, not ccd_ws
   ContactWorkspace contact_ws;
   HandleSample handle;                 // last sample read
   GodObjectSnapshot snapshot;          // what step 5 publishes
