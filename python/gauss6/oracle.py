@@ -16,7 +16,8 @@ The checks (thresholds: harness/oracle.toml, each with its reason):
   no_force_when_free   a wrench in free space, or while the handle is on the free side of every
                        contact (METHOD.md property 3)
   energy               passivity observer on the device port, over the run and per contact episode
-  force_jumps          the change of the wrench from one tick to the next
+  force_jumps          the force (torque) a tick adds: its change from the last tick's, less
+                       any release of that one (added_per_tick)
   wrench_sanity        non-finite or over-limit wrenches
   cost                 the engine's step time: the rate it sustains, its stalls
 Geometric checks skip ticks with a non-finite pose or wrench (wrench_sanity counts them); the
@@ -51,6 +52,17 @@ CHECKS = [
     ("wrench_sanity", "7. non-finite or over-limit wrench"),
     ("cost", "8. cost (step time)"),
 ]
+
+
+def added_per_tick(V: np.ndarray) -> np.ndarray:
+    """What each tick adds to the vector of the tick before (force or torque rows of V, shape (n,
+    3)): min over a in [0, 1] of |V[k+1] - a V[k]|, the distance of the new vector from the segment
+    [0, V[k]]. A release, whole or in part (a contact that breaks, a force that shrinks along
+    itself), adds nothing; a force that appears, grows, or turns adds the rest. Shape (n - 1,)."""
+    prev, cur = V[:-1], V[1:]
+    pp = np.einsum("ij,ij->i", prev, prev)
+    a = np.clip(np.einsum("ij,ij->i", cur, prev) / np.where(pp > 0, pp, 1.0), 0.0, 1.0)
+    return np.linalg.norm(cur - a[:, None] * prev, axis=1)
 
 
 def load_thresholds(path=None) -> dict:
@@ -544,18 +556,29 @@ class Oracle:
              "episodes": len(episodes), "max_episode_work": max_episode,
              "energy_injected": float(sum(max(ep[2], 0) for ep in episodes))}))
 
-        # 7. Force jumps; non-finite and over-limit wrenches.
+        # 7. Force jumps (the force a tick adds: a release adds none); non-finite and over-limit
+        # wrenches. The whole change is reported beside it, with the time of the largest.
         tj = th["jumps"]
         both = finite_wrench[1:] & finite_wrench[:-1]
-        df = np.where(both, np.linalg.norm(np.diff(np.where(finite_wrench[:, None], W, 0)[:, :3], axis=0), axis=1), 0)
-        dtau = np.where(both, np.linalg.norm(np.diff(np.where(finite_wrench[:, None], W, 0)[:, 3:], axis=0), axis=1), 0)
-        jumps = np.flatnonzero((df > tj["max_force_step"]) | (dtau > tj["max_torque_step"])) + 1
+        Wf = np.where(finite_wrench[:, None], W, 0)
+        df = np.where(both, np.linalg.norm(np.diff(Wf[:, :3], axis=0), axis=1), 0)
+        dtau = np.where(both, np.linalg.norm(np.diff(Wf[:, 3:], axis=0), axis=1), 0)
+        f_add = np.where(both, added_per_tick(Wf[:, :3]), 0)
+        tau_add = np.where(both, added_per_tick(Wf[:, 3:]), 0)
+        jumps = np.flatnonzero((f_add > tj["max_force_step"]) | (tau_add > tj["max_torque_step"])) + 1
+        largest = int(np.argmax(df)) + 1 if len(df) else 0
         verdicts.append(Verdict(
-            "force_jumps", CHECKS[6][1], len(jumps) == 0, len(jumps), float(df.max()) if len(df) else 0.0,
-            "N per tick", float(t[jumps[0]]) if len(jumps) else None,
-            f"max force step {df.max() if len(df) else 0:.3g} N, max torque step {dtau.max() if len(dtau) else 0:.3g} N m",
-            {"max_force_step": float(df.max()) if len(df) else 0.0,
-             "max_torque_step": float(dtau.max()) if len(dtau) else 0.0}))
+            "force_jumps", CHECKS[6][1], len(jumps) == 0, len(jumps), float(f_add.max()) if len(df) else 0.0,
+            "N added per tick", float(t[jumps[0]]) if len(jumps) else None,
+            f"max force added {f_add.max() if len(df) else 0:.3g} N, torque {tau_add.max() if len(df) else 0:.3g} N m; "
+            f"largest change {df.max() if len(df) else 0:.3g} N"
+            + (f" at {t[largest]:.3f} s" if len(df) and df.max() > 0 else "")
+            + f", torque {dtau.max() if len(dtau) else 0:.3g} N m",
+            {"max_force_added": float(f_add.max()) if len(df) else 0.0,
+             "max_torque_added": float(tau_add.max()) if len(df) else 0.0,
+             "max_force_step": float(df.max()) if len(df) else 0.0,
+             "max_torque_step": float(dtau.max()) if len(dtau) else 0.0,
+             "max_force_step_time": float(t[largest]) if len(df) else None}))
         slack = 1 + th["limits"]["slack"]
         over = finite_wrench & ((f_norm > self.max_force * slack) | (tau_norm > self.max_torque * slack))
         insane = np.flatnonzero(~finite_wrench | ~finite_pose | over)

@@ -21,7 +21,7 @@ import pytest
 from gauss6 import paths
 from gauss6.driver import drive, scene_script
 from gauss6.engine import CEngine, EngineError, EngineScene, engine_library, load_engine
-from gauss6.oracle import Oracle
+from gauss6.oracle import Oracle, added_per_tick
 from gauss6.trace import read_trace, to_csv
 
 PEG = paths.DATASETS_DIR / "scenes" / "peg_in_hole.toml"
@@ -95,6 +95,24 @@ def test_gauss6_engine_raises_no_alarm_on_the_bunny(tmp_path):
     assert tunnels.count == 0 and tunnels.details["undecided"] == 0 and tunnels.details["near"] > 1000
     assert jumps.details["max_force_step"] < 0.3  # the graze's release was 0.84 N
     assert result.verdict("force_direction").details["ticks"] > 100
+
+
+def test_force_jumps_judge_the_force_a_tick_adds():
+    """Property 7 (harness/oracle.toml [jumps], version 4): a release adds nothing, whole or in part;
+    a force that appears, grows along itself or turns counts whole. Exact to rounding (1e-12)."""
+    F = np.array([[0, -1.29, 0],     # pressed
+                  [0, 0, 0],         # released at once (the peg's wedge at 11.574 s): adds 0
+                  [0, 0.8, 0],       # a new contact's knock: adds 0.8
+                  [0, 0.4, 0],       # half released: adds 0
+                  [0, 1.0, 0],       # grows along itself: adds 0.6
+                  [0.3, 1.0, 0],     # turns: adds 0.3
+                  [-0.3, -1.0, 0]])  # turned round: adds all of it
+    added = added_per_tick(F)
+    np.testing.assert_allclose(added, [0, 0.8, 0, 0.6, 0.3, np.hypot(0.3, 1.0)], atol=1e-12)
+    # Never more than the whole change (a = 1), so whatever passed before still passes.
+    assert np.all(added <= np.linalg.norm(np.diff(F, axis=0), axis=1) + 1e-15)
+    # A drop-out and its return: the return is the knock.
+    np.testing.assert_allclose(added_per_tick(np.array([[0, 1.0, 0], [0, 0, 0], [0, 1.0, 0]])), [0, 1.0])
 
 
 def test_fig13_tangential_share_against_the_nearest_features(tmp_path, peg_oracle):
