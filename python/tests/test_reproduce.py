@@ -37,6 +37,23 @@ def test_summary_keys_are_exactly_the_issues(peg_run):
     json.dumps(summary)  # serialisable as is
 
 
+def test_lockstep_repeats_and_each_steps_least_time(peg_run, tmp_path):
+    """The lockstep run is repeated LOCKSTEP_RUNS - 1 times, tick for tick, and report.md's least times are
+    each step's least over the runs: at most the single run's, step by step. A repeat that differs fails."""
+    out, summary, extra = peg_run
+    least = extra["update_least"]
+    assert least["runs"] == reproduce.LOCKSTEP_RUNS >= 3
+    for key in ("update_cpu_time_ms", "update_time_ms"):
+        for stat in ("median", "p99", "max"):
+            assert 0 < least[key][stat] <= summary[key][stat]
+    assert not list(out.glob(".*repeat*"))  # the repeats' traces are removed
+    # A run that is not repeatable (a trace doctored after the fact) is refused.
+    tr = read_trace(out / "peg.g6trace")
+    tr.ticks["wrench"][600, 2] += 1e-9
+    with pytest.raises(RuntimeError, match="differs from the first .wrench."):
+        reproduce.least_update_times("peg", reproduce.SCENES["peg"], tr, tmp_path, 1.2, 1)
+
+
 def test_peg_phase_a_contacts_and_forces(peg_run):
     out, summary, extra = peg_run
     tr = read_trace(out / "peg.g6trace")
