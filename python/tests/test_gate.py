@@ -221,13 +221,26 @@ def _build_with_bench() -> Path | None:
 def test_real_identical_run_passes_and_planted_slowdown_fails(tmp_path):
     build = _build_with_bench()
     cmd = [sys.executable, "-m", "gauss6.gate", "--base-build", str(build), "--work-build", str(build),
-           "--no-build-work", "--no-accuracy", "--no-count", "--json", "--cache-dir", str(tmp_path),
+           "--no-build-work", "--no-accuracy", "--no-count", "--json",
            "--filter", "ForceWarm/box/m|CcdQuery/unit-tests/vf", "--rounds", "3", "--repetitions", "3",
            "--min-time", "0.02"]
     env = dict(os.environ, PYTHONPATH=str(paths.REPO_ROOT / "python"))
-    proc = subprocess.run(cmd, capture_output=True, text=True, env=env, timeout=300)
-    assert proc.returncode == 0, proc.stdout + proc.stderr
-    result = json.loads(proc.stdout)
+    # Wall time on a shared 2-core VM: an identical build was once judged slower (CcdQuery/unit-tests/vf,
+    # 390 -> 501 ns at the median, p = 0.0035, under other tenants' load). So up to three tries, each
+    # with its own runs; every try that fails may fail on speed alone, and one must pass: a gate that
+    # flags identical builds every time still fails here.
+    outputs = []
+    for attempt in range(3):
+        proc = subprocess.run(cmd + ["--cache-dir", str(tmp_path / f"try{attempt}")], capture_output=True,
+                              text=True, env=env, timeout=300)
+        outputs.append(proc.stdout + proc.stderr)
+        assert proc.returncode in (0, 1), outputs[-1]
+        result = json.loads(proc.stdout)
+        assert all(f.split()[0] in {"ForceWarm/box/m<=12", "CcdQuery/unit-tests/vf"} and " slower x" in f
+                   for f in result["failures"]), outputs[-1]
+        if proc.returncode == 0:
+            break
+    assert proc.returncode == 0, "\n".join(outputs)
     assert result["passed"]
     names = {r["name"] for r in result["speed"]}
     assert names == {"ForceWarm/box/m<=12", "CcdQuery/unit-tests/vf"}
