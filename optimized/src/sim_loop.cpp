@@ -361,9 +361,10 @@ void update_contacts(const RuntimeModel& model, SimState* s) {
 
 // A settling step's first leg's near pairs, kept in s->proven_near before the
 // settling leg reuses s->ccd_ws (its candidates hold them): the poses later
-// served from that leg take their contacts from them (serve_proven_leg).
+// served from that leg take their contacts from them (serve_proven_leg). Called
+// in the try that ran that leg, so s->ccd's near pairs (if any) are ccd_ws's.
 void keep_proven_near(SimState* s) {
-  const int n = s->near_is_proven ? -1 : s->ccd.num_near_pairs;
+  const int n = s->ccd.num_near_pairs;
   s->num_proven_near = n >= 0 && n <= static_cast<int>(s->proven_near.size()) ? n : -1;
   const NearPairs list = s->ccd_ws.near_pairs(s->num_proven_near);
   for (int k = 0; k < s->num_proven_near; ++k) s->proven_near[k] = list[k];

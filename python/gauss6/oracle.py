@@ -566,19 +566,17 @@ class Oracle:
         f_add = np.where(both, added_per_tick(Wf[:, :3]), 0)
         tau_add = np.where(both, added_per_tick(Wf[:, 3:]), 0)
         jumps = np.flatnonzero((f_add > tj["max_force_step"]) | (tau_add > tj["max_torque_step"])) + 1
-        largest = int(np.argmax(df)) + 1 if len(df) else 0
+        peak = {k: float(v.max()) if len(v) else 0.0
+                for k, v in (("force_added", f_add), ("torque_added", tau_add), ("force_step", df), ("torque_step", dtau))}
+        largest_time = float(t[int(np.argmax(df)) + 1]) if len(df) else None
         verdicts.append(Verdict(
-            "force_jumps", CHECKS[6][1], len(jumps) == 0, len(jumps), float(f_add.max()) if len(df) else 0.0,
+            "force_jumps", CHECKS[6][1], len(jumps) == 0, len(jumps), peak["force_added"],
             "N added per tick", float(t[jumps[0]]) if len(jumps) else None,
-            f"max force added {f_add.max() if len(df) else 0:.3g} N, torque {tau_add.max() if len(df) else 0:.3g} N m; "
-            f"largest change {df.max() if len(df) else 0:.3g} N"
-            + (f" at {t[largest]:.3f} s" if len(df) and df.max() > 0 else "")
-            + f", torque {dtau.max() if len(dtau) else 0:.3g} N m",
-            {"max_force_added": float(f_add.max()) if len(df) else 0.0,
-             "max_torque_added": float(tau_add.max()) if len(df) else 0.0,
-             "max_force_step": float(df.max()) if len(df) else 0.0,
-             "max_torque_step": float(dtau.max()) if len(dtau) else 0.0,
-             "max_force_step_time": float(t[largest]) if len(df) else None}))
+            f"max force added {peak['force_added']:.3g} N, torque {peak['torque_added']:.3g} N m; "
+            f"largest change {peak['force_step']:.3g} N"
+            + (f" at {largest_time:.3f} s" if peak["force_step"] > 0 else "")
+            + f", torque {peak['torque_step']:.3g} N m",
+            {**{f"max_{k}": v for k, v in peak.items()}, "max_force_step_time": largest_time}))
         slack = 1 + th["limits"]["slack"]
         over = finite_wrench & ((f_norm > self.max_force * slack) | (tau_norm > self.max_torque * slack))
         insane = np.flatnonzero(~finite_wrench | ~finite_pose | over)

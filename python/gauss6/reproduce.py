@@ -102,9 +102,10 @@ PAPER = {
     },
 }
 
+LOCKSTEP_RUNS = 5  # lockstep runs of each scenario: the first is the trace; all give each step's least time
+
 # Peg scene geometry used by the let-go check (datasets_generated/scenes/peg_in_hole.toml):
 # the hole's axis is the Y axis, the box spans |y| <= 3 cm.
-LOCKSTEP_RUNS = 5  # lockstep runs of each scenario: the first is the trace; all give each step's least time
 HOLE_AXIS_TOLERANCE = 5e-4   # m: the peg's centre within this of the axis (clearance is about 0.2 mm)
 BOX_HALF_LENGTH = 0.03       # m
 SETTLE_TIME = 0.5            # s after the let-go before the drift and force are measured
