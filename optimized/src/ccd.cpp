@@ -47,7 +47,6 @@ bool valid_settings(const CcdSettings& s) {
 GAUSS6_ALWAYS_INLINE IVec3 operator+(const IVec3& a, const IVec3& b) { return {a[0] + b[0], a[1] + b[1], a[2] + b[2]}; }
 GAUSS6_ALWAYS_INLINE IVec3 operator-(const IVec3& a, const IVec3& b) { return {a[0] - b[0], a[1] - b[1], a[2] - b[2]}; }
 GAUSS6_ALWAYS_INLINE IVec3 operator*(double s, const IVec3& a) { return {s * a[0], s * a[1], s * a[2]}; }
-GAUSS6_ALWAYS_INLINE IVec3 hull(const IVec3& a, const IVec3& b) { return {hull(a[0], b[0]), hull(a[1], b[1]), hull(a[2], b[2])}; }
 
 // Heuristic weights of the three box dimensions: how much F can change across
 // the full range of each (scene units). They steer the splitting only.

@@ -24,6 +24,10 @@ from gauss6 import paths
 pytestmark = pytest.mark.skipif(os.environ.get("GAUSS6_SKIP_WHEEL") == "1", reason="GAUSS6_SKIP_WHEEL=1")
 
 
+# The main build's compiler (tools/setup.sh), so that the wheel's build reuses its objects.
+MAIN_BUILD_CXX = os.environ.get("GAUSS6_CXX", "clang++")
+
+
 def ccache_env() -> dict:
     """The environment of tools/setup.sh's builds: ccache with paths relative to the checkout."""
     env = dict(os.environ)
@@ -40,7 +44,8 @@ def test_wheel_installs_into_a_fresh_venv_and_runs(tmp_path: Path):
     version = project_version()
     wheels = tmp_path / "wheels"
     subprocess.run([sys.executable, "-m", "pip", "wheel", str(paths.REPO_ROOT), "--no-deps", "--no-build-isolation",
-                    "--config-settings=cmake.define.CMAKE_CXX_COMPILER_LAUNCHER=ccache", "-w", str(wheels)],
+                    "--config-settings=cmake.define.CMAKE_CXX_COMPILER_LAUNCHER=ccache",
+                    f"--config-settings=cmake.define.CMAKE_CXX_COMPILER={MAIN_BUILD_CXX}", "-w", str(wheels)],
                    check=True, env=ccache_env())
     (wheel,) = wheels.glob("gauss6-*.whl")
     assert wheel.name.startswith(f"gauss6-{version}-")
