@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # The C++ suites under the sanitizers, in clang builds of their own beside the
-# main gcc build (no Python extension, no benchmarks; ccache as tools/ccache.env):
+# main build (no Python extension, no benchmarks; ccache as tools/ccache.env):
 #   asan  build-asan/: ASan + UBSan (float-cast-overflow included, every report
 #         fatal): the core, device, trace and harness suites (gauss6_tests,
 #         gauss6_device_tests, gauss6_trace_tests, gauss6_harness_tests), all
@@ -46,7 +46,7 @@ configure() {
 # The core suite's tests left out of the ASan run: each spends its time in the
 # test's own brute force (a long-double KKT enumeration over 16 instances; a
 # brute-force first contact of every triangle pair at each of 120-300 steps),
-# 1-4 min in the gcc build and 6-25 min under ASan on 2 cores.
+# 1-4 min in the main build and 6-25 min under ASan on 2 cores.
 ASAN_SKIP=('~"regression: nearly parallel rows of the redundant family"'
            '~"ccd_step: a ball wandering among blocks*"'
            '~"ccd_step: steps served by the proximity cache*"')
