@@ -24,8 +24,12 @@ from gauss6 import paths
 pytestmark = pytest.mark.skipif(os.environ.get("GAUSS6_SKIP_WHEEL") == "1", reason="GAUSS6_SKIP_WHEEL=1")
 
 
-# The main build's compiler (tools/setup.sh), so that the wheel's build reuses its objects.
-MAIN_BUILD_CXX = os.environ.get("GAUSS6_CXX", "clang++")
+def main_build_compiler() -> list[str]:
+    """The compiler the main build was configured with (its CMakeCache.txt: tools/setup.sh
+    chooses it), as a config setting, so that the wheel's build reuses its objects."""
+    cache = paths.build_dir() / "CMakeCache.txt"
+    found = re.search(r"^CMAKE_CXX_COMPILER:\w+=(.+)$", cache.read_text(), re.M) if cache.exists() else None
+    return [f"--config-settings=cmake.define.CMAKE_CXX_COMPILER={found.group(1)}"] if found else []
 
 
 def ccache_env() -> dict:
@@ -44,8 +48,8 @@ def test_wheel_installs_into_a_fresh_venv_and_runs(tmp_path: Path):
     version = project_version()
     wheels = tmp_path / "wheels"
     subprocess.run([sys.executable, "-m", "pip", "wheel", str(paths.REPO_ROOT), "--no-deps", "--no-build-isolation",
-                    "--config-settings=cmake.define.CMAKE_CXX_COMPILER_LAUNCHER=ccache",
-                    f"--config-settings=cmake.define.CMAKE_CXX_COMPILER={MAIN_BUILD_CXX}", "-w", str(wheels)],
+                    "--config-settings=cmake.define.CMAKE_CXX_COMPILER_LAUNCHER=ccache", *main_build_compiler(),
+                    "-w", str(wheels)],
                    check=True, env=ccache_env())
     (wheel,) = wheels.glob("gauss6-*.whl")
     assert wheel.name.startswith(f"gauss6-{version}-")
