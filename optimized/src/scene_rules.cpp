@@ -94,12 +94,12 @@ double scene_extent(const Scene& scene) {
 }
 
 SettingsProblem check_delta_scale(const Scene& scene) {
-  static_assert(kMinDeltaPerExtent == 1e-14, "the message below states it");
+  static_assert(kMinDeltaPerExtent == 1e-14 && kMinDelta == 1e-150, "the message below states them");
   const double extent = scene_extent(scene), delta = scene.contact.delta;
-  if (!(delta >= std::numeric_limits<double>::min() && delta >= kMinDeltaPerExtent * extent))
+  if (!(delta >= kMinDelta && delta >= kMinDeltaPerExtent * extent))
     return {"contact", "delta",
             "must be at least 1e-14 of the scene's extent (" + std::to_string(extent) +
-                ", the farthest vertex from the origin) and a normal number: smaller, it "
+                ", the farthest vertex from the origin) and at least 1e-150: smaller, it "
                 "nears the coordinates' rounding and the CCD cannot keep its stop distance inside the contact band"};
   return {};
 }

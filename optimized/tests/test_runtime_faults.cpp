@@ -591,6 +591,21 @@ TEST_CASE("faults: invalid handle poses give zero force and an event, invalid se
     Scene small = make_scene();
     small.contact.delta = 2e-14;
     CHECK_NOTHROW(RuntimeModel(small, RuntimeSettings{}));
+    // Below kMinDelta (1e-150) whatever the scene's size: the whole scene shrunk
+    // by 1e-170, delta 1e-14 of its extent; at 1e-145 it is served.
+    for (const double d : {1e-160, 1e-145}) {
+      Scene shrunk = make_scene();
+      const double scale = d / 1e-14;
+      for (Body& b : shrunk.obstacles) b.mesh.V *= scale, b.pose.p *= scale;
+      shrunk.god_object.mesh.V *= scale;
+      shrunk.god_object.pose.p *= scale;
+      shrunk.contact.delta = d;
+      INFO("delta " << d);
+      if (d < kMinDelta)
+        CHECK_THROWS_WITH(RuntimeModel(shrunk, RuntimeSettings{}), Catch::Contains("contact.delta"));
+      else
+        CHECK_FALSE(check_delta_scale(shrunk));
+    }
     // The limits themselves are accepted.
     RuntimeSettings ok;
     ok.device_timeout = ok.sim_timeout = ok.coupling_timeout = kMaxTimeout;

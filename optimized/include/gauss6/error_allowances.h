@@ -118,9 +118,10 @@ constexpr double kBoxPoseRounding = 1e-12;
 
 // An absolute floor under the relative allowances of box extents, where the
 // relative term vanishes or underflows (all coordinates 0 or subnormal): each
-// underflowing product or sum errs by at most 2^-1075 (2.5e-324), and a box's
-// few dozen of them stay below 1e-322; 1e-300 covers them by far and is below
-// any extent that matters. Sites: fit_obb, generate_contacts.
+// underflowing product or sum errs by at most 2^-1075 (2.5e-324; 2^-1022,
+// 2.2e-308, on a thread that flushes subnormals to zero), and a box's few
+// dozen of them stay below 1e-306; 1e-300 covers them and is below any extent
+// that matters. Sites: fit_obb, generate_contacts.
 constexpr double kUnderflowFloor = 1e-300;
 
 // A corner value of F = (w + a ea) - b eb for linearly moving points (the
@@ -132,11 +133,14 @@ constexpr double kUnderflowFloor = 1e-300;
 //   w, e1, e2 = p - p'    |.|  <= 6M    error <= 14uM + 6uM = 20uM
 //   a e1, b e2            |.|  <= 6M    error <= 20uM + 6uM = 26uM
 //   (w - a e1) - b e2     |.|  <= 18M   error <= 20 + 26 + 12 + 26 + 18 = 102uM
-// so 128 u M + 64 2^-1074 (underflows) bounds the error of every corner value
-// (a margin of 1.25). A fused multiply-add, if a compiler contracted one,
-// rounds once instead of twice: within the same bound.
+// so 128 u M + 64 2^-1022 (underflows) bounds the error of every corner value
+// (a margin of 1.25). The underflow term counts each underflow at 2^-1022, not
+// 2^-1075: a result flushed to zero on a thread with FTZ set errs by up to the
+// least normal (rounding.h), and the term itself stays normal (a subnormal
+// operand costs a microcode assist on Intel cores). A fused multiply-add, if a
+// compiler contracted one, rounds once instead of twice: within the same bound.
 constexpr double kLinearCornerRounding = 0x1p-46;  // 128 u
-constexpr double kLinearCornerUnderflow = 64 * std::numeric_limits<double>::denorm_min();
+constexpr double kLinearCornerUnderflow = 64 * std::numeric_limits<double>::min();  // 2^-1016
 
 // Not a bound but a floor on the narrow phase's distance tolerance, relative
 // to the query's largest coordinate: F's enclosures are at least a few units

@@ -20,18 +20,31 @@ namespace gauss6 {
 // Proof of enclosure. Every operation below computes its double result(s) in the
 // default round-to-nearest mode (IEEE 754, SSE2 on x86-64: no excess precision)
 // and then widens the lower bound down and the upper bound up, branch-free:
-//   next_up(r) = fl(r' + t),  r' = max(r, -DBL_MAX),  t = fl(|r'| 2^-52 + 2^-1074).
+//   next_up(r) = fl(r' + t),  r' = max(r, -DBL_MAX),  t = fl(|r'| 2^-52 + 2^-600).
 // Let s be the gap from a finite r to the next float above it (r+). For normal r,
-// s <= |r| 2^-52 (also at r = -2^e, where s is half the usual gap); for
-// subnormal r or 0, s = 2^-1074. If |r| 2^-52 underflows, its rounding loses at
-// most 2^-1075 and adding 2^-1074 (exact there) restores it. So t >= s, and,
-// rounding being monotone, fl(r + t) >= fl(r + s) = r+ (or +inf past DBL_MAX).
-// If r = fl(x) is a nearest float to the exact real x, then x <= r+, hence
-// next_up(r) >= x; the result is r+ or the float after it. The argument only uses
-// r + t >= (smallest float >= x), so it still holds if a compiler contracts the
-// product that produced r into a fused multiply-add with the "+ t" (x + t >= that
-// float too). Overflow: fl(x) = -inf means x < -DBL_MAX, and r' = -DBL_MAX
-// gives a result >= -DBL_MAX >= x; +inf stays +inf. next_down(r) = -next_up(-r) mirrors all this.
+// s <= |r| 2^-52 (also at r = -2^e, where s is half the usual gap), and the
+// product |r| 2^-52 is exact while it is normal; for |r| < 2^-970 (the product
+// subnormal, inexact or flushed to zero), s <= 2^-1022 < 2^-600. Rounding being
+// monotone, t >= max(fl(|r'| 2^-52), 2^-600) >= s, and fl(r + t) >= fl(r + s) = r+
+// (or +inf past DBL_MAX). If r = fl(x) is a nearest float to the exact real x,
+// then x <= r+, hence next_up(r) >= x: the result is r+ or the float after it
+// for |r| >= 2^-548, and within 2^-599 of r below (an absolute widening no
+// length of a scene comes near: scene.h bounds them far above). The argument
+// only uses r + t >= (smallest float >= x), so it still holds if a compiler
+// contracts the product that produced r into a fused multiply-add with the
+// "+ t" (x + t >= that float too). Overflow: fl(x) = -inf means x < -DBL_MAX,
+// and r' = -DBL_MAX gives a result >= -DBL_MAX >= x; +inf stays +inf.
+// next_down(r) = -next_up(-r) mirrors all this.
+// Why 2^-600 and not the least subnormal, 2^-1074, which widened r by exactly
+// one float: every interval holding a zero then had a subnormal end, and
+// products with subnormal operands take a microcode assist on Intel cores (on
+// the 2-core Xeon VM, about half of a scenario step's median time;
+// docs/benchmarks.md, issue 20, tenth session). 2^-600 times a few factors
+// down to 1e-30 stays normal. It also keeps the bounds sound on a thread that
+// flushes subnormals to zero (FTZ and DAZ, as audio and game hosts often set):
+// an input read as zero moves by < 2^-1022, a result flushed to zero errs by <
+// 2^-1022, and the widening covers both, where 2^-1074, read as zero, widened
+// nothing.
 // No -frounding-math is needed: the rounding mode is never changed. A NaN bound
 // makes every exclusion test false (comparisons with NaN are false, and the max
 // keeps a NaN first argument), so a NaN can only cause a false positive, never a
@@ -45,7 +58,7 @@ namespace gauss6 {
 
 GAUSS6_ALWAYS_INLINE double next_up(double x) {
   constexpr double kMax = std::numeric_limits<double>::max();
-  constexpr double kUlp = 0x1p-52, kTiny = std::numeric_limits<double>::denorm_min();
+  constexpr double kUlp = 0x1p-52, kTiny = 0x1p-600;  // (the proof above)
   const double r = x < -kMax ? -kMax : x;  // maxsd; keeps a NaN (the comparison is false)
   return r + (std::abs(r) * kUlp + kTiny);
 }

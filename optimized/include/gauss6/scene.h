@@ -137,12 +137,16 @@ SettingsProblem check_surface_settings(const SurfaceSettings& surface);  // text
                                                                          // axis; height map: an image of
                                                                          // >= 2 x 2 values in [0, 1]
 SettingsProblem check_crease_angle(double degrees);                      // [[obstacle]]: 0 <= crease_angle <= 180
-// delta against the scene's size: delta a normal double and at least
+// delta against the scene's size: delta at least kMinDelta and at least
 // kMinDeltaPerExtent of scene_extent(scene), the largest distance from the origin
 // any vertex reaches (obstacles where they stand, the god-object at its initial
 // pose). Below it delta nears the rounding of the coordinates (1e-14 is ~45 ulps)
 // and the CCD's stop distance can no longer be kept inside the contact band.
 inline constexpr double kMinDeltaPerExtent = 1e-14;
+// And delta at least kMinDelta, whatever the scene's size: the CCD's rounded
+// bounds widen values near zero by up to 2^-599 (4.8e-181) absolute
+// (rounding.h); 1e-150 keeps that 30 orders of magnitude below delta.
+inline constexpr double kMinDelta = 1e-150;
 double scene_extent(const Scene& scene);
 SettingsProblem check_delta_scale(const Scene& scene);
 SettingsProblem check_device_settings(const DeviceSettings& device);     // 100 <= rate_hz <= 10000,
