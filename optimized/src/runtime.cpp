@@ -7,6 +7,9 @@
 #include <algorithm>
 #include <cmath>
 #include <thread>
+#if defined(__x86_64__) || defined(__i386__)
+#include <immintrin.h>
+#endif
 
 #include "runtime_detail.h"
 
@@ -49,6 +52,14 @@ void flush_all_events(double t, const RuntimeObserver& observer, RuntimeData* da
 }  // namespace
 
 namespace {
+
+// One turn of a busy wait: x86's PAUSE, which lets a sibling hyperthread (a VM's
+// other vCPU may be one) run while this one waits.
+inline void cpu_relax() {
+#if defined(__x86_64__) || defined(__i386__)
+  _mm_pause();
+#endif
+}
 
 // What a loop's thread asks of the OS (RuntimeSettings::realtime_priority,
 // pin_threads), called first thing in the thread; the outcome goes to its stats.
@@ -140,7 +151,8 @@ void run_threaded(const RuntimeModel& model, Device* device, double seconds, con
     });
   }
 
-  // Haptic loop: fixed rate, sleep_until pacing; a late start beyond one period
+  // Haptic loop: fixed rate, sleep_until pacing (the last spin_wait of each
+  // wait busy: RuntimeSettings::spin_wait); a late start beyond one period
   // is an overrun and the schedule resyncs to now. It marks the run time each
   // tick ends at for the watchdog (haptic_alive).
   std::atomic<double> haptic_alive{0};
@@ -149,7 +161,12 @@ void run_threaded(const RuntimeModel& model, Device* device, double seconds, con
     apply_thread_policy(settings, 0, &hs);
     double scheduled = 0, t = 0;
     for (;;) {
-      std::this_thread::sleep_until(at(scheduled));
+      if (settings.spin_wait > 0) {
+        std::this_thread::sleep_until(at(scheduled - settings.spin_wait));
+        while (Clock::now() < at(scheduled)) cpu_relax();
+      } else {
+        std::this_thread::sleep_until(at(scheduled));
+      }
       t = seconds_since(start);
       if (t >= seconds || (stop && stop->load(std::memory_order_acquire))) break;
       const double late = t - scheduled;

@@ -72,6 +72,7 @@ RuntimeModel::RuntimeModel(const Scene& scene, const RuntimeSettings& s) : setti
   if (s.lockstep_sim_period < 1) fail("settings: lockstep_sim_period must be >= 1");
   if (s.max_contacts < 1 || s.max_contacts > kMaxContactCapacity)
     fail("settings: max_contacts must be in [1, " + std::to_string(kMaxContactCapacity) + "]");
+  if (!(s.spin_wait >= 0 && s.spin_wait <= 1)) fail("settings: spin_wait must be in [0, 1] s");
   // A loop paced slower than its own watchdog would trip it on every step.
   if (!(s.sim_min_period >= 0 && s.sim_min_period < s.sim_timeout) ||
       !(s.coupling_min_period >= 0 && s.coupling_min_period < s.coupling_timeout))

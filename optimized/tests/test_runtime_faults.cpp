@@ -307,11 +307,15 @@ TEST_CASE("faults: watchdogs of the threaded run (haptic thread, sim, coupling)"
     check_bounded(device);
     CHECK(device.writes.back().F.norm() == 0.0);
   }
-  for (const bool coupling_thread : {false, true}) {
+  // (spin: the haptic loop waits the last 0.2 ms of each period busily,
+  // RuntimeSettings::spin_wait; its watchdog must act the same.)
+  for (const auto [coupling_thread, spin] : {std::pair{false, false}, std::pair{true, false}, std::pair{false, true}}) {
     DYNAMIC_SECTION((coupling_thread ? "a coupling thread" : "a sim thread")
-                    << " that stalls 0.3 s: the haptic thread's watchdog zeroes the force") {
+                    << " that stalls 0.3 s" << (spin ? ", the haptic loop busy-waiting" : "")
+                    << ": the haptic thread's watchdog zeroes the force") {
       RuntimeSettings settings;
       settings.sim_timeout = 0.1;
+      if (spin) settings.spin_wait = 2e-4;
       if (coupling_thread) {
         settings.force_source = ForceSource::kCouplingLoop;
         settings.coupling_min_period = 1e-4;
@@ -557,6 +561,8 @@ TEST_CASE("faults: invalid handle poses give zero force and an event, invalid se
     refused([](RuntimeSettings* s) { s->sim_min_period = INFINITY; }, "sim_min_period infinite");
     refused([](RuntimeSettings* s) { s->sim_min_period = s->sim_timeout; }, "sim_min_period >= sim_timeout");
     refused([](RuntimeSettings* s) { s->coupling_min_period = 1.0; }, "coupling_min_period >= coupling_timeout");
+    for (double bad : {kInf, std::nan(""), -1e-6, 1.5})
+      refused([=](RuntimeSettings* s) { s->spin_wait = bad; }, "spin_wait");
     // The CCD's own settings (not resolved from delta) enter here too.
     refused([](RuntimeSettings* s) { s->ccd.narrow.time_tolerance = 0; }, "time_tolerance 0");
     refused([](RuntimeSettings* s) { s->ccd.narrow.time_tolerance = std::nan(""); }, "time_tolerance NaN");

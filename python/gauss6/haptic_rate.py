@@ -1,7 +1,7 @@
 """`gauss6 rate`: a threaded run at a high haptic rate, its deadline misses and jitter.
 
     gauss6 rate [--scene peg|bunny] [--rate-hz 10000] [--duration 60] [--priority 80 | --no-realtime]
-                [--no-pin] --out DIR
+                [--no-pin] [--spin-us US] --out DIR
 
 Runs the scene's scripted scenario threaded (run_threaded: the haptic loop paced
 by sleep_until at --rate-hz, the sim loop free-running at most every 0.5 ms), the
@@ -13,6 +13,9 @@ What the loops ask of the OS (RuntimeSettings::realtime_priority, pin_threads):
 SCHED_FIFO for the haptic loop at --priority (the sim loop two below), the
 haptic loop alone on the last CPU and the other loops on the others. Whether the
 machine granted each is reported per loop (granted, or the errno it refused with).
+And RuntimeSettings::spin_wait (--spin-us; by default one period when pinned):
+the haptic loop sleeps until that long before each tick and waits the rest
+busily, on its own CPU: a timer's wake-up on a VM lands 50-100 us late.
 
 Reported, from the trace's tick start times t_k and the steps (start = end time
 minus update time):
@@ -60,12 +63,13 @@ def _granted(loop: dict) -> str:
     return f"{fifo}; {pin}"
 
 
-def run(scene: str, rate_hz: float, duration: float, priority: int, pin: bool, out: Path) -> dict:
+def run(scene: str, rate_hz: float, duration: float, priority: int, pin: bool, out: Path,
+        spin_us: float = 0.0) -> dict:
     out.mkdir(parents=True, exist_ok=True)
     trace_path = out / "rate.g6trace"
     r = _gauss6.runtime.run_scenario(str(SCENES[scene]), str(trace_path), threaded=True, duration=duration,
                                      rate_hz=rate_hz, realtime_priority=priority, pin_threads=pin,
-                                     hold_until=duration + 1.0)
+                                     hold_until=duration + 1.0, spin_wait=spin_us * 1e-6)
     tr = read_trace(trace_path)
     period = 1.0 / rate_hz
     t = np.asarray(tr.ticks["t"], dtype=float)
@@ -77,7 +81,7 @@ def run(scene: str, rate_hz: float, duration: float, priority: int, pin: bool, o
     result = {
         "scene": scene, "rate_hz": rate_hz, "duration_s": duration, "run_time_s": r["run_time"],
         "machine": {"cpus": len(os.sched_getaffinity(0)), "load_average": list(os.getloadavg())},
-        "asked": {"realtime_priority": priority, "pin_threads": pin},
+        "asked": {"realtime_priority": priority, "pin_threads": pin, "spin_us": spin_us},
         "haptic": {"ticks": int(len(t)), "granted": _granted({**r["haptic"], "role": "haptic"}),
                    "jitter_us": _q(np.abs(dt - period)), "period_us": _q(dt),
                    "late_starts": int(r["haptic"]["overruns"]), "skipped_periods": int((dt > 2 * period).sum()),
@@ -101,7 +105,8 @@ def format_result(r: dict) -> str:
 
     return "\n".join([
         f"Threaded run of the {r['scene']} scenario at {r['rate_hz']:g} Hz for {r['run_time_s']:.1f} s "
-        f"({r['machine']['cpus']} CPUs, load average {', '.join(f'{x:.1f}' for x in r['machine']['load_average'])}).",
+        f"({r['machine']['cpus']} CPUs, load average {', '.join(f'{x:.1f}' for x in r['machine']['load_average'])}; "
+        f"the haptic loop's busy wait {r['asked'].get('spin_us', 0):g} us a period).",
         "", "| loop | what it got from the OS | runs | period (us) p50 / p99 / max | jitter (us) p50 / p99 / max "
         "| deadline misses |", "|---|---|---|---|---|---|",
         f"| haptic | {h['granted']} | {h['ticks']} ticks | {q(h['period_us'])} | {q(h['jitter_us'])} | "
@@ -121,14 +126,18 @@ def register(subparsers) -> None:
     p.add_argument("--priority", type=int, default=80, help="SCHED_FIFO priority of the haptic loop")
     p.add_argument("--no-realtime", action="store_true", help="leave the default scheduling policy")
     p.add_argument("--no-pin", action="store_true", help="no CPU affinity")
+    p.add_argument("--spin-us", type=float, default=None,
+                   help="us of each haptic period waited busily before the tick (RuntimeSettings::spin_wait; "
+                        "default: one period when pinned, else 0)")
     p.add_argument("--out", type=Path, required=True)
     p.set_defaults(func=run_cli)
 
 
 def run_cli(args: argparse.Namespace) -> int:
     try:
+        spin_us = args.spin_us if args.spin_us is not None else (0.0 if args.no_pin else 1e6 / args.rate_hz)
         r = run(args.scene, args.rate_hz, args.duration, 0 if args.no_realtime else args.priority, not args.no_pin,
-                args.out)
+                args.out, spin_us)
     except ValueError as e:
         print(f"gauss6: error: {e}", file=sys.stderr)
         return 2

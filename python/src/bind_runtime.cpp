@@ -165,13 +165,15 @@ py::dict result_dict(const ScenarioResult& r, const std::vector<HandPhase>& phas
 
 py::dict run(const std::string& scene_path, const std::string& trace_path, bool threaded, double duration,
              int lockstep_sim_period, const std::string& extra_json, const std::function<void(double)>& progress,
-             double rate_hz, int realtime_priority, bool pin_threads, double hold_until, int max_contacts) {
+             double rate_hz, int realtime_priority, bool pin_threads, double hold_until, int max_contacts,
+             double spin_wait) {
   Scene scene = load(scene_path);
   if (rate_hz != 0) {
     if (!(rate_hz >= 1 && rate_hz <= 1e5)) throw py::value_error("rate_hz must be in [1, 1e5] (0: the scene's)");
     scene.device.rate_hz = rate_hz;
   }
   if (realtime_priority < 0 || realtime_priority > 99) throw py::value_error("realtime_priority must be in [0, 99]");
+  if (!(spin_wait >= 0 && spin_wait <= 1)) throw py::value_error("spin_wait must be in [0, 1] s");
   HandScript script;
   try {
     script = load_scene_script(scene);
@@ -184,6 +186,7 @@ py::dict run(const std::string& scene_path, const std::string& trace_path, bool 
       run_options(trace_path, threaded, duration, lockstep_sim_period, extra_json, progress, max_contacts);
   options.runtime.realtime_priority = realtime_priority;
   options.runtime.pin_threads = pin_threads;
+  options.runtime.spin_wait = spin_wait;  // checked by the RuntimeModel: [0, 1] s
   const ScenarioResult r = run_released([&] { return run_scenario(scene, script, options); });
   py::dict d = result_dict(r, script.phases);
   d["let_go_time"] = script.let_go_time;
@@ -288,14 +291,15 @@ void bind_runtime(py::module_& parent) {
         py::arg("duration") = -1.0, py::arg("lockstep_sim_period") = 1, py::arg("extra_json") = "{}",
         py::arg("progress") = nullptr, py::arg("rate_hz") = 0.0, py::arg("realtime_priority") = 0,
         py::arg("pin_threads") = false, py::arg("hold_until") = -1.0,
-        py::arg("max_contacts") = kDefaultMaxContacts,
+        py::arg("max_contacts") = kDefaultMaxContacts, py::arg("spin_wait") = 0.0,
         "Runs the scene with its hand script (lockstep by default, or threaded) and writes the trace. Returns a dict "
         "of run statistics and property checks (orthogonality, constraint energy, passivity observer). "
         "progress(run_time_s) is called about every 0.2 s of wall time. rate_hz overrides the scene's haptic rate "
         "(0: the scene's); realtime_priority and pin_threads are RuntimeSettings' (threaded runs; each loop's "
         "outcome in its dict: realtime 1 applied / 0 not asked / -errno, pinned_cpu, pin_error); hold_until (s): "
         "the hand holds still after the script until then. max_contacts: RuntimeSettings::max_contacts, the "
-        "contact capacity of the loops (a larger set is truncated and reported as contact_overflow).");
+        "contact capacity of the loops (a larger set is truncated and reported as contact_overflow). spin_wait (s, "
+        "in [0, 1]): RuntimeSettings::spin_wait, the haptic loop's busy wait before each tick (threaded runs).");
   m.def("replay", &replay, py::arg("scene"), py::arg("recording"), py::arg("trace"),
         py::arg("phases") = std::vector<std::pair<std::string, double>>{}, py::arg("threaded") = false,
         py::arg("duration") = -1.0, py::arg("lockstep_sim_period") = 1, py::arg("extra_json") = "{}",

@@ -5,6 +5,8 @@ from __future__ import annotations
 
 import re
 
+import pytest
+
 from gauss6 import haptic_rate
 
 
@@ -23,3 +25,16 @@ def test_realtime_request_is_reported_granted_or_refused(tmp_path):
     r = haptic_rate.run("peg", 10000.0, 0.3, priority=10, pin=True, out=tmp_path)
     assert re.match(r"SCHED_FIFO (10|refused \(errno \d+\))", r["haptic"]["granted"])
     assert re.match(r"SCHED_FIFO (8|refused \(errno \d+\))", r["sim"]["granted"])
+
+
+def test_busy_wait_is_asked_and_reported(tmp_path):
+    # RuntimeSettings::spin_wait (--spin-us): the run goes on as before, the report says it.
+    r = haptic_rate.run("peg", 10000.0, 0.3, priority=0, pin=True, out=tmp_path, spin_us=100.0)
+    assert r["asked"]["spin_us"] == 100.0
+    assert r["haptic"]["ticks"] > 500
+    assert "busy wait 100 us a period" in (tmp_path / "rate.md").read_text()
+
+
+def test_busy_wait_out_of_range_is_refused(tmp_path):
+    with pytest.raises(ValueError, match="spin_wait"):
+        haptic_rate.run("peg", 10000.0, 0.1, priority=0, pin=False, out=tmp_path, spin_us=2e6)

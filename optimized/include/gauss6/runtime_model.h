@@ -77,6 +77,11 @@ struct RuntimeSettings {
                                        // loop one below, the sim loop two below (>= 1); 0: the default policy
   bool pin_threads = false;            // true: the haptic loop on the last CPU alone, the other loops on the
                                        // others (no pinning on a single-CPU machine)
+  double spin_wait = 0;                // s, in [0, 1]: the haptic loop sleeps until this long before each
+                                       // tick's start, then waits for it busily (0: sleeps all the way). A
+                                       // timer's wake-up can land 50-100 us late (a VM's, measured:
+                                       // docs/benchmarks.md): at 10 kHz, a period. Pinned alone to its CPU,
+                                       // the busy wait takes nothing from the other loops.
 };
 
 // The immutable model: built once from a Scene, shared read-only by every loop.
