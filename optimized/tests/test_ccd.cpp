@@ -133,18 +133,21 @@ namespace {
 // A host may run the library on a thread that flushes subnormal results to
 // zero and reads subnormal inputs as zero (MXCSR's FTZ and DAZ, set by many
 // audio and game engines): the widening of every rounded bound (rounding.h,
-// 2^-600 at least) still covers both errors (each under 2^-1022), so the
-// intervals still enclose the exact results. Operands from 2^-1074 (the least
-// subnormal) to 2^-900, where sums and products fall in or below the
-// subnormal range; their exact values are taken before the mode is set (GMP
-// reads doubles with floating-point operations too).
+// 2^-600 at least) still covers both errors (a flushed result's, under
+// 2^-1022; a subnormal operand's, under 2^-1022 times the other operand, which
+// the pipeline keeps under 2^100), so the intervals still enclose the exact
+// results. Operands a from 2^-1074 (the least subnormal) to 2^-900, b up to
+// 2^100, where sums and products fall in, below or far above the subnormal
+// range; their exact values are taken before the mode is set (GMP reads
+// doubles with floating-point operations too).
 TEST_CASE("interval operations enclose the exact result on a thread that flushes subnormals", "[ccd]") {
 #if defined(__SSE2__)
   std::mt19937_64 rng(12);
   std::uniform_real_distribution<double> mant(-1, 1);
-  std::uniform_int_distribution<int> ex(-1074, -900);
+  std::uniform_int_distribution<int> ex(-1074, -900), ex_b(-1074, 100);
   std::vector<double> a(20000), b(20000);
-  for (size_t i = 0; i < a.size(); ++i) a[i] = std::ldexp(mant(rng), ex(rng)), b[i] = std::ldexp(mant(rng), ex(rng));
+  for (size_t i = 0; i < a.size(); ++i)
+    a[i] = std::ldexp(mant(rng), ex(rng)), b[i] = std::ldexp(mant(rng), i % 2 ? ex(rng) : ex_b(rng));
   a[0] = std::numeric_limits<double>::denorm_min(), b[0] = 0;
   std::vector<std::array<Interval, 4>> got(a.size());
   const unsigned csr = _mm_getcsr();

@@ -42,9 +42,10 @@ namespace gauss6 {
 // docs/benchmarks.md, issue 20, tenth session). 2^-600 times a few factors
 // down to 1e-30 stays normal. It also keeps the bounds sound on a thread that
 // flushes subnormals to zero (FTZ and DAZ, as audio and game hosts often set):
-// an input read as zero moves by < 2^-1022, a result flushed to zero errs by <
-// 2^-1022, and the widening covers both, where 2^-1074, read as zero, widened
-// nothing.
+// a result flushed to zero errs by < 2^-1022; a subnormal operand read as zero
+// errs by < 2^-1022 times the other operand, which the collision pipeline
+// keeps under 1e30 (2^100: ccd.cpp refuses larger coordinates), so by < 2^-922;
+// the widening covers both, where 2^-1074, read as zero, widened nothing.
 // No -frounding-math is needed: the rounding mode is never changed. A NaN bound
 // makes every exclusion test false (comparisons with NaN are false, and the max
 // keeps a NaN first argument), so a NaN can only cause a false positive, never a
