@@ -161,12 +161,8 @@ void run_threaded(const RuntimeModel& model, Device* device, double seconds, con
     apply_thread_policy(settings, 0, &hs);
     double scheduled = 0, t = 0;
     for (;;) {
-      if (settings.spin_wait > 0) {
-        std::this_thread::sleep_until(at(scheduled - settings.spin_wait));
-        while (Clock::now() < at(scheduled)) cpu_relax();
-      } else {
-        std::this_thread::sleep_until(at(scheduled));
-      }
+      std::this_thread::sleep_until(at(scheduled - settings.spin_wait));  // spin_wait 0: to the tick itself
+      while (Clock::now() < at(scheduled)) cpu_relax();
       t = seconds_since(start);
       if (t >= seconds || (stop && stop->load(std::memory_order_acquire))) break;
       const double late = t - scheduled;

@@ -106,7 +106,7 @@ def format_result(r: dict) -> str:
     return "\n".join([
         f"Threaded run of the {r['scene']} scenario at {r['rate_hz']:g} Hz for {r['run_time_s']:.1f} s "
         f"({r['machine']['cpus']} CPUs, load average {', '.join(f'{x:.1f}' for x in r['machine']['load_average'])}; "
-        f"the haptic loop's busy wait {r['asked'].get('spin_us', 0):g} us a period).",
+        f"the haptic loop's busy wait {r['asked']['spin_us']:g} us a period).",
         "", "| loop | what it got from the OS | runs | period (us) p50 / p99 / max | jitter (us) p50 / p99 / max "
         "| deadline misses |", "|---|---|---|---|---|---|",
         f"| haptic | {h['granted']} | {h['ticks']} ticks | {q(h['period_us'])} | {q(h['jitter_us'])} | "

@@ -173,7 +173,6 @@ py::dict run(const std::string& scene_path, const std::string& trace_path, bool 
     scene.device.rate_hz = rate_hz;
   }
   if (realtime_priority < 0 || realtime_priority > 99) throw py::value_error("realtime_priority must be in [0, 99]");
-  if (!(spin_wait >= 0 && spin_wait <= 1)) throw py::value_error("spin_wait must be in [0, 1] s");
   HandScript script;
   try {
     script = load_scene_script(scene);
@@ -186,7 +185,7 @@ py::dict run(const std::string& scene_path, const std::string& trace_path, bool 
       run_options(trace_path, threaded, duration, lockstep_sim_period, extra_json, progress, max_contacts);
   options.runtime.realtime_priority = realtime_priority;
   options.runtime.pin_threads = pin_threads;
-  options.runtime.spin_wait = spin_wait;  // checked by the RuntimeModel: [0, 1] s
+  options.runtime.spin_wait = spin_wait;  // checked by the RuntimeModel ([0, 1] s): a ValueError naming it
   const ScenarioResult r = run_released([&] { return run_scenario(scene, script, options); });
   py::dict d = result_dict(r, script.phases);
   d["let_go_time"] = script.let_go_time;
