@@ -27,7 +27,9 @@
 // Profiles of the tail: GAUSS6_BENCH_STEP_LOG=<file> writes one line per step;
 // GAUSS6_BENCH_COLLECT=<i,j,...> switches callgrind's collection on around
 // those steps only (run under valgrind --tool=callgrind --collect-atstart=no),
-// so that the instructions of the slowest steps can be read apart from the rest.
+// so that the instructions of the slowest steps can be read apart from the rest
+// (each collected step is dumped apart: <out>.<n>, its step index in the
+// dump's description).
 #include <benchmark/benchmark.h>
 
 #include <cmath>
@@ -42,6 +44,7 @@
 #include <valgrind/callgrind.h>
 #else
 #define CALLGRIND_TOGGLE_COLLECT
+#define CALLGRIND_DUMP_STATS_AT(x)
 #endif
 
 #include "bench_data.h"
@@ -251,7 +254,10 @@ void time_steps(benchmark::State& state, const RuntimeModel& model, const std::v
       const bool profiled = collect.count(index) > 0;
       if (profiled) CALLGRIND_TOGGLE_COLLECT;
       iteration_ns += rec.sample([&] { advance_god_object(model, st.x_start, st.x_target, st.residual, &sim, &info); });
-      if (profiled) CALLGRIND_TOGGLE_COLLECT;
+      if (profiled) {
+        CALLGRIND_TOGGLE_COLLECT;
+        CALLGRIND_DUMP_STATS_AT(std::to_string(index).c_str());  // one profile per collected step
+      }
       const double cpu_ns = thread_cpu_ns() - cpu0;
       cpu.add(cpu_ns);
       benchmark::DoNotOptimize(sim.contacts.num_contacts);

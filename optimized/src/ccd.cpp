@@ -593,12 +593,23 @@ double rigid_speed(const CcdMotion& m, double rho) {
 //     need an end of each within d of the other's slab (for the moving edge,
 //     along C ea': again cubics), so both ends beyond the same plane by more
 //     than d exclude. (Stage 2: added only when (1) and (2) keep the window.)
+// (4) The lines' distance (edge/edge). With N(u) = Dc(u) ea' x eb = D C ea' x eb
+//     (quadratic in u) the cubic of (1) is P = (x_a0(u) - b0).N, so the lines
+//     are more than d apart exactly where S(u) = P^2 - d^2 |N|^2 > 0, a
+//     polynomial of degree 6 with no bound L in it. (1)'s L grows with the turn
+//     over the whole window: an edge sliding across another at a gap of
+//     d (1 + 1e-5) while the step turns by a degree has |P| <= d L D everywhere,
+//     and its endpoints swing across the axis of (2) by a thousand times the
+//     gap's margin, so neither excluded any u-interval wider than about 1e-4
+//     of the window: 256 of them (the cap), the rest left to the bisection
+//     (0.2 ms a query; docs/benchmarks.md, issue 20). S decides such a window
+//     whole. (Stage 2, tried last: the cheaper tests decide most intervals.)
 //     Every condition reads "g(u) > 0 on all of U excludes U", g a cubic whose
-//     interval coefficients enclose the exact ones; positive_on() bounds g from
-//     below over U by its Bernstein coefficients (outward rounded).
+//     interval coefficients enclose the exact ones (S: degree 6); positive_on()
+//     bounds g from below over U by its Bernstein coefficients (outward rounded).
 //
 // Guarantee. A u-interval is dropped only when (1), (2) (with the window
-// start's axis, or the interval's own: filtered_bisect()) or (3) proves that no
+// start's axis, or the interval's own: filtered_bisect()), (3) or (4) proves that no
 // contact within d occurs in it; the bisection then runs on the remaining
 // intervals in increasing u, so its first accepted interval still starts at or
 // before u*. Intervals come from a depth-first left-first 1-D subdivision down
@@ -652,6 +663,73 @@ bool positive_on(const Cubic& c, double u0, double u1) {
   const Interval A3 = c.k[3] * (h2 * h);
   if (!((a0 + A1 + A2 + A3).lo > 0)) return false;
   return (a0 + kThird * A1).lo > 0 && (a0 + kThird * (2.0 * A1 + A2)).lo > 0;
+}
+
+// A polynomial of degree 6 whose interval coefficients enclose the exact ones.
+struct Sextic {
+  Interval k[7];
+  double mid[7] = {};  // the coefficients' midpoints (set_mid): a quick screen in doubles
+  void set_mid() {
+    for (int j = 0; j < 7; ++j) mid[j] = 0.5 * (k[j].lo + k[j].hi);
+  }
+};
+
+// The Bernstein basis change of degree 6: b_i = sum_{j <= i} C(i, j) / C(6, j)
+// a_j for the Taylor coefficients a_j of p(u0 + t h) in t; the weights
+// enclosed (C(i, j) and C(6, j) are exact small integers), once.
+struct BernsteinWeights6 {
+  Interval w[7][7];
+  BernsteinWeights6() {
+    const double c6[7] = {1, 6, 15, 20, 15, 6, 1};
+    for (int i = 0; i <= 6; ++i) {
+      double cij = 1;  // C(i, j)
+      for (int j = 0; j <= i; ++j) {
+        w[i][j] = div_positive(Interval::point(cij), Interval::point(c6[j]));
+        cij = cij * (i - j) / (j + 1);
+      }
+    }
+  }
+};
+const BernsteinWeights6 kBernstein6;
+
+// True when every polynomial with coefficients in p is > 0 on all of [u0, u1]
+// (0 <= u0 <= u1): as positive_on(Cubic) above, its values at u0 and u1 (b0
+// and b6, by Horner's rule) and then the inner Bernstein coefficients b1..b5,
+// from the Taylor coefficients at u0 (repeated synthetic division) scaled by
+// powers of h = u1 - u0, all outward rounded.
+bool positive_on(const Sextic& p, double u0, double u1) {
+  // Screen (a heuristic: a false here only keeps the interval): the midpoint
+  // polynomial at both ends, in doubles.
+  const auto screen_at = [&](double u) {
+    double v = p.mid[6];
+    for (int j = 5; j >= 0; --j) v = p.mid[j] + u * v;
+    return v > 0;
+  };
+  if (!screen_at(u0) || !screen_at(u1)) return false;
+  const auto value_at = [&](double u) {
+    const Interval U = Interval::point(u);
+    Interval v = p.k[6];
+    for (int j = 5; j >= 0; --j) v = p.k[j] + U * v;
+    return v;
+  };
+  if (!(value_at(u0).lo > 0) || !(value_at(u1).lo > 0)) return false;
+  Interval a[7];
+  for (int j = 0; j < 7; ++j) a[j] = p.k[j];
+  const Interval U = Interval::point(u0);
+  for (int i = 0; i < 6; ++i)
+    for (int j = 5; j >= i; --j) a[j] = a[j] + U * a[j + 1];
+  const Interval h = Interval::point(u1) - U;
+  Interval hj = h;
+  for (int j = 1; j < 7; ++j) {
+    a[j] = a[j] * hj;
+    hj = hj * h;
+  }
+  for (int i = 1; i <= 5; ++i) {
+    Interval b = a[0];
+    for (int j = 1; j <= i; ++j) b = b + kBernstein6.w[i][j] * a[j];
+    if (!(b.lo > 0)) return false;
+  }
+  return true;
 }
 
 // D(u) (x(u) - f).m for the body point with world-oriented offset w = R0 r_B
@@ -726,6 +804,8 @@ struct UFilter {
   Cubic cond[kMaxConditions];
   bool joins_previous[kMaxConditions] = {};
   int num_conditions = 0;
+  Sextic lines;         // (4), edge/edge (rigid): S(u) = P^2 - d^2 |N|^2, tried last
+  bool has_lines = false;
   SeparatingAxis axis;  // (2), with the axis of the window's start (rigid queries)
   const CcdMotion* motion = nullptr;  // the axis test's motion (rigid queries; null: no axis test)
   Interval g2{};  // s = |g|^2 of D(u) = 1 + s u^2 (zero for linear motion: D = 1)
@@ -759,7 +839,8 @@ struct UFilter {
       if (all) return true;
       i = j;
     }
-    return motion != nullptr && axis.excludes(*motion, u0, u1);
+    if (motion != nullptr && axis.excludes(*motion, u0, u1)) return true;
+    return has_lines && positive_on(lines, u0, u1);
   }
 };
 
@@ -840,6 +921,12 @@ void filtered_bisect(const Enclose& enclose, bool triangle, const Scales& sc, UF
                      const CcdSettings& s, CcdWorkspace* ws, CcdResult* r, int max_evaluations = 256) {
   constexpr int kStack = 64;
   int evaluations = 1, total_iterations = 0;
+  // Every return below leaves *r final; the count of u-intervals goes in on the way out.
+  struct CountIntervals {
+    CcdResult* r;
+    const int* n;
+    ~CountIntervals() { r->filter_intervals = *n; }
+  } count_intervals{r, &evaluations};
   const double tol_d = std::max(s.distance_tolerance, kDistanceToleranceFloor * sc.coordinate);  // as in bisect()
   const auto probe = [&](double u0, double u1, int iterations, CcdResult* res) {
     const Guide g = guides.at(u0);
@@ -1184,6 +1271,24 @@ void ccd_rigid_edge_edge(const RigidEdgeEdgeQuery& q, const CcdSettings& s, CcdW
     f->at_least(static_point_along(m, b1, a0W, eaW, ca), ra, /*join=*/true);
     f->at_most(static_point_along(m, b0, a1W, eaW, ca), ra);
     f->at_most(static_point_along(m, b1, a1W, eaW, ca), ra, /*join=*/true);
+    // The lines' distance (4): S = P^2 - d^2 |N|^2, N = T0 + u T1 + u^2 T2.
+    {
+      Sextic& q6 = f->lines;
+      for (int i = 0; i < 4; ++i) {
+        q6.k[2 * i] = q6.k[2 * i] + sqr(P.k[i]);
+        for (int j = i + 1; j < 4; ++j) q6.k[i + j] = q6.k[i + j] + 2.0 * (P.k[i] * P.k[j]);
+      }
+      const Interval d2 = sqr(Interval::point(d));
+      for (int c = 0; c < 3; ++c) {
+        const Interval n[3] = {T0[c], T1[c], T2[c]};
+        for (int i = 0; i < 3; ++i) {
+          q6.k[2 * i] = q6.k[2 * i] - d2 * sqr(n[i]);
+          for (int j = i + 1; j < 3; ++j) q6.k[i + j] = q6.k[i + j] - d2 * (2.0 * (n[i] * n[j]));
+        }
+      }
+      q6.set_mid();
+      f->has_lines = true;
+    }
   }, Guides<decltype(guide_at), decltype(separated)>{guide_at, separated}, q.u_begin, q.u_end, s, ws, r);
 }
 

@@ -445,7 +445,7 @@ void bind_ccd(py::module_& m) {
   // Per-query CCD (documented for users in python/gauss6/ccd.py).
   py::class_<QueryResult>(ccd, "QueryResult",
                           "One CCD query's answer: hit, u_hit (<= the exact first contact u*), status, "
-                          "time_tolerance_reached, distance_reached, iterations.")
+                          "time_tolerance_reached, distance_reached, iterations, filter_intervals.")
       .def_property_readonly("hit", [](const QueryResult& q) { return q.r.hit; },
                              "a contact (or, with min_separation > 0, a distance <= min_separation) may occur in "
                              "[u_begin, u_end]; true on a give-up (conservative)")
@@ -459,6 +459,8 @@ void bind_ccd(py::module_& m) {
       .def_property_readonly("distance_reached", [](const QueryResult& q) { return q.r.distance_reached; },
                              "on a hit, the features are within this distance at u_hit (inf on a give-up)")
       .def_property_readonly("iterations", [](const QueryResult& q) { return q.r.iterations; }, "boxes examined")
+      .def_property_readonly("filter_intervals", [](const QueryResult& q) { return q.r.filter_intervals; },
+                             "u-intervals the u-filter examined (filtered queries; at most 256)")
       .def("__repr__", [](const QueryResult& q) {
         return "<QueryResult status=" + q.status + " hit=" + (q.r.hit ? "True" : "False") +
                " u_hit=" + py::repr(py::float_(q.r.u_hit)).cast<std::string>() + ">";

@@ -22,7 +22,8 @@
 // in the accepted interval, u* - u_hit <= time_tolerance_reached (in practice
 // u* - u_hit <= 2 time_tolerance unless the motion grazes: see the tests).
 // Rigid queries first drop u-ranges with cheap cubic filters (the coplanarity
-// cubic's roots isolated in Bernstein form, and slabs); linear queries that a
+// cubic's roots isolated in Bernstein form, and slabs; edge/edge, the lines'
+// distance as a polynomial of degree 6, which decides a sliding pair whole); linear queries that a
 // short bisection (64 boxes) does not decide continue with the same filters
 // and guides (sliding contacts, nearly parallel edges: ccd.cpp); with early_hit the
 // earliest kept u-interval is accepted without the bisection when a feature
@@ -126,6 +127,7 @@ struct CcdResult {
   double distance_reached = 0;        // hit: the features are within this distance (Euclidean) at u_hit,
                                       // for some feature parameters; +inf on give-up
   int iterations = 0;                 // boxes examined
+  int filter_intervals = 0;           // u-intervals the u-filter examined (filtered queries; at most 256)
 };
 
 // Box stack of the bisection (the parameter-box fronts of the pending
