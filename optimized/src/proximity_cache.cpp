@@ -159,6 +159,7 @@ struct CacheRanges {
   double u_probe;  // over [0, u_probe] no point moves a quarter of the margin
   int n;           // sub-intervals
   double max_probe;  // a first search is shorter than this many sub-intervals (max_probe_sub_intervals)
+  bool stops_early;  // a leg expected to stop early (CcdStepSettings::lead_sweep > 0): any range serves
   // [0, u] keeps every point within m of a list's pose, the points `moved`
   // from there by X0 (0: none).
   double range(double moved, double m) const {
@@ -166,12 +167,13 @@ struct CacheRanges {
     return u > 0 ? std::min(u, 1.0) : 0.0;  // also NaN
   }
   // The part of a cache range [0, u] to search from the cache (0: none): all
-  // of it when it covers the rest of the step; as a first search, at most
+  // of it when it covers the rest of the step or the leg stops early
+  // (stops_early); else, as a first search, at most
   // the range over which no point moves slow_fraction of the margin, and only
   // when that is under max_probe sub-intervals (a longer one saves no descent).
   double window(double u) const {
     if (!(u > 0)) return 0.0;  // also NaN
-    if (u >= u_rest) return u;
+    if (u >= u_rest || stops_early) return u;
     const double w = std::min(u, u_probe);
     return probing && w > 0 && w < max_probe / n ? w : 0.0;
   }
@@ -284,7 +286,15 @@ void search_cached_pairs(StepState* s, const ProximityCache& pc, const Displacem
 // (under half a sub-interval: a contact likely to be met soon, as a bunny's
 // ear turned back onto the back it rests on, ends the step there without
 // sweeping the boxes over the whole step). A range covering only part of a
-// step would search the pairs near X0 twice: not used. The cache is refilled
+// step would search the pairs near X0 twice (the list, then the descents of
+// the rest): not used, but by a leg expected to stop early (a settling leg,
+// CcdStepSettings::lead_sweep > 0), which stops at u 0.0003-0.06 of its motion
+// and so most often inside the list's range: the list then answers its lead
+// pieces, where each of them descended the trees to the same standing
+// proximity (the peg's wedge: 1,700-3,900 node pairs a settling leg; over the
+// replays' 150 slowest steps 6% fewer instructions on both scenes, the peg's
+// slowest step 15.4 -> 13.7 M, the whole replays within 1%: docs/benchmarks.md,
+// issue 20, eleventh session). The cache is refilled
 // at X0 when its own range cannot be used for this step and a fresh one's
 // would (a step that moves less than the margin, or a short first search).
 void serve_proximity_cache(StepState* s) {
@@ -301,7 +311,8 @@ void serve_proximity_cache(StepState* s) {
                       s->hints && s->num_hints > 0 && !result.hit,
                       speed > 0 ? round_down(policy(*s).slow_fraction * margin / speed).v : 1.0,
                       s->n,
-                      policy(*s).max_probe_sub_intervals};
+                      policy(*s).max_probe_sub_intervals,
+                      s->settings.lead_sweep > 0};
   const bool keyed = s->cache_keyed;
   Displacement since(keyed ? pc.ref : s->X0, s->X0);
   s->cache_moved = keyed ? since.bound(s->rho) : std::numeric_limits<double>::infinity();
