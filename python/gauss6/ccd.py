@@ -9,7 +9,7 @@ each; the exact twin of reference/ccd.h beside it):
     r = ccd.rigid_vertex_face(p0, q0, p1, q1, vertex_B, face_W)           # Cayley rigid motion
     r = ccd.rigid_face_vertex(p0, q0, p1, q1, face_B, vertex_W)
     r = ccd.rigid_edge_edge(p0, q0, p1, q1, edge_B, edge_W)
-    r.hit, r.u_hit, r.status, r.time_tolerance_reached, r.distance_reached, r.iterations
+    r.hit, r.u_hit, r.status, r.time_tolerance_reached, r.distance_reached, r.iterations, r.filter_intervals
 
 Linear: every vertex moves on x(u) = x_start + u (x_end - x_start), u in [0, 1];
 a vertex is (3,), a face (3, 3) and an edge (2, 3), one point a row. Rigid: the
@@ -28,7 +28,10 @@ up (hit is then True, u_hit the earliest u not proven free); "invalid_input"
 (non-finite or huge coordinate, bad window); "half_turn" (rigid: a relative
 rotation near 180 degrees, split the step; hit True, u_hit 0).
 time_tolerance_reached is the u-width of the accepted box and distance_reached
-a distance within which the features lie at u_hit. The tests
+a distance within which the features lie at u_hit; iterations counts the boxes
+of the bisection and filter_intervals the u-intervals the u-filter examined
+(rigid queries and the linear ones a short bisection did not decide; at most
+256, past which the rest of the window goes to the bisection whole). The tests
 (python/tests/test_ccd_queries.py) check u_hit <= u* exactly on every shared
 query and bound u* - u_hit.
 

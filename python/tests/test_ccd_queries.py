@@ -142,6 +142,7 @@ def test_rigid_queries_known_contacts():
     r = ccd.rigid_edge_edge([0, 0, 1.0], ID, [0, 0, -2.0], ID, edge_B, edge_W)
     e = ccd.exact_rigid_edge_edge([0, 0, 1.0], ID, [0, 0, -2.0], ID, edge_B, edge_W)
     assert r.hit and e.hit and e.compare(r.u_hit) <= 0 and 1 / 3 - r.u_hit <= 2 * TOL
+    assert 1 <= r.filter_intervals <= 256  # the u-filter ran (rigid), within its budget
     # A half turn is a status (split the step), reported as a conservative hit at 0.
     r = ccd.rigid_vertex_face([0, 0, 1.0], ID, [0, 0, 1.0], [0, 1.0, 0, 0], [0, 0, 0], face_W)
     assert r.status == "half_turn" and r.hit and r.u_hit == 0
