@@ -893,6 +893,7 @@ bool axis_clears(const UFilter& filter, double u_begin, double u_end, CcdResult*
   r->status = CcdStatus::kOk;
   r->hit = false;
   r->u_hit = u_end;
+  r->filter_intervals = 1;  // the whole window, once
   return true;
 }
 
