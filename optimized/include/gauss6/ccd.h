@@ -21,11 +21,11 @@
 // u_hit the features are already within distance_reached; if they truly touch
 // in the accepted interval, u* - u_hit <= time_tolerance_reached (in practice
 // u* - u_hit <= 2 time_tolerance unless the motion grazes: see the tests).
-// Rigid queries first drop u-ranges with cheap cubic filters (the coplanarity
-// cubic's roots isolated in Bernstein form, and slabs; edge/edge, the lines'
-// distance as a polynomial of degree 6, which decides a sliding pair whole); linear queries that a
-// short bisection (64 boxes) does not decide continue with the same filters
-// and guides (sliding contacts, nearly parallel edges: ccd.cpp); with early_hit the
+// Rigid queries first drop u-ranges with cheap polynomial filters in Bernstein
+// form (the coplanarity cubic, the slabs; edge/edge, also the lines' distance
+// as a polynomial of degree 6, which decides a sliding pair whole); linear
+// queries that a short bisection (64 boxes) does not decide continue with the
+// same filters and guides (sliding contacts, nearly parallel edges: ccd.cpp); with early_hit the
 // earliest kept u-interval is accepted without the bisection when a feature
 // pair there is proven within min_separation + distance_tolerance (the same
 // acceptance rule; everything before it was proven free, so u_hit <= u*).
