@@ -84,8 +84,8 @@ void PairTester::test(const TriangleMesh& gm, const Bvh& gb, int gf, const Trian
   // contact sliding along at its gap is then searched from where the
   // motion can first close it, not across the whole step).
   double from = u0;
-  const auto apart = [&](const Vec3 A[3], const Vec3 B[3], double radius, const Vec3& axis) {
-    from = std::max(u0, start->earliest(A, B, radius, reach, end(), &axis));
+  const auto apart = [&](double earliest) {
+    from = std::max(u0, earliest);
     if (from <= end()) return false;
     ++result->num_feature_culls;
     return true;
@@ -100,7 +100,8 @@ void PairTester::test(const TriangleMesh& gm, const Bvh& gb, int gf, const Trian
         if (!overlap(god_swept[k], obs_face_box)) return true;
         pose_god_face();
         const Vec3 A[3] = {X[k], X[k], X[k]};
-        if (apart(A, Y, rad[k], X[k] - closest_point_on_triangle(X[k], Y[0], Y[1], Y[2]))) return true;
+        const Vec3 axis = X[k] - closest_point_on_triangle(X[k], Y[0], Y[1], Y[2]);
+        if (apart(start->earliest<Shape::kVertex, Shape::kTriangle>(A, Y, rad[k], reach, end(), &axis))) return true;
         RigidVertexFaceQuery q{motion, god_face[k], obs_face, from, end()};
         ccd_rigid_vertex_face(q, settings->narrow, ws, &r);
         break;
@@ -109,8 +110,9 @@ void PairTester::test(const TriangleMesh& gm, const Bvh& gb, int gf, const Trian
         if (!overlap(god_face_swept, inflate(box_of(obs_face[j], obs_face[j]), margin))) return true;
         pose_god_face();
         const Vec3 B[3] = {Y[j], Y[j], Y[j]};
-        if (apart(X, B, std::max({rad[0], rad[1], rad[2]}), closest_point_on_triangle(Y[j], X[0], X[1], X[2]) - Y[j]))
-          return true;
+        const Vec3 axis = closest_point_on_triangle(Y[j], X[0], X[1], X[2]) - Y[j];
+        const double radius = std::max({rad[0], rad[1], rad[2]});
+        if (apart(start->earliest<Shape::kTriangle, Shape::kVertex>(X, B, radius, reach, end(), &axis))) return true;
         RigidFaceVertexQuery q{motion, obs_face[j], god_face, from, end()};
         ccd_rigid_face_vertex(q, settings->narrow, ws, &r);
         break;
@@ -122,8 +124,9 @@ void PairTester::test(const TriangleMesh& gm, const Bvh& gb, int gf, const Trian
         const Vec3 A[3] = {X[k], X[k1], X[k1]}, B[3] = {Y[j], Y[j1], Y[j1]};
         double s = 0, t = 0;
         closest_segment_parameters(X[k], X[k1], Y[j], Y[j1], &s, &t);
-        if (apart(A, B, std::max(rad[k], rad[k1]), (X[k] + s * (X[k1] - X[k])) - (Y[j] + t * (Y[j1] - Y[j]))))
-          return true;
+        const Vec3 axis = (X[k] + s * (X[k1] - X[k])) - (Y[j] + t * (Y[j1] - Y[j]));
+        const double radius = std::max(rad[k], rad[k1]);
+        if (apart(start->earliest<Shape::kEdge, Shape::kEdge>(A, B, radius, reach, end(), &axis))) return true;
         RigidEdgeEdgeQuery q{motion, {god_face[k], god_face[k1]}, {obs_face[j], obs_face[j1]}, from, end()};
         ccd_rigid_edge_edge(q, settings->narrow, ws, &r);
         break;

@@ -43,20 +43,34 @@ void closest_segment_parameters(const Vec3& p0, const Vec3& p1, const Vec3& q0, 
 // the norm and the quotient (error_allowances.h).
 // A zero or non-finite axis proves nothing (NaN or inf is dropped).
 // extra: one more axis to try first (any vector; nullptr: none), e.g. the
-// direction between the closest points of two features given as degenerate
-// triangles (a vertex: its point thrice; an edge: its ends, one twice), whose
-// normals and cross products are then zero or few.
-template <class OnAxis>
+// direction between the closest points of two features.
+//
+// Features. A vertex or an edge is given as a degenerate triangle (a vertex:
+// its point thrice; an edge: its ends, the second twice) with its Shape, the
+// number of its distinct corners. Its normal and the cross products of its
+// zero edges are zero, and an edge's two edges (A[1] - A[0] and A[0] - A[2] =
+// -(A[1] - A[0]), exactly) give the same axis up to sign, hence the same gap
+// (the projections negate exactly): so only the axes a Shape can have are
+// formed (a vertex and a face: the face's normal; two edges: their cross
+// product), in the order of the 11, and the result is that of the 11.
+enum class Shape : int { kVertex = 1, kEdge = 2, kTriangle = 3 };
+
+template <Shape ShapeA = Shape::kTriangle, Shape ShapeB = Shape::kTriangle, class OnAxis>
 GAUSS6_ALWAYS_INLINE void for_each_separating_axis(const Vec3 A[3], const Vec3 B[3], OnAxis&& on_axis,
                                                    const Vec3* extra = nullptr) {
+  constexpr int na = static_cast<int>(ShapeA), nb = static_cast<int>(ShapeB);
   double s = 0;
-  for (int k = 0; k < 3; ++k) s = std::max(s, std::max(A[k].cwiseAbs().maxCoeff(), B[k].cwiseAbs().maxCoeff()));
+  for (int k = 0; k < na; ++k) s = std::max(s, A[k].cwiseAbs().maxCoeff());
+  for (int k = 0; k < nb; ++k) s = std::max(s, B[k].cwiseAbs().maxCoeff());
   const auto along = [&](const Vec3& a) GAUSS6_ALWAYS_INLINE_LAMBDA {
     double a_lo = a.dot(A[0]), a_hi = a_lo, b_lo = a.dot(B[0]), b_hi = b_lo;
-    for (int k = 1; k < 3; ++k) {
-      const double pa = a.dot(A[k]), pb = a.dot(B[k]);
+    for (int k = 1; k < na; ++k) {
+      const double pa = a.dot(A[k]);
       a_lo = std::min(a_lo, pa);
       a_hi = std::max(a_hi, pa);
+    }
+    for (int k = 1; k < nb; ++k) {
+      const double pb = a.dot(B[k]);
       b_lo = std::min(b_lo, pb);
       b_hi = std::max(b_hi, pb);
     }
@@ -69,9 +83,12 @@ GAUSS6_ALWAYS_INLINE void for_each_separating_axis(const Vec3 A[3], const Vec3 B
   };
   if (extra && along(*extra)) return;
   const Vec3 ea[3] = {A[1] - A[0], A[2] - A[1], A[0] - A[2]}, eb[3] = {B[1] - B[0], B[2] - B[1], B[0] - B[2]};
-  if (along(ea[0].cross(ea[1])) || along(eb[0].cross(eb[1]))) return;
-  for (int i = 0; i < 3; ++i)
-    for (int j = 0; j < 3; ++j)
+  if (na == 3 && along(ea[0].cross(ea[1]))) return;
+  if (nb == 3 && along(eb[0].cross(eb[1]))) return;
+  // Edges: a triangle's three, an edge's one, a vertex's none.
+  constexpr int edges_a = na == 3 ? 3 : na - 1, edges_b = nb == 3 ? 3 : nb - 1;
+  for (int i = 0; i < edges_a; ++i)
+    for (int j = 0; j < edges_b; ++j)
       if (along(ea[i].cross(eb[j]))) return;
 }
 

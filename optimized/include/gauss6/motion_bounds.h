@@ -76,14 +76,16 @@ struct TriangleMotion {
 // kAxisProductRounding |a|_1 |omega|_inf |r|_inf (error_allowances.h); the
 // rest is rounded the safe way. Inline: the mesh step calls it for every
 // candidate triangle pair and feature pair.
+template <Shape ShapeA = Shape::kTriangle, Shape ShapeB = Shape::kTriangle>
 inline double triangle_time_lower_bound(const Vec3 A[3], const Vec3 B[3], const TriangleMotion& m, double reach,
                                         double enough, const Vec3* extra = nullptr) {
+  constexpr int na = static_cast<int>(ShapeA);  // A's distinct corners
   const double v_inf = m.v.cwiseAbs().maxCoeff(), omega_inf = m.omega.cwiseAbs().maxCoeff();
   const Vec3 r[3] = {A[0] - m.centre, A[1] - m.centre, A[2] - m.centre};
   double r_inf = 0;
-  for (int k = 0; k < 3; ++k) r_inf = std::max(r_inf, r[k].cwiseAbs().maxCoeff());
+  for (int k = 0; k < na; ++k) r_inf = std::max(r_inf, r[k].cwiseAbs().maxCoeff());
   double best = 0;
-  for_each_separating_axis(A, B, [&](const Vec3& a, double g, double side) GAUSS6_ALWAYS_INLINE_LAMBDA {
+  for_each_separating_axis<ShapeA, ShapeB>(A, B, [&](const Vec3& a, double g, double side) GAUSS6_ALWAYS_INLINE_LAMBDA {
     const Lower clear = Lower{g} - Upper{reach};
     if (!(clear.v > 0)) return false;
     const double a_1 = a.cwiseAbs().sum();
@@ -92,7 +94,7 @@ inline double triangle_time_lower_bound(const Vec3 A[3], const Vec3 B[3], const 
     if (omega_inf > 0) {
       const Vec3 c = a.cross(m.omega);  // r.(a x omega) = a.(omega x r)
       approach = -std::numeric_limits<double>::infinity();
-      for (int k = 0; k < 3; ++k) {
+      for (int k = 0; k < na; ++k) {
         const double b = side * r[k].dot(c);
         approach = std::max(approach, along_v + b + m.lag * std::max(0.0, -b));
       }
@@ -351,8 +353,9 @@ struct StartFrame {
   }
   // The same for a god triangle X (its corners at u0, doubles; r >= the
   // largest |r_B| of them) and an obstacle triangle Y, either possibly
-  // degenerate (a feature: see for_each_separating_axis), `extra` an axis to
-  // try first.
+  // degenerate (a feature of the given Shapes: see for_each_separating_axis),
+  // `extra` an axis to try first.
+  template <Shape ShapeX = Shape::kTriangle, Shape ShapeY = Shape::kTriangle>
   double earliest(const Vec3 X[3], const Vec3 Y[3], double r, double d, double u_limit,
                   const Vec3* extra = nullptr) const {
     const Upper tau_max = Upper{u_limit} - Lower{u0};
@@ -366,7 +369,7 @@ struct StartFrame {
     m.w = ((Upper{drift} + (Upper{omega_error} + second) * Upper{r}) + offsets).v;
     if (!(m.w < std::numeric_limits<double>::infinity())) return u0;
     const Upper reach = Upper{static_error} + Upper{d};
-    const double tau = triangle_time_lower_bound(X, Y, m, reach.v, tau_max.v, extra);
+    const double tau = triangle_time_lower_bound<ShapeX, ShapeY>(X, Y, m, reach.v, tau_max.v, extra);
     if (!(tau > 0)) return u0;
     return (Lower{u0} + Lower{tau}).v;
   }
