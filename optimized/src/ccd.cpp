@@ -499,8 +499,13 @@ void enclose_motion(const CcdMotion& m, Interval u, MotionEnclosure* out) {
   for (int i = 0; i < 3; ++i)
     for (int j = 0; j < 3; ++j) {
       Interval e = C[3 * i] * m.R0[j] + C[3 * i + 1] * m.R0[3 + j] + C[3 * i + 2] * m.R0[6 + j];
-      out->R[3 * i + j] = {std::max(e.lo, -1.0), std::min(e.hi, 1.0)};
+      const Interval r = {std::max(e.lo, -1.0), std::min(e.hi, 1.0)};
+      out->R[3 * i + j] = r;
+      const double mid = 0.5 * r.lo + 0.5 * r.hi;  // any double will do: the radius covers it
+      out->R_mid(i, j) = mid;
+      out->R_rad(i, j) = next_up(std::max(r.hi - mid, mid - r.lo));
     }
+  out->R_abs = out->R_mid.cwiseAbs();
   out->u = u;
   for (int i = 0; i < 3; ++i) out->p[i] = m.p0[i] + u * m.dp[i];
 }

@@ -32,6 +32,17 @@ TEST_CASE("BVH: swept boxes contain the moving box over the u-range", "[motion_b
     const Vec3 c(n(rng), n(rng), n(rng)), h = Vec3(n(rng), n(rng), n(rng)).cwiseAbs() * 0.3;
     const Aabb body{c - h, c + h};
     const Aabb w = swept_box(e, body);
+    // As tight as the interval product of the enclosure (enclose_point) but
+    // for twice the product of the two radii, R_rad h (an entry's product
+    // R r: its extreme is at one end of r, where midpoint-radius takes the
+    // other end's R_rad |r|), and the rounding allowance.
+    const IVec3 iw = enclose_point(e, {Interval{body.lo.x(), body.hi.x()}, Interval{body.lo.y(), body.hi.y()},
+                                       Interval{body.lo.z(), body.hi.z()}});
+    const Vec3 slack = 2 * (e.R_rad * h) + Vec3::Constant(1e-12 * (1 + c.cwiseAbs().maxCoeff() + h.maxCoeff()));
+    for (int i = 0; i < 3; ++i) {
+      REQUIRE(w.lo[i] >= iw[i].lo - slack[i]);
+      REQUIRE(w.hi[i] <= iw[i].hi + slack[i]);
+    }
     for (int k = 0; k <= 10; ++k)
       for (int corner = 0; corner < 8; ++corner) {
         const Vec3 r(corner & 1 ? body.hi.x() : body.lo.x(), corner & 2 ? body.hi.y() : body.lo.y(),

@@ -82,6 +82,9 @@ struct MotionEnclosure {
   Interval u;
   IMat3 R;   // entries intersected with [-1, 1] (R(u) is exactly a rotation)
   IVec3 p;
+  // R in midpoint-radius form: every entry of R within R_rad of R_mid's
+  // (exactly), and R_abs = |R_mid|; for swept_box (motion_bounds.h).
+  Mat3 R_mid, R_rad, R_abs;
 };
 void enclose_motion(const CcdMotion& motion, Interval u, MotionEnclosure* out);
 // Enclosure of the world points p(u) + R(u) r_B for u in e.u and r_B in r_B.

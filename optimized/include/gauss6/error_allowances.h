@@ -116,12 +116,22 @@ constexpr double kObbFitRounding = 1e-13;
 // |G|). Site: generate_contacts.
 constexpr double kBoxPoseRounding = 1e-12;
 
+// A body box c +- h mapped by an interval rotation in midpoint-radius form
+// (swept_box: R within R_rad of R_mid entrywise): the world box R_mid c +-
+// (|R_mid| h + R_rad (|c| + h)), in doubles. With T = (|R_mid| + R_rad) (|c| +
+// h) per coordinate, R_mid c rounds within 3.01 u sum |R_mid| |c| <= 3.01 u T,
+// and the half-width, a sum of six rounded products of rounded sums of
+// nonnegative terms, within 7.01 u of itself <= 7.01 u T; T itself is
+// computed within 7.01 u. Under 10.1 u (1.12e-15) of the computed T in all;
+// 2e-15 covers it 1.8 times (kUnderflowFloor below it). Site: swept_box.
+constexpr double kBoxProductRounding = 2e-15;
+
 // An absolute floor under the relative allowances of box extents, where the
 // relative term vanishes or underflows (all coordinates 0 or subnormal): each
 // underflowing product or sum errs by at most 2^-1075 (2.5e-324; 2^-1022,
 // 2.2e-308, on a thread that flushes subnormals to zero), and a box's few
 // dozen of them stay below 1e-306; 1e-300 covers them and is below any extent
-// that matters. Sites: fit_obb, generate_contacts.
+// that matters. Sites: fit_obb, generate_contacts, swept_box.
 constexpr double kUnderflowFloor = 1e-300;
 
 // A corner value of F = (w + a ea) - b eb for linearly moving points (the
