@@ -180,7 +180,8 @@ bool search_sub_intervals(StepState* s) {
     const TraversalStatus ts = descend(s, std::min(u1, result->u_hit), [&](int gf, int of, int o) {
       const CcdBody& ob = s->obstacles[o];
       ++result->num_triangle_pairs;
-      const double t = s->start.earliest(*god.mesh, gf, *ob.mesh, of, s->reach, tester.end());
+      const double t = s->start.earliest(s->start.posed_face(*god.mesh, gf, &s->ws->swept), *ob.mesh, of, s->reach,
+                                         tester.end());
       if (t > tester.end()) {
         ++result->num_axis_culls;
         return true;

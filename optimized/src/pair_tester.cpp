@@ -67,16 +67,14 @@ void PairTester::test(const TriangleMesh& gm, const Bvh& gb, int gf, const Trian
   // as degenerate triangles, the axis between their closest points at u0
   // tried first): a pair sliding along at its gap, or turning across it,
   // needs no test.
-  Vec3 X[3];
-  double rad[3];
-  bool posed = false;
+  SweptBoxCache::PosedFace posed;  // the god face at u0 (StartFrame::posed_face), a copy
+  const Vec3* const X = posed.X;
+  const double* const rad = posed.radius;
+  bool is_posed = false;
   const auto pose_god_face = [&] {  // once, for the first feature past the box filter
-    if (posed) return;
-    posed = true;
-    for (int k = 0; k < 3; ++k) {
-      X[k] = start->pose(god_face[k]);
-      rad[k] = start->radius(god_face[k].squaredNorm());
-    }
+    if (is_posed) return;
+    is_posed = true;
+    posed = start->posed_face(gm, gf, swept);
   };
   const Vec3* Y = obs_face.data();
   // The bound also starts the feature pair's search: nothing comes within

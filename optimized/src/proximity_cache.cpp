@@ -112,7 +112,8 @@ bool fill_some(StepState* s, long budget) {
     const TraversalStatus ts = traverse(*s, frame, enc, pf.swept, 0.0, fill_dist, pf.obstacle, &pf.stack, &pf.pending,
                                         budget, &used, [&](int gf, int of, int o) {
       double radius = 0;
-      const double gap = frame.gap(*god.mesh, gf, *s->obstacles[o].mesh, of, fill_dist, &radius);
+      const double gap = frame.gap(frame.posed_face(*god.mesh, gf, &pf.swept), *s->obstacles[o].mesh, of, fill_dist,
+                                   &radius);
       if (gap > fill_dist) return true;
       if (pf.num_pairs == capacity) return false;  // does not fit: no cache
       pf.pairs[static_cast<size_t>(pf.num_pairs++)] = {gap, radius, gf, of, o};
@@ -264,8 +265,8 @@ void search_cached_pairs(StepState* s, const ProximityCache& pc, const Displacem
       ++result->num_axis_culls;
       continue;
     }
-    const double t = s->start.earliest(*s->god.mesh, c.god_face, *s->obstacles[c.obstacle].mesh, c.obstacle_face,
-                                       s->reach, tester.end());
+    const double t = s->start.earliest(s->start.posed_face(*s->god.mesh, c.god_face, &s->ws->swept),
+                                       *s->obstacles[c.obstacle].mesh, c.obstacle_face, s->reach, tester.end());
     if (t > tester.end()) {
       ++result->num_axis_culls;
       continue;

@@ -240,6 +240,12 @@ GAUSS6_ALWAYS_INLINE bool node_pair_separated(const PosedObb& god_node, const Bv
 // mesh fits without allocation. Entries are valid while their stamp equals
 // `stamp` (next_interval() invalidates them all in O(1)).
 struct SweptBoxCache {
+  // A god face's corners at the sub-interval's start in doubles
+  // (StartFrame::pose) and a bound on each one's |r_B| (StartFrame::radius).
+  struct PosedFace {
+    Vec3 X[3];
+    double radius[3];
+  };
   template <class T>
   struct Entry {
     T value;
@@ -250,7 +256,7 @@ struct SweptBoxCache {
   using Table = std::vector<Entry<T>>;
   explicit SweptBoxCache(int capacity_log2 = 12)
       : nodes(size_t{1} << std::clamp(capacity_log2, 0, 24)), faces(nodes.size()), vertices(nodes.size()),
-        node_obbs(nodes.size()) {}
+        node_obbs(nodes.size()), posed_faces(nodes.size()) {}
   void next_interval() {
     if (++stamp != 0) return;
     // Wrapped around (every 2^32 sub-intervals).
@@ -258,6 +264,7 @@ struct SweptBoxCache {
     for (auto& e : faces) e.stamp = 0;
     for (auto& e : vertices) e.stamp = 0;
     for (auto& e : node_obbs) e.stamp = 0;
+    for (auto& e : posed_faces) e.stamp = 0;
     stamp = 1;
   }
   // The cached value of `index` in `table`, computed by make() when missing.
@@ -273,6 +280,7 @@ struct SweptBoxCache {
   }
   Table<Aabb> nodes, faces, vertices;  // god BVH nodes, faces, vertices (by mesh index)
   Table<PosedObb> node_obbs;           // god BVH nodes
+  Table<PosedFace> posed_faces;        // god faces (StartFrame::posed_face)
   uint32_t stamp = 0;
 };
 
@@ -345,11 +353,14 @@ struct StartFrame {
   // turn_rate (static_error + kCornerOffsetRounding r) (the double corners'
   // offsets from G are within static_error of the exact ones, and their
   // subtraction rounds).
-  double earliest(const TriangleMesh& gm, int gf, const TriangleMesh& om, int of, double d, double u_limit) const {
-    Vec3 X[3], Y[3];
-    const double r2 = place(gm, gf, om, of, X, Y);
+  // The god face comes posed (posed_face, cached per sub-interval in a
+  // SweptBoxCache: a god face meets several obstacle faces).
+  double earliest(const SweptBoxCache::PosedFace& g, const TriangleMesh& om, int of, double d,
+                  double u_limit) const {
+    Vec3 Y[3];
+    place(om, of, Y);
     // |r_B| of any point of the triangle <= that of its farthest corner.
-    return earliest(X, Y, radius(r2), d, u_limit);
+    return earliest(g.X, Y, std::max({g.radius[0], g.radius[1], g.radius[2]}), d, u_limit);
   }
   // The same for a god triangle X (its corners at u0, doubles; r >= the
   // largest |r_B| of them) and an obstacle triangle Y, either possibly
@@ -378,30 +389,36 @@ struct StartFrame {
   // the obstacle triangle `of`: the separating-axis bound of the double
   // triangles less static_error (0 when none proves more), computed until it
   // exceeds `enough`; *radius: the largest |r_B| of gf's corners.
-  double gap(const TriangleMesh& gm, int gf, const TriangleMesh& om, int of, double enough, double* r) const {
-    Vec3 X[3], Y[3];
-    *r = radius(place(gm, gf, om, of, X, Y));
-    const double g = triangle_gap_lower_bound(X, Y, (Upper{static_error} + Upper{enough}).v);
-    return std::max(0.0, (Lower{g} - Upper{static_error}).v);
+  double gap(const SweptBoxCache::PosedFace& g, const TriangleMesh& om, int of, double enough, double* r) const {
+    Vec3 Y[3];
+    place(om, of, Y);
+    *r = std::max({g.radius[0], g.radius[1], g.radius[2]});
+    const double b = triangle_gap_lower_bound(g.X, Y, (Upper{static_error} + Upper{enough}).v);
+    return std::max(0.0, (Lower{b} - Upper{static_error}).v);
   }
 
   // A body point's double position at u0.
   Vec3 pose(const Vec3& r_B) const { return R * r_B + p; }
   // A bound >= sqrt(r2) and <= rho (every body point's |r_B| is).
   double radius(double r2) const { return std::min(rho, round_up(std::sqrt(r2) * (1 + kRelativeRounding)).v); }
+  // The god face gf at u0 (pose, radius), from `cache` when posed there in
+  // this sub-interval.
+  const SweptBoxCache::PosedFace& posed_face(const TriangleMesh& gm, int gf, SweptBoxCache* cache) const {
+    return cache->get(cache->posed_faces, gf, [&] {
+      SweptBoxCache::PosedFace f;
+      for (int k = 0; k < 3; ++k) {
+        const Vec3 r_B = gm.V.row(gm.F(gf, k)).transpose();
+        f.X[k] = pose(r_B);
+        f.radius[k] = radius(r_B.squaredNorm());
+      }
+      return f;
+    });
+  }
 
  private:
-  // The god triangle's corners at u0 (doubles) and the obstacle triangle's;
-  // returns the largest |r_B|^2 of the god corners.
-  double place(const TriangleMesh& gm, int gf, const TriangleMesh& om, int of, Vec3 X[3], Vec3 Y[3]) const {
-    double r2 = 0;
-    for (int k = 0; k < 3; ++k) {
-      const Vec3 r_B = gm.V.row(gm.F(gf, k)).transpose();
-      r2 = std::max(r2, r_B.squaredNorm());
-      X[k] = R * r_B + p;
-      Y[k] = om.V.row(om.F(of, k)).transpose();
-    }
-    return r2;
+  // The obstacle triangle's corners.
+  static void place(const TriangleMesh& om, int of, Vec3 Y[3]) {
+    for (int k = 0; k < 3; ++k) Y[k] = om.V.row(om.F(of, k)).transpose();
   }
 };
 
