@@ -68,7 +68,7 @@ void PairTester::test(const TriangleMesh& gm, const Bvh& gb, int gf, const Trian
   // tried first): a pair sliding along at its gap, or turning across it,
   // needs no test.
   SweptBoxCache::PosedFace posed;  // the god face at u0 (StartFrame::posed_face), a copy
-  const Vec3* const X = posed.X;
+  const Vec3* const X = posed.side.P;
   const double* const rad = posed.radius;
   bool is_posed = false;
   const auto pose_god_face = [&] {  // once, for the first feature past the box filter

@@ -55,22 +55,42 @@ void closest_segment_parameters(const Vec3& p0, const Vec3& p1, const Vec3& q0, 
 // product), in the order of the 11, and the result is that of the 11.
 enum class Shape : int { kVertex = 1, kEdge = 2, kTriangle = 3 };
 
+// One side of the test, prepared once where it meets several others (a god
+// face posed at a sub-interval's start: StartFrame::posed_face): its corners
+// (a feature's repeated, as above), its edges P1 - P0, P2 - P1, P0 - P2, its
+// normal e0 x e1 (a triangle's; zero otherwise) and the largest |coordinate|
+// of its Shape's corners.
+struct SatSide {
+  Vec3 P[3], e[3], n;
+  double abs_max = 0;
+};
+template <Shape S = Shape::kTriangle>
+GAUSS6_ALWAYS_INLINE SatSide sat_side(const Vec3 P[3]) {
+  constexpr int np = static_cast<int>(S);
+  SatSide t;
+  for (int k = 0; k < 3; ++k) t.P[k] = P[k];
+  for (int k = 0; k < np; ++k) t.abs_max = std::max(t.abs_max, P[k].cwiseAbs().maxCoeff());
+  t.e[0] = P[1] - P[0];
+  t.e[1] = P[2] - P[1];
+  t.e[2] = P[0] - P[2];
+  t.n = np == 3 ? Vec3(t.e[0].cross(t.e[1])) : Vec3::Zero();
+  return t;
+}
+
 template <Shape ShapeA = Shape::kTriangle, Shape ShapeB = Shape::kTriangle, class OnAxis>
-GAUSS6_ALWAYS_INLINE void for_each_separating_axis(const Vec3 A[3], const Vec3 B[3], OnAxis&& on_axis,
+GAUSS6_ALWAYS_INLINE void for_each_separating_axis(const SatSide& A, const SatSide& B, OnAxis&& on_axis,
                                                    const Vec3* extra = nullptr) {
   constexpr int na = static_cast<int>(ShapeA), nb = static_cast<int>(ShapeB);
-  double s = 0;
-  for (int k = 0; k < na; ++k) s = std::max(s, A[k].cwiseAbs().maxCoeff());
-  for (int k = 0; k < nb; ++k) s = std::max(s, B[k].cwiseAbs().maxCoeff());
+  const double s = std::max(A.abs_max, B.abs_max);
   const auto along = [&](const Vec3& a) GAUSS6_ALWAYS_INLINE_LAMBDA {
-    double a_lo = a.dot(A[0]), a_hi = a_lo, b_lo = a.dot(B[0]), b_hi = b_lo;
+    double a_lo = a.dot(A.P[0]), a_hi = a_lo, b_lo = a.dot(B.P[0]), b_hi = b_lo;
     for (int k = 1; k < na; ++k) {
-      const double pa = a.dot(A[k]);
+      const double pa = a.dot(A.P[k]);
       a_lo = std::min(a_lo, pa);
       a_hi = std::max(a_hi, pa);
     }
     for (int k = 1; k < nb; ++k) {
-      const double pb = a.dot(B[k]);
+      const double pb = a.dot(B.P[k]);
       b_lo = std::min(b_lo, pb);
       b_hi = std::max(b_hi, pb);
     }
@@ -82,14 +102,18 @@ GAUSS6_ALWAYS_INLINE void for_each_separating_axis(const Vec3 A[3], const Vec3 B
     return on_axis(a, g, side);
   };
   if (extra && along(*extra)) return;
-  const Vec3 ea[3] = {A[1] - A[0], A[2] - A[1], A[0] - A[2]}, eb[3] = {B[1] - B[0], B[2] - B[1], B[0] - B[2]};
-  if (na == 3 && along(ea[0].cross(ea[1]))) return;
-  if (nb == 3 && along(eb[0].cross(eb[1]))) return;
+  if (na == 3 && along(A.n)) return;
+  if (nb == 3 && along(B.n)) return;
   // Edges: a triangle's three, an edge's one, a vertex's none.
   constexpr int edges_a = na == 3 ? 3 : na - 1, edges_b = nb == 3 ? 3 : nb - 1;
   for (int i = 0; i < edges_a; ++i)
     for (int j = 0; j < edges_b; ++j)
-      if (along(ea[i].cross(eb[j]))) return;
+      if (along(A.e[i].cross(B.e[j]))) return;
+}
+template <Shape ShapeA = Shape::kTriangle, Shape ShapeB = Shape::kTriangle, class OnAxis>
+GAUSS6_ALWAYS_INLINE void for_each_separating_axis(const Vec3 A[3], const Vec3 B[3], OnAxis&& on_axis,
+                                                   const Vec3* extra = nullptr) {
+  for_each_separating_axis<ShapeA, ShapeB>(sat_side<ShapeA>(A), sat_side<ShapeB>(B), on_axis, extra);
 }
 
 // Separating-axis bound of the distance of two triangles: the largest gap
@@ -97,13 +121,16 @@ GAUSS6_ALWAYS_INLINE void for_each_separating_axis(const Vec3 A[3], const Vec3 B
 // when none proves a positive gap), returned as soon as one axis proves more
 // than `enough`. Inline: the contact generation calls it for every candidate
 // triangle pair.
-inline double triangle_gap_lower_bound(const Vec3 A[3], const Vec3 B[3], double enough) {
+inline double triangle_gap_lower_bound(const SatSide& A, const SatSide& B, double enough) {
   double best = 0;
   for_each_separating_axis(A, B, [&](const Vec3&, double g, double) GAUSS6_ALWAYS_INLINE_LAMBDA {
     best = std::max(best, g);
     return best > enough;
   });
   return best;
+}
+inline double triangle_gap_lower_bound(const Vec3 A[3], const Vec3 B[3], double enough) {
+  return triangle_gap_lower_bound(sat_side(A), sat_side(B), enough);
 }
 
 }  // namespace gauss6

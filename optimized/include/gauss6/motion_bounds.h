@@ -76,14 +76,15 @@ struct TriangleMotion {
 // kAxisProductRounding |a|_1 |omega|_inf |r|_inf (error_allowances.h); the
 // rest is rounded the safe way. Inline: the mesh step calls it for every
 // candidate triangle pair and feature pair.
+// The same from the sides prepared (sat_side; a god face's: StartFrame::
+// posed_face), r[k] = A's corner k less m.centre and r_inf the largest
+// |coordinate| of those of A's Shape.
 template <Shape ShapeA = Shape::kTriangle, Shape ShapeB = Shape::kTriangle>
-inline double triangle_time_lower_bound(const Vec3 A[3], const Vec3 B[3], const TriangleMotion& m, double reach,
-                                        double enough, const Vec3* extra = nullptr) {
+inline double triangle_time_lower_bound(const SatSide& A, const Vec3 r[3], double r_inf, const SatSide& B,
+                                        const TriangleMotion& m, double reach, double enough,
+                                        const Vec3* extra = nullptr) {
   constexpr int na = static_cast<int>(ShapeA);  // A's distinct corners
   const double v_inf = m.v.cwiseAbs().maxCoeff(), omega_inf = m.omega.cwiseAbs().maxCoeff();
-  const Vec3 r[3] = {A[0] - m.centre, A[1] - m.centre, A[2] - m.centre};
-  double r_inf = 0;
-  for (int k = 0; k < na; ++k) r_inf = std::max(r_inf, r[k].cwiseAbs().maxCoeff());
   double best = 0;
   for_each_separating_axis<ShapeA, ShapeB>(A, B, [&](const Vec3& a, double g, double side) GAUSS6_ALWAYS_INLINE_LAMBDA {
     const Lower clear = Lower{g} - Upper{reach};
@@ -108,6 +109,22 @@ inline double triangle_time_lower_bound(const Vec3 A[3], const Vec3 B[3], const 
     return best > enough;
   }, extra);
   return best;
+}
+// r and r_inf of A's corners about `centre`.
+template <Shape ShapeA = Shape::kTriangle>
+GAUSS6_ALWAYS_INLINE double corner_offsets(const Vec3 A[3], const Vec3& centre, Vec3 r[3]) {
+  double r_inf = 0;
+  for (int k = 0; k < 3; ++k) r[k] = A[k] - centre;
+  for (int k = 0; k < static_cast<int>(ShapeA); ++k) r_inf = std::max(r_inf, r[k].cwiseAbs().maxCoeff());
+  return r_inf;
+}
+template <Shape ShapeA = Shape::kTriangle, Shape ShapeB = Shape::kTriangle>
+inline double triangle_time_lower_bound(const Vec3 A[3], const Vec3 B[3], const TriangleMotion& m, double reach,
+                                        double enough, const Vec3* extra = nullptr) {
+  Vec3 r[3];
+  const double r_inf = corner_offsets<ShapeA>(A, m.centre, r);
+  return triangle_time_lower_bound<ShapeA, ShapeB>(sat_side<ShapeA>(A), r, r_inf, sat_side<ShapeB>(B), m, reach,
+                                                   enough, extra);
 }
 
 // Oriented-box test of the simultaneous descent. A god node's box is tight in the
@@ -240,10 +257,15 @@ GAUSS6_ALWAYS_INLINE bool node_pair_separated(const PosedObb& god_node, const Bv
 // mesh fits without allocation. Entries are valid while their stamp equals
 // `stamp` (next_interval() invalidates them all in O(1)).
 struct SweptBoxCache {
-  // A god face's corners at the sub-interval's start in doubles
-  // (StartFrame::pose) and a bound on each one's |r_B| (StartFrame::radius).
+  // A god face at the sub-interval's start: its corners in doubles
+  // (StartFrame::pose) prepared for the separating axes (side.P), their
+  // offsets r from G and the largest |coordinate| of those (r_inf: for
+  // triangle_time_lower_bound), and a bound on each one's |r_B|
+  // (StartFrame::radius).
   struct PosedFace {
-    Vec3 X[3];
+    SatSide side;
+    Vec3 r[3];
+    double r_inf;
     double radius[3];
   };
   template <class T>
@@ -360,7 +382,12 @@ struct StartFrame {
     Vec3 Y[3];
     place(om, of, Y);
     // |r_B| of any point of the triangle <= that of its farthest corner.
-    return earliest(g.X, Y, std::max({g.radius[0], g.radius[1], g.radius[2]}), d, u_limit);
+    const double r = std::max({g.radius[0], g.radius[1], g.radius[2]});
+    TriangleMotion m;
+    Upper tau_max;
+    if (!motion(r, u_limit, &m, &tau_max)) return u0;
+    const Upper reach = Upper{static_error} + Upper{d};
+    return after(triangle_time_lower_bound(g.side, g.r, g.r_inf, sat_side(Y), m, reach.v, tau_max.v));
   }
   // The same for a god triangle X (its corners at u0, doubles; r >= the
   // largest |r_B| of them) and an obstacle triangle Y, either possibly
@@ -369,20 +396,11 @@ struct StartFrame {
   template <Shape ShapeX = Shape::kTriangle, Shape ShapeY = Shape::kTriangle>
   double earliest(const Vec3 X[3], const Vec3 Y[3], double r, double d, double u_limit,
                   const Vec3* extra = nullptr) const {
-    const Upper tau_max = Upper{u_limit} - Lower{u0};
     TriangleMotion m;
-    m.v = dp_mid;
-    m.omega = omega;
-    m.centre = p;
-    m.lag = lag(tau_max.v);
-    const Upper second = 0.5 * (tau_max * Upper{omega2});
-    const Upper offsets = Upper{turn_rate} * round_up(static_error + kCornerOffsetRounding * r);
-    m.w = ((Upper{drift} + (Upper{omega_error} + second) * Upper{r}) + offsets).v;
-    if (!(m.w < std::numeric_limits<double>::infinity())) return u0;
+    Upper tau_max;
+    if (!motion(r, u_limit, &m, &tau_max)) return u0;
     const Upper reach = Upper{static_error} + Upper{d};
-    const double tau = triangle_time_lower_bound<ShapeX, ShapeY>(X, Y, m, reach.v, tau_max.v, extra);
-    if (!(tau > 0)) return u0;
-    return (Lower{u0} + Lower{tau}).v;
+    return after(triangle_time_lower_bound<ShapeX, ShapeY>(X, Y, m, reach.v, tau_max.v, extra));
   }
 
   // A lower bound of the distance of the god triangle gf at u0 (exact) from
@@ -393,7 +411,7 @@ struct StartFrame {
     Vec3 Y[3];
     place(om, of, Y);
     *r = std::max({g.radius[0], g.radius[1], g.radius[2]});
-    const double b = triangle_gap_lower_bound(g.X, Y, (Upper{static_error} + Upper{enough}).v);
+    const double b = triangle_gap_lower_bound(g.side, sat_side(Y), (Upper{static_error} + Upper{enough}).v);
     return std::max(0.0, (Lower{b} - Upper{static_error}).v);
   }
 
@@ -406,16 +424,35 @@ struct StartFrame {
   const SweptBoxCache::PosedFace& posed_face(const TriangleMesh& gm, int gf, SweptBoxCache* cache) const {
     return cache->get(cache->posed_faces, gf, [&] {
       SweptBoxCache::PosedFace f;
+      Vec3 X[3];
       for (int k = 0; k < 3; ++k) {
         const Vec3 r_B = gm.V.row(gm.F(gf, k)).transpose();
-        f.X[k] = pose(r_B);
+        X[k] = pose(r_B);
         f.radius[k] = radius(r_B.squaredNorm());
       }
+      f.side = sat_side(X);
+      f.r_inf = corner_offsets(X, p, f.r);
       return f;
     });
   }
 
  private:
+  // The motion of a god triangle whose corners' |r_B| are <= r, as
+  // triangle_time_lower_bound takes it, for u in [u0, u_limit] (tau_max =
+  // u_limit - u0); false when its speed bound w is not finite.
+  bool motion(double r, double u_limit, TriangleMotion* m, Upper* tau_max) const {
+    *tau_max = Upper{u_limit} - Lower{u0};
+    m->v = dp_mid;
+    m->omega = omega;
+    m->centre = p;
+    m->lag = lag(tau_max->v);
+    const Upper second = 0.5 * (*tau_max * Upper{omega2});
+    const Upper offsets = Upper{turn_rate} * round_up(static_error + kCornerOffsetRounding * r);
+    m->w = ((Upper{drift} + (Upper{omega_error} + second) * Upper{r}) + offsets).v;
+    return m->w < std::numeric_limits<double>::infinity();
+  }
+  // The u a time bound tau from u0 gives (u0 when it is not positive).
+  double after(double tau) const { return tau > 0 ? (Lower{u0} + Lower{tau}).v : u0; }
   // The obstacle triangle's corners.
   static void place(const TriangleMesh& om, int of, Vec3 Y[3]) {
     for (int k = 0; k < 3; ++k) Y[k] = om.V.row(om.F(of, k)).transpose();
