@@ -70,7 +70,7 @@ struct ContactWorkspace {
   std::vector<Vec3> god_world;
   std::vector<uint32_t> posed;
   uint32_t stamp = 0;
-  SweptBoxCache boxes;  // nodes, faces and node_obbs at the call's pose
+  SweptBoxCache boxes{12, 0};  // nodes, faces and node_obbs at the call's pose (no posed faces)
   BvhStack stack;
 };
 

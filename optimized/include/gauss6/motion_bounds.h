@@ -76,9 +76,10 @@ struct TriangleMotion {
 // kAxisProductRounding |a|_1 |omega|_inf |r|_inf (error_allowances.h); the
 // rest is rounded the safe way. Inline: the mesh step calls it for every
 // candidate triangle pair and feature pair.
-// The same from the sides prepared (sat_side; a god face's: StartFrame::
-// posed_face), r[k] = A's corner k less m.centre and r_inf the largest
-// |coordinate| of those of A's Shape.
+// Two forms: this one takes the sides prepared (sat_side; a god face's:
+// StartFrame::posed_face) with r[k] = A's corner k less m.centre and r_inf
+// the largest |coordinate| of those of A's Shape (corner_offsets); the one
+// below takes the corners and prepares them.
 template <Shape ShapeA = Shape::kTriangle, Shape ShapeB = Shape::kTriangle>
 inline double triangle_time_lower_bound(const SatSide& A, const Vec3 r[3], double r_inf, const SatSide& B,
                                         const TriangleMotion& m, double reach, double enough,
@@ -276,9 +277,11 @@ struct SweptBoxCache {
   };
   template <class T>
   using Table = std::vector<Entry<T>>;
-  explicit SweptBoxCache(int capacity_log2 = 12)
+  // posed_faces_log2: the posed faces' table apart (a user that never poses
+  // faces, the contact generation, keeps one entry, not 2^12 of ~300 bytes).
+  explicit SweptBoxCache(int capacity_log2 = 12, int posed_faces_log2 = 12)
       : nodes(size_t{1} << std::clamp(capacity_log2, 0, 24)), faces(nodes.size()), vertices(nodes.size()),
-        node_obbs(nodes.size()), posed_faces(nodes.size()) {}
+        node_obbs(nodes.size()), posed_faces(size_t{1} << std::clamp(posed_faces_log2, 0, 24)) {}
   void next_interval() {
     if (++stamp != 0) return;
     // Wrapped around (every 2^32 sub-intervals).
