@@ -137,17 +137,69 @@ void search_hints(StepState* s) {
 }
 
 // The descent of every obstacle's tree with the god-object's over the motion
-// enclosed in s->e from s->start (traverse), up to u_end.
+// enclosed in s->e from s->start (traverse), up to u_end: from the root pairs,
+// or from the cut of the last descent in this workspace (DescentFront) when it
+// was made for these trees, pushed onto the stack a part at a time; it writes
+// its own cut for the next. A descent stopped by visit leaves as its cut the
+// pairs it stopped at, those still pending and the old cut's pairs not yet
+// pushed; a full stack or a cut that does not fit leaves none (the next
+// descent starts at the root).
 template <class Visit>
 TraversalStatus descend(StepState* s, double u_end, const Visit& visit) {
+  DescentFront& f = s->ws->front;
+  BvhStack& stack = s->ws->stack;
+  const bool keep = s->num_obstacles <= f.obstacle_capacity();
+  const bool from_cut = keep && f.keyed(s->god, s->obstacles, s->num_obstacles);
+  f.clear();
+  if (keep) f.start();
+  const auto record = [&](int g, int h) {
+    if (keep) f.add(g, h);
+  };
+  const bool god_empty = s->god.bvh->nodes.empty();
+  // The root pair's cut, or obstacle o's part of the old one (n pairs).
+  const auto cut_of = [&](int o, int* n) -> const DescentFront::NodePair* {
+    if (from_cut) return f.read(o, n);
+    *n = god_empty || s->obstacles[o].bvh->nodes.empty() ? 0 : 1;  // an empty tree: nothing to reach
+    return nullptr;
+  };
+  // Room on the stack for each part of the old cut: what the descent below
+  // its pairs pushes (two per level) stays within the rest.
+  const int part = std::max(1, static_cast<int>(stack.items.size()) / 2);
   for (int o = 0; o < s->num_obstacles; ++o) {
-    int pending = 0;
-    if (!start_candidate_pairs(*s->god.bvh, *s->obstacles[o].bvh, &s->ws->stack, &pending))
-      return TraversalStatus::kStackFull;
-    const TraversalStatus ts = traverse(*s, s->start, s->e, s->ws->swept, u_end, s->reach, o, &s->ws->stack, &pending,
-                                        std::numeric_limits<long>::max(), &s->result->num_node_pairs, visit);
-    if (ts != TraversalStatus::kDone) return ts;
+    if (keep) f.start_obstacle(o);
+    int n = 0;
+    const DescentFront::NodePair* old = cut_of(o, &n);
+    for (int k = 0; k < n;) {
+      int pending = 0;
+      if (old == nullptr) {
+        if (!start_candidate_pairs(*s->god.bvh, *s->obstacles[o].bvh, &stack, &pending))
+          return TraversalStatus::kStackFull;
+        k = n;
+      } else {
+        for (; k < n && pending < part; ++k) stack.items[static_cast<size_t>(pending++)] = old[k];
+      }
+      const TraversalStatus ts = traverse(*s, s->start, s->e, s->ws->swept, u_end, s->reach, o, &stack, &pending,
+                                          std::numeric_limits<long>::max(), &s->result->num_node_pairs, visit, record);
+      if (ts == TraversalStatus::kStopped && keep) {
+        // The cut: what it stopped at, what is pending, the rest of the old
+        // cut, and the later obstacles' cuts as they were.
+        for (int i = 0; i < pending; ++i) {
+          const DescentFront::NodePair& q = stack.items[static_cast<size_t>(i)];
+          record(q.first, q.second);
+        }
+        for (; old != nullptr && k < n; ++k) record(old[k].first, old[k].second);
+        for (int p = o + 1; p < s->num_obstacles; ++p) {
+          f.start_obstacle(p);
+          int m = 0;
+          const DescentFront::NodePair* rest = cut_of(p, &m);
+          for (int i = 0; i < m; ++i) rest ? record(rest[i].first, rest[i].second) : record(0, 0);
+        }
+        f.finish(s->god, s->obstacles, s->num_obstacles);
+      }
+      if (ts != TraversalStatus::kDone) return ts;
+    }
   }
+  if (keep) f.finish(s->god, s->obstacles, s->num_obstacles);
   return TraversalStatus::kDone;
 }
 
@@ -291,6 +343,7 @@ void ccd_step(const CcdBody* obstacles, int num_obstacles, const CcdBody& god, c
   step_settings.narrow.time_tolerance = step_time_tolerance(result->motion, god, settings);
   if (!(step_settings.narrow.time_tolerance > 0)) step_settings.narrow.time_tolerance = settings.narrow.time_tolerance;
   StepState s(obstacles, num_obstacles, god, X0, step_settings, ws, result, hints, num_hints);
+  if (!ws->front.carry) ws->front.clear();  // the last step's cut serves only when carried (DescentFront)
   // Plan the sub-intervals.
   s.n = plan_sub_intervals(s.motion, god, settings);
   s.lead = plan_lead(s.motion, god, s.n, s.reach, settings.lead_sweep);

@@ -92,10 +92,10 @@ void set_near_pairs(StepState* s, int num_cand, double u0);
 // counted in *num_node_pairs. The god-object's boxes are cached in `swept`
 // (the step's, ws->swept, or a fill's own): call swept.next_interval() first
 // whenever the enclosure or dist changed.
-template <class Visit>
+template <class Visit, class Cut = NoCut>
 TraversalStatus traverse(const StepState& s, const StartFrame& frame, const MotionEnclosure& enc, SweptBoxCache& swept,
                          double u_end, double dist, int o, BvhStack* stack, int* pending, long budget,
-                         int* num_node_pairs, const Visit& visit) {
+                         int* num_node_pairs, const Visit& visit, const Cut& cut = Cut{}) {
   const CcdBody& god = s.god;
   const SweptObbFrame obb_frame = frame.obb_frame(u_end, dist);
   const auto god_node_obb = [&](int node) -> const PosedObb& {
@@ -116,7 +116,7 @@ TraversalStatus traverse(const StepState& s, const StartFrame& frame, const Moti
   const auto separated = [&](int gi, int oi) { return node_pair_separated(god_node_obb(gi), ob.bvh->nodes[oi]); };
   return resume_candidate_pairs(*god.mesh, *god.bvh, *ob.mesh, *ob.bvh, god_node_box, god_face_box, /*margin=*/0,
                                 stack, pending, budget, [&](int gf, int of) { return visit(gf, of, o); },
-                                num_node_pairs, separated);
+                                num_node_pairs, separated, cut);
 }
 
 // The stages of the proximity cache (proximity_cache.cpp; settings.cache.margin > 0):

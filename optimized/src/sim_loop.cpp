@@ -35,6 +35,10 @@ SimState::SimState(const RuntimeModel& model)
   xs = model.initial_pose;
   M = mass_matrix_at(model, xs.q);
   contacts.num_contacts = 0;
+  // The legs of one update share their descents' cuts (cleared at each update:
+  // advance_god_object).
+  ccd_ws.front.carry = true;
+  check_ws.front.carry = true;
 }
 
 // ---------------------------------------------------------------------------
@@ -445,6 +449,10 @@ void advance_god_object(const RuntimeModel& model, const Pose& x_start, const Po
   info->num_shortenings = 0;
   info->num_halves = 1;
   s->num_proven_near = -1;
+  // The descents' cuts serve this update's legs and pieces (DescentFront):
+  // a cut only refines, so none outlives the update that made it.
+  s->ccd_ws.front.clear();
+  s->check_ws.front.clear();
   // The contacts at x_start (the set of the last step, at s->xs) are the pairs
   // most likely to stop either leg: ccd_step tests them first.
   const int num_hints = std::min(s->contacts.num_contacts, s->capacity);

@@ -926,3 +926,55 @@ TEST_CASE("ccd_step timing on spheres", "[ccd_step][timing]") {
               "per step %ld triangle pairs, %ld pair tests, %ld boxes\n",
               1e6 * total / n, 1e6 * worst, hits, n, triangle_pairs / n, pair_tests / n, boxes / n);
 }
+
+TEST_CASE("ccd_step: a descent's cut serves only the trees it was made for", "[ccd_step]") {
+  // DescentFront, carried across steps: a workspace whose last descent was of
+  // other trees (another obstacle, another count of them) starts from the root
+  // pairs, as a fresh workspace does: the same result, bit for bit. And one
+  // whose cut is of these trees, carried over several steps without clear(),
+  // finds the first contact of a fresh workspace (the 1e-5 bound of the tests
+  // above: a cut may list more candidate pairs, never fewer). Not carried (the
+  // default), a step's result does not depend on the steps before it.
+  const TriangleMesh god = make_icosphere(2, 0.5);
+  const TriangleMesh box = make_box(2, 2, 1, Vec3(0, 0, -0.5)), ball = make_icosphere(2, 0.4);
+  const Bvh gb = build_bvh(god, 2), bb = build_bvh(box, 2), sb = build_bvh(ball, 2);
+  const CcdBody both[2] = {{&ball, &sb}, {&box, &bb}};
+  CcdStepSettings settings;
+  settings.lead_sweep = 4;  // pieces: several descents a step
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> U(-1, 1);
+  CcdStepWorkspace carried;
+  carried.front.carry = true;
+  int hits = 0;
+  for (int i = 0; i < 30; ++i) {
+    const Pose x0{Vec3(U(rng), U(rng), 0.55 + 0.05 * std::abs(U(rng))),
+                  normalized(Quat{1 + U(rng), U(rng), U(rng), U(rng)})};
+    const Pose x1{Vec3(U(rng), U(rng), 0.2 * U(rng)), normalized(quat_exp(0.5 * Vec3(U(rng), U(rng), U(rng))) * x0.q)};
+    const CcdBody* obstacles = i % 3 == 0 ? &both[0] : &both[1];
+    const int n = i % 3 == 2 ? 1 : (i % 3 == 0 ? 2 : 1);
+    CcdStepWorkspace fresh;
+    CcdStepResult r_fresh, r_carried;
+    ccd_step(obstacles, n, {&god, &gb}, x0, x1, settings, &fresh, &r_fresh);
+    const bool same_trees = carried.front.keyed({&god, &gb}, obstacles, n);
+    ccd_step(obstacles, n, {&god, &gb}, x0, x1, settings, &carried, &r_carried);
+    REQUIRE(r_fresh.status == CcdStatus::kOk);
+    REQUIRE(r_carried.status == CcdStatus::kOk);
+    CHECK(r_carried.hit == r_fresh.hit);
+    if (!same_trees) {
+      CHECK(r_carried.u_hit == r_fresh.u_hit);
+      CHECK(r_carried.num_node_pairs == r_fresh.num_node_pairs);
+    } else if (r_carried.hit && r_fresh.hit) {
+      CHECK(std::abs(r_carried.u_hit - r_fresh.u_hit) <= 1e-5);
+    }
+    hits += r_fresh.hit;
+    // Not carried: bit for bit a fresh workspace's, whatever ran before.
+    CcdStepWorkspace& plain = i % 2 ? carried : fresh;
+    plain.front.carry = false;
+    CcdStepResult r_plain;
+    ccd_step(obstacles, n, {&god, &gb}, x0, x1, settings, &plain, &r_plain);
+    CHECK(r_plain.u_hit == r_fresh.u_hit);
+    CHECK(r_plain.num_node_pairs == r_fresh.num_node_pairs);
+    carried.front.carry = true;
+  }
+  CHECK(hits >= 5);
+}

@@ -123,11 +123,23 @@ enum class TraversalStatus { kDone = 0, kStopped, kStackFull, kPaused };
 // when the budget runs out: a traversal spread over several calls (the
 // proximity cache's background fill, ccd_step). On kStopped the pairs of the
 // leaf pair being visited are not all visited.
-template <class GodNodeBox, class GodFaceBox, class Visit, class Separated>
+//
+// cut(god_node, obstacle_node), when given, gets every node pair the traversal
+// stops at: those found apart and the leaf pairs (before their triangles are
+// visited). With the pairs still pending on kStopped or kPaused they are a cut
+// of the two trees' traversal: every leaf pair it could reach from the pairs
+// it started from lies at or below exactly one of them (a later traversal may
+// start from a cut instead of the root pair: ccd_step.h, DescentFront). On
+// kStackFull the pair being expanded is in neither: no cut.
+struct NoCut {
+  void operator()(int, int) const {}
+};
+template <class GodNodeBox, class GodFaceBox, class Visit, class Separated, class Cut = NoCut>
 TraversalStatus resume_candidate_pairs([[maybe_unused]] const TriangleMesh& god_mesh, const Bvh& god,
                                        const TriangleMesh& obs_mesh, const Bvh& obs, const GodNodeBox& god_node_box,
                                        const GodFaceBox& god_face_box, double margin, BvhStack* stack, int* pending,
-                                       long budget, Visit&& visit, int* num_node_pairs, const Separated& separated) {
+                                       long budget, Visit&& visit, int* num_node_pairs, const Separated& separated,
+                                       const Cut& cut = Cut{}) {
   const int capacity = static_cast<int>(stack->items.size());
   auto* items = stack->items.data();
   int size = *pending;
@@ -142,8 +154,12 @@ TraversalStatus resume_candidate_pairs([[maybe_unused]] const TriangleMesh& god_
     const BvhNode& on = obs.nodes[oi];
     ++*num_node_pairs;
     const Aabb gw = god_node_box(gi);
-    if (!overlap(gw, inflate(on.box, margin)) || separated(gi, oi)) continue;
+    if (!overlap(gw, inflate(on.box, margin)) || separated(gi, oi)) {
+      cut(gi, oi);
+      continue;
+    }
     if (gn.count > 0 && on.count > 0) {
+      cut(gi, oi);
       // Leaf pair: test triangle boxes, then hand the pair over.
       for (int i = 0; i < gn.count; ++i) {
         const int gf = god.triangles[gn.first + i];

@@ -18,6 +18,7 @@
 
 #include <algorithm>
 #include <cstdint>
+#include <utility>
 #include <vector>
 
 #include "gauss6/bvh.h"
@@ -87,6 +88,80 @@ struct CcdStepResult {
 };
 
 // Everything ccd_step needs, allocated once.
+// The cut where a descent of the trees stopped (resume_candidate_pairs: the
+// node pairs found apart, the leaf pairs, those left pending), obstacle by
+// obstacle, so that the next descent starts there instead of at the root
+// pair: every leaf pair it could reach lies below exactly one of them. The
+// pieces of a settling leg, and the legs of one god-object update, sweep the
+// same standing proximity (the peg wedged in its hole: 1,500-2,500 node
+// pairs a settling leg, four legs in a refused settle's step), which each
+// descended again from the root. A cut is sound for any motion; starting
+// from it only skips the tests of the pairs above it, so a descent may list
+// a few more candidate triangle pairs than one from the root, and its result
+// may differ from a fresh workspace's within the tolerances). Within one step
+// its pieces always share it; across steps only when `carry` is set (else
+// each step starts at the root pairs, so its result does not depend on the
+// steps run before in the workspace). It is keyed by the trees (pointers) and
+// only ever refines: the runtime carries it over the legs of one god-object
+// update and clears it at the next (clear()). Two buffers: the cut read and
+// the one written.
+struct DescentFront {
+  using NodePair = std::pair<int32_t, int32_t>;
+  DescentFront(int capacity, int obstacle_capacity)
+      : pairs{std::vector<NodePair>(static_cast<size_t>(std::max(capacity, 0))),
+              std::vector<NodePair>(static_cast<size_t>(std::max(capacity, 0)))},
+        begin{std::vector<int>(static_cast<size_t>(std::max(obstacle_capacity, 0) + 1)),
+              std::vector<int>(static_cast<size_t>(std::max(obstacle_capacity, 0) + 1))} {
+    obstacles.reserve(static_cast<size_t>(std::max(obstacle_capacity, 0)));
+  }
+  std::vector<NodePair> pairs[2];  // [cur]: the cut read, [1 - cur]: the one being written
+  std::vector<int> begin[2];       // obstacle o's pairs: [begin[o], begin[o + 1])
+  int cur = 0;
+  bool carry = false;                     // a step starts from the last step's cut (see above)
+  bool ready = false;                     // pairs[cur] is a cut of the trees below (keys)
+  const Bvh* god = nullptr;               // the keys
+  std::vector<const Bvh*> obstacles;      // capacity obstacle_capacity, reserved (never grows)
+  int size = 0;                           // of the cut being written
+  bool overflow = false;
+  void clear() { ready = false; }
+  int obstacle_capacity() const { return static_cast<int>(begin[0].size()) - 1; }
+  // The cut read was made for these trees.
+  bool keyed(const CcdBody& g, const CcdBody* obs, int num_obs) const {
+    bool k = ready && god == g.bvh && static_cast<int>(obstacles.size()) == num_obs;
+    for (int o = 0; k && o < num_obs; ++o) k = obstacles[static_cast<size_t>(o)] == obs[o].bvh;
+    return k;
+  }
+  // Writing: a new cut, obstacle o's part starting now, a pair of it.
+  void start() {
+    size = 0;
+    overflow = false;
+  }
+  void start_obstacle(int o) { begin[1 - cur][static_cast<size_t>(o)] = size; }
+  void add(int g, int h) {
+    if (size == static_cast<int>(pairs[1 - cur].size())) {
+      overflow = true;
+      return;
+    }
+    pairs[1 - cur][static_cast<size_t>(size++)] = {g, h};
+  }
+  // The cut written becomes the one read, for these trees (none if it
+  // overflowed); num_obs <= obstacle_capacity().
+  void finish(const CcdBody& g, const CcdBody* obs, int num_obs) {
+    begin[1 - cur][static_cast<size_t>(num_obs)] = size;
+    ready = !overflow;
+    if (!ready) return;
+    cur = 1 - cur;
+    god = g.bvh;
+    obstacles.clear();
+    for (int o = 0; o < num_obs; ++o) obstacles.push_back(obs[o].bvh);
+  }
+  const NodePair* read(int o, int* n) const {
+    const std::vector<int>& b = begin[cur];
+    *n = b[static_cast<size_t>(o) + 1] - b[static_cast<size_t>(o)];
+    return pairs[cur].data() + b[static_cast<size_t>(o)];
+  }
+};
+
 struct CcdStepWorkspace {
   // The default capacities. obstacle_capacity: the most obstacles the proximity
   // cache can be keyed by (a step with more is served without it; nothing grows
@@ -98,7 +173,8 @@ struct CcdStepWorkspace {
       : narrow(box_capacity),
         stack(stack_capacity),
         candidates(static_cast<size_t>(std::max(candidate_capacity, 0))),
-        cache(std::max(candidate_capacity, 0), stack_capacity, obstacle_capacity) {}
+        cache(std::max(candidate_capacity, 0), stack_capacity, obstacle_capacity),
+        front(std::max(candidate_capacity, 0), obstacle_capacity) {}
   // A candidate triangle pair of one sub-interval and a lower bound of its first contact parameter.
   struct Candidate {
     TrianglePair pair;
@@ -120,6 +196,7 @@ struct CcdStepWorkspace {
   }
   SweptBoxCache swept;                // god boxes of the current sub-interval
   ProximityCache cache;               // coherence between steps (proximity_cache.h)
+  DescentFront front;                 // coherence between descents (a step's pieces, an update's legs)
   // Another workspace's list, served read-only to the steps run here with
   // their own cache off (settings.cache.margin 0): a step that stays within
   // that list's margin of its pose, and searches no farther than the list's
