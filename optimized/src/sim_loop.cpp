@@ -245,6 +245,9 @@ bool motion_free(const RuntimeModel& model, const Pose& x0, const Pose& x1, int 
   // within its margin (ccd_step.h, CcdStepWorkspace::borrowed): the same
   // candidates a descent would find, without descending the trees.
   s->check_ws.borrowed = &s->ccd_ws.cache;
+  // And where it descends, it starts from the legs' last cut (DescentFront):
+  // the direct motion sweeps the proximity they swept.
+  s->check_ws.front.copy_from(s->ccd_ws.front);
   ccd_step(model.obstacles.data(), static_cast<int>(model.obstacles.size()), model.god, x0, x1, settings,
            &s->check_ws, &s->check, s->ccd_hints.data(), num_hints);
   return s->check.status == CcdStatus::kOk && !s->check.hit;

@@ -124,6 +124,20 @@ struct DescentFront {
   int size = 0;                           // of the cut being written
   bool overflow = false;
   void clear() { ready = false; }
+  // The cut `other` reads, copied to be read here (none when it does not fit).
+  void copy_from(const DescentFront& other) {
+    const int num_obs = static_cast<int>(other.obstacles.size());
+    ready = other.ready && num_obs <= obstacle_capacity();
+    if (!ready) return;
+    const std::vector<int>& b = other.begin[other.cur];
+    const int n = b[static_cast<size_t>(num_obs)];
+    ready = n <= static_cast<int>(pairs[cur].size());
+    if (!ready) return;
+    std::copy(b.begin(), b.begin() + num_obs + 1, begin[cur].begin());
+    std::copy(other.pairs[other.cur].begin(), other.pairs[other.cur].begin() + n, pairs[cur].begin());
+    god = other.god;
+    obstacles.assign(other.obstacles.begin(), other.obstacles.end());  // within the reserved capacity
+  }
   int obstacle_capacity() const { return static_cast<int>(begin[0].size()) - 1; }
   // The cut read was made for these trees.
   bool keyed(const CcdBody& g, const CcdBody* obs, int num_obs) const {
