@@ -3,8 +3,8 @@
 // motion, over all their feature pairs, with its settings (CcdStepSettings),
 // its result (CcdStepResult, the near pairs for the contact generation
 // included) and its workspace (CcdStepWorkspace: the narrow phase's boxes,
-// the descent's stack, the candidate list, the god-object's swept boxes and
-// the proximity cache), each allocated once.
+// the descent's stack and its last cut (DescentFront), the candidate list,
+// the god-object's swept boxes and the proximity cache), each allocated once.
 //
 // Frames: obstacles in the world frame W, the god-object in its body frame B
 // (origin at G); swept boxes of god nodes come from the interval enclosure of
@@ -87,7 +87,6 @@ struct CcdStepResult {
   double u_cached = 0;                     // [0, u_cached] searched from the proximity cache (0: not used)
 };
 
-// Everything ccd_step needs, allocated once.
 // The cut where a descent of the trees stopped (resume_candidate_pairs: the
 // node pairs found apart, the leaf pairs, those left pending), obstacle by
 // obstacle, so that the next descent starts there instead of at the root
@@ -97,7 +96,7 @@ struct CcdStepResult {
 // pairs a settling leg, four legs in a refused settle's step), which each
 // descended again from the root. A cut is sound for any motion; starting
 // from it only skips the tests of the pairs above it, so a descent may list
-// a few more candidate triangle pairs than one from the root, and its result
+// a few more candidate triangle pairs than one from the root (and its result
 // may differ from a fresh workspace's within the tolerances). Within one step
 // its pieces always share it; across steps only when `carry` is set (else
 // each step starts at the root pairs, so its result does not depend on the
@@ -176,6 +175,7 @@ struct DescentFront {
   }
 };
 
+// Everything ccd_step needs, allocated once.
 struct CcdStepWorkspace {
   // The default capacities. obstacle_capacity: the most obstacles the proximity
   // cache can be keyed by (a step with more is served without it; nothing grows
