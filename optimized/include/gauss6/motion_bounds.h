@@ -157,6 +157,7 @@ struct PosedObb {
   Vec3 half_step = Vec3::Zero();  // step / 2
   double grow = 0;
   bool pays = false;              // less than half its world axis-aligned box (obb_volume_ratio)
+  bool still = true;              // half_step is exactly zero (a fixed pose: the proximity cache's fills)
 };
 
 // The pose and motion bounds of one sub-interval (or of a fixed pose: step 0,
@@ -200,6 +201,7 @@ struct SweptObbFrame {
       out.half_step = 0.5 * step;
     }
     if (!(out.grow < std::numeric_limits<double>::infinity())) out.grow = std::numeric_limits<double>::infinity();
+    out.still = (out.half_step.array() == 0).all();
     out.pays = obb_volume_ratio(b.half, out.axes.cwiseAbs() * b.half) < 0.5;
     return out;
   }
@@ -210,34 +212,54 @@ struct SweptObbFrame {
 // the obstacle's box `b` (world frame). Rounding: |C| + kObbAxisRounding and
 // grow + kObbSeparationRounding s, s the largest coordinate, extent or step
 // involved (error_allowances.h). False on NaN.
-GAUSS6_ALWAYS_INLINE bool obb_separated(const PosedObb& a, const Obb& b) {
+// kMoving false: the form for a box that does not sweep (a.half_step exactly
+// zero, PosedObb::still), the same test with the step's terms left out (each
+// is an exact zero there, so the answer is the same bit for bit).
+template <bool kMoving>
+GAUSS6_ALWAYS_INLINE bool obb_separated_as(const PosedObb& a, const Obb& b) {
   const Mat3 C = a.axes.transpose() * b.axes;  // C(i, j) = a_i . b_j
   Mat3 A = C.cwiseAbs();
   A.array() += kObbAxisRounding;
-  const Vec3 t_w = b.center - (a.center + a.half_step);
+  const Vec3 t_w = kMoving ? Vec3(b.center - (a.center + a.half_step)) : Vec3(b.center - a.center);
   const Vec3 ta = a.axes.transpose() * t_w, tb = b.axes.transpose() * t_w;
-  const Vec3 da = a.axes.transpose() * a.half_step, db = b.axes.transpose() * a.half_step;
+  Vec3 da, db;  // the half step in each frame (moving only)
+  if constexpr (kMoving) {
+    da = a.axes.transpose() * a.half_step;
+    db = b.axes.transpose() * a.half_step;
+  }
   const Vec3 &ha = a.half, &hb = b.half;
-  const double s = std::max({ha.maxCoeff(), hb.maxCoeff(), t_w.cwiseAbs().maxCoeff(), a.center.cwiseAbs().maxCoeff(),
-                             b.center.cwiseAbs().maxCoeff(), a.half_step.cwiseAbs().maxCoeff(), a.grow});
+  double s = std::max({ha.maxCoeff(), hb.maxCoeff(), t_w.cwiseAbs().maxCoeff(), a.center.cwiseAbs().maxCoeff(),
+                       b.center.cwiseAbs().maxCoeff(), a.grow});
+  if constexpr (kMoving) s = std::max(s, a.half_step.cwiseAbs().maxCoeff());
   const double g = a.grow + kObbSeparationRounding * s;
-  for (int i = 0; i < 3; ++i)
-    if (std::abs(ta[i]) > ha[i] + A.row(i).dot(hb) + std::abs(da[i]) + g) return true;
-  for (int j = 0; j < 3; ++j)
-    if (std::abs(tb[j]) > hb[j] + A.col(j).dot(ha) + std::abs(db[j]) + g) return true;
+  // Each reach sums as (extents + sweep) + g, the sweep's term only when moving.
+  for (int i = 0; i < 3; ++i) {
+    double reach = ha[i] + A.row(i).dot(hb);
+    if constexpr (kMoving) reach += std::abs(da[i]);
+    if (std::abs(ta[i]) > reach + g) return true;
+  }
+  for (int j = 0; j < 3; ++j) {
+    double reach = hb[j] + A.col(j).dot(ha);
+    if constexpr (kMoving) reach += std::abs(db[j]);
+    if (std::abs(tb[j]) > reach + g) return true;
+  }
   for (int i = 0; i < 3; ++i) {
     const int i1 = (i + 1) % 3, i2 = (i + 2) % 3;
     for (int j = 0; j < 3; ++j) {
       const int j1 = (j + 1) % 3, j2 = (j + 2) % 3;
       // L = a_i x b_j, in a's frame: (0, ...) with t.L = t[i2] C(i1, j) - t[i1] C(i2, j).
       const double dist = std::abs(ta[i2] * C(i1, j) - ta[i1] * C(i2, j));
-      const double sweep = std::abs(da[i2] * C(i1, j) - da[i1] * C(i2, j));
       const double ra = ha[i1] * A(i2, j) + ha[i2] * A(i1, j);
       const double rb = hb[j1] * A(i, j2) + hb[j2] * A(i, j1);
-      if (dist > ra + rb + sweep + g) return true;
+      double reach = ra + rb;
+      if constexpr (kMoving) reach += std::abs(da[i2] * C(i1, j) - da[i1] * C(i2, j));
+      if (dist > reach + g) return true;
     }
   }
   return false;
+}
+GAUSS6_ALWAYS_INLINE bool obb_separated(const PosedObb& a, const Obb& b) {
+  return a.still ? obb_separated_as<false>(a, b) : obb_separated_as<true>(a, b);
 }
 
 // The traversals' oriented-box test of a node pair (the god node's box posed
