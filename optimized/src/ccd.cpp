@@ -8,6 +8,7 @@
 #include <cmath>
 #include <limits>
 
+#include "gauss6/bernstein.h"  // the u-filter's positivity tests
 #include "gauss6/distance.h"  // closest points: the separating axes of the u-filter
 #include "gauss6/error_allowances.h"
 
@@ -611,7 +612,8 @@ double rigid_speed(const CcdMotion& m, double rho) {
 //     whole. (Stage 2, tried last: the cheaper tests decide most intervals.)
 //     Every condition reads "g(u) > 0 on all of U excludes U", g a cubic whose
 //     interval coefficients enclose the exact ones (S: degree 6); positive_on()
-//     bounds g from below over U by its Bernstein coefficients (outward rounded).
+//     bounds g from below over U by its Bernstein coefficients' least values
+//     over those intervals (in doubles, with a certified rounding bound).
 //
 // Guarantee. A u-interval is dropped only when (1), (2) (with the window
 // start's axis, or the interval's own: filtered_bisect()), (3) or (4) proves that no
@@ -648,112 +650,48 @@ struct Cubic {
   Interval k[4];
 };
 
-// True when every cubic with coefficients in c is > 0 on all of [u0, u1]
-// (0 <= u0 <= u1). On t = (u - u0) / h, h = u1 - u0, the cubic's Bernstein
-// coefficients b0..b3 bound it from below (convex hull property); they are
-// computed from the Taylor coefficients at u0 in outward-rounded intervals, with
-// h enclosed, so the test holds for the exact cubic. The ends (b0, b3: the values
-// at u0 and u1) are checked first: they decide most calls.
-// 1/3, enclosed: div_positive(point(1), point(3)), once.
-const Interval kThird = div_positive(Interval::point(1), Interval::point(3));
-bool positive_on(const Cubic& c, double u0, double u1) {
-  const Interval U = Interval::point(u0);
-  const Interval a0 = c.k[0] + U * (c.k[1] + U * (c.k[2] + U * c.k[3]));
-  if (!(a0.lo > 0)) return false;
-  const Interval h = Interval::point(u1) - U;
-  const Interval u3k3 = 3.0 * (U * c.k[3]);
-  const Interval A1 = (c.k[1] + U * (2.0 * c.k[2] + u3k3)) * h;  // p'(u0) h
-  const Interval h2 = sqr(h);
-  const Interval A2 = (c.k[2] + u3k3) * h2;                      // p''(u0) / 2 h^2
-  const Interval A3 = c.k[3] * (h2 * h);
-  if (!((a0 + A1 + A2 + A3).lo > 0)) return false;
-  return (a0 + kThird * A1).lo > 0 && (a0 + kThird * (2.0 * A1 + A2)).lo > 0;
-}
-
 // A polynomial of degree 6 whose interval coefficients enclose the exact ones.
 struct Sextic {
   Interval k[7];
-  double mid[7] = {};  // the coefficients' midpoints (set_mid): a quick screen in doubles
-  void set_mid() {
-    for (int j = 0; j < 7; ++j) mid[j] = 0.5 * (k[j].lo + k[j].hi);
-  }
 };
-
-// The Bernstein basis change of degree 6: b_i = sum_{j <= i} C(i, j) / C(6, j)
-// a_j for the Taylor coefficients a_j of p(u0 + t h) in t; the weights
-// enclosed (C(i, j) and C(6, j) are exact small integers), once.
-struct BernsteinWeights6 {
-  Interval w[7][7];
-  BernsteinWeights6() {
-    const double c6[7] = {1, 6, 15, 20, 15, 6, 1};
-    for (int i = 0; i <= 6; ++i) {
-      double cij = 1;  // C(i, j)
-      for (int j = 0; j <= i; ++j) {
-        w[i][j] = div_positive(Interval::point(cij), Interval::point(c6[j]));
-        cij = cij * (i - j) / (j + 1);
-      }
-    }
-  }
-};
-const BernsteinWeights6 kBernstein6;
-
-// True when every polynomial with coefficients in p is > 0 on all of [u0, u1]
-// (0 <= u0 <= u1): as positive_on(Cubic) above, its values at u0 and u1 (b0
-// and b6, by Horner's rule) and then the inner Bernstein coefficients b1..b5,
-// from the Taylor coefficients at u0 (repeated synthetic division) scaled by
-// powers of h = u1 - u0, all outward rounded.
-bool positive_on(const Sextic& p, double u0, double u1) {
-  // Screen (a heuristic: a false here only keeps the interval): the midpoint
-  // polynomial at both ends, in doubles.
-  const auto screen_at = [&](double u) {
-    double v = p.mid[6];
-    for (int j = 5; j >= 0; --j) v = p.mid[j] + u * v;
-    return v > 0;
-  };
-  if (!screen_at(u0) || !screen_at(u1)) return false;
-  const auto value_at = [&](double u) {
-    const Interval U = Interval::point(u);
-    Interval v = p.k[6];
-    for (int j = 5; j >= 0; --j) v = p.k[j] + U * v;
-    return v;
-  };
-  if (!(value_at(u0).lo > 0) || !(value_at(u1).lo > 0)) return false;
-  Interval a[7];
-  for (int j = 0; j < 7; ++j) a[j] = p.k[j];
-  const Interval U = Interval::point(u0);
-  for (int i = 0; i < 6; ++i)
-    for (int j = 5; j >= i; --j) a[j] = a[j] + U * a[j + 1];
-  const Interval h = Interval::point(u1) - U;
-  Interval hj = h;
-  for (int j = 1; j < 7; ++j) {
-    a[j] = a[j] * hj;
-    hj = hj * h;
-  }
-  for (int i = 1; i <= 5; ++i) {
-    Interval b = a[0];
-    for (int j = 1; j <= i; ++j) b = b + kBernstein6.w[i][j] * a[j];
-    if (!(b.lo > 0)) return false;
-  }
-  return true;
-}
 
 // D(u) (x(u) - f).m for the body point with world-oriented offset w = R0 r_B
 // (cw: its Cayley coefficients), a static point f and a static direction m:
 // D (p(u) - f).m + (Dc(u) w).m, with D = 1 + s u^2 and Dc(u) w = w + u c1 + u^2 c2.
+// Its parts: the direction's (E = dp.m), the static point's (A = (p0 - f).m)
+// and the corner's (w.m, c1.m, c2.m), so that the edge/edge slabs, two
+// corners against two points along one direction, form each once.
+struct CornerAlong {
+  Interval w, c1, c2;
+};
+GAUSS6_ALWAYS_INLINE CornerAlong corner_along(const IVec3& w, const CayleyCoefficients& cw, const IVec3& dir) {
+  return {dot(w, dir), dot(cw.c1, dir), dot(cw.c2, dir)};
+}
+GAUSS6_ALWAYS_INLINE Cubic body_point_along(const CcdMotion& m, Interval A, Interval E, const CornerAlong& c) {
+  return {{A + c.w, E + c.c1, m.g2 * A + c.c2, m.g2 * E}};
+}
 GAUSS6_ALWAYS_INLINE Cubic body_point_along(const CcdMotion& m, const IVec3& w, const CayleyCoefficients& cw, const IVec3& f,
                        const IVec3& dir) {
-  const Interval A = dot(m.p0 - f, dir), E = dot(m.dp, dir);
-  return {{A + dot(w, dir), E + dot(cw.c1, dir), m.g2 * A + dot(cw.c2, dir), m.g2 * E}};
+  return body_point_along(m, dot(m.p0 - f, dir), dot(m.dp, dir), corner_along(w, cw, dir));
 }
 // D(u) (y - x_f(u)).(C(u) n') for a static point y and the body point f' = R0 f_B
 // with body direction n' = R0 n_B (cn: the Cayley coefficients of n'):
 // (y - p(u)).Dc(u) n' - D f'.n' (C is a rotation: (C f').(C n') = f'.n').
+// Its parts, as above: the direction's (dp.n', dp.c1, dp.c2), the static
+// point's (Y.n', Y.c1, Y.c2, Y = y - p0) and the body point's (F = f'.n').
+struct DirectionAlong {
+  Interval n, c1, c2;
+};
+GAUSS6_ALWAYS_INLINE DirectionAlong direction_along(const IVec3& v, const IVec3& nW, const CayleyCoefficients& cn) {
+  return {dot(v, nW), dot(v, cn.c1), dot(v, cn.c2)};
+}
+GAUSS6_ALWAYS_INLINE Cubic static_point_along(const CcdMotion& m, const DirectionAlong& Y, const DirectionAlong& D,
+                                              Interval F) {
+  return {{Y.n - F, Y.c1 - D.n, (Y.c2 - D.c1) - m.g2 * F, -D.c2}};
+}
 GAUSS6_ALWAYS_INLINE Cubic static_point_along(const CcdMotion& m, const IVec3& y, const IVec3& fW, const IVec3& nW,
                          const CayleyCoefficients& cn) {
-  const IVec3 Y = y - m.p0;
-  const Interval F = dot(fW, nW);
-  return {{dot(Y, nW) - F, dot(Y, cn.c1) - dot(m.dp, nW), (dot(Y, cn.c2) - dot(m.dp, cn.c1)) - m.g2 * F,
-           -dot(m.dp, cn.c2)}};
+  return static_point_along(m, direction_along(y - m.p0, nW, cn), direction_along(m.dp, nW, cn), dot(fW, nW));
 }
 
 // A body corner w = R0 r_B of the moving feature, with the terms of its
@@ -762,6 +700,28 @@ struct MovingCorner {
   IVec3 at0, gxw, ggw, rate;
   MovingCorner(const CcdMotion& m, const IVec3& w)
       : at0(m.p0 + w), gxw(cross(m.g, w)), ggw(cross(m.g, gxw)), rate(m.dp + 2.0 * gxw) {}
+};
+
+// The turn's terms of a body corner's projection over [u0, u1] (see (2)
+// above): B, the hull of beta(u) = 2 u^2 / D(u) (increasing in u), and Gamma =
+// [0, 2 u1^3 s], which holds gamma(u) = 2 u^3 s / D(u). One entry: the
+// separating-axis tests of one u-interval (the filter's axis, then the
+// interval's own guide) share them.
+struct TurnTerms {
+  const CcdMotion* motion = nullptr;
+  mutable double u0 = -1, u1 = -1;
+  mutable Interval B{}, Gamma{};
+  void at(double a, double b) const {
+    if (a == u0 && b == u1) return;
+    u0 = a;
+    u1 = b;
+    const Interval s = motion->g2;
+    const auto beta_at = [&](double v) {
+      return div_positive(2.0 * sqr(Interval::point(v)), Interval::point(1) + sqr(Interval::point(v)) * s);
+    };
+    B = hull(beta_at(a), beta_at(b));
+    Gamma = {0, (2.0 * (sqr(Interval::point(b)) * Interval::point(b)) * s).hi};
+  }
 };
 
 // The separating-axis test (2) for one axis n: the moving feature's corners'
@@ -784,15 +744,11 @@ struct SeparatingAxis {
     static_proj = widen(proj, d * norm_upper(n));
   }
   // True when the projections are proven apart for every u in [u0, u1].
-  bool excludes(const CcdMotion& m, double u0, double u1) const {
+  bool excludes(const TurnTerms& turns, double u0, double u1) const {
     if (num_corners == 0) return false;
     const Interval U{u0, u1};
-    const Interval s = m.g2;
-    const auto beta_at = [&](double v) {
-      return div_positive(2.0 * sqr(Interval::point(v)), Interval::point(1) + sqr(Interval::point(v)) * s);
-    };
-    const Interval B = hull(beta_at(u0), beta_at(u1));
-    const Interval Gamma{0, (2.0 * (sqr(Interval::point(u1)) * Interval::point(u1)) * s).hi};
+    turns.at(u0, u1);
+    const Interval &B = turns.B, &Gamma = turns.Gamma;
     Interval proj{};
     for (int j = 0; j < num_corners; ++j) {
       const Interval pj = c0[j] + U * c1[j] - Gamma * c2[j] + B * c3[j];
@@ -806,16 +762,14 @@ struct UFilter {
   // Exclusion conditions g(u) > 0, in groups: a group excludes U when each of
   // its members is positive on all of U (a single condition is a group of one).
   static constexpr int kMaxConditions = 12;
-  Cubic cond[kMaxConditions];
-  // The conditions' coefficient midpoints: a screen in doubles before each
-  // interval test (screened_positive_on).
-  double mid[kMaxConditions][4] = {};
+  LowerCoefficients<3> cond[kMaxConditions];
   bool joins_previous[kMaxConditions] = {};
   int num_conditions = 0;
-  Sextic lines;         // (4), edge/edge (rigid): S(u) = P^2 - d^2 |N|^2, tried last
+  LowerCoefficients<6> lines;  // (4), edge/edge (rigid): S(u) = P^2 - d^2 |N|^2, tried last
   bool has_lines = false;
   SeparatingAxis axis;  // (2), with the axis of the window's start (rigid queries)
   const CcdMotion* motion = nullptr;  // the axis test's motion (rigid queries; null: no axis test)
+  TurnTerms turns;                    // its turn's terms (set_motion), shared with the guides' axis tests
   Interval g2{};  // s = |g|^2 of D(u) = 1 + s u^2 (zero for linear motion: D = 1)
 
   // Q(u) <= r D(u) is necessary for a contact: exclude where Q - r D > 0.
@@ -831,38 +785,37 @@ struct UFilter {
   void add(const Cubic& c, bool join) {
     if (num_conditions == kMaxConditions) return;  // fewer conditions: still conservative
     joins_previous[num_conditions] = join && num_conditions > 0;
-    for (int j = 0; j < 4; ++j) mid[num_conditions][j] = 0.5 * (c.k[j].lo + c.k[j].hi);
-    cond[num_conditions++] = c;
+    cond[num_conditions++].set(c.k);
+  }
+  void set_lines(const Sextic& p) {
+    lines.set(p.k);
+    has_lines = true;
+  }
+  void set_motion(const CcdMotion* m) {
+    motion = m;
+    turns.motion = m;
   }
   void add_corner(const MovingCorner& k, const Vec3& n) { axis.add_corner(k, n); }
   void set_axis_static(Interval proj, const IVec3& n, double d) { axis.set_static(proj, n, d); }
 
-  // positive_on(cond[j], u0, u1), screened first (a heuristic, as the
-  // sextic's: a false here only keeps the interval): the midpoint cubic at both
-  // ends, in doubles. A condition that fails at an end is then dropped after
-  // two Horner evaluations in doubles instead of the interval ones (a sliding
-  // pair's filter tests each of its u-intervals against up to 12 conditions;
-  // the bunnies' p99 band: 2.8% fewer instructions, the same trajectories bit
-  // for bit: docs/benchmarks.md, issue 20, thirteenth session).
-  bool screened_positive_on(int j, double u0, double u1) const {
-    const double* c = mid[j];
-    const auto at = [&](double u) { return c[0] + u * (c[1] + u * (c[2] + u * c[3])); };
-    return at(u0) > 0 && at(u1) > 0 && positive_on(cond[j], u0, u1);
-  }
-
+  // The cubics' weights are formed once per u-interval for all the
+  // conditions; the sextic's only when it is reached.
   bool excludes(double u0, double u1) const {
-    for (int i = 0; i < num_conditions;) {
-      bool all = true;
-      int j = i;
-      do {
-        all = all && screened_positive_on(j, u0, u1);
-        ++j;
-      } while (j < num_conditions && joins_previous[j]);
-      if (all) return true;
-      i = j;
+    if (num_conditions > 0) {
+      const BernsteinBasis<3> basis(u0, u1);
+      for (int i = 0; i < num_conditions;) {
+        bool all = true;
+        int j = i;
+        do {
+          all = all && positive_on(cond[j], basis);
+          ++j;
+        } while (j < num_conditions && joins_previous[j]);
+        if (all) return true;
+        i = j;
+      }
     }
-    if (motion != nullptr && axis.excludes(*motion, u0, u1)) return true;
-    return has_lines && positive_on(lines, u0, u1);
+    if (motion != nullptr && axis.excludes(turns, u0, u1)) return true;
+    return has_lines && positive_on(lines, BernsteinBasis<6>(u0, u1));
   }
 };
 
@@ -1102,7 +1055,7 @@ void rigid_vertex_face(Moving moving, const VertexFacePair& q, const CcdSettings
   const CcdMotion& m = *q.motion;
   const double d = s.min_separation;
   UFilter filter;
-  filter.motion = &m;
+  filter.set_motion(&m);
   filter.g2 = m.g2;
   const IVec3 corner[3] = {f0, to_interval(q.face[1]), to_interval(q.face[2])};
   const IVec3 n = cross(e1, e2);
@@ -1137,7 +1090,7 @@ void rigid_vertex_face(Moving moving, const VertexFacePair& q, const CcdSettings
       const IVec3 na = to_interval(axis_u);
       sa.add_corner(corner_w, axis_u);
       sa.set_static(hull(hull(dot(na, corner[0]), dot(na, corner[1])), dot(na, corner[2])), na, d);
-      return sa.excludes(m, u0, u1);
+      return sa.excludes(filter.turns, u0, u1);
     };
     // Edge slabs: m_k = n x (f_k+1 - f_k) points into the triangle; a point
     // within d of it has (x - f_k).m_k >= -d |m_k|.
@@ -1181,7 +1134,7 @@ void rigid_vertex_face(Moving moving, const VertexFacePair& q, const CcdSettings
     SeparatingAxis sa;
     for (int k = 0; k < 3; ++k) sa.add_corner(face_corners[k], axis_u);
     sa.set_static(along(axis_u, v), to_interval(axis_u), d);
-    return sa.excludes(m, u0, u1);
+    return sa.excludes(filter.turns, u0, u1);
   };
   // Edge slabs in the body frame: (y - x_fk(u)).(C m_k') >= -d |m_k|.
   filtered_bisect(enclose, /*triangle=*/true, sc, filter, [&](UFilter* f) {
@@ -1234,7 +1187,7 @@ void ccd_rigid_edge_edge(const RigidEdgeEdgeQuery& q, const CcdSettings& s, CcdW
   const CcdMotion& m = *q.motion;
   const double d = s.min_separation;
   UFilter filter;
-  filter.motion = &m;
+  filter.set_motion(&m);
   filter.g2 = m.g2;
   const IVec3 a0W = mul(m.R0, a0), eaW = mul(m.R0, ea), Q = m.p0 - b0;
   const IVec3 a1W = mul(m.R0, a0 + ea);
@@ -1281,22 +1234,29 @@ void ccd_rigid_edge_edge(const RigidEdgeEdgeQuery& q, const CcdSettings& s, CcdW
     sa.add_corner(ends[0], axis_u);
     sa.add_corner(ends[1], axis_u);
     sa.set_static(hull(along(axis_u, b0), along(axis_u, b1)), to_interval(axis_u), d);
-    return sa.excludes(m, u0, u1);
+    return sa.excludes(filter.turns, u0, u1);
   };
   filtered_bisect(enclose, /*triangle=*/false, sc, filter, [&](UFilter* f) {
     const CayleyCoefficients c0 = cayley_coefficients(m, a0W), c1 = cayley_coefficients(m, a1W);
     const double rb = (d * norm_upper(eb)).v, ra = (d * norm_upper(ea)).v;
-    f->at_least(body_point_along(m, a0W, c0, b0, eb), rb);
-    f->at_least(body_point_along(m, a1W, c1, b0, eb), rb, /*join=*/true);
-    f->at_most(body_point_along(m, a0W, c0, b1, eb), rb);
-    f->at_most(body_point_along(m, a1W, c1, b1, eb), rb, /*join=*/true);
-    f->at_least(static_point_along(m, b0, a0W, eaW, ca), ra);
-    f->at_least(static_point_along(m, b1, a0W, eaW, ca), ra, /*join=*/true);
-    f->at_most(static_point_along(m, b0, a1W, eaW, ca), ra);
-    f->at_most(static_point_along(m, b1, a1W, eaW, ca), ra, /*join=*/true);
+    // Along eb: A's ends (body) against B's ends (static points).
+    const Interval E = dot(m.dp, eb), A0 = dot(m.p0 - b0, eb), A1 = dot(m.p0 - b1, eb);
+    const CornerAlong k0 = corner_along(a0W, c0, eb), k1 = corner_along(a1W, c1, eb);
+    f->at_least(body_point_along(m, A0, E, k0), rb);
+    f->at_least(body_point_along(m, A0, E, k1), rb, /*join=*/true);
+    f->at_most(body_point_along(m, A1, E, k0), rb);
+    f->at_most(body_point_along(m, A1, E, k1), rb, /*join=*/true);
+    // Along C ea': B's ends (static points) against A's ends (body points).
+    const DirectionAlong D = direction_along(m.dp, eaW, ca), Y0 = direction_along(b0 - m.p0, eaW, ca),
+                         Y1 = direction_along(b1 - m.p0, eaW, ca);
+    const Interval F0 = dot(a0W, eaW), F1 = dot(a1W, eaW);
+    f->at_least(static_point_along(m, Y0, D, F0), ra);
+    f->at_least(static_point_along(m, Y1, D, F0), ra, /*join=*/true);
+    f->at_most(static_point_along(m, Y0, D, F1), ra);
+    f->at_most(static_point_along(m, Y1, D, F1), ra, /*join=*/true);
     // The lines' distance (4): S = P^2 - d^2 |N|^2, N = T0 + u T1 + u^2 T2.
     {
-      Sextic& q6 = f->lines;
+      Sextic q6;
       for (int i = 0; i < 4; ++i) {
         q6.k[2 * i] = q6.k[2 * i] + sqr(P.k[i]);
         for (int j = i + 1; j < 4; ++j) q6.k[i + j] = q6.k[i + j] + 2.0 * (P.k[i] * P.k[j]);
@@ -1309,8 +1269,7 @@ void ccd_rigid_edge_edge(const RigidEdgeEdgeQuery& q, const CcdSettings& s, CcdW
           for (int j = i + 1; j < 3; ++j) q6.k[i + j] = q6.k[i + j] - d2 * (2.0 * (n[i] * n[j]));
         }
       }
-      q6.set_mid();
-      f->has_lines = true;
+      f->set_lines(q6);
     }
   }, Guides<decltype(guide_at), decltype(separated)>{guide_at, separated}, q.u_begin, q.u_end, s, ws, r);
 }
@@ -1332,7 +1291,7 @@ void ccd_rigid_edge_edge(const RigidEdgeEdgeQuery& q, const CcdSettings& s, CcdW
 //     most the segments'). A contact within d at u needs |P(u)| <= d |n(u)| <=
 //     d Nmax, Nmax = |N0| + |N1| + |N2| >= |n(u)| on [0, 1]. With d = 0 this is
 //     P(u) = 0: filtered_bisect()'s 1-D subdivision with positive_on() (P's
-//     Bernstein coefficients on each u-interval, outward rounded) drops every
+//     Bernstein coefficients on each u-interval, rounding bounded) drops every
 //     u-interval on which P is proven nonzero and narrows the rest to
 //     time_tolerance around P's roots, in increasing u; the bisection then
 //     decides each of those narrow intervals. A vertex sliding along a face at a
