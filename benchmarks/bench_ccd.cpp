@@ -235,7 +235,8 @@ void time_steps(benchmark::State& state, const RuntimeModel& model, const std::v
   PerCallCounters counters;
   // The slowest step (CPU time) and what it did; GAUSS6_BENCH_STEP_LOG=<file>
   // writes one line per step (index, CPU ns and the same counts, then the
-  // settling step's shortenings) for profiles.
+  // settling step's shortenings, and whether the leg filled the proximity
+  // cache at once and put a background fill in use) for profiles.
   double slowest_ns = -1, over_1ms = 0, over_100us = 0;
   std::FILE* log = std::getenv("GAUSS6_BENCH_STEP_LOG") ? std::fopen(std::getenv("GAUSS6_BENCH_STEP_LOG"), "w") : nullptr;
   size_t i = 0;
@@ -275,10 +276,10 @@ void time_steps(benchmark::State& state, const RuntimeModel& model, const std::v
         state.counters["slowest_settled"] = info.settled;
       }
       if (log != nullptr)
-        std::fprintf(log, "%zu %.0f %d %ld %d %d %d %d %d %d %d\n", index, cpu_ns, r.num_pair_tests, r.num_box_iterations,
+        std::fprintf(log, "%zu %.0f %d %ld %d %d %d %d %d %d %d %d %d\n", index, cpu_ns, r.num_pair_tests, r.num_box_iterations,
                      r.num_node_pairs, r.num_fill_node_pairs, r.num_triangle_pairs, static_cast<int>(info.settled),
                      static_cast<int>(info.status == SimStepStatus::kContact), r.num_sub_intervals,
-                     info.num_shortenings);
+                     info.num_shortenings, int(r.cache_filled), int(r.cache_refilled));
       counters.add("hits", info.status == SimStepStatus::kContact);
       counters.add("settling_legs", info.settled);
       counters.add("gave_up", info.ccd != CcdStatus::kOk);
