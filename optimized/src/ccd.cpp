@@ -706,16 +706,15 @@ struct MovingCorner {
 // above): B, the hull of beta(u) = 2 u^2 / D(u) (increasing in u), and Gamma =
 // [0, 2 u1^3 s], which holds gamma(u) = 2 u^3 s / D(u). One entry: the
 // separating-axis tests of one u-interval (the filter's axis, then the
-// interval's own guide) share them.
+// interval's own guide) share them. For one motion: a query's (UFilter::turns).
 struct TurnTerms {
-  const CcdMotion* motion = nullptr;
   mutable double u0 = -1, u1 = -1;
   mutable Interval B{}, Gamma{};
-  void at(double a, double b) const {
+  void at(const CcdMotion& m, double a, double b) const {
     if (a == u0 && b == u1) return;
     u0 = a;
     u1 = b;
-    const Interval s = motion->g2;
+    const Interval s = m.g2;
     const auto beta_at = [&](double v) {
       return div_positive(2.0 * sqr(Interval::point(v)), Interval::point(1) + sqr(Interval::point(v)) * s);
     };
@@ -744,10 +743,10 @@ struct SeparatingAxis {
     static_proj = widen(proj, d * norm_upper(n));
   }
   // True when the projections are proven apart for every u in [u0, u1].
-  bool excludes(const TurnTerms& turns, double u0, double u1) const {
+  bool excludes(const CcdMotion& m, const TurnTerms& turns, double u0, double u1) const {
     if (num_corners == 0) return false;
     const Interval U{u0, u1};
-    turns.at(u0, u1);
+    turns.at(m, u0, u1);
     const Interval &B = turns.B, &Gamma = turns.Gamma;
     Interval proj{};
     for (int j = 0; j < num_corners; ++j) {
@@ -769,7 +768,7 @@ struct UFilter {
   bool has_lines = false;
   SeparatingAxis axis;  // (2), with the axis of the window's start (rigid queries)
   const CcdMotion* motion = nullptr;  // the axis test's motion (rigid queries; null: no axis test)
-  TurnTerms turns;                    // its turn's terms (set_motion), shared with the guides' axis tests
+  TurnTerms turns;                    // its turn's terms, shared with the guides' axis tests
   Interval g2{};  // s = |g|^2 of D(u) = 1 + s u^2 (zero for linear motion: D = 1)
 
   // Q(u) <= r D(u) is necessary for a contact: exclude where Q - r D > 0.
@@ -791,10 +790,6 @@ struct UFilter {
     lines.set(p.k);
     has_lines = true;
   }
-  void set_motion(const CcdMotion* m) {
-    motion = m;
-    turns.motion = m;
-  }
   void add_corner(const MovingCorner& k, const Vec3& n) { axis.add_corner(k, n); }
   void set_axis_static(Interval proj, const IVec3& n, double d) { axis.set_static(proj, n, d); }
 
@@ -814,7 +809,7 @@ struct UFilter {
         i = j;
       }
     }
-    if (motion != nullptr && axis.excludes(turns, u0, u1)) return true;
+    if (motion != nullptr && axis.excludes(*motion, turns, u0, u1)) return true;
     return has_lines && positive_on(lines, BernsteinBasis<6>(u0, u1));
   }
 };
@@ -1055,7 +1050,7 @@ void rigid_vertex_face(Moving moving, const VertexFacePair& q, const CcdSettings
   const CcdMotion& m = *q.motion;
   const double d = s.min_separation;
   UFilter filter;
-  filter.set_motion(&m);
+  filter.motion = &m;
   filter.g2 = m.g2;
   const IVec3 corner[3] = {f0, to_interval(q.face[1]), to_interval(q.face[2])};
   const IVec3 n = cross(e1, e2);
@@ -1090,7 +1085,7 @@ void rigid_vertex_face(Moving moving, const VertexFacePair& q, const CcdSettings
       const IVec3 na = to_interval(axis_u);
       sa.add_corner(corner_w, axis_u);
       sa.set_static(hull(hull(dot(na, corner[0]), dot(na, corner[1])), dot(na, corner[2])), na, d);
-      return sa.excludes(filter.turns, u0, u1);
+      return sa.excludes(m, filter.turns, u0, u1);
     };
     // Edge slabs: m_k = n x (f_k+1 - f_k) points into the triangle; a point
     // within d of it has (x - f_k).m_k >= -d |m_k|.
@@ -1134,7 +1129,7 @@ void rigid_vertex_face(Moving moving, const VertexFacePair& q, const CcdSettings
     SeparatingAxis sa;
     for (int k = 0; k < 3; ++k) sa.add_corner(face_corners[k], axis_u);
     sa.set_static(along(axis_u, v), to_interval(axis_u), d);
-    return sa.excludes(filter.turns, u0, u1);
+    return sa.excludes(m, filter.turns, u0, u1);
   };
   // Edge slabs in the body frame: (y - x_fk(u)).(C m_k') >= -d |m_k|.
   filtered_bisect(enclose, /*triangle=*/true, sc, filter, [&](UFilter* f) {
@@ -1187,7 +1182,7 @@ void ccd_rigid_edge_edge(const RigidEdgeEdgeQuery& q, const CcdSettings& s, CcdW
   const CcdMotion& m = *q.motion;
   const double d = s.min_separation;
   UFilter filter;
-  filter.set_motion(&m);
+  filter.motion = &m;
   filter.g2 = m.g2;
   const IVec3 a0W = mul(m.R0, a0), eaW = mul(m.R0, ea), Q = m.p0 - b0;
   const IVec3 a1W = mul(m.R0, a0 + ea);
@@ -1234,7 +1229,7 @@ void ccd_rigid_edge_edge(const RigidEdgeEdgeQuery& q, const CcdSettings& s, CcdW
     sa.add_corner(ends[0], axis_u);
     sa.add_corner(ends[1], axis_u);
     sa.set_static(hull(along(axis_u, b0), along(axis_u, b1)), to_interval(axis_u), d);
-    return sa.excludes(filter.turns, u0, u1);
+    return sa.excludes(m, filter.turns, u0, u1);
   };
   filtered_bisect(enclose, /*triangle=*/false, sc, filter, [&](UFilter* f) {
     const CayleyCoefficients c0 = cayley_coefficients(m, a0W), c1 = cayley_coefficients(m, a1W);
