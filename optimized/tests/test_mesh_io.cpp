@@ -205,6 +205,14 @@ TEST_CASE("Mesh files whose headers are broken or whose counts lie are refused b
                      "not a vertex number below 3");
   require_file_error(dir.write("negative_index.off", "OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 -1\n"),
                      "not a vertex number below 3");
+  // CGAL's header reader swallows the character after the keyword: "OFF#3333" made it
+  // read 333,333,330 vertices from the comment and allocate 8 GB (found by the fuzzer).
+  require_file_error(dir.write("glued_comment.off", "OFF#333333330 0\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n"),
+                     "a comment right after 'OFF'");
+  require_file_error(dir.write("glued_comment_noff.off", "NOFF#9 9 9\n1 0 0\n0 0 0 0 0 1\n"),
+                     "a comment right after 'NOFF'");
+  // Set apart by a space, the comment is read as one by both.
+  CHECK(read_mesh(dir.write("spaced_comment.off", "OFF #333333330 0\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n")).F.rows() == 1);
   require_file_error(dir.write("color.off", "COFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n"), "variant 'COFF'");
   {
     std::string stl(80, ' ');

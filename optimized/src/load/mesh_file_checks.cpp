@@ -59,6 +59,7 @@ class LineCursor {
       std::string_view line = text_.substr(pos_, end - pos_);
       pos_ = end + 1;
       ++line_;
+      raw_ = line;
       if (const size_t hash = line.find('#'); hash != std::string_view::npos) line = line.substr(0, hash);
       *toks = tokens_of(line);
       if (!toks->empty()) return true;
@@ -66,9 +67,12 @@ class LineCursor {
     return false;
   }
   int line() const { return line_; }
+  // The last line returned, comment included.
+  std::string_view raw() const { return raw_; }
 
  private:
   std::string_view text_;
+  std::string_view raw_;
   size_t pos_ = 0;
   int line_ = 0;
 };
@@ -87,6 +91,16 @@ void check_off_structure(const std::string& path, const std::string& bytes) {
     if (t[0].size() >= 3 && t[0].substr(t[0].size() - 3) == "OFF")
       fail(path, "cannot parse as OFF: the variant '" + std::string(t[0]) + "' is not read (only OFF and NOFF)");
     fail(path, "cannot parse as OFF: the file does not start with 'OFF'");
+  }
+  // CGAL 5.5's header reader takes the character after the keyword as a separator,
+  // whatever it is: "OFF#c 9 9 9" hides the comment's '#' from it, so it would read
+  // counts from inside the comment. A comment there must be set apart by a space.
+  {
+    const std::string_view raw = lines.raw();
+    const size_t after_keyword = raw.find(t[0]) + t[0].size();
+    if (after_keyword < raw.size() && raw[after_keyword] == '#')
+      fail(path, "cannot parse as OFF: line " + std::to_string(lines.line()) + ": a comment right after '" +
+                     std::string(t[0]) + "' (put a space before the '#')");
   }
   // Counts may follow on the same line or come on the next one.
   std::vector<std::string_view> counts(t.begin() + 1, t.end());
