@@ -196,6 +196,10 @@ TEST_CASE("Mesh files whose headers are broken or whose counts lie are refused b
   }
   require_file_error(dir.write("no_properties.ply", "ply\nformat ascii 1.0\nelement vertex 99999999999\nend_header\n"),
                      "but no properties");
+  // CGAL doubles the edge count in an int (the fuzzer's 2 * 2087506048).
+  require_file_error(dir.write("edges.off", "OFF\n3 1 2087506048\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n"),
+                     "the edge count 2087506048 is over 1073741823");
+  CHECK(read_mesh(dir.write("edges_max.off", "OFF\n3 1 1073741823\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n")).F.rows() == 1);
   require_file_error(dir.write("lying.off", "OFF\n2000000000 2000000000 0\n0 0 0\n"), "more than a file of");
   require_file_error(dir.write("short.off", "OFF\n3 1 0\n0 0 0\n1 0 0\n"), "the file holds 2");
   require_file_error(dir.write("corners.off", "OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n99999999999 0 1 2\n"),

@@ -111,6 +111,11 @@ void check_off_structure(const std::string& path, const std::string& bytes) {
       !parse_count(counts[2], &ne))
     fail(path, "cannot parse as OFF: line " + std::to_string(lines.line()) +
                    ": expected three non-negative integer counts (vertices, faces, edges)");
+  // CGAL 5.5 reads the edge count into an int and doubles it (its guess of the
+  // half-edges), overflowing beyond 2^30 - 1; nothing else uses it.
+  if (ne > (uint64_t{1} << 30) - 1)
+    fail(path, "cannot parse as OFF: line " + std::to_string(lines.line()) + ": the edge count " + std::to_string(ne) +
+                   " is over 1073741823 (2^30 - 1)");
   // Each vertex takes at least 6 bytes and each face at least 2: a count beyond that is a lie.
   if (nv > bytes.size() / 6 || nf > bytes.size() / 2)
     fail(path, "cannot parse as OFF: the header states " + std::to_string(nv) + " vertices and " + std::to_string(nf) +
