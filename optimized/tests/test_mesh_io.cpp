@@ -181,6 +181,17 @@ TEST_CASE("Mesh files whose headers are broken or whose counts lie are refused b
                                                  "property list uint int vertex_indices\nend_header\n"
                                                  "0 0 0\n1 0 0\n0 1 0\n4000000000 0 1 2\n"),
                      "bad list length");
+  // ASCII values are whole numbers of their type: CGAL's reader stopped inside
+  // "0-4000" and took -4000 as the face's list length (2^32 - 4000: 17 GB; the fuzzer's).
+  {
+    const std::string header = "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
+                               "property float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n";
+    require_file_error(dir.write("glued.ply", header + "0 0 0\n1 0 0\n0 1 0-4000 1 2\n"), "'0-4000' is not a value of type float");
+    require_file_error(dir.write("hex.ply", header + "0 0 0\n1 0 0\n0 0x1 0\n3 0 1 2\n"), "'0x1' is not a value of type float");
+    require_file_error(dir.write("float_index.ply", header + "0 0 0\n1 0 0\n0 1 0\n3 0 1 2.5\n"), "'2.5' is not a value of type int");
+    // Signs, exponents and bare points are numbers.
+    CHECK(read_mesh(dir.write("numbers.ply", header + "+0 -0. .0\n1e0 0 0E+1\n0 1.0 -2.5e-3\n3 0 1 +2\n")).F.rows() == 1);
+  }
   {
     // Binary: a list length of 2^32 - 1 int32 values in a file of 200 bytes.
     std::string ply = "ply\nformat binary_little_endian 1.0\nelement face 1\n"

@@ -160,6 +160,39 @@ int ply_type_size(std::string_view type) {
 bool ply_type_signed(std::string_view type) {
   return type == "char" || type == "int8" || type == "short" || type == "int16" || type == "int" || type == "int32";
 }
+bool ply_type_floating(std::string_view type) {
+  return type == "float" || type == "float32" || type == "double" || type == "float64";
+}
+
+// An ASCII PLY value that is one whole number of its type, as CGAL 5.5's reader
+// (stream >> value) takes it: for an integer type an optional sign ('-' only for
+// signed types) and decimal digits; for a floating type a decimal number, the
+// whole token. The reader stops inside a token it cannot read whole and takes
+// the rest as the next value: "0-4000" was z = 0 and then a list length of
+// -4000, read as 2^32 - 4000 (a 17 GB allocation).
+bool ply_ascii_value(std::string_view tok, std::string_view type) {
+  if (!tok.empty() && (tok[0] == '+' || (tok[0] == '-' && (ply_type_signed(type) || ply_type_floating(type)))))
+    tok.remove_prefix(1);
+  if (tok.empty()) return false;
+  if (!ply_type_floating(type))
+    return std::all_of(tok.begin(), tok.end(), [](char c) { return c >= '0' && c <= '9'; });
+  // Digits with at most one '.', then an optional exponent e[+-]digits.
+  size_t i = 0, digits = 0;
+  while (i < tok.size() && tok[i] >= '0' && tok[i] <= '9') ++i, ++digits;
+  if (i < tok.size() && tok[i] == '.') {
+    ++i;
+    while (i < tok.size() && tok[i] >= '0' && tok[i] <= '9') ++i, ++digits;
+  }
+  if (digits == 0) return false;
+  if (i < tok.size() && (tok[i] == 'e' || tok[i] == 'E')) {
+    ++i;
+    if (i < tok.size() && (tok[i] == '+' || tok[i] == '-')) ++i;
+    const size_t exponent = i;
+    while (i < tok.size() && tok[i] >= '0' && tok[i] <= '9') ++i;
+    if (i == exponent) return false;
+  }
+  return i == tok.size();
+}
 
 struct PlyProperty {
   std::string_view name;
@@ -300,13 +333,23 @@ void check_ply_structure(const std::string& path, const std::string& bytes) {
           if (!next_token(&tok))
             fail(path, "cannot parse as PLY: element '" + e.name + "' ends after " + std::to_string(i) + " of " +
                            std::to_string(e.count) + " items");
-          if (!p.is_list) continue;
+          const auto check_value = [&](std::string_view type) {
+            if (!ply_ascii_value(tok, type))
+              fail(path, "cannot parse as PLY: element '" + e.name + "' item " + std::to_string(i) + ": '" +
+                             std::string(tok) + "' is not a value of type " + std::string(type));
+          };
+          if (!p.is_list) {
+            check_value(p.type);
+            continue;
+          }
           uint64_t n = 0;
           if (!parse_count(tok, &n) || n > (size - pos) / 2 + 1)
             fail(path, "cannot parse as PLY: element '" + e.name + "' item " + std::to_string(i) + ": bad list length '" +
                            std::string(tok) + "' (not a count, or more values than the file holds)");
-          for (uint64_t k = 0; k < n; ++k)
+          for (uint64_t k = 0; k < n; ++k) {
             if (!next_token(&tok)) fail(path, "cannot parse as PLY: element '" + e.name + "': the file ends inside a list");
+            check_value(p.type);
+          }
         }
     }
   } else {
