@@ -59,7 +59,6 @@ class LineCursor {
       std::string_view line = text_.substr(pos_, end - pos_);
       pos_ = end + 1;
       ++line_;
-      raw_ = line;
       if (const size_t hash = line.find('#'); hash != std::string_view::npos) line = line.substr(0, hash);
       *toks = tokens_of(line);
       if (!toks->empty()) return true;
@@ -67,12 +66,9 @@ class LineCursor {
     return false;
   }
   int line() const { return line_; }
-  // The last line returned, comment included.
-  std::string_view raw() const { return raw_; }
 
  private:
   std::string_view text_;
-  std::string_view raw_;
   size_t pos_ = 0;
   int line_ = 0;
 };
@@ -95,10 +91,10 @@ void check_off_structure(const std::string& path, const std::string& bytes) {
   // CGAL 5.5's header reader takes the character after the keyword as a separator,
   // whatever it is: "OFF#c 9 9 9" hides the comment's '#' from it, so it would read
   // counts from inside the comment. A comment there must be set apart by a space.
+  // (The cursor cut the line at the '#': the keyword's token then ends right before it.)
   {
-    const std::string_view raw = lines.raw();
-    const size_t after_keyword = raw.find(t[0]) + t[0].size();
-    if (after_keyword < raw.size() && raw[after_keyword] == '#')
+    const char* after_keyword = t[0].data() + t[0].size();
+    if (after_keyword < bytes.data() + bytes.size() && *after_keyword == '#')
       fail(path, "cannot parse as OFF: line " + std::to_string(lines.line()) + ": a comment right after '" +
                      std::string(t[0]) + "' (put a space before the '#')");
   }
@@ -174,22 +170,25 @@ bool ply_ascii_value(std::string_view tok, std::string_view type) {
   if (!tok.empty() && (tok[0] == '+' || (tok[0] == '-' && (ply_type_signed(type) || ply_type_floating(type)))))
     tok.remove_prefix(1);
   if (tok.empty()) return false;
-  if (!ply_type_floating(type))
-    return std::all_of(tok.begin(), tok.end(), [](char c) { return c >= '0' && c <= '9'; });
+  size_t i = 0;
+  // The decimal digits from i on, skipped; how many.
+  const auto skip_digits = [&] {
+    const size_t start = i;
+    while (i < tok.size() && tok[i] >= '0' && tok[i] <= '9') ++i;
+    return i - start;
+  };
+  if (!ply_type_floating(type)) return skip_digits() == tok.size();
   // Digits with at most one '.', then an optional exponent e[+-]digits.
-  size_t i = 0, digits = 0;
-  while (i < tok.size() && tok[i] >= '0' && tok[i] <= '9') ++i, ++digits;
+  size_t digits = skip_digits();
   if (i < tok.size() && tok[i] == '.') {
     ++i;
-    while (i < tok.size() && tok[i] >= '0' && tok[i] <= '9') ++i, ++digits;
+    digits += skip_digits();
   }
   if (digits == 0) return false;
   if (i < tok.size() && (tok[i] == 'e' || tok[i] == 'E')) {
     ++i;
     if (i < tok.size() && (tok[i] == '+' || tok[i] == '-')) ++i;
-    const size_t exponent = i;
-    while (i < tok.size() && tok[i] >= '0' && tok[i] <= '9') ++i;
-    if (i == exponent) return false;
+    if (skip_digits() == 0) return false;
   }
   return i == tok.size();
 }
