@@ -1537,27 +1537,33 @@ Upper difference_norm(const std::array<Interval, N>& a, const std::array<Interva
 }  // namespace
 
 double motion_distance_bound(const Pose& a0, const Pose& a1, const Pose& b0, const CcdMotion& b, double ub,
-                             double body_radius) {
+                             double body_radius, double ua) {
   constexpr double kNone = std::numeric_limits<double>::infinity();
   CcdMotion a;
   IQuat qa, qb;
-  if (!(ub >= 0 && ub <= 1 && body_radius >= 0) || make_ccd_motion(a0, a1, &a) != MotionStatus::kOk ||
+  if (!(ub >= 0 && ub <= 1 && ua >= 0 && ua <= 1 && body_radius >= 0) ||
+      make_ccd_motion(a0, a1, &a) != MotionStatus::kOk ||
       !unit_quaternion(a0.q, &qa) || !unit_quaternion(b0.q, &qb))
     return kNone;
   // q and -q are the same rotation: b's quaternions taken on a's side.
   if (a0.q.w * b0.q.w + a0.q.x * b0.q.x + a0.q.y * b0.q.y + a0.q.z * b0.q.z < 0)
     for (Interval& c : qb) c = -c;
   // Rotations: max over u = 0, 1 of the affine quaternions' difference.
-  IVec3 gb;
-  for (int i = 0; i < 3; ++i) gb[static_cast<size_t>(i)] = ub * b.g[static_cast<size_t>(i)];
+  IVec3 ga, gb;
+  for (int i = 0; i < 3; ++i) {
+    ga[static_cast<size_t>(i)] = ua * a.g[static_cast<size_t>(i)];
+    gb[static_cast<size_t>(i)] = ub * b.g[static_cast<size_t>(i)];
+  }
   // (1, g) q: the affine quaternion at u = 1 of the motion from q with Gibbs vector g.
   const auto at_end = [](const IVec3& g, const IQuat& q) { return hamilton({Interval::point(1), g[0], g[1], g[2]}, q); };
-  const Upper turn = max(difference_norm(qa, qb), difference_norm(at_end(a.g, qa), at_end(gb, qb)));
-  // Positions: max over u = 0, 1 (b's start is b0.p, its position at ub p0 + ub dp).
-  IVec3 pb1;
-  for (int i = 0; i < 3; ++i)
+  const Upper turn = max(difference_norm(qa, qb), difference_norm(at_end(ga, qa), at_end(gb, qb)));
+  // Positions: max over u = 0, 1 (b's start is b0.p, its position at ub p0 + ub dp; a's likewise at ua).
+  IVec3 pa1, pb1;
+  for (int i = 0; i < 3; ++i) {
+    pa1[static_cast<size_t>(i)] = a.p0[static_cast<size_t>(i)] + ua * a.dp[static_cast<size_t>(i)];
     pb1[static_cast<size_t>(i)] = b.p0[static_cast<size_t>(i)] + ub * b.dp[static_cast<size_t>(i)];
-  const Upper shift = max(difference_norm(a.p0, to_interval(b0.p)), difference_norm(a.p0 + a.dp, pb1));
+  }
+  const Upper shift = max(difference_norm(a.p0, to_interval(b0.p)), difference_norm(pa1, pb1));
   const double bound = (shift + 2.0 * (turn * Upper{body_radius})).v;
   return std::isfinite(bound) ? bound : kNone;
 }

@@ -95,7 +95,8 @@ bool among(const FeaturePair* hints, int count, int gf, int of, int o) {
   return false;
 }
 
-// The hints' triangle pairs first, over the whole step (each distinct pair once).
+// The hints' triangle pairs first, over the whole step (each distinct pair once;
+// from known_free, as every search of the step).
 // A pair searched here over [0, e] needs no second search: every later
 // window [u0, end()] ends at or before e (end() only shrinks), and the
 // search returned the pair's first contact in [0, e], if any. The sliding
@@ -105,9 +106,9 @@ void search_hints(StepState* s) {
   const int num_hints = s->num_hints;
   if (!(hints && num_hints > 0)) return;
   PairTester& tester = s->tester;
-  enclose_motion(s->motion, {0, 1}, &s->e);
+  enclose_motion(s->motion, {s->settings.known_free, 1}, &s->e);
   s->ws->swept.next_interval();
-  tester.u0 = 0;
+  tester.u0 = s->settings.known_free;
   tester.u1 = 1;
   // The hint on the triangle pair that stopped the workspace's last step, if
   // any, goes first (CcdStepWorkspace::last_hit); the others keep their
@@ -215,8 +216,8 @@ bool search_sub_intervals(StepState* s) {
   for (int j = 0; j < s->n + s->lead && !answered(*s); ++j) {
     double u0 = 0, u1 = 1;
     plan_piece(j, s->lead, s->n, &u0, &u1);
-    u0 = std::max(u0, s->u_cached);
-    if (!(u0 < u1)) continue;  // inside the cached range
+    u0 = std::max({u0, s->u_cached, s->settings.known_free});
+    if (!(u0 < u1)) continue;  // inside the cached range, or known free
     if (result->hit && result->u_hit - s->settings.narrow.time_tolerance <= u0) break;  // nothing left to search
     enclose_motion(s->motion, {u0, std::min(u1, result->u_hit)}, &s->e);
     s->start.set(s->motion, u0, god.bvh->radius);
@@ -320,6 +321,7 @@ const char* ccd_step_settings_problem(const CcdStepSettings& s) {
     return "ccd.sub_interval_angle and ccd.sub_interval_travel must be > 0 and finite";
   if (!non_negative(s.near_distance)) return "ccd.near_distance must be >= 0 and finite";
   if (!non_negative(s.lead_sweep)) return "ccd.lead_sweep must be >= 0 and finite";
+  if (!(s.known_free >= 0 && s.known_free < 1)) return "ccd.known_free must be in [0, 1)";
   if (!valid_proximity_cache_settings(s.cache)) return "ccd.cache: the proximity cache's settings are not valid";
   return nullptr;
 }

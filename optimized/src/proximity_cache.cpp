@@ -251,9 +251,11 @@ void search_cached_pairs(StepState* s, const ProximityCache& pc, const Displacem
   CcdStepResult* result = s->result;
   PairTester& tester = s->tester;
   CcdStepWorkspace::Candidate* const cand = s->ws->candidates.data();
-  enclose_motion(s->motion, {0, std::min(s->u_cached, result->u_hit)}, &s->e);
+  const double u0 = s->settings.known_free;  // the caller's proof covers [0, u0]
+  if (!(u0 < std::min(s->u_cached, result->u_hit))) return;
+  enclose_motion(s->motion, {u0, std::min(s->u_cached, result->u_hit)}, &s->e);
   s->ws->swept.next_interval();
-  tester.u0 = 0;
+  tester.u0 = u0;
   tester.u1 = s->u_cached;
   Displacement moving = since;
   moving.add(s->start, s->u_cached);

@@ -229,8 +229,12 @@ bool ccd_leg(const RuntimeModel& model, const Pose& x0, const Pose& x1, int num_
 // list serves it read-only when it covers the motion) or near pairs, in its
 // own workspace (s->check_ws, s->check: the legs' state is left as it
 // was). A hit, a give-up, invalid input or a half turn answer false.
-bool motion_free(const RuntimeModel& model, const Pose& x0, const Pose& x1, int num_hints, SimState* s) {
+// known_free: [0, known_free] of the motion is already proven free (proven_prefix):
+// the search starts there.
+bool motion_free(const RuntimeModel& model, const Pose& x0, const Pose& x1, int num_hints, SimState* s,
+                 double known_free = 0) {
   CcdStepSettings settings = model.settings.ccd;
+  settings.known_free = known_free;
   settings.narrow.min_separation = 0;
   settings.near_distance = 0;
   settings.cache.margin = settings.cache.margin_max = 0;
@@ -253,23 +257,35 @@ bool motion_free(const RuntimeModel& model, const Pose& x0, const Pose& x1, int 
   return s->check.status == CcdStatus::kOk && !s->check.hit;
 }
 
-// Whether a CCD leg already run, `leg` (from b0, in one piece; its exact
-// motion keeps every pair at least min_separation apart up to ub: ccd.h),
-// proves the motion a0 -> a1 free of contact without a search of its own: no
-// body point of a0 -> a1 strays by as much as min_separation from where the leg
-// puts it at the same pace (motion_distance_bound). A graze's lift is such a
-// case: its leg starts a fraction of delta from x_start and the direct motion
-// x_start -> end shares the leg's end. Searched instead, that direct motion
-// descended the same 1,050-1,530 node pairs and tested the same sliding pairs
-// as the lift's leg (0.25-0.65 ms of the peg's heaviest steps; 20 of the 25
-// lifts of the peg's replay and all 6 of the bunnies' are now proven so:
-// docs/benchmarks.md, issue 20, fifth session). The other direct motions, a settling step's, stray farther
-// from both of their legs: in the peg's and bunnies' replays the bound never
-// served one, and it is not tried there.
-bool leg_proves(const RuntimeModel& model, const Pose& a0, const Pose& a1, const Pose& b0, const CcdStepResult& leg,
-                double ub) {
-  return leg.status == CcdStatus::kOk &&
-         motion_distance_bound(a0, a1, b0, leg.motion, ub, model.god_radius) < model.settings.ccd.narrow.min_separation;
+// How much of the motion a0 -> a1 a CCD leg already run, `leg` (from b0, in
+// one piece; its exact motion keeps every pair at least min_separation apart up
+// to ub: ccd.h), proves free of contact without a search of its own: the
+// largest ua found for which no body point of a0 -> a1 on [0, ua] strays by as
+// much as min_separation from where the leg puts it at the same pace
+// (motion_distance_bound); 1 for the whole motion, 0 for none. A graze's lift
+// is proven whole so: its leg starts a fraction of delta from x_start and the
+// direct motion x_start -> end shares the leg's end. Searched instead, that
+// direct motion descended the same 1,050-1,530 node pairs and tested the same
+// sliding pairs as the lift's leg (0.25-0.65 ms of the peg's heaviest steps;
+// 20 of the 25 lifts of the peg's replay and all 6 of the bunnies' are proven
+// whole: docs/benchmarks.md, issue 20, fifth session). A settling step's
+// direct motion x_start -> end leaves with its first leg and parts from it by
+// the settling leg's travel at the end (2-4 delta in the peg's slowest step):
+// its first part is proven, where the two motions are still within
+// min_separation of each other, and only the rest is searched (motion_free's
+// known_free). Both start at x_start, so the bound of their first parts grows
+// about in proportion to ua: ua is taken at kPrefixShare of the share that
+// proportion gives, then the bound is computed for it.
+constexpr double kPrefixShare = 0.9;
+double proven_prefix(const RuntimeModel& model, const Pose& a0, const Pose& a1, const Pose& b0,
+                     const CcdStepResult& leg, double ub) {
+  if (leg.status != CcdStatus::kOk) return 0;
+  const double d = model.settings.ccd.narrow.min_separation;
+  const double whole = motion_distance_bound(a0, a1, b0, leg.motion, ub, model.god_radius);
+  if (whole < d) return 1;
+  const double ua = kPrefixShare * d / whole;
+  if (!(ua > 0 && ua < 1)) return 0;  // also NaN, an unbounded whole
+  return motion_distance_bound(a0, a1, b0, leg.motion, ua * ub, model.god_radius, ua) < d ? ua : 0;
 }
 
 // A graze: the leg just run (s->ccd) was stopped by a pair of the last contact
@@ -312,7 +328,7 @@ void restore_leg(const Pose& xs, const CcdStepResult& leg, double deviation, Sim
 // the CCD's band; its end is kept only when the direct motion x_start -> end is
 // proven free of contact (the published motion, property 5): by the lift's leg
 // itself when the two motions stay within min_separation of each other
-// (leg_proves), by the CCD otherwise. x_lift is a
+// (proven_prefix), by the CCD otherwise. x_lift is a
 // waypoint, never published; every pose of the second leg keeps the CCD's
 // min_separation. Returns false, with s->xs, s->ccd and s->stop_deviation as the
 // grazed leg left them, when the gap rows conflict or either CCD refuses.
@@ -333,11 +349,13 @@ bool lift_out_of_graze(const RuntimeModel& model, const Pose& x_start, const Pos
   const double grazed_deviation = s->stop_deviation;
   int halves = 1;
   const Pose x_lift = pose_update(x_start, s->shading.ac);
-  if (ccd_leg(model, x_lift, target, num_hints, s, &halves, /*first_leg=*/false) &&
-      ((halves == 1 && leg_proves(model, x_start, s->xs, x_lift, s->ccd, s->ccd.hit ? s->ccd.u_hit : 1.0)) ||
-       motion_free(model, x_start, s->xs, num_hints, s))) {
-    *num_halves = std::max(*num_halves, halves);
-    return true;
+  if (ccd_leg(model, x_lift, target, num_hints, s, &halves, /*first_leg=*/false)) {
+    const double known =
+        halves == 1 ? proven_prefix(model, x_start, s->xs, x_lift, s->ccd, s->ccd.hit ? s->ccd.u_hit : 1.0) : 0;
+    if (known >= 1 || motion_free(model, x_start, s->xs, num_hints, s, known)) {
+      *num_halves = std::max(*num_halves, halves);
+      return true;
+    }
   }
   restore_leg(grazed_xs, grazed_leg, grazed_deviation, s);
   return false;
@@ -505,8 +523,12 @@ void advance_god_object(const RuntimeModel& model, const Pose& x_start, const Po
     // Each leg is free of contact, but the step publishes only its end: the
     // motion between two published poses is the direct one, x_start -> end,
     // which can cut through the crease the two legs went round (property 5,
-    // METHOD.md s.5). The end is kept only when the CCD proves that motion free.
-    if (motion_free(model, x_start, s->xs, num_hints, s)) {
+    // METHOD.md s.5). The end is kept only when the CCD proves that motion free,
+    // from where the first leg no longer proves it (proven_prefix: the first
+    // leg, one piece from x_start, free on [0, shortened_u] of its motion).
+    const double known =
+        info->num_halves == 1 && !lifted ? proven_prefix(model, x_start, s->xs, x_start, first_leg, shortened_u) : 0;
+    if (known >= 1 || motion_free(model, x_start, s->xs, num_hints, s, known)) {
       if (s->ccd.hit) info->status = SimStepStatus::kContact;
       update_contacts(model, s);
       break;

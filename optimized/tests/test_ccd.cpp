@@ -6,6 +6,7 @@
 
 #include <gmpxx.h>
 
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -562,13 +563,16 @@ TEST_CASE("stop pose: deviation from the exact motion is bounded and tiny", "[cc
 // whose ends agree up to b's pace (a ends at b's pose at ub, rounded to
 // doubles), and unrelated motions; every sampled body point within the radius
 // at every sampled u lies within the bound of its place under b. It must also
-// be useful: for a shared end and starts 1e-6 apart, far below 1e-3.
+// be useful: for a shared end and starts 1e-6 apart, far below 1e-3. The
+// first parts (a over [0, ua], b over [0, ua ub]) likewise, and for a shared
+// start the first part's bound shrinks with ua (what proven_prefix relies on).
 TEST_CASE("motion distance bound: no body point of one motion strays farther from the other", "[ccd]") {
   std::mt19937 rng(20);
   std::normal_distribution<double> n(0, 1);
   std::uniform_real_distribution<double> unit(0, 1);
   const double radius = 0.05;
-  int checked = 0, tight = 0;
+  const std::array<double, 3> k_first_parts = {0.5, 0.1, 0.9};
+  int checked = 0, checked_parts = 0, tight = 0;
   for (int i = 0; i < 60; ++i) {
     const bool related = i % 4 != 3;
     const double lift = related ? std::pow(10.0, -3.0 - 4.0 * unit(rng)) : 1.0;
@@ -597,9 +601,35 @@ TEST_CASE("motion distance bound: no body point of one motion strays farther fro
       CHECK(dot(d, d) <= Q(bound) * Q(bound));
       ++checked;
     }
+    // The first parts, a over [0, ua] and b over [0, ua ub].
+    const double ua = k_first_parts[static_cast<size_t>(i) % k_first_parts.size()];
+    const double part = motion_distance_bound(a0, a1, b0, b, ua * ub, radius, ua);
+    REQUIRE(std::isfinite(part));
+    for (int k = 0; k < 20; ++k) {
+      const mpq_class u = (k == 0 ? mpq_class(1) : Q(unit(rng))) * Q(ua);
+      const Q3 r = q3(radius * unit(rng) * Vec3(n(rng), n(rng), n(rng)).normalized());
+      const Q3 d = ea.point(u, r) - eb.point(u * Q(ub), r);  // (u is already within [0, ua])
+      CHECK(dot(d, d) <= Q(part) * Q(part));
+      ++checked_parts;
+    }
   }
   CHECK(checked >= 50 * 40);
+  CHECK(checked_parts >= 50 * 20);
   CHECK(tight > 0);
+  // A shared start: the first part's bound is about ua times the whole's.
+  for (int i = 0; i < 20; ++i) {
+    const Pose x0{{n(rng), n(rng), n(rng)}, normalized(Quat{n(rng), n(rng), n(rng), n(rng)})};
+    const Pose x1{x0.p + 0.01 * Vec3(n(rng), n(rng), n(rng)),
+                  normalized(quat_exp(0.3 * unit(rng) * Vec3(n(rng), n(rng), n(rng)).normalized()) * x0.q)};
+    const Pose x2{x1.p + 1e-5 * Vec3(n(rng), n(rng), n(rng)),
+                  normalized(quat_exp(1e-4 * Vec3(n(rng), n(rng), n(rng))) * x1.q)};
+    CcdMotion b;
+    REQUIRE(make_ccd_motion(x0, x1, &b) == MotionStatus::kOk);
+    const double whole = motion_distance_bound(x0, x2, x0, b, 1.0, radius);
+    const double quarter = motion_distance_bound(x0, x2, x0, b, 0.25, radius, 0.25);
+    CHECK(quarter < 0.26 * whole);
+    CHECK(quarter > 0.24 * whole);
+  }
   // Cannot bound: an invalid pose or a half turn for a.
   CcdMotion b;
   const Pose x{{0, 0, 0}, {1, 0, 0, 0}};

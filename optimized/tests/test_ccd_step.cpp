@@ -747,6 +747,82 @@ TEST_CASE("ccd_step: lead pieces find a first contact in whichever piece it fall
   }
 }
 
+TEST_CASE("ccd_step: a step told its first part is free searches only the rest", "[ccd_step]") {
+  // CcdStepSettings::known_free: the caller proved [0, known_free] free (the
+  // runtime: a settling step's direct motion, its first part within
+  // min_separation of the first leg, sim_loop.cpp proven_prefix). A unit box
+  // falling flat onto a slab meets it at u*: told less than u*, the step finds
+  // the same first contact as a plain one, through each way it searches (the
+  // hints, a borrowed list, the descents, lead pieces). Settings outside
+  // [0, 1) are refused.
+  const TriangleMesh god = make_box(1, 1, 1);
+  const TriangleMesh slab = make_box(4, 4, 1, Vec3(0, 0, -0.5));  // top face z = 0
+  const Bvh gb = build_bvh(god), sb = build_bvh(slab);
+  const CcdBody obstacle{&slab, &sb}, body{&god, &gb};
+  CcdStepSettings cached;
+  cached.cache.margin = 1.0;  // the list covers the whole fall
+  cached.cache.margin_max = 1.0;
+  for (int way = 0; way < 4; ++way) {
+    for (double u_star : {0.01, 0.2, 0.45, 0.8}) {
+      for (double known : {0.0, 0.5 * u_star, 0.99 * u_star}) {
+        const Pose x0{Vec3(0.1, 0.2, 0.5 + 0.5 * u_star), Quat{}}, x1{Vec3(0.1, 0.2, 0.5 + 0.5 * u_star - 0.5), Quat{}};
+        CcdStepSettings plain, told;
+        if (way == 3) plain.lead_sweep = 1;
+        told = plain;
+        told.known_free = known;
+        CcdStepWorkspace ws, ws_told, ws_list;
+        std::vector<FeaturePair> hints;
+        if (way == 1) {  // the bottom face's pairs as hints: a contact searched first
+          CcdStepResult full;
+          ccd_step(&obstacle, 1, body, x0, x1, plain, &ws, &full);
+          REQUIRE(full.hit);
+          hints.push_back(full.pair);
+        }
+        if (way == 2) {  // a list filled at x0 in another workspace, borrowed
+          CcdStepResult r_fill;
+          ccd_step(&obstacle, 1, body, x0, x0, cached, &ws_list, &r_fill);
+          REQUIRE(ws_list.cache.num_pairs > 0);
+          ws.borrowed = ws_told.borrowed = &ws_list.cache;
+        }
+        CcdStepResult r_plain, r_told;
+        ccd_step(&obstacle, 1, body, x0, x1, plain, &ws, &r_plain, hints.data(), static_cast<int>(hints.size()));
+        ccd_step(&obstacle, 1, body, x0, x1, told, &ws_told, &r_told, hints.data(), static_cast<int>(hints.size()));
+        INFO("way " << way << " u* " << u_star << " known_free " << known);
+        REQUIRE(r_plain.status == CcdStatus::kOk);
+        REQUIRE(r_told.status == CcdStatus::kOk);
+        REQUIRE(r_told.hit);
+        if (way == 2) CHECK(r_told.u_cached > 0);
+        CHECK(r_told.u_hit <= u_star + 1e-15);
+        CHECK(std::abs(r_told.u_hit - r_plain.u_hit) <= 1e-5);
+      }
+    }
+  }
+  // And what it is told is not searched again: the box falls through a thin
+  // plate on [0.195, 0.7] of its motion (a contact at 0.195 for a plain step)
+  // and onto the slab at 0.8; told [0, 0.75] is free, the step reports the slab.
+  {
+    const TriangleMesh obstacles = concatenate(slab, make_box(4, 4, 0.01, Vec3(0, 0, 1.205)));
+    const Bvh ob = build_bvh(obstacles);
+    const CcdBody both{&obstacles, &ob};
+    const Pose x0{Vec3(0.1, 0.2, 0.5 + 1.6), Quat{}}, x1{Vec3(0.1, 0.2, 0.5 + 1.6 - 2), Quat{}};
+    CcdStepSettings plain, told;
+    told.known_free = 0.75;
+    CcdStepWorkspace ws;
+    CcdStepResult r_plain, r_told;
+    ccd_step(&both, 1, body, x0, x1, plain, &ws, &r_plain);
+    ccd_step(&both, 1, body, x0, x1, told, &ws, &r_told);
+    REQUIRE(r_plain.hit);
+    REQUIRE(r_told.hit);
+    CHECK(std::abs(r_plain.u_hit - 0.195) <= 1e-5);
+    CHECK(std::abs(r_told.u_hit - 0.8) <= 1e-5);
+  }
+  for (double bad : {-0.1, 1.0, 1.5, std::numeric_limits<double>::quiet_NaN()}) {
+    CcdStepSettings s;
+    s.known_free = bad;
+    CHECK(ccd_step_settings_problem(s) != nullptr);
+  }
+}
+
 TEST_CASE("ccd_step: a box falling flat onto a slab, and one tipping onto it", "[ccd_step]") {
   const TriangleMesh god = make_box(1, 1, 1);
   const TriangleMesh slab = make_box(4, 4, 1, Vec3(0, 0, -0.5));  // top face z = 0

@@ -223,7 +223,10 @@ StopPose make_stop_pose(const CcdMotion& motion, double u, double body_radius);
 // other; the positions are affine in u too. A
 // CCD run of b at min_separation d that stopped at ub keeps a distance >= d
 // on [0, ub]: when the bound is below d, the motion a is free of contact.
+// With ua < 1, a over [0, ua] only (its Cayley motion of Gibbs vector ua g_a,
+// run at the same pace: a at u ua when b is at u ub): when the bound is below
+// d, a is free of contact on [0, ua].
 double motion_distance_bound(const Pose& a0, const Pose& a1, const Pose& b0, const CcdMotion& b, double ub,
-                             double body_radius);
+                             double body_radius, double ua = 1.0);
 
 }  // namespace gauss6

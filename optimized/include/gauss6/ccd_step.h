@@ -47,13 +47,16 @@ struct CcdStepSettings {
   bool any_hit = false;                    // a yes/no question, "is the motion free?": the step stops at the
                                            // first hit it finds (hit and status are the answer; u_hit and pair
                                            // are then a hit's, not the first contact's: no stop pose)
+  double known_free = 0;                   // in [0, 1): the caller has proven [0, known_free] of the motion
+                                           // free at narrow.min_separation (motion_distance_bound against a
+                                           // leg already searched): every search starts there (0: none)
 };
 
 // Why the settings cannot serve a step (nullptr when they can): every
 // tolerance positive and finite (time_tolerance below 1, the whole window),
 // min_separation and near_distance finite and >= 0, max_iterations and
 // max_sub_intervals >= 1, the sub-interval bounds positive and finite,
-// lead_sweep finite and >= 0, the proximity cache's settings valid. ccd_step refuses such a step (kInvalidInput)
+// lead_sweep finite and >= 0, known_free in [0, 1), the proximity cache's settings valid. ccd_step refuses such a step (kInvalidInput)
 // before any pair test; RuntimeModel refuses them when it is built.
 const char* ccd_step_settings_problem(const CcdStepSettings& settings);
 
