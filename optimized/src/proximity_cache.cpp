@@ -243,10 +243,11 @@ void refill_if_worth(StepState* s, const CacheRanges& r, Displacement* since) {
   }
 }
 
-// [0, u_cached] from the list's pairs: each pair's own certificate first (its
-// gap at the cache's pose less how far its points can move from there by
-// u_cached: a few flops); the time bound only for the pairs it does not keep
-// beyond the reach; then the candidates' tests.
+// [0, u_cached] (from known_free on: CcdStepSettings) from the list's pairs:
+// each pair's own certificate first (its gap at the cache's pose less how far
+// its points can move from there by u_cached: a few flops); the time bound
+// only for the pairs it does not keep beyond the reach; then the candidates'
+// tests.
 void search_cached_pairs(StepState* s, const ProximityCache& pc, const Displacement& since) {
   CcdStepResult* result = s->result;
   PairTester& tester = s->tester;

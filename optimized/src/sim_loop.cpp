@@ -230,9 +230,10 @@ bool ccd_leg(const RuntimeModel& model, const Pose& x0, const Pose& x1, int num_
 // own workspace (s->check_ws, s->check: the legs' state is left as it
 // was). A hit, a give-up, invalid input or a half turn answer false.
 // known_free: [0, known_free] of the motion is already proven free (proven_prefix):
-// the search starts there.
+// the search starts there, and a motion proven whole (1) needs none.
 bool motion_free(const RuntimeModel& model, const Pose& x0, const Pose& x1, int num_hints, SimState* s,
                  double known_free = 0) {
+  if (known_free >= 1) return true;
   CcdStepSettings settings = model.settings.ccd;
   settings.known_free = known_free;
   settings.narrow.min_separation = 0;
@@ -352,7 +353,7 @@ bool lift_out_of_graze(const RuntimeModel& model, const Pose& x_start, const Pos
   if (ccd_leg(model, x_lift, target, num_hints, s, &halves, /*first_leg=*/false)) {
     const double known =
         halves == 1 ? proven_prefix(model, x_start, s->xs, x_lift, s->ccd, s->ccd.hit ? s->ccd.u_hit : 1.0) : 0;
-    if (known >= 1 || motion_free(model, x_start, s->xs, num_hints, s, known)) {
+    if (motion_free(model, x_start, s->xs, num_hints, s, known)) {
       *num_halves = std::max(*num_halves, halves);
       return true;
     }
@@ -528,7 +529,7 @@ void advance_god_object(const RuntimeModel& model, const Pose& x_start, const Po
     // leg, one piece from x_start, free on [0, shortened_u] of its motion).
     const double known =
         info->num_halves == 1 && !lifted ? proven_prefix(model, x_start, s->xs, x_start, first_leg, shortened_u) : 0;
-    if (known >= 1 || motion_free(model, x_start, s->xs, num_hints, s, known)) {
+    if (motion_free(model, x_start, s->xs, num_hints, s, known)) {
       if (s->ccd.hit) info->status = SimStepStatus::kContact;
       update_contacts(model, s);
       break;
