@@ -608,7 +608,7 @@ double rigid_speed(const CcdMotion& m, double rho) {
 //     and its endpoints swing across the axis of (2) by a thousand times the
 //     gap's margin, so neither excluded any u-interval wider than about 1e-4
 //     of the window: 256 of them (the cap), the rest left to the bisection
-//     (0.2 ms a query; docs/benchmarks.md, issue 20). S decides such a window
+//     (the slowest queries of the shared sets). S decides such a window
 //     whole. (Stage 2, tried last: the cheaper tests decide most intervals.)
 //     Every condition reads "g(u) > 0 on all of U excludes U", g a cubic whose
 //     interval coefficients enclose the exact ones (S: degree 6); positive_on()
