@@ -61,8 +61,8 @@ fi
 #    build of the extension (build-<wheel tag>/, python/tests/test_packaging.py) and
 #    other checkouts' builds reuse these objects.
 #    The compiler is Debian's clang 14 (GAUSS6_CXX to change it): the real-time loops
-#    take 10-15% less CPU per step than with g++ 12 at the same -O3, with the same
-#    results bit for bit (docs/benchmarks.md, issue 20). A build configured with another
+#    take less CPU per step than with g++ 12 at the same -O3, with the same results
+#    bit for bit (the replay benchmarks of docs/benchmarks.md measure it). A build configured with another
 #    compiler is configured again (its cache only: the artefacts under build/ stay).
 . tools/ccache.env
 cxx=$(command -v "${GAUSS6_CXX:-clang++}") || { echo "gauss6 setup: ${GAUSS6_CXX:-clang++} not found" >&2; exit 1; }
