@@ -14,20 +14,17 @@ from .variants import Delay, Friction, Skin
 
 
 class NegativeDamping(Wrapped):
-    """Energy injected slowly: a negative damper beta (N s/m) along the contact's wrench, F += beta
-    (v . n) n while in contact -- it eases the push as the hand goes in and adds to it as it comes out."""
+    """Energy injected slowly: a negative damper beta (N s/m) on the handle's velocity while in contact,
+    F += beta v -- it pushes the hand along wherever it goes."""
 
     def __init__(self, beta: float):
         super().__init__()
         self.beta, self.name = beta, f"negative damping {beta:g} N s/m"
 
     def modify(self, t, xh_p, xh_q, s):
-        n = force_direction(s)
-        if n is None:
+        if force_direction(s) is None:
             return s
-        f = np.linalg.norm(s.wrench[:3])
-        grow = self.beta * float(self.velocity(xh_p) @ n)
-        return with_wrench(s, np.asarray(s.wrench) * max(0.0, 1 + grow / f))
+        return with_wrench(s, np.asarray(s.wrench) + np.concatenate([self.beta * self.velocity(xh_p), np.zeros(3)]))
 
 
 class SlowSteps(Wrapped):
