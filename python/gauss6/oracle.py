@@ -113,6 +113,7 @@ class OracleResult:
     series: dict             # per tick arrays for the plots: t, separation, cone_distance, energy, ...
     phases: list             # (name, start)
     declarations: dict = field(default_factory=dict)   # what the engine declared (and was judged by)
+    calibration: dict = field(default_factory=dict)    # the deadlines' machine allowance (calibrate())
 
     @property
     def passed(self) -> bool:
@@ -1051,7 +1052,7 @@ class Oracle:
                 v = c.run(r, self.thresholds[c.section])
                 v.title = c.title
                 verdicts.append(v)
-        return OracleResult(verdicts, self._series(r, wanted), r.phases, r.declared)
+        return OracleResult(verdicts, self._series(r, wanted), r.phases, r.declared, calibration or {})
 
     def _series(self, r: RunData, wanted) -> dict:
         """Per tick arrays for the plots (from the shared quantities the checks computed)."""

@@ -110,6 +110,25 @@ def write_witnesses(result, trace, scene_path, out_dir, thresholds: dict, calibr
     return written
 
 
+def report_witnesses(result, trace, oracle, out_dir, viewer_page: str = "run.html") -> str:
+    """For `gauss6 validate`: writes the witnesses of a judged run (write_witnesses, with the oracle's
+    scene, thresholds and the result's calibration) and returns the report's markdown section that
+    links each to its file and to the viewer page at its tick ('' when every check passed)."""
+    written = write_witnesses(result, trace, oracle.scene_path, out_dir, oracle.thresholds, result.calibration,
+                              oracle, viewer_page)
+    if not written:
+        return ""
+    rows = ["## Witnesses", "",
+            f"Re-check one exactly: `gauss6 certify --witness FILE`. The viewer: `gauss6 view {trace.path} --out "
+            f"{Path(out_dir) / viewer_page}`, then open the links.", "",
+            "| check | violation | tick | t (s) | witness | viewer |", "| --- | --- | --- | --- | --- | --- |"]
+    for w in written:
+        rel = Path(w["path"]).relative_to(Path(out_dir))
+        rows.append(f"| {w['check']} | {w['role']} | {w['tick']} | {w['t']:.4f} | [{rel}]({rel}) | "
+                    f"[at {w['t']:.4f} s]({w['viewer']}) |")
+    return "\n".join(rows) + "\n"
+
+
 def _trace_of(doc: dict):
     """The witness's rows as a trace (ticks [a, b] renumbered from 0)."""
     from . import trace as trace_mod

@@ -46,13 +46,21 @@ VARIANTS = [
     ("skin_declared", lambda d: V.Skin(20 * d, declared=20 * d)),
 ]
 
+# What an honest variant may fail for a true reason (machine-dependent, so allowed, not required):
+# in lockstep, gauss6's sim step every 8 ticks runs inside the tick it falls on, and on the bunny's
+# contact that sim step (8 ticks of motion) costs 1.0-1.55 ms of CPU: a missed haptic deadline of
+# the lockstep engine (the threaded runtime runs the sim step on its own thread).
+TRUE_FINDINGS = {("gauss6 sim_period=8", BUNNY): ["cost"]}
+
 
 @pytest.mark.parametrize("scene", [PEG, BUNNY], ids=["peg", "bunny"])
 @pytest.mark.parametrize("make", [v[1] for v in VARIANTS], ids=[v[0] for v in VARIANTS])
 def test_honest_variant_passes(tmp_path, oracles, scene, make):
     engine = make(_delta(scene))
     result = oracles[scene].judge(run(engine, scene, tmp_path / "run.g6trace", SLICE[scene]))
-    assert result.failed() == [], [v.to_json() for v in result.verdicts if not v.passed]
+    findings = TRUE_FINDINGS.get((getattr(engine, "name", ""), scene), [])
+    assert [c for c in result.failed() if c not in findings] == [], \
+        [v.to_json() for v in result.verdicts if not v.passed]
     assert result.declarations == dict(getattr(engine, "declarations", {}) or {})
     assert result.verdict("force_direction").details["ticks"] > 50  # the slice reaches contact
 
@@ -91,3 +99,13 @@ def test_planted_fault_is_named_by_its_check(tmp_path, oracles, make, scene, dur
     v = result.verdict(check)
     assert not v.passed, v.to_json()
     assert v.violations and v.first_time is not None  # a witness can be written
+
+
+def test_the_contract_tables_list_every_variant_and_fault():
+    """docs/engine-contract.md's tables name each variant and fault of this file, with its check."""
+    doc = (paths.REPO_ROOT / "docs" / "engine-contract.md").read_text()
+    section = doc[doc.index("## Honest variants and planted faults"):]
+    for name, *_ in VARIANTS:
+        assert f"| `{name}` |" in section, name
+    for name, _, _, _, check in FAULTS:
+        assert f"| `{name}` |" in section and f"`{check}`" in section, name
