@@ -386,7 +386,7 @@ class RunData:
             out["rows"][k] = len(J)
             if len(J) == 0:
                 no_contacts += 1
-                out["cone"][k] = out["tangential"][k] = 1.0
+                out["cone"][k] = out["tangential"][k] = out["friction"][k] = 1.0
                 out["wrong"][k] = out["normal"][k] = 0.0
                 out["tangential_wrench"][k] = self.W[k]
                 continue
@@ -647,7 +647,7 @@ def check_energy(r: RunData, th: dict) -> Verdict:
     run_bad = run_min < -floor
     E = O["E"]
     e_min = int(np.argmin(E)) if r.n else 0
-    worst = min(eps, key=lambda ep: ep["min"] - 1e-300 * ep["out"], default=None)
+    worst = min(eps, key=lambda ep: ep["min"], default=None)
     if worst is not None and worst["min"] >= 0:  # no deficit: the largest energy return instead
         worst = max(eps, key=lambda ep: ep["out"])
     details = {"observer_min": run_min, "observer_min_time": float(t[m]) if r.n else None,
