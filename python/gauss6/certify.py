@@ -149,7 +149,7 @@ def certify_range(scene: ExactScene, ticks, start: int, stop: int) -> CertifyRes
                 exact_pairs = 0
                 try:
                     for i in near:
-                        c = scene.pairs[i].exact_first_contact(P[j - 1], Q[j - 1], P[j], Q[j])
+                        c = scene.first_contact(i, P[j - 1], Q[j - 1], P[j], Q[j])
                         res.pairs["candidate"] += c.num_candidate_pairs
                         res.pairs["filtered"] += c.num_filtered_pairs
                         res.pairs["exact"] += c.num_exact_pairs
@@ -267,7 +267,27 @@ def write_report(res: CertifyResult, scene_path, trace_path, out: Path, name: st
     return doc
 
 
+def cmd_witness(args: argparse.Namespace) -> int:
+    """`gauss6 certify --witness FILE [--scene SCENE]`: re-check a validate witness exactly (witness.recheck);
+    exit 0 when the violation stands, 1 when it does not, 2 on a bad file."""
+    from .witness import recheck
+
+    try:
+        doc = json.loads(Path(args.witness).read_text())
+        stands, text = recheck(doc, args.scene)
+    except (OSError, ValueError, KeyError, TypeError, RuntimeError) as e:
+        print(f"gauss6 certify: {args.witness}: {e}", file=sys.stderr)
+        return 2
+    print(text)
+    return 0 if stands else 1
+
+
 def cmd_certify(args: argparse.Namespace) -> int:
+    if args.witness:
+        return cmd_witness(args)
+    if not args.trace or not args.scene:
+        print("gauss6 certify: give a TRACE and --scene SCENE (or --witness FILE)", file=sys.stderr)
+        return 2
     trace, scene = Path(args.trace), Path(args.scene)
     for p, what in ((trace, "trace"), (scene, "scene")):
         if not p.is_file():
@@ -303,8 +323,10 @@ def register(subparsers) -> None:
     p = subparsers.add_parser("certify", help="exactly certify a recorded run: every pose free, every motion "
                                               "between poses free of contact, separations within the bound "
                                               "(exit 1 on a violation)")
-    p.add_argument("trace", help="a .g6trace")
-    p.add_argument("--scene", required=True, help="the run's scene TOML file")
+    p.add_argument("trace", nargs="?", help="a .g6trace")
+    p.add_argument("--scene", help="the run's scene TOML file (a witness names its own)")
+    p.add_argument("--witness", help="re-check a witness file of `gauss6 validate` exactly instead (exit 0: the "
+                                     "violation stands)")
     p.add_argument("--out", help="directory for certify.json and certify.md (default: the trace's)")
     p.add_argument("--ticks", help="only the ticks A:B (a chunk, as a campaign runs it)")
     p.add_argument("--json", action="store_true", help="print certify.json instead of the table")

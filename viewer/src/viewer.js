@@ -620,6 +620,9 @@ function main() {
   const raw = JSON.parse(document.getElementById('gauss6-data').textContent);
   const data = decodeArrays(raw);
   const view = new View(data);
+  // A page opened at a time: PAGE#t=SECONDS (the links to validate's witnesses).
+  const at = /(?:^#|&)t=([-+0-9.eE]+)/.exec(window.location.hash);
+  if (at && Number.isFinite(Number(at[1]))) view.seek(Number(at[1]));
   window.gauss6View = {
     get ready() { return view.ready; },
     get framesRendered() { return view.framesRendered; },
