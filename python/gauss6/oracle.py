@@ -591,7 +591,9 @@ class Oracle:
 
         # 8. Cost.
         tc = th["cost"]
-        st = np.asarray(ticks["force_time"], float)
+        # A driven run's steps stream holds the driver's own timing of each call (gauss6.driver).
+        driven = "isolation" in trace.meta.get("extra", {}) and len(trace.steps) == n
+        st = np.asarray(trace.steps["update_time"] if driven else ticks["force_time"], float)
         period = 1 / self.rate_hz
         med = float(np.median(st)) if n else 0.0
         p99 = float(np.percentile(st, 99)) if n else 0.0
