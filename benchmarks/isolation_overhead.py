@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import os
 import sys
 import tempfile
 from pathlib import Path
@@ -61,8 +62,10 @@ def main() -> int:
             t, e = r["transport_us"], r["engine_call_us"]
             print(f"| {mode} | {r['ticks']} | {t['median']:.1f} | {t['p99']:.1f} | {t['max']:.0f} | "
                   f"{e['median']:.1f} | {e['p99']:.1f} | {r['run_us_per_tick']:.1f} |")
+    load = os.getloadavg()
+    print(f"\n{os.cpu_count()} cpus, load average {load[0]:.1f} {load[1]:.1f} {load[2]:.1f} (the figures grow with it)")
     if args.json:
-        Path(args.json).write_text(json.dumps(results, indent=2) + "\n")
+        Path(args.json).write_text(json.dumps({"load_average": load, **results}, indent=2) + "\n")
     return 0
 
 

@@ -14,11 +14,13 @@ call alone (inside the child for ProcessHost, so that the transport is not charg
 and both refuse an output that cannot be judged (gauss6.engine.StepCheck).
 
 Transport of a step: shared memory (a memfd both processes map). The validator writes the request
-(t, the handle's pose) and bumps its sequence number; the child, spinning on that number for up to
-SPIN_SECONDS before it blocks on an eventfd, steps the engine, writes the answer and bumps its own
+(t, the handle's pose) and bumps its sequence number; the child, spinning on that number for a
+while (_Spin) before it blocks on an eventfd, steps the engine, writes the answer and bumps its own
 number; the validator spins on it likewise. Each side also writes the other's eventfd, so that a
-side that gave up spinning wakes (a stale wake-up costs one more look). Spinning relies on x86's
-ordered stores; elsewhere both sides block on the eventfd at once (a system call orders memory).
+side that gave up spinning wakes (a stale wake-up costs one more look). A side spins about twice
+as long as its recent waits, and not at all once they exceed SPIN_SECONDS: a slow peer or a loaded
+machine (where spinning takes the CPU the peer needs) makes both sides block at once. Spinning
+relies on x86's ordered stores; elsewhere both sides always block (a system call orders memory).
 Set-up and tear-down (start, reset, close) go by pickled messages on a socket pair, whose end of
 file tells the validator that the child died: waitpid then names the signal or the exit status.
 The validator's watchdogs: a step that does not answer within step_timeout, or a run (its set-up
@@ -47,7 +49,8 @@ from .engine import CONTACT_CAPACITY, FAILURE_KINDS, EngineFailure, EngineScene,
 
 STEP_TIMEOUT = 2.0     # s: default per-step watchdog (a step's answer)
 RUN_TIMEOUT = 3600.0   # s: default per-run watchdog, from the child's start to the last step
-SPIN_SECONDS = 200e-6 if platform.machine() in ("x86_64", "AMD64") else 0.0  # spin before blocking
+SPIN_SECONDS = 200e-6 if platform.machine() in ("x86_64", "AMD64") else 0.0  # the longest spin before blocking
+SPIN_AVERAGE = 16      # waits in the spin's exponential average
 CLOSE_SECONDS = 2.0    # s: what a child gets to destroy its engine and exit before it is killed
 
 # Shared memory: int64 words, then float64 slots, then the failure's text.
@@ -69,6 +72,27 @@ class Stepped:
     step: EngineStep
     wall: float
     cpu: float
+
+
+class _Spin:
+    """How long one side spins on the other's sequence number before it blocks: twice its recent
+    waits (an exponential average over SPIN_AVERAGE), or not at all while those exceed SPIN_SECONDS."""
+
+    def __init__(self):
+        self.average = 0.0
+
+    def until(self, words, index: int, value: int, since: float) -> bool:
+        """Whether words[index] became value within the spin (since: when the wait began)."""
+        budget = 0.0 if self.average > SPIN_SECONDS else min(2 * self.average, SPIN_SECONDS)
+        end = since + budget
+        while words[index] != value:
+            if time.perf_counter() >= end:
+                return False
+        self.record(since)
+        return True
+
+    def record(self, since: float) -> None:
+        self.average += (time.perf_counter() - since - self.average) / SPIN_AVERAGE
 
 
 def _describe(e: BaseException) -> str:
@@ -191,6 +215,7 @@ class ProcessHost(Host):
         os.close(mem_fd)
         self._conn = Connection(ours.detach())
         self._seq = 0
+        self._spin = _Spin()
         info = self._message(("start", self.spec, self.config), "in create (loading the engine)")
         self.name, self.library, self.declarations = info["name"], info["library"], info["declarations"]
 
@@ -235,8 +260,9 @@ class ProcessHost(Host):
         start = time.perf_counter()
         words[_REQ_SEQ] = self._seq
         os.write(self._req_fd, _ONE)
-        if words[_RESP_SEQ] != self._seq:
+        if not self._spin.until(words, _RESP_SEQ, self._seq, start):
             self._await(self._seq, t)
+            self._spin.record(start)
         total = time.perf_counter() - start
         tick = self._tick
         self._tick += 1
@@ -253,10 +279,6 @@ class ProcessHost(Host):
 
     def _await(self, seq: int, t: float) -> None:
         words = self._words
-        spin_end = time.perf_counter() + SPIN_SECONDS
-        while time.perf_counter() < spin_end:
-            if words[_RESP_SEQ] == seq:
-                return
         deadline, watchdog = self._deadline()
         stage = f"in the step at tick {self._tick} (t = {t!r})"
         while words[_RESP_SEQ] != seq:
@@ -330,15 +352,14 @@ def _serve(conn_fd: int, mem_fd: int, req_fd: int, resp_fd: int) -> int:
     f = np.frombuffer(mem, np.float64, _FLOATS, 8 * _F0)
     engine, check = None, None
     seq = 0
+    spin, answered = _Spin(), time.perf_counter()
 
     def answer(ok_value=None, failure: EngineFailure | None = None):
         conn.send(("fail", failure.kind, failure.detail) if failure else ("ok", ok_value))
 
     while True:
         # The next step request, or a message.
-        spin_end = time.perf_counter() + SPIN_SECONDS
-        while words[_REQ_SEQ] == seq and time.perf_counter() < spin_end:
-            pass
+        spun = spin.until(words, _REQ_SEQ, seq + 1, answered)
         while words[_REQ_SEQ] == seq:
             ready = select.select([req_fd, conn.fileno()], [], [])[0]
             if req_fd in ready:
@@ -369,7 +390,10 @@ def _serve(conn_fd: int, mem_fd: int, req_fd: int, resp_fd: int) -> int:
                     return 0
             except EngineFailure as e:
                 answer(failure=e)
+            answered = time.perf_counter()
             continue
+        if not spun:
+            spin.record(answered)
         seq = words[_REQ_SEQ]
         try:
             s = _step(engine, check, float(f[_T]), f[_XH:_XH + 3].copy(), f[_XH + 3:_XH + 7].copy())
@@ -388,6 +412,7 @@ def _serve(conn_fd: int, mem_fd: int, req_fd: int, resp_fd: int) -> int:
             words[_DETAIL_LEN], words[_KIND], words[_STATUS] = len(text), FAILURE_KINDS.index(e.kind), 1
         words[_RESP_SEQ] = seq
         os.write(resp_fd, _ONE)
+        answered = time.perf_counter()
 
 
 if __name__ == "__main__":
