@@ -216,7 +216,7 @@ def test_the_documented_exit_codes_and_limits_are_the_commands():
     rows = re.findall(r"^\| (\d) \| ([^|]+) \|", section, re.M)
     assert {int(code): text.strip() for code, text in rows} == EXIT_CODES
     for said in (f"`--step-timeout S` (default {STEP_TIMEOUT:g} s", f"`--run-timeout S` (default {RUN_TIMEOUT:g} s",
-                 f"for up to {SPIN_SECONDS * 1e6:g}\nus", f"farther than {POSE_RANGE:g} scene radii",
+                 f"for up to {SPIN_SECONDS * 1e6:g} us", f"farther than {POSE_RANGE:g} scene radii",
                  f"more than {CONTACT_CAPACITY}", f"with {CANARY} bytes of a known pattern", "k <= "
                  f"{CONTACT_CAPACITY}"):
         assert said in doc, said
