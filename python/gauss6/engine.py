@@ -171,30 +171,32 @@ class StepCheck:
                   for b in [*scene.obstacles, scene.tool] if len(b.V)]
         allp = np.concatenate(points) if points else np.zeros((1, 3))
         lo, hi = allp.min(axis=0), allp.max(axis=0)
-        self.centre = (lo + hi) / 2
+        self.centre = ((lo + hi) / 2).tolist()
         self.limit = POSE_RANGE * max(float(np.linalg.norm(hi - lo)) / 2, scene.delta, 1e-300)
 
     def __call__(self, step: EngineStep, t: float) -> None:
-        where = f"step at t = {t!r}"
+        # Plain floats, not numpy reductions: this runs every tick.
         p, q = np.asarray(step.xs_p, float), np.asarray(step.xs_q, float)
         if p.shape != (3,) or q.shape != (4,) or np.shape(step.wrench) != (6,):
-            raise EngineFailure("abi", f"{where}: pose or wrench of the wrong shape ({p.shape}, {q.shape}, "
-                                       f"{np.shape(step.wrench)}; expected (3,), (4,), (6,))")
-        if not (np.all(np.isfinite(p)) and np.all(np.isfinite(q))):
-            raise EngineFailure("abi", f"{where}: displayed pose not finite (p = {p.tolist()}, q = {q.tolist()})")
-        if np.linalg.norm(p - self.centre) > self.limit:
-            raise EngineFailure("abi", f"{where}: displayed position {p.tolist()} is beyond {POSE_RANGE:g} scene "
+            raise EngineFailure("abi", f"step at t = {t!r}: pose or wrench of the wrong shape ({p.shape}, "
+                                       f"{q.shape}, {np.shape(step.wrench)}; expected (3,), (4,), (6,))")
+        pl, ql = p.tolist(), q.tolist()
+        if not all(map(math.isfinite, pl + ql)):
+            raise EngineFailure("abi", f"step at t = {t!r}: displayed pose not finite (p = {pl}, q = {ql})")
+        c = self.centre
+        if math.hypot(pl[0] - c[0], pl[1] - c[1], pl[2] - c[2]) > self.limit:
+            raise EngineFailure("abi", f"step at t = {t!r}: displayed position {pl} is beyond {POSE_RANGE:g} scene "
                                        f"radii of the scene ({self.limit:g} length units from its centre)")
-        if not np.any(q):
-            raise EngineFailure("abi", f"{where}: displayed quaternion is zero")
+        if not any(ql):
+            raise EngineFailure("abi", f"step at t = {t!r}: displayed quaternion is zero")
         s = step.step_seconds
         if s is not None and not (isinstance(s, (int, float, np.floating)) and s >= 0):
-            raise EngineFailure("abi", f"{where}: reported step time {s!r} s (NaN or negative; "
+            raise EngineFailure("abi", f"step at t = {t!r}: reported step time {s!r} s (NaN or negative; "
                                        f"not reporting one is allowed)")
         if step.contacts is not None:
-            c = np.asarray(step.contacts)
-            if c.ndim != 2 or c.shape[1] != 7 or len(c) > CONTACT_CAPACITY:
-                raise EngineFailure("abi", f"{where}: contacts of shape {c.shape} (expected (k, 7), "
+            shape = np.shape(step.contacts)
+            if len(shape) != 2 or shape[1] != 7 or shape[0] > CONTACT_CAPACITY:
+                raise EngineFailure("abi", f"step at t = {t!r}: contacts of shape {shape} (expected (k, 7), "
                                            f"k <= {CONTACT_CAPACITY})")
 
 
@@ -391,6 +393,10 @@ class CEngine:
         self._contacts = _Guarded(_Contact * CONTACT_CAPACITY)
         self._out = _Guarded(_StepOut)
         self._pose = _Pose()
+        # numpy views of the handle's pose and of the output's pose and wrench (13 doubles from X_WS on)
+        self._pose_view = np.frombuffer(self._pose, np.float64)
+        self._answer_view = np.frombuffer(self._out.obj, np.float64, 13, _StepOut.X_WS.offset)
+        self._contacts_address = ctypes.cast(ctypes.addressof(self._contacts.obj), ctypes.POINTER(_Contact))
 
     def declarations(self) -> dict:
         """What the engine declares through its version 2 `declare` ({} without one)."""
@@ -432,11 +438,10 @@ class CEngine:
     def step_timed(self, t: float, xh_p, xh_q) -> tuple[EngineStep, float, float]:
         """One step, with the wall and CPU seconds of the call into the library alone."""
         pose, out = self._pose, self._out.obj
-        pose.p[0], pose.p[1], pose.p[2] = float(xh_p[0]), float(xh_p[1]), float(xh_p[2])
-        pose.q[0], pose.q[1], pose.q[2], pose.q[3] = (float(v) for v in xh_q)
+        self._pose_view[:3], self._pose_view[3:] = xh_p, xh_q
         out.struct_size = ctypes.sizeof(_StepOut)
         out.contact_capacity = CONTACT_CAPACITY
-        out.contacts = ctypes.cast(ctypes.addressof(self._contacts.obj), ctypes.POINTER(_Contact))
+        out.contacts = self._contacts_address
         out.num_contacts = -1
         out.step_seconds = STEP_SECONDS_UNSET
         cpu, wall = time.process_time(), time.perf_counter()
@@ -457,7 +462,8 @@ class CEngine:
             n = out.num_contacts
             contacts = np.frombuffer(self._contacts.obj, dtype=np.float64, count=7 * n).reshape(n, 7).copy()
         seconds = out.step_seconds
-        step = EngineStep(np.array(out.X_WS.p[:]), np.array(out.X_WS.q[:]), np.array(out.wrench[:]), contacts,
+        answer = self._answer_view.copy()
+        step = EngineStep(answer[0:3], answer[3:7], answer[7:13], contacts,
                           None if seconds == STEP_SECONDS_UNSET else seconds)
         return step, wall, cpu
 

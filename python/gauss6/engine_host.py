@@ -253,9 +253,7 @@ class ProcessHost(Host):
 
     def step(self, t: float, xh_p, xh_q) -> Stepped:
         f, words = self._f, self._words
-        f[_T] = t
-        f[_XH:_XH + 3] = xh_p
-        f[_XH + 3:_XH + 7] = xh_q
+        f[_T:_XH + 7] = [t, *xh_p, *xh_q]
         self._seq += 1
         start = time.perf_counter()
         words[_REQ_SEQ] = self._seq
@@ -270,12 +268,12 @@ class ProcessHost(Host):
             detail = bytes(self._mem[_TEXT:_TEXT + words[_DETAIL_LEN]]).decode(errors="replace")
             raise EngineFailure(FAILURE_KINDS[words[_KIND]], f"tick {tick}: {detail}")
         m = words[_NUM_CONTACTS]
-        own = f[_OWN]
-        step = EngineStep(f[_XS:_XS + 3].copy(), f[_XS + 3:_XS + 7].copy(), f[_W:_W + 6].copy(),
+        a = f[_XS:_C].copy()
+        own, wall, cpu = a[_OWN - _XS:_C - _XS].tolist()
+        step = EngineStep(a[0:3], a[3:7], a[_W - _XS:_W - _XS + 6],
                           None if m < 0 else f[_C:_C + 7 * m].reshape(m, 7).copy(), None if math.isnan(own) else own)
-        wall = float(f[_WALL])
         self._overhead.append(total - wall)
-        return Stepped(step, wall, float(f[_CPU]))
+        return Stepped(step, wall, cpu)
 
     def _await(self, seq: int, t: float) -> None:
         words = self._words
@@ -396,11 +394,11 @@ def _serve(conn_fd: int, mem_fd: int, req_fd: int, resp_fd: int) -> int:
             spin.record(answered)
         seq = words[_REQ_SEQ]
         try:
-            s = _step(engine, check, float(f[_T]), f[_XH:_XH + 3].copy(), f[_XH + 3:_XH + 7].copy())
+            request = f[_T:_XH + 7].copy()
+            s = _step(engine, check, float(request[0]), request[_XH:_XH + 3], request[_XH + 3:_XH + 7])
             step = s.step
             f[_XS:_XS + 3], f[_XS + 3:_XS + 7], f[_W:_W + 6] = step.xs_p, step.xs_q, step.wrench
-            f[_OWN] = math.nan if step.step_seconds is None else step.step_seconds
-            f[_WALL], f[_CPU] = s.wall, s.cpu
+            f[_OWN:_C] = (math.nan if step.step_seconds is None else step.step_seconds, s.wall, s.cpu)
             m = -1 if step.contacts is None else len(step.contacts)
             if m > 0:
                 f[_C:_C + 7 * m] = np.asarray(step.contacts, float).ravel()
