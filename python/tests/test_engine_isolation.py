@@ -10,7 +10,7 @@
   Python paths record the same; a version 1 engine still loads;
 - the driver times every step itself (wall and CPU in the steps stream) and records the
   isolation's per-tick cost;
-- unknown config keys are refused by the shipped engines; usage errors exit 3; the exit codes
+- unknown config keys are refused by the shipped engines and adapters; usage errors exit 3; the exit codes
   documented are the command's.
 
 Runs are 0.1 s of the peg script (the tool in free space), the misbehaviour at tick 50.
@@ -220,3 +220,11 @@ def test_the_documented_exit_codes_and_limits_are_the_commands():
                  f"more than {CONTACT_CAPACITY}", f"with {CANARY} bytes of a known pattern", "k <= "
                  f"{CONTACT_CAPACITY}"):
         assert said in doc, said
+
+
+@pytest.mark.parametrize("factory", ["mujoco", "pybullet", "drake"])
+def test_shipped_adapters_refuse_unknown_config_keys(factory):
+    import gauss6.adapters as adapters
+
+    with pytest.raises(ValueError, match=r"config 'bogus=1': expected key=value with key one of"):
+        getattr(adapters, factory)("bogus=1")
