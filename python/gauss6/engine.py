@@ -451,7 +451,8 @@ class CEngine:
                              (self._contacts, f"its contact buffer ({CONTACT_CAPACITY} contacts)")):
             side = buffer.overrun()
             if side:
-                raise EngineFailure("abi", f"{self.name}: step at t = {t!r} wrote {'past the end of' if side == 'after' else 'before the start of'} {what}")
+                where = "past the end of" if side == "after" else "before the start of"
+                raise EngineFailure("abi", f"{self.name}: step at t = {t!r} wrote {where} {what}")
         if status != 0:
             raise EngineFailure("exception", f"{self.name}: step at t = {t!r} returned an error: {self._last_error()}")
         if not -1 <= out.num_contacts <= CONTACT_CAPACITY:

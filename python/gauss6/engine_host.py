@@ -44,8 +44,8 @@ from multiprocessing.connection import Connection
 
 import numpy as np
 
-from .engine import CONTACT_CAPACITY, FAILURE_KINDS, EngineFailure, EngineScene, EngineStep, StepCheck, engine_declarations, \
-    make_engine
+from .engine import (CONTACT_CAPACITY, FAILURE_KINDS, EngineFailure, EngineScene, EngineStep, StepCheck,
+                     engine_declarations, make_engine)
 
 STEP_TIMEOUT = 2.0     # s: default per-step watchdog (a step's answer)
 RUN_TIMEOUT = 3600.0   # s: default per-run watchdog, from the child's start to the last step

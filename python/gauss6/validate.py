@@ -131,9 +131,17 @@ def verdict_table(verdicts) -> str:
 
 def failure_verdict(failure: dict, rate_hz: float) -> oracle_mod.Verdict:
     """The check engine_failure of a run the engine ended (the trace's extra["engine_failure"])."""
-    return oracle_mod.Verdict("engine_failure", "0. engine failure", False, 1, None, "", (failure["tick"] + 1) / rate_hz,
-                              f"{failure['kind']}: {failure['detail']}",
+    return oracle_mod.Verdict("engine_failure", "0. engine failure", False, 1, None, "",
+                              (failure["tick"] + 1) / rate_hz, f"{failure['kind']}: {failure['detail']}",
                               {"kind": failure["kind"], "last_good_tick": failure["tick"]})
+
+
+def engine_lines(engine: dict) -> list[str]:
+    """The report's lines on how the engine ran: its isolation and what it declared."""
+    iso = engine["isolation"]
+    cost = ", ".join(f"{k} {_fmt(v)}" for k, v in iso["round_trip_us"].items())
+    return [f"- isolation: {iso['mode']} (transport per tick, us: {cost})",
+            f"- declared: {json.dumps(engine['declarations']) if engine['declarations'] else 'nothing'}"]
 
 
 def write_outputs(result, out: Path, info: dict) -> dict:
@@ -156,10 +164,7 @@ def write_outputs(result, out: Path, info: dict) -> dict:
              f"- scene: `{info['scene']}`" + (f", script `{info['script']}`" if info.get("script") else ""),
              f"- engine: {info.get('engine_name') or 'recorded offline'}"
              + (f" (`{info['engine']['library']}`, config `{info['engine']['config']}`)" if info.get("engine") else ""),
-             *([f"- isolation: {info['engine']['isolation']['mode']} (transport per tick, us: "
-                + ", ".join(f"{k} {_fmt(v)}" for k, v in info['engine']['isolation']['round_trip_us'].items()) + ")",
-                f"- declared: {json.dumps(info['engine']['declarations']) if info['engine']['declarations'] else 'nothing'}"]
-              if info.get("engine") else []),
+             *(engine_lines(info["engine"]) if info.get("engine") else []),
              *([f"- **the engine failed** ({failure['kind']}) after tick {failure['tick']}: {failure['detail']}"]
                if failure else []),
              f"- thresholds: `{info['thresholds']}` (version {info['thresholds_version']})",

@@ -10,7 +10,9 @@
 #include <stdio.h>
 #include <string.h>
 
-static inline int gauss6_config_separator(char c) { return c == ';' || c == ' ' || c == '\t' || c == '\n' || c == '\r'; }
+static inline int gauss6_config_separator(char c) {
+  return c == ';' || c == ' ' || c == '\t' || c == '\n' || c == '\r';
+}
 
 /* The next item of config from *p: its key [*key, *key + *key_len) and value
  * [*value, *value + *value_len); 0 when there is none left. */
