@@ -223,7 +223,9 @@ def validate(args) -> int:
             text, script_path = script_text(args.script, args.scene)
             trace.meta["phases"] = [{"name": n, "start": s} for n, s in script_phases(text)]
             info["script"] = script_path
-        info.update(run=str(run_path), engine_name=trace.meta.get("extra", {}).get("engine"))
+        # A driven run that ended in the engine's failure stays one when judged again.
+        failure = trace.meta.get("extra", {}).get("engine_failure")
+        info.update(run=str(run_path), engine_name=trace.meta.get("extra", {}).get("engine"), engine_failure=failure)
     ticks = trace.ticks
     info.update(ticks=len(ticks), duration=float(ticks["t"][-1] - ticks["t"][0]) if len(ticks) else 0.0)
     if failure is None:

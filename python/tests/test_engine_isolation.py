@@ -87,6 +87,15 @@ SETUP_PROBES = [
 ]
 
 
+def test_a_failed_run_judged_offline_is_still_a_failure(tmp_path):
+    """The partial trace of a failed run, judged again as a recorded RUN, exits 2 (not 0: what ran passes)."""
+    assert_engine_failure(tmp_path, probe_library(), f"probe=exit_step;at={AT}", "exit", "status 0", AT - 1)
+    off = tmp_path / "offline"
+    code = main(["validate", str(tmp_path / "out" / "run.g6trace"), "--scene", str(PEG), "--out", str(off), "--quiet"])
+    doc = json.loads((off / "validation.json").read_text())
+    assert code == EXIT_ENGINE_FAILED and doc["failed"] == ["engine_failure"], doc["failed"]
+
+
 @pytest.mark.parametrize("probe,kind,pattern,last", STEP_PROBES, ids=[p[0] for p in STEP_PROBES])
 def test_a_misbehaving_c_step_is_a_named_engine_failure(tmp_path, probe, kind, pattern, last):
     assert_engine_failure(tmp_path, probe_library(), f"probe={probe};at={AT}", kind, pattern, last)
