@@ -339,10 +339,12 @@ class ProcessHost(Host):
 
 def _serve(conn_fd: int, mem_fd: int, req_fd: int, resp_fd: int) -> int:
     import ctypes
+    import faulthandler
     import resource
 
     ctypes.CDLL(None).prctl(1, signal.SIGKILL)  # PR_SET_PDEATHSIG: die with the validator
     resource.setrlimit(resource.RLIMIT_CORE, (0, 0))  # a crashing engine leaves no core file
+    faulthandler.enable()  # a fatal signal prints the Python frames on stderr, then kills as before
     conn = Connection(conn_fd)
     mem = mmap.mmap(mem_fd, _SIZE)
     os.close(mem_fd)
