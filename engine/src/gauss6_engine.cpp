@@ -12,7 +12,8 @@
 // are the sim loop's current set (point on the god-object, normal out of the
 // obstacle, separation); step_seconds is the wall time of the call.
 //
-// Config text: "sim_period=N" (haptic ticks per sim step, default 1).
+// Config text: "sim_period=N" (haptic ticks per sim step, default 1); any other key is
+// refused (gauss6/engine_config.h).
 // Scene: the gauss6 scene file when scene_path is set (every setting of the file),
 // otherwise a scene built from the description (offset_eps -10 delta, offset_time
 // 0.05 s: the scene format's defaults).
@@ -24,6 +25,7 @@
 #include <string>
 
 #include "gauss6/engine.h"
+#include "gauss6/engine_config.h"
 #include "gauss6/runtime.h"
 #include "gauss6/scene.h"
 
@@ -123,10 +125,16 @@ Scene scene_from_description(const gauss6_scene_desc& d) {
 
 void* create(const char* config, char* error, size_t error_size) {
   auto e = std::make_unique<Engine>();
-  const char* p = config ? std::strstr(config, "sim_period=") : nullptr;
-  if (p) e->sim_period = std::atoi(p + std::strlen("sim_period="));
+  static const char* const keys[] = {"sim_period", nullptr};
+  if (gauss6_config_check(config, keys, "gauss6 engine", error, error_size) != 0) return nullptr;
+  char value[32];
+  if (gauss6_config_value(config, "sim_period", value, sizeof value)) {
+    char* end = nullptr;
+    const long n = std::strtol(value, &end, 10);
+    e->sim_period = end != value && *end == 0 && n >= 1 && n <= 1000000 ? static_cast<int>(n) : 0;
+  }
   if (e->sim_period < 1) {
-    set_error(error, error_size, "gauss6 engine: sim_period must be >= 1");
+    set_error(error, error_size, "gauss6 engine: config sim_period must be an integer >= 1");
     return nullptr;
   }
   return e.release();

@@ -186,4 +186,4 @@ def test_validate_command_exit_codes_and_offline_runs(tmp_path):
     bad = tmp_path / "penalty"
     assert main(["validate", "--engine", "box-penalty", "--scene", str(PEG), "--duration", "1.0", "--out", str(bad),
                  "--quiet"]) == 1
-    assert main(["validate", "--scene", str(PEG), "--out", str(bad), "--quiet"]) == 2
+    assert main(["validate", "--scene", str(PEG), "--out", str(bad), "--quiet"]) == 3  # usage
