@@ -202,13 +202,29 @@ const char* last_error(void* handle) { return static_cast<Engine*>(handle)->erro
 
 void destroy(void* handle) { delete static_cast<Engine*>(handle); }
 
-const gauss6_engine_v1 kTable = {
-    GAUSS6_ENGINE_ABI_VERSION, sizeof(gauss6_engine_v1), sizeof(gauss6_scene_desc), sizeof(gauss6_step_out),
-    "gauss6 (god-object, lockstep tick)", create, reset, step, last_error, destroy,
-};
+// With its sim step every sim_period ticks, the god-object and its contacts are updated at
+// 1 / sim_period of the haptic rate: a crossing of a new constraint is answered up to
+// 2 (sim_period - 1) ticks later than at sim_period 1, which the engine declares.
+int declare(void* handle, gauss6_declarations* out) {
+  const auto* e = static_cast<const Engine*>(handle);
+  if (e->sim_period > 1) {
+    out->flags |= GAUSS6_DECLARE_LATENCY;
+    out->latency_ticks = 2 * (e->sim_period - 1);
+  }
+  return GAUSS6_ENGINE_OK;
+}
+
+#define GAUSS6_ENGINE_V1_FIELDS(version, size) \
+  version, size, sizeof(gauss6_scene_desc), sizeof(gauss6_step_out), "gauss6 (god-object, lockstep tick)", \
+      create, reset, step, last_error, destroy
+
+const gauss6_engine_v1 kTable = {GAUSS6_ENGINE_V1_FIELDS(GAUSS6_ENGINE_ABI_VERSION, sizeof(gauss6_engine_v1))};
+const gauss6_engine_v2 kTable2 = {
+    {GAUSS6_ENGINE_V1_FIELDS(GAUSS6_ENGINE_ABI_VERSION_2, sizeof(gauss6_engine_v2))}, declare};
 
 }  // namespace
 
 extern "C" __attribute__((visibility("default"))) const void* gauss6_engine_get(uint32_t abi_version) {
+  if (abi_version == GAUSS6_ENGINE_ABI_VERSION_2) return &kTable2;
   return abi_version == GAUSS6_ENGINE_ABI_VERSION ? &kTable : nullptr;
 }

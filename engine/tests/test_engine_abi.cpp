@@ -164,11 +164,37 @@ TEST_CASE("a version 2 table declares, and a version 1 engine answers NULL for v
   REQUIRE(std::string(error).find("'declare_nu=0.3'") != std::string::npos);
   dlclose(probe);
 
-  void* v1 = dlopen(GAUSS6_ENGINE_PATH, RTLD_NOW | RTLD_LOCAL);
+  void* v1 = dlopen(GAUSS6_BOX_PENALTY_ENGINE_PATH, RTLD_NOW | RTLD_LOCAL);
   REQUIRE(v1);
   auto get1 = reinterpret_cast<gauss6_engine_get_fn>(dlsym(v1, GAUSS6_ENGINE_ENTRY));
   REQUIRE(get1);
   REQUIRE(get1(GAUSS6_ENGINE_ABI_VERSION_2) == nullptr);
   REQUIRE(get1(GAUSS6_ENGINE_ABI_VERSION) != nullptr);
   dlclose(v1);
+}
+
+TEST_CASE("gauss6's engine speaks both versions and declares the latency of a slower sim step", "[engine][abi]") {
+  void* lib = dlopen(GAUSS6_ENGINE_PATH, RTLD_NOW | RTLD_LOCAL);
+  REQUIRE(lib);
+  auto get = reinterpret_cast<gauss6_engine_get_fn>(dlsym(lib, GAUSS6_ENGINE_ENTRY));
+  REQUIRE(get);
+  REQUIRE(get(GAUSS6_ENGINE_ABI_VERSION) != nullptr);
+  const auto* t = static_cast<const gauss6_engine_v2*>(get(GAUSS6_ENGINE_ABI_VERSION_2));
+  REQUIRE(t);
+  REQUIRE(t->v1.table_size == sizeof(gauss6_engine_v2));
+  REQUIRE(t->declare);
+  char error[256] = "";
+  for (int period : {1, 2, 8}) {
+    void* engine = t->v1.create(("sim_period=" + std::to_string(period)).c_str(), error, sizeof error);
+    INFO("sim_period " << period << ": " << error);
+    REQUIRE(engine);
+    gauss6_declarations d{};
+    d.struct_size = sizeof d;
+    REQUIRE(t->declare(engine, &d) == GAUSS6_ENGINE_OK);
+    // At sim_period 1 nothing is declared; above it, the crossing is answered 2 (period - 1) ticks later.
+    REQUIRE(d.flags == (period > 1 ? GAUSS6_DECLARE_LATENCY : 0u));
+    if (period > 1) REQUIRE(d.latency_ticks == 2 * (period - 1));
+    t->v1.destroy(engine);
+  }
+  dlclose(lib);
 }

@@ -39,7 +39,7 @@ from __future__ import annotations
 import functools
 import math
 import tomllib
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Callable
 
@@ -430,7 +430,7 @@ class RunData:
 # CHECK_TABLE below.
 
 def check_penetration(r: RunData, th: dict) -> Verdict:
-    """1. Every distinct finite displayed pose, exactly: touching or intersecting fails."""
+    """Every distinct finite displayed pose, exactly: touching or intersecting fails."""
     P = r.penetration
     ids = np.flatnonzero(P["pose"])
     ticks = r.first_tick[ids]
@@ -445,7 +445,7 @@ def check_penetration(r: RunData, th: dict) -> Verdict:
 
 
 def check_tunnelling(r: RunData, th: dict) -> Verdict:
-    """2. The in-between motion between successive free distinct poses: swept boxes (ExactScene.near),
+    """The in-between motion between successive free distinct poses: swept boxes (ExactScene.near),
     gauss6's conservative CCD, then the exact first contact on every step the CCD stops."""
     o, ft, delta = r.o, r.first_tick, r.delta
     pen = r.penetration["pose"]
@@ -498,7 +498,7 @@ def check_tunnelling(r: RunData, th: dict) -> Verdict:
 
 
 def check_force_at_distance(r: RunData, th: dict) -> Verdict:
-    """3. A wrench at a free pose whose exact separation exceeds the bound (plus a declared skin) but
+    """A wrench at a free pose whose exact separation exceeds the bound (plus a declared skin) but
     not free_space."""
     S = r.separations
     ad = np.flatnonzero(S["at_distance"])
@@ -517,7 +517,7 @@ def check_force_at_distance(r: RunData, th: dict) -> Verdict:
 
 
 def check_force_direction(r: RunData, th: dict) -> Verdict:
-    """4. The wrench's distance from the cone of contact wrenches (M^-1 metric): its wrong-side share,
+    """The wrench's distance from the cone of contact wrenches (M^-1 metric): its wrong-side share,
     and its tangential share. With a declared Coulomb friction mu the tangential share is judged by
     the friction cone instead (tangential <= mu x normal, to the cone test's resolution
     max_tangential_share), and by maximal dissipation: where the displayed tool slides, the
@@ -568,7 +568,7 @@ def check_force_direction(r: RunData, th: dict) -> Verdict:
 
 
 def check_no_force_when_free(r: RunData, th: dict) -> Verdict:
-    """5. A wrench beyond free_space, or while the handle is on the free side of every contact by the
+    """A wrench beyond free_space, or while the handle is on the free side of every contact by the
     margin (METHOD.md property 3)."""
     S, C = r.separations, r.cone
     bad = S["in_free_space"] | C["away"]
@@ -635,7 +635,7 @@ def port_energy(r: RunData, th: dict) -> dict:
 
 
 def check_energy(r: RunData, th: dict) -> Verdict:
-    """6. Passivity on the device port (port_energy): the observer P(n) stays above -max_deficit. The
+    """Passivity on the device port (port_energy): the observer P(n) stays above -max_deficit. The
     report says where and when energy came out: the episode whose own observer falls lowest, its
     span, phase, energy and mean power (from its observer's peak to its minimum)."""
     O = port_energy(r, th)
@@ -678,12 +678,12 @@ def check_energy(r: RunData, th: dict) -> Verdict:
         first = int(np.flatnonzero(P < -floor)[0])
         violations = {role: {"tick": k, "window_start": 0, "window_end": k, "observer": float(P[k]), "floor": -floor}
                       for role, k in (("first", first), ("worst", m))}
-    return Verdict("energy", "", not run_bad, int((P < -floor).sum()), max(-run_min, 0.0), "J (deficit)",
+    return Verdict("energy", "", not run_bad, int((P < -floor).sum()), max(-run_min, 0.0) + 0.0, "J (deficit)",
                    float(t[violations["first"]["tick"]]) if violations else None, note, details, violations)
 
 
 def check_force_jumps(r: RunData, th: dict) -> Verdict:
-    """7. The force (torque) a tick adds: its change less any release of the last tick's force
+    """The force (torque) a tick adds: its change less any release of the last tick's force
     (added_per_tick); the whole change is reported beside it, with the time of the largest."""
     both = r.finite_wrench[1:] & r.finite_wrench[:-1]
     Wf = np.where(r.finite_wrench[:, None], r.W, 0)
@@ -708,7 +708,7 @@ def check_force_jumps(r: RunData, th: dict) -> Verdict:
 
 
 def check_wrench_sanity(r: RunData, th: dict) -> Verdict:
-    """7. A non-finite wrench or pose (displayed or handle), or a wrench over the device's limits."""
+    """A non-finite wrench or pose (displayed or handle), or a wrench over the device's limits."""
     o = r.o
     slack = 1 + th["slack"]
     over = r.finite_wrench & ((r.f_norm > o.max_force * slack) | (r.tau_norm > o.max_torque * slack))
@@ -729,7 +729,7 @@ def check_wrench_sanity(r: RunData, th: dict) -> Verdict:
 
 
 def check_tracking(r: RunData, th: dict) -> Verdict:
-    """9. In free space the displayed pose follows the handle: at ticks without a wrench whose handle
+    """In free space the displayed pose follows the handle: at ticks without a wrench whose handle
     pose is beyond free_space from every obstacle (the certified bracket), the displayed pose is the
     handle's pose of one of the last max_lag_ticks ticks (plus a declared latency), within the bound:
     error = min over the lag j of |p_s - p_h(k - j)| + radius x angle(q_s, q_h(k - j)), delta units.
@@ -765,7 +765,7 @@ def check_tracking(r: RunData, th: dict) -> Verdict:
 
 
 def check_latency(r: RunData, th: dict) -> Verdict:
-    """10. Latency: at each fresh contact (no wrench in the window before it), the ticks from the
+    """Latency: at each fresh contact (no wrench in the window before it), the ticks from the
     handle's crossing into an obstacle (its pose first intersects one, exactly, after being clear
     by more than `approach` delta at the window's start) to the first tick with a wrench, judged
     against onset_ticks plus the declared latency. (The force's lag in contact is not judged: in
@@ -840,7 +840,7 @@ def timing_summary(wall: np.ndarray, cpu: np.ndarray, period: float, quantile: f
 
 
 def check_cost(r: RunData, th: dict) -> Verdict:
-    """8. Deadlines, from the driver's timing of each step call (never the engine's own figure).
+    """Deadlines, from the driver's timing of each step call (never the engine's own figure).
     The cost of a step is its CPU time: a loaded machine preempts a step for tens of ms (wall), which
     is no cost of the engine (without the CPU timing only the stall bound is judged). Fails when more
     than max_over_fraction of the steps cost over the period T, when the quantile's cost exceeds T,
@@ -902,19 +902,21 @@ class Check:
 
 # The checks, in report order (the deadlines last).
 CHECK_TABLE = [
-    Check("penetration", "1. penetration of the displayed poses", "penetration", check_penetration),
-    Check("tunnelling", "2. tunnelling between successive poses", "tunnelling", check_tunnelling),
-    Check("force_at_distance", "3. force at a distance", "distance", check_force_at_distance),
-    Check("force_direction", "4. force outside the contact (or declared friction) cone", "direction",
+    Check("penetration", "penetration of the displayed poses", "penetration", check_penetration),
+    Check("tunnelling", "tunnelling between successive poses", "tunnelling", check_tunnelling),
+    Check("force_at_distance", "force at a distance", "distance", check_force_at_distance),
+    Check("force_direction", "force outside the contact (or declared friction) cone", "direction",
           check_force_direction),
-    Check("no_force_when_free", "5. force in free space or moving away", "moving_away", check_no_force_when_free),
-    Check("energy", "6. energy (passivity observer on the device port)", "energy", check_energy),
-    Check("force_jumps", "7. force jumps", "jumps", check_force_jumps),
-    Check("wrench_sanity", "7. non-finite or over-limit wrench or pose", "limits", check_wrench_sanity),
-    Check("tracking", "9. displayed pose follows the handle in free space", "tracking", check_tracking),
-    Check("latency", "10. latency of the force's response", "latency", check_latency),
-    Check("cost", "8. deadlines (the driver's timing of each step)", "cost", check_cost),
+    Check("no_force_when_free", "force in free space or moving away", "moving_away", check_no_force_when_free),
+    Check("energy", "energy (passivity observer on the device port)", "energy", check_energy),
+    Check("force_jumps", "force jumps", "jumps", check_force_jumps),
+    Check("wrench_sanity", "non-finite or over-limit wrench or pose", "limits", check_wrench_sanity),
+    Check("tracking", "displayed pose follows the handle in free space", "tracking", check_tracking),
+    Check("latency", "latency of the force's response", "latency", check_latency),
+    Check("cost", "deadlines (the driver's timing of each step)", "cost", check_cost),
 ]
+# A check's title is numbered by its place in the table.
+CHECK_TABLE = [replace(c, title=f"{i}. {c.title}") for i, c in enumerate(CHECK_TABLE, 1)]
 CHECKS = [(c.name, c.title) for c in CHECK_TABLE]
 CHECK_NAMES = [c.name for c in CHECK_TABLE]
 

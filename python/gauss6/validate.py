@@ -144,7 +144,7 @@ def engine_lines(engine: dict) -> list[str]:
             f"- declared: {json.dumps(engine['declarations']) if engine['declarations'] else 'nothing'}"]
 
 
-def write_outputs(result, out: Path, info: dict) -> dict:
+def write_outputs(result, out: Path, info: dict, witnesses: str = "") -> dict:
     title = f"{info.get('engine_name') or 'recorded run'} on {Path(info['scene']).stem}"
     plotted = len(result.series.get("t", ())) > 0
     if plotted:
@@ -172,9 +172,24 @@ def write_outputs(result, out: Path, info: dict) -> dict:
              verdict_table(result.verdicts), "",
              "Geometric verdicts are exact (gauss6's reference, CGAL); depths are estimates; lengths in units of "
              "the scene's delta. Definitions and thresholds: docs/engine-contract.md, harness/oracle.toml.", "",
-             *(["![validation](validation.png)"] if plotted else []), ""]
+             *(["![validation](validation.png)"] if plotted else []), "",
+             *([witnesses] if witnesses else [])]
     (out / "report.md").write_text("\n".join(lines))
     return doc
+
+
+def witness_section(result, trace, oracle, out: Path) -> str:
+    """Writes the witnesses of the failed checks (witness.py) and, when there are any, the viewer page
+    they link to (run.html, opened at each witness's tick); returns the report's section ('' if none)."""
+    from .view import write_view
+    from .witness import report_witnesses
+
+    if not len(trace.ticks):
+        return ""
+    section = report_witnesses(result, trace, oracle, out, viewer_page="run.html")
+    if section:
+        write_view([trace.path], scene=oracle.scene_path, out=out / "run.html")
+    return section
 
 
 def validate(args) -> int:
@@ -228,20 +243,21 @@ def validate(args) -> int:
         info.update(run=str(run_path), engine_name=trace.meta.get("extra", {}).get("engine"), engine_failure=failure)
     ticks = trace.ticks
     info.update(ticks=len(ticks), duration=float(ticks["t"][-1] - ticks["t"][0]) if len(ticks) else 0.0)
+    oracle = oracle_mod.Oracle(args.scene, thresholds)
     if failure is None:
-        result = oracle_mod.Oracle(args.scene, thresholds).judge(trace, judge_progress)
+        result = oracle.judge(trace, judge_progress)
     else:
         # What ran is judged as well when it can be (two ticks at least); the failure is the verdict.
         result = oracle_mod.OracleResult([], {}, [(p["name"], float(p["start"])) for p in trace.meta.get("phases", [])])
         if len(ticks) >= 2:
             try:
-                result = oracle_mod.Oracle(args.scene, thresholds).judge(trace, judge_progress)
+                result = oracle.judge(trace, judge_progress)
             except Exception as e:  # a partial run the checks cannot take: the failure alone is reported
                 print(f"gauss6 validate: the partial run was not judged ({type(e).__name__}: {e})", file=sys.stderr)
         result.verdicts.insert(0, failure_verdict(failure, trace.meta["device"]["rate_hz"]))
     if judge_progress:
         print("\r" + " " * 60 + "\r", end="", file=sys.stderr)
-    doc = write_outputs(result, out, info)
+    doc = write_outputs(result, out, info, witness_section(result, trace, oracle, out))
     if args.json:
         print(json.dumps(doc, indent=2))
     else:

@@ -181,9 +181,15 @@ def test_declarations_and_timing_reach_the_trace(tmp_path, engine, config):
     assert np.all(np.isnan(trace.ticks["force_time"]))
 
 
-def test_a_version_1_engine_loads_and_declares_nothing(tmp_path):
-    engine = load_engine("gauss6")
+def test_a_version_1_engine_loads_and_declares_nothing():
+    engine = load_engine("box-penalty")
     assert engine.abi_version == 1 and engine.declarations() == {}
+
+
+def test_gauss6_declares_the_latency_of_a_slower_sim_step(tmp_path):
+    assert load_engine("gauss6").abi_version == 2
+    assert load_engine("gauss6").declarations() == {}
+    assert load_engine("gauss6", "sim_period=3").declarations() == {"latency_ticks": 4}
     code, doc, out = validate(tmp_path, "gauss6")
     assert code == EXIT_PASS and doc["engine"]["declarations"] == {}
     ticks = read_trace(out / "run.g6trace").ticks
