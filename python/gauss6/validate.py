@@ -37,6 +37,7 @@ import numpy as np
 
 from . import oracle as oracle_mod
 from .engine import EngineError, EngineScene, load_engine
+from .trace import coverage_line
 
 FORMAT_VERSION = 1
 
@@ -132,14 +133,15 @@ def write_outputs(result, out: Path, info: dict) -> dict:
     plot(result, out, title)
     doc = {"format": "gauss6-validation", "version": FORMAT_VERSION, "pass": result.passed, "failed": result.failed(),
            "engine": info.get("engine"), "run": info["run"], "scene": info["scene"], "script": info.get("script"),
-           "ticks": info["ticks"], "duration": info["duration"],
+           "ticks": info["ticks"], "duration": info["duration"], "coverage": info.get("coverage"),
            "thresholds": {"file": info["thresholds"], "version": info["thresholds_version"]},
            "verdicts": [v.to_json() for v in result.verdicts], "machine": machine()}
     (out / "validation.json").write_text(json.dumps(doc, indent=2) + "\n")
     lines = [f"# Validation: {title}", "",
              f"Verdict: **{'PASS' if result.passed else 'FAIL'}**"
              + ("" if result.passed else f" ({', '.join(result.failed())})"), "",
-             f"- run: `{info['run']}` ({info['ticks']} ticks, {info['duration']:.3f} s)",
+             f"- run: `{info['run']}` ({info['ticks']} ticks, {info['duration']:.3f} s)"
+             + (f"; the trace: {coverage_line(info['coverage'])}" if info.get("coverage") else ""),
              f"- scene: `{info['scene']}`" + (f", script `{info['script']}`" if info.get("script") else ""),
              f"- engine: {info.get('engine_name') or 'recorded offline'}"
              + (f" (`{info['engine']['library']}`, config `{info['engine']['config']}`)" if info.get("engine") else ""),
@@ -153,11 +155,37 @@ def write_outputs(result, out: Path, info: dict) -> dict:
     return doc
 
 
-def validate(args) -> int:
-    from .trace import read_trace
+def read_run(run, scene) -> tuple:
+    """A recorded RUN as judged offline: (trace, path). A .g6trace (a cut one read up to its
+    last complete chunk, the cut stated by trace.coverage in the outputs, and warned of on
+    stderr) or a ticks CSV; positions beyond the coordinate bound refused, quaternions
+    rescaled (trace.checked_poses); a run without ticks refused (ValueError naming it)."""
+    import warnings
 
-    out = Path(args.out)
-    out.mkdir(parents=True, exist_ok=True)
+    from .trace import TraceWarning, checked_poses, read_trace
+
+    run_path = Path(run)
+    if run_path.suffix == ".g6trace":
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always", TraceWarning)
+            trace = read_trace(run_path)
+        for w in caught:
+            print(f"gauss6 validate: warning: {w.message}; judged on the ticks it holds "
+                  "(validation.json: coverage)", file=sys.stderr)
+    else:
+        from .logs import read_csv_dir
+
+        trace = read_csv_dir(run_path, scene=str(scene))
+    if len(trace.ticks) == 0:
+        raise ValueError(f"{run_path}: the run holds no ticks: there is nothing to judge")
+    return checked_poses(trace), run_path
+
+
+def validate(args) -> int:
+    from .paths import check_output_dir
+    from .trace import coverage
+
+    out = check_output_dir(args.out)
     thresholds_path = Path(args.thresholds) if args.thresholds else oracle_mod.THRESHOLDS
     thresholds = oracle_mod.load_thresholds(thresholds_path)
     run_progress, judge_progress = _progress(args.quiet)
@@ -177,13 +205,8 @@ def validate(args) -> int:
         info.update(engine={"name": engine.name, "library": getattr(engine, "path", args.engine),
                             "config": args.config}, engine_name=engine.name, script=script_path, run=str(run_path))
     else:
-        run_path = Path(args.run)
-        if run_path.suffix == ".g6trace":
-            trace = read_trace(run_path)
-        else:
-            from .logs import read_csv_dir
-
-            trace = read_csv_dir(run_path, scene=str(args.scene))
+        trace, run_path = read_run(args.run, args.scene)
+        info["coverage"] = coverage(trace)
         if args.script:
             from .driver import script_phases
 
@@ -217,17 +240,21 @@ def cmd_validate(args: argparse.Namespace) -> int:
 
 
 def register(subparsers) -> None:
+    from .cli import input_file, output_dir, run_seconds
+
     p = subparsers.add_parser("validate", help="drive an engine with the simulated device and judge its run, or "
                                                "judge a recorded run (exit 1 on a failed check)")
-    p.add_argument("run", nargs="?", help="a recorded run to judge: a .g6trace, or a ticks CSV (docs/engine-contract.md)")
+    p.add_argument("run", nargs="?", type=input_file("run", directory_ok=True),
+                   help="a recorded run to judge: a .g6trace, or a ticks CSV (docs/engine-contract.md)")
     p.add_argument("--engine", help="engine library path, a built engine (gauss6, box-penalty, fault), or "
                                     "python:MODULE:FACTORY")
     p.add_argument("--config", default="", help="the engine's config text (default: empty)")
-    p.add_argument("--scene", required=True, help="scene TOML file")
+    p.add_argument("--scene", required=True, type=input_file("scene"), help="scene TOML file")
     p.add_argument("--script", help="hand script name or .json path (default: the scene's device.script)")
-    p.add_argument("--duration", type=float, default=None, help="run only the first S seconds of the script")
-    p.add_argument("--out", required=True, help="output directory")
-    p.add_argument("--thresholds", help="thresholds file (default harness/oracle.toml)")
+    p.add_argument("--duration", type=run_seconds, default=None, help="run only the first S seconds of the script")
+    p.add_argument("--out", required=True, type=output_dir, help="output directory")
+    p.add_argument("--thresholds", type=input_file("thresholds file"),
+                   help="thresholds file (default harness/oracle.toml)")
     p.add_argument("--json", action="store_true", help="print validation.json instead of the table")
     p.add_argument("--quiet", action="store_true", help="no progress on stderr")
     p.set_defaults(func=cmd_validate)
