@@ -24,8 +24,11 @@ judges the poses first shown at its ticks and the motions arriving at them (the 
 from the pose of tick start - 1 belongs to this chunk).
 
 Output: certify.json ({"format": "gauss6-certify", "version": 1, "pass", "scene", "trace", "ticks",
-"counts", "paths", "max_separation_delta", "bound_delta", "first_violation", "violations", "seconds",
-"machine"}) and certify.md. Exit status: 0 certified, 1 a violation, 2 a usage or load error.
+"coverage", "counts", "paths", "max_separation_delta", "bound_delta", "first_violation", "violations",
+"seconds", "machine"}; "ticks" the range certified, "coverage" what the trace held: trace.coverage, its
+ticks, time span, complete or cut, sha256) and certify.md (which says INCOMPLETE for a cut trace).
+A trace without ticks, or a tick range that is empty or beyond the trace, is refused.
+Exit status: 0 certified, 1 a violation, 2 a usage or load error.
 """
 from __future__ import annotations
 

@@ -16,6 +16,7 @@ port energy over time, the script's phases marked) and validation.json:
     {"format": "gauss6-validation", "version": 1, "pass": bool, "failed": [names],
      "engine": {"name", "library", "config"} or null, "run": path of the judged trace,
      "scene": path, "script": path or null, "ticks": int, "duration": s,
+     "coverage": a recorded RUN's trace.coverage (ticks, time span, complete or cut, sha256) or null,
      "thresholds": {"file": path, "version": int},
      "verdicts": [{"name", "title", "pass", "count", "worst", "unit", "first_time", "note", "details"}],
      "machine": {"platform", "processor", "cpus", "python"}}
