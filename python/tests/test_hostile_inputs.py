@@ -493,3 +493,10 @@ def test_a_scene_path_that_is_not_utf8_is_refused_by_name(tmp_path):
         done = subprocess.run([sys.executable, "-m", "gauss6.cli", *argv], capture_output=True, timeout=60)
         err = done.stderr.decode("utf-8", "replace")
         assert done.returncode == 2 and "not UTF-8" in err and "Traceback" not in err, err
+
+
+def test_the_readme_states_these_bounds_as_the_code_defines_them():
+    readme = (paths.REPO_ROOT / "README.md").read_text()
+    assert f"({logs.MAX_LINE // 1024} KiB; a 40 MB line)" in readme
+    assert MAX_RUN_SECONDS == 86400.0 and "over a day (`cli.MAX_RUN_SECONDS`)" in readme
+    assert trace.MAX_COORDINATE == 1e12 and "positions beyond 1e12 (`trace.MAX_COORDINATE`" in readme
