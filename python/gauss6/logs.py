@@ -313,6 +313,12 @@ def _read_stream_csv(path: Path, name: str, required: list[str]) -> np.ndarray:
         if column in names:
             j = names.index(column)
             _check_values(path, values[:, j], line_numbers, col_of(j), column, lo, hi, integer)
+    if name == "ticks" and "xh_q_0" in names:  # the handle's rotation drives replay: never zero
+        zero = np.nonzero(np.all(flat[:, 4:8] == 0, axis=1))[0]
+        if len(zero):
+            k = int(zero[0])
+            raise LogFormatError(f"{path}:{line_numbers[k]}:{col_of(names.index('xh_q_0'))(k)}: xh_q is the zero "
+                                 "quaternion (no rotation)")
     return np.ascontiguousarray(flat).view(DTYPES[name]).reshape(-1)
 
 
