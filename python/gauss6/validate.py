@@ -179,6 +179,12 @@ def read_run(run, scene) -> tuple:
         trace = read_csv_dir(run_path, scene=str(scene))
     if len(trace.ticks) == 0:
         raise ValueError(f"{run_path}: the run holds no ticks: there is nothing to judge")
+    for column in ("xh_q", "xs_q"):  # a zero quaternion is no rotation: the oracle cannot judge it
+        zero = np.nonzero(np.all(trace.ticks[column] == 0, axis=1))[0]
+        if len(zero):
+            k = int(zero[0])
+            raise ValueError(f"{run_path}: tick {k} (t = {float(trace.ticks['t'][k])!r}): {column} is the zero "
+                             f"quaternion, which is no rotation ({len(zero)} such ticks)")
     return checked_poses(trace), run_path
 
 

@@ -152,6 +152,16 @@ def test_positions_beyond_the_coordinate_bound_are_refused_by_name(tmp_path, cap
         assert code == 2 and f"tick 17" in err and column in err and "beyond 1e+12" in err, err
 
 
+@pytest.mark.parametrize("column", ["xs_q", "xh_q"])
+def test_offline_validate_refuses_a_zero_quaternion_by_tick(tmp_path, capsys, peg_run, column):
+    tr = read_trace(peg_run)
+    ticks = tr.ticks.copy()
+    ticks[column][23] = 0.0
+    path = write_trace(Trace(**{**tr.__dict__, "ticks": ticks}), tmp_path / "zero.g6trace")
+    code, err = _exit(["validate", str(path), "--scene", str(PEG), "--out", str(tmp_path / "v"), "--quiet"], capsys)
+    assert code == 2 and f"tick 23 (t = {float(ticks['t'][23])!r}): {column} is the zero quaternion" in err, err
+
+
 def test_the_coordinate_bound_is_the_cpp_one():
     text = (paths.REPO_ROOT / "optimized" / "include" / "gauss6" / "scene.h").read_text()
     assert f"kMaxSceneCoordinate = {trace.MAX_COORDINATE:.0e}".replace("+", "") in text
