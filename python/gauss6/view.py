@@ -201,6 +201,8 @@ def write_view(traces, scene=None, out=None, labels=None, title: str | None = No
         with warnings.catch_warnings():
             warnings.simplefilter("ignore", TraceWarning)  # a cut trace shows what it has
             loaded.append(read_trace(p))
+        if len(loaded[-1].ticks) == 0:
+            raise ValueError(f"{p}: the trace holds no ticks: there is no run to view")
     if scene is None:
         scene = default_scene(loaded[0])
         if scene is None:

@@ -66,11 +66,13 @@ def _header_size(path) -> int:
     return trace.HEADER.size + meta_len
 
 
-def test_certify_and_validate_refuse_a_run_without_ticks(tmp_path, capsys, peg_run):
+def test_certify_validate_and_view_refuse_a_run_without_ticks(tmp_path, capsys, peg_run):
     no_ticks = write_trace(_trace([]), tmp_path / "empty.g6trace")
     header_only = _cut(peg_run, tmp_path / "header.g6trace", _header_size(peg_run))
     in_first_chunk = _cut(peg_run, tmp_path / "chunk.g6trace", _header_size(peg_run) + trace.CHUNK.size + 100)
     for run in (no_ticks, header_only, in_first_chunk):
+        code, err = _exit(["view", str(run), "--scene", str(PEG), "--out", str(tmp_path / "p.html")], capsys)
+        assert code == 2 and "holds no ticks" in err, err
         code, err = _exit(["certify", str(run), "--scene", str(PEG), "--out", str(tmp_path / "c"), "--quiet"], capsys)
         assert code == 2 and "holds no ticks" in err, err
         code, err = _exit(["validate", str(run), "--scene", str(PEG), "--out", str(tmp_path / "v"), "--quiet"], capsys)
