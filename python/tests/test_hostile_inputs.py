@@ -429,6 +429,8 @@ def test_view_page_data_is_strict_json_with_non_finite_values(tmp_path, peg_run)
     ["validate", "--engine", "gauss6", "--duration", "nan"],
     ["validate", "--engine", "gauss6", "--duration", "1e7"],
     ["validate", "--engine", "gauss6", "--duration", "-1"],
+    ["rate", "--duration", "inf"],
+    ["rate", "--duration", "1e7"],
     ["replay", "REC", "--duration", "inf"],
     ["replay", "REC", "--duration", "0"],
     ["view", "REC", "--max-frames", "-5"],
