@@ -313,12 +313,14 @@ def _read_stream_csv(path: Path, name: str, required: list[str]) -> np.ndarray:
         if column in names:
             j = names.index(column)
             _check_values(path, values[:, j], line_numbers, col_of(j), column, lo, hi, integer)
-    if name == "ticks" and "xh_q_0" in names:  # the handle's rotation drives replay: never zero
-        zero = np.nonzero(np.all(flat[:, 4:8] == 0, axis=1))[0]
-        if len(zero):
-            k = int(zero[0])
-            raise LogFormatError(f"{path}:{line_numbers[k]}:{col_of(names.index('xh_q_0'))(k)}: xh_q is the zero "
-                                 "quaternion (no rotation)")
+    for q in ("xh_q", "xs_q") if name == "ticks" else ():  # replay and validate refuse a zero rotation
+        if f"{q}_0" in names:
+            at = known.index(f"{q}_0")
+            zero = np.nonzero(np.all(flat[:, at:at + 4] == 0, axis=1))[0]
+            if len(zero):
+                k = int(zero[0])
+                raise LogFormatError(f"{path}:{line_numbers[k]}:{col_of(names.index(f'{q}_0'))(k)}: {q} is the "
+                                     "zero quaternion (no rotation)")
     return np.ascontiguousarray(flat).view(DTYPES[name]).reshape(-1)
 
 

@@ -299,6 +299,8 @@ CSV_BAD = [
     ("ticks.csv", "t,xh_p_0,xh_p_1,xh_p_2,buttons\n0,0,0,0,1e20\n", r"ticks.csv:2:9: buttons 1e\+20"),
     ("ticks.csv", "t,xh_p_0,xh_p_1,xh_p_2,xh_q_0,xh_q_1,xh_q_2,xh_q_3\n0,0,0,0,0,0,0,0\n",
      r"ticks.csv:2:9: xh_q is the zero quaternion"),
+    ("ticks.csv", "t,xh_p_0,xh_p_1,xh_p_2,xs_q_0,xs_q_1,xs_q_2,xs_q_3\n0,0,0,0,1,0,0,0\n1,0,0,0,0,0,0,0\n",
+     r"ticks.csv:3:9: xs_q is the zero quaternion"),
     ("events.csv", "t,code,value\n0,1e20,0\n", r"events.csv:2:3: code 1e\+20"),
     ("events.csv", "t,code,value\n0,-1,0\n", r"events.csv:2:3: code -1.0"),
     ("steps.csv", "step,t,update_time,num_contacts,status\n0.5,0,0,0,0\n", r"steps.csv:2:1: step 0.5"),
