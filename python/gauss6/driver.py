@@ -57,7 +57,9 @@ def script_text(name: str, scene_path) -> tuple[str, str]:
         path = Path(scene_path).resolve().parent.parent / "scripts" / f"{name}.json"
     if not path.exists():
         raise ValueError(f"{name}: no such hand script ({path})")
-    return path.read_text(), str(path)
+    from .paths import read_input_text  # a regular file (not a FIFO or a device), bounded
+
+    return read_input_text(path, "hand script", 1 << 26), str(path)
 
 
 def safe_wrench(F: np.ndarray, max_force: float, max_torque: float) -> tuple[np.ndarray, bool]:
@@ -88,6 +90,9 @@ def drive(engine, scene: EngineScene, script_json: str, out_path, duration: floa
     dev = _device.SimulatedDevice(script_json, rate_hz=scene.rate_hz, max_force=scene.max_force,
                                   max_torque=scene.max_torque)
     end = dev.end_time if duration is None or duration < 0 else duration
+    from .cli import check_run_span  # a script spanning 1e9 s would be a run without end
+
+    check_run_span(end, "the hand script")
     num_ticks = int(math.floor(end * scene.rate_hz + 1e-9)) + 1
     ticks = np.zeros(num_ticks, dtype=trace_mod.DTYPES["ticks"])
     steps = np.zeros(num_ticks, dtype=trace_mod.DTYPES["steps"])

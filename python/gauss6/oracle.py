@@ -67,8 +67,19 @@ def added_per_tick(V: np.ndarray) -> np.ndarray:
 
 
 def load_thresholds(path=None) -> dict:
-    with open(path or THRESHOLDS, "rb") as f:
-        return tomllib.load(f)
+    """The thresholds file (default harness/oracle.toml): a regular file (paths.read_input_text),
+    valid TOML, not empty; ValueError naming the file otherwise."""
+    from .paths import read_input_text
+
+    path = Path(path or THRESHOLDS)
+    try:
+        thresholds = tomllib.loads(read_input_text(path, "thresholds file", 1 << 20))
+    except tomllib.TOMLDecodeError as e:
+        raise ValueError(f"{path}: not valid TOML: {e}") from None
+    if not thresholds:
+        raise ValueError(f"{path}: the thresholds file is empty (no setting): give the file to judge by, "
+                         "or none for the defaults")
+    return thresholds
 
 
 @dataclass

@@ -21,6 +21,7 @@ port energy over time, the script's phases marked) and validation.json:
      "engine": {"name", "library", "config", "isolation", "declarations"} or null,
      "engine_failure": {"kind", "detail", "tick"} or null, "run": path of the judged trace,
      "scene": path, "script": path or null, "ticks": int, "duration": s,
+     "coverage": a recorded RUN's trace.coverage (ticks, time span, complete or cut, sha256) or null,
      "thresholds": {"file": path, "version": int},
      "verdicts": [{"name", "title", "pass", "count", "worst", "unit", "first_time", "note", "details"}],
      "machine": {"platform", "processor", "cpus", "python"}}
@@ -43,6 +44,7 @@ import numpy as np
 from . import oracle as oracle_mod
 from .engine import EngineError, EngineScene, check_spec
 from .engine_host import RUN_TIMEOUT, STEP_TIMEOUT, InlineHost, ProcessHost
+from .trace import coverage_line
 
 FORMAT_VERSION = 1
 
@@ -153,14 +155,15 @@ def write_outputs(result, out: Path, info: dict, witnesses: str = "") -> dict:
     doc = {"format": "gauss6-validation", "version": FORMAT_VERSION, "pass": result.passed, "failed": result.failed(),
            "engine": info.get("engine"), "engine_failure": failure, "run": info["run"], "scene": info["scene"],
            "script": info.get("script"),
-           "ticks": info["ticks"], "duration": info["duration"],
+           "ticks": info["ticks"], "duration": info["duration"], "coverage": info.get("coverage"),
            "thresholds": {"file": info["thresholds"], "version": info["thresholds_version"]},
            "verdicts": [v.to_json() for v in result.verdicts], "machine": machine()}
     (out / "validation.json").write_text(json.dumps(doc, indent=2) + "\n")
     lines = [f"# Validation: {title}", "",
              f"Verdict: **{'PASS' if result.passed else 'FAIL'}**"
              + ("" if result.passed else f" ({', '.join(result.failed())})"), "",
-             f"- run: `{info['run']}` ({info['ticks']} ticks, {info['duration']:.3f} s)",
+             f"- run: `{info['run']}` ({info['ticks']} ticks, {info['duration']:.3f} s)"
+             + (f"; the trace: {coverage_line(info['coverage'])}" if info.get("coverage") else ""),
              f"- scene: `{info['scene']}`" + (f", script `{info['script']}`" if info.get("script") else ""),
              f"- engine: {info.get('engine_name') or 'recorded offline'}"
              + (f" (`{info['engine']['library']}`, config `{info['engine']['config']}`)" if info.get("engine") else ""),
@@ -192,11 +195,43 @@ def witness_section(result, trace, oracle, out: Path) -> str:
     return section
 
 
-def validate(args) -> int:
-    from .trace import read_trace
+def read_run(run, scene) -> tuple:
+    """A recorded RUN as judged offline: (trace, path). A .g6trace (a cut one read up to its
+    last complete chunk, the cut stated by trace.coverage in the outputs, and warned of on
+    stderr) or a ticks CSV; positions beyond the coordinate bound refused, quaternions
+    rescaled (trace.checked_poses); a run without ticks refused (ValueError naming it)."""
+    import warnings
 
-    out = Path(args.out)
-    out.mkdir(parents=True, exist_ok=True)
+    from .trace import TraceWarning, checked_poses, read_trace
+
+    run_path = Path(run)
+    if run_path.suffix == ".g6trace":
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always", TraceWarning)
+            trace = read_trace(run_path)
+        for w in caught:
+            print(f"gauss6 validate: warning: {w.message}; judged on the ticks it holds "
+                  "(validation.json: coverage)", file=sys.stderr)
+    else:
+        from .logs import read_csv_dir
+
+        trace = read_csv_dir(run_path, scene=str(scene))
+    if len(trace.ticks) == 0:
+        raise ValueError(f"{run_path}: the run holds no ticks: there is nothing to judge")
+    for column in ("xh_q", "xs_q"):  # a zero quaternion is no rotation: the oracle cannot judge it
+        zero = np.nonzero(np.all(trace.ticks[column] == 0, axis=1))[0]
+        if len(zero):
+            k = int(zero[0])
+            raise ValueError(f"{run_path}: tick {k} (t = {float(trace.ticks['t'][k])!r}): {column} is the zero "
+                             f"quaternion, which is no rotation ({len(zero)} such ticks)")
+    return checked_poses(trace), run_path
+
+
+def validate(args) -> int:
+    from .paths import check_output_dir
+    from .trace import coverage
+
+    out = check_output_dir(args.out)
     thresholds_path = Path(args.thresholds) if args.thresholds else oracle_mod.THRESHOLDS
     thresholds = oracle_mod.load_thresholds(thresholds_path)
     run_progress, judge_progress = _progress(args.quiet)
@@ -225,13 +260,8 @@ def validate(args) -> int:
                             "isolation": extra["isolation"], "declarations": extra["declarations"]},
                     engine_name=extra["engine"], script=script_path, run=str(run_path), engine_failure=failure)
     else:
-        run_path = Path(args.run)
-        if run_path.suffix == ".g6trace":
-            trace = read_trace(run_path)
-        else:
-            from .logs import read_csv_dir
-
-            trace = read_csv_dir(run_path, scene=str(args.scene))
+        trace, run_path = read_run(args.run, args.scene)
+        info["coverage"] = coverage(trace)
         if args.script:
             from .driver import script_phases
 
@@ -274,9 +304,6 @@ def cmd_validate(args: argparse.Namespace) -> int:
     if bool(args.engine) == bool(args.run):
         print("gauss6 validate: give either --engine ENGINE or a recorded RUN (not both)", file=sys.stderr)
         return EXIT_USAGE
-    if not (args.step_timeout > 0 and args.run_timeout > 0):
-        print("gauss6 validate: --step-timeout and --run-timeout must be > 0 s", file=sys.stderr)
-        return EXIT_USAGE
     try:
         return validate(args)
     except (EngineError, ValueError, FileNotFoundError) as e:
@@ -285,27 +312,31 @@ def cmd_validate(args: argparse.Namespace) -> int:
 
 
 def register(subparsers) -> None:
+    from .cli import input_file, output_dir, run_seconds
+
     p = subparsers.add_parser("validate", help="drive an engine with the simulated device and judge its run, or "
                                                "judge a recorded run (exit 1: a check failed, 2: the engine "
                                                "failed, 3: usage)")
-    p.add_argument("run", nargs="?", help="a recorded run to judge: a .g6trace, or a ticks CSV (docs/engine-contract.md)")
+    p.add_argument("run", nargs="?", type=input_file("run", directory_ok=True),
+                   help="a recorded run to judge: a .g6trace, or a ticks CSV (docs/engine-contract.md)")
     p.add_argument("--engine", help="engine library path, a built engine (gauss6, box-penalty, fault), "
                                     "python:MODULE:FACTORY or python:path/to/file.py:FACTORY")
     p.add_argument("--isolation", choices=("process", "inline"), default="process",
                    help="run the engine in a child process (default; a crash or hang is reported) or inline")
-    p.add_argument("--step-timeout", type=float, default=STEP_TIMEOUT, metavar="S",
+    p.add_argument("--step-timeout", type=run_seconds, default=STEP_TIMEOUT, metavar="S",
                    help=f"per-step watchdog: a step with no answer in S s is a hang "
                         f"(default {STEP_TIMEOUT:g})")
-    p.add_argument("--run-timeout", type=float, default=RUN_TIMEOUT, metavar="S",
+    p.add_argument("--run-timeout", type=run_seconds, default=RUN_TIMEOUT, metavar="S",
                    help=f"per-run watchdog: a run (create and reset included) not done S s after the engine's start "
                         f"is a hang "
                         f"(default {RUN_TIMEOUT:g})")
     p.add_argument("--config", default="", help="the engine's config text (default: empty)")
-    p.add_argument("--scene", required=True, help="scene TOML file")
+    p.add_argument("--scene", required=True, type=input_file("scene"), help="scene TOML file")
     p.add_argument("--script", help="hand script name or .json path (default: the scene's device.script)")
-    p.add_argument("--duration", type=float, default=None, help="run only the first S seconds of the script")
-    p.add_argument("--out", required=True, help="output directory")
-    p.add_argument("--thresholds", help="thresholds file (default harness/oracle.toml)")
+    p.add_argument("--duration", type=run_seconds, default=None, help="run only the first S seconds of the script")
+    p.add_argument("--out", required=True, type=output_dir, help="output directory")
+    p.add_argument("--thresholds", type=input_file("thresholds file"),
+                   help="thresholds file (default harness/oracle.toml)")
     p.add_argument("--json", action="store_true", help="print validation.json instead of the table")
     p.add_argument("--quiet", action="store_true", help="no progress on stderr")
     p.set_defaults(func=cmd_validate)
