@@ -146,3 +146,27 @@ def test_the_bullet_engine_runs_through_the_c_abi():
     np.testing.assert_allclose(step.xs_p, target, atol=1e-5)
     with pytest.raises(EngineError, match="unknown key"):
         load_engine(str(bullet_library()), "stiffness=1")
+
+
+@pytest.mark.parametrize("name", ["rapier", "dart"])
+def test_the_rapier_and_dart_adapters_follow_the_hand_and_stop_on_the_box(name):
+    from gauss6 import adapters
+    from gauss6.engine import EngineScene
+
+    if not adapters.available(name):
+        pytest.skip(f"{adapters.MODULES[name]} is not installed")
+    engine = adapters.FACTORIES[name]("kc=4000")
+    scene = EngineScene.from_scene_file(SCENES_DIR / "peg_in_hole.toml")
+    engine.reset(scene)
+    p0, q0 = np.asarray(scene.tool.p, float), np.asarray(scene.tool.q, float)
+    for k in range(200):  # free motion: 1 mm down, critically damped (200 ms = 12.6 / sqrt(kc))
+        step = engine.step(k / scene.rate_hz, p0 + [0.0, 0.0, -0.001], q0)
+    np.testing.assert_allclose(step.xs_p, p0 + [0.0, 0.0, -0.001], atol=1e-5)
+    engine.reset(scene)
+    for k in range(600):  # the hand 1 cm below the box's top: the peg's tip stops on it (z = 0.03)
+        step = engine.step(k / scene.rate_hz, p0 + [0.0, 0.0, -0.02], q0)
+    # The peg's G is 5 cm above its tip; a contact model may sink or float by up to 0.5 mm.
+    assert abs(step.xs_p[2] - 0.08) < 5e-4
+    # The user feels the coupling's push back up: kc m times the 1 cm the hand is below, 9.85 N.
+    assert step.wrench[2] == pytest.approx(4000.0 * scene.mass * 0.01, rel=0.1)
+    assert len(step.contacts) > 0

@@ -18,10 +18,12 @@ with M = diag(m I, R I_B R^T), applied as the body's external force and torque f
 the wrench sent to the user is -F_tool. Contacts: the world's last collision result (point,
 normal turned to point from the obstacle to the tool, separation = -penetration depth).
 
-Parameters (config keys; docs/engine-adapters.md gives the reasons):
-  kc          the coupling stiffness (1/s^2): the swept parameter, penetration against force
-  zeta        the coupling's damping ratio (1: critical)
-  friction    Coulomb friction coefficient
+Parameters (config keys) and how they were chosen:
+  kc          4000 1/s^2, the coupling stiffness: the swept parameter (250 to 64000, the Drake
+              adapter's range), penetration against force; the default is the peg scene's kh
+              (985 N/m on the peg), as for Drake
+  zeta        1, the coupling's damping ratio: critical damping of the tool in free motion
+  friction    0.3, Coulomb friction: the other adapters' dry contact
 """
 from __future__ import annotations
 
@@ -43,7 +45,8 @@ def _urdf(name: str, links: list[tuple[str, str, np.ndarray, np.ndarray]], inert
 
     geoms = []
     for geom_name, path, p, q in links:
-        rpy = Rotation.from_quat(common.wxyz_to_xyzw(common.unit(q))).as_euler("xyz")
+        rpy = [float(a) for a in Rotation.from_quat(common.wxyz_to_xyzw(common.unit(q))).as_euler("xyz")]
+        p = [float(x) for x in p]
         geoms.append(f'<collision name="{geom_name}"><origin xyz="{p[0]!r} {p[1]!r} {p[2]!r}" '
                      f'rpy="{rpy[0]!r} {rpy[1]!r} {rpy[2]!r}"/><geometry><mesh filename="{path}"/></geometry>'
                      f'</collision>')
@@ -85,8 +88,11 @@ class DartEngine:
         body.setInertia(dart.dynamics.Inertia(float(scene.mass), np.zeros(3), I))
         for skel in (obstacles, tool):
             for i in range(skel.getNumBodyNodes()):
-                skel.getBodyNode(i).setFrictionCoeff(c["friction"])
-                skel.getBodyNode(i).setRestitutionCoeff(0.0)
+                bn = skel.getBodyNode(i)
+                for k in range(bn.getNumShapeNodes()):
+                    dyn = bn.getShapeNode(k).getDynamicsAspect()
+                    dyn.setFrictionCoeff(c["friction"])
+                    dyn.setRestitutionCoeff(0.0)
         world.addSkeleton(obstacles)
         world.addSkeleton(tool)
         self.world, self.tool, self.body = world, tool, body
