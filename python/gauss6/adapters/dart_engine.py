@@ -11,19 +11,12 @@ Model, built from the EngineScene at reset (a dart.simulation.World of its own):
 - the scene's mass and inertia about G set on the tool's body node; no gravity; one world step
   of 1 / rate a tick.
 
-The coupling, each tick, from the tool's pose and velocity at the tick's start (the Drake
-adapter's):
-    F_tool = -kc M (x_tool (-) xh) - 2 zeta sqrt(kc) M v_tool
-with M = diag(m I, R I_B R^T), applied as the body's external force and torque for one step;
-the wrench sent to the user is -F_tool. Contacts: the world's last collision result (point,
-normal turned to point from the obstacle to the tool, separation = -penetration depth).
+The coupling, each tick: rapier_engine.coupling_wrench (the Drake adapter's law), applied as the
+body's external force and torque for one step; the wrench sent to the user is its opposite.
+Contacts: the world's last collision result (point, normal turned to point from the obstacle to
+the tool, separation = -penetration depth).
 
-Parameters (config keys) and how they were chosen:
-  kc          4000 1/s^2, the coupling stiffness: the swept parameter (250 to 64000, the Drake
-              adapter's range), penetration against force; the default is the peg scene's kh
-              (985 N/m on the peg), as for Drake
-  zeta        1, the coupling's damping ratio: critical damping of the tool in free motion
-  friction    0.3, Coulomb friction: the other adapters' dry contact
+Parameters (config keys): kc, zeta, friction, with rapier_engine's defaults and reasons.
 """
 from __future__ import annotations
 
@@ -34,9 +27,9 @@ import numpy as np
 from ..engine import EngineScene, EngineStep
 from ..oracle import rotation_matrices
 from . import common
-from .rapier_engine import coupling_wrench
+from .rapier_engine import DEFAULTS as RAPIER_DEFAULTS, coupling_wrench
 
-DEFAULTS = {"kc": 4000.0, "zeta": 1.0, "friction": 0.3}
+DEFAULTS = {k: RAPIER_DEFAULTS[k] for k in ("kc", "zeta", "friction")}
 
 
 def _urdf(name: str, links: list[tuple[str, str, np.ndarray, np.ndarray]], inertial: str = "") -> str:
