@@ -9,8 +9,10 @@
 //   shape for a moving concave mesh, the tool's own triangles, no convex decomposition), whose
 //   frame is G with axes along the principal axes of the scene's inertia about G;
 // - a virtual coupling (spring and damper, 6 DoF) pulls the tool towards the handle's pose:
-//   F = kc m (p_h - p_s) - 2 zeta sqrt(kc) m v,  tau = kc I_W theta - 2 zeta sqrt(kc) I_W omega,
-//   theta the rotation vector from the tool's orientation to the handle's; the user feels -(F, tau);
+//   F = kc m (p_h - p_s) - 2 zeta sqrt(kc) m (v - v_h),
+//   tau = kc I_W theta - 2 zeta sqrt(kc) I_W (omega - omega_h),
+//   theta the rotation vector from the tool's orientation to the handle's, (v_h, omega_h) the
+//   handle's velocity by backward difference (zero at the first tick); the user feels -(F, tau);
 // - no gravity, one Bullet step of 1 / rate_hz a tick (substeps smaller steps when asked).
 // The swept stiffness-like parameter is kc (1/s^2: kc m is the coupling's stiffness, N/m).
 #include <gauss6/engine.h>
@@ -159,6 +161,7 @@ class BulletEngine {
     info.m_angularDamping = 0.0;
     tool_ = std::make_unique<btRigidBody>(info);
     tool_->setWorldTransform(pose_to_I(s.tool.X_WB));
+    have_prev_ = false;
     tool_->setActivationState(DISABLE_DEACTIVATION);
     tool_->setSleepingThresholds(0, 0);
     world_->addRigidBody(tool_.get());
@@ -174,16 +177,21 @@ class BulletEngine {
     }
     auto start = std::chrono::steady_clock::now();
     const btTransform X_WH = pose_to_I(xh);
+    btVector3 v_h(0, 0, 0), omega_h(0, 0, 0);
+    if (have_prev_) {
+      v_h = (X_WH.getOrigin() - prev_X_WH_.getOrigin()) / dt_;
+      omega_h = rotation_vector(X_WH.getRotation() * prev_X_WH_.getRotation().inverse()) / dt_;
+    }
+    prev_X_WH_ = X_WH;
+    have_prev_ = true;
     const double w = std::sqrt(cfg_.kc), c = 2.0 * cfg_.damping_ratio * w;
     btVector3 force(0, 0, 0), torque(0, 0, 0);
     for (int k = 0; k < cfg_.substeps; ++k) {
       const btTransform X = tool_->getWorldTransform();
-      force = cfg_.kc * mass_ * (X_WH.getOrigin() - X.getOrigin()) - c * mass_ * tool_->getLinearVelocity();
-      btQuaternion dq = X_WH.getRotation() * X.getRotation().inverse();
-      if (dq.w() < 0) dq = -dq;
-      const btVector3 theta = dq.getAxis() * dq.getAngle();
+      force = cfg_.kc * mass_ * (X_WH.getOrigin() - X.getOrigin()) - c * mass_ * (tool_->getLinearVelocity() - v_h);
+      const btVector3 theta = rotation_vector(X_WH.getRotation() * X.getRotation().inverse());
       const btMatrix3x3 I_W = X.getBasis().scaled(tool_->getLocalInertia()) * X.getBasis().transpose();
-      torque = I_W * (cfg_.kc * theta - c * tool_->getAngularVelocity());
+      torque = I_W * (cfg_.kc * theta - c * (tool_->getAngularVelocity() - omega_h));
       tool_->clearForces();
       tool_->applyCentralForce(force);
       tool_->applyTorque(torque);
@@ -242,8 +250,18 @@ class BulletEngine {
     collision_config_.reset();
   }
 
+  // The rotation vector of a rotation q (the shorter way round).
+  static btVector3 rotation_vector(btQuaternion q) {
+    if (q.w() < 0) q = -q;
+    const btScalar s = btVector3(q.x(), q.y(), q.z()).length();
+    if (s < 1e-300) return btVector3(2 * q.x(), 2 * q.y(), 2 * q.z());
+    return btVector3(q.x(), q.y(), q.z()) * (2 * std::atan2(s, q.w()) / s);
+  }
+
   Config cfg_;
   double mass_ = 0, dt_ = 1e-3;
+  btTransform prev_X_WH_;
+  bool have_prev_ = false;
   btMatrix3x3 R_BI_ = btMatrix3x3::getIdentity();
   std::unique_ptr<btDefaultCollisionConfiguration> collision_config_;
   std::unique_ptr<btCollisionDispatcher> dispatcher_;

@@ -11,7 +11,7 @@ Model, built from the EngineScene at reset (a dart.simulation.World of its own):
 - the scene's mass and inertia about G set on the tool's body node; no gravity; one world step
   of 1 / rate a tick.
 
-The coupling, each tick: rapier_engine.coupling_wrench (the Drake adapter's law), applied as the
+The coupling, each tick: rapier_engine.Coupling (the Drake adapter's law), applied as the
 body's external force and torque for one step; the wrench sent to the user is its opposite.
 Contacts: the world's last collision result (point, normal turned to point from the obstacle to
 the tool, separation = -penetration depth).
@@ -27,7 +27,7 @@ import numpy as np
 from ..engine import EngineScene, EngineStep
 from ..oracle import rotation_matrices
 from . import common
-from .rapier_engine import DEFAULTS as RAPIER_DEFAULTS, coupling_wrench
+from .rapier_engine import DEFAULTS as RAPIER_DEFAULTS, Coupling
 
 DEFAULTS = {k: RAPIER_DEFAULTS[k] for k in ("kc", "zeta", "friction")}
 
@@ -89,7 +89,7 @@ class DartEngine:
         world.addSkeleton(obstacles)
         world.addSkeleton(tool)
         self.world, self.tool, self.body = world, tool, body
-        self.m, self.I_B = float(scene.mass), I
+        self.coupling = Coupling(c, scene.mass, I, 1.0 / scene.rate_hz)
         self.tool_shapes = {body.getShapeNode(i).getShape().getID() for i in range(body.getNumShapeNodes())}
         self._set_pose(scene.tool.p, scene.tool.q)
 
@@ -110,11 +110,9 @@ class DartEngine:
         return np.array(T.translation(), float), np.array([w, x, y, z])
 
     def step(self, t: float, xh_p, xh_q) -> EngineStep:
-        c = self.cfg
         start = time.perf_counter()
         p, q = self.pose()
-        F = coupling_wrench(c, self.m, self.I_B, p, q, self.body.getLinearVelocity(), self.body.getAngularVelocity(),
-                            xh_p, xh_q)
+        F = self.coupling.wrench(p, q, self.body.getLinearVelocity(), self.body.getAngularVelocity(), xh_p, xh_q)
         force, torque = F[:3], F[3:]
         self.body.clearExternalForces()
         self.body.setExtForce(force, np.zeros(3), False, True)   # at G (the body's origin), world frame

@@ -13,8 +13,9 @@ Model, built from the EngineScene at reset (a PhysicsWorld of its own):
 
 The coupling, each tick, from the tool's pose and velocity at the tick's start (the Drake
 adapter's):
-    F_tool = -kc M (x_tool (-) xh) - 2 zeta sqrt(kc) M v_tool
-with M = diag(m I, R I_B R^T), applied as the body's force and torque for one step; the wrench
+    F_tool = -kc M (x_tool (-) xh) - 2 zeta sqrt(kc) M (v_tool - v_h)
+with M = diag(m I, R I_B R^T), v_h the handle's velocity by backward difference, applied as the
+body's force and torque for one step; the wrench
 sent to the user is -F_tool. Contacts: the narrow phase's manifolds of the tool's colliders
 (point on the tool, normal from the obstacle to the tool, Rapier's distance).
 
@@ -42,15 +43,27 @@ from .pybullet_engine import _principal  # (principal moments, quaternion of the
 DEFAULTS = {"kc": 4000.0, "zeta": 1.0, "friction": 0.3, "iterations": 4}
 
 
-def coupling_wrench(cfg: dict, m: float, I_B: np.ndarray, p, q, v, omega, xh_p, xh_q) -> np.ndarray:
-    """The coupling's wrench on the tool (force, torque about G; world frame), the Drake adapter's
-    law with the tool's own velocity: -kc M (x_tool (-) xh) - 2 zeta sqrt(kc) M v_tool."""
-    R = rotation_matrices(q)[0]
-    d = pose_difference(p, q, np.asarray(xh_p, float), common.unit(np.asarray(xh_q, float)))  # x_tool (-) xh
-    damp = 2.0 * cfg["zeta"] * np.sqrt(cfg["kc"])
-    force = -cfg["kc"] * m * d[:3] - damp * m * np.asarray(v, float)
-    torque = (R @ I_B @ R.T) @ (-cfg["kc"] * d[3:] - damp * np.asarray(omega, float))
-    return np.concatenate([force, torque])
+class Coupling:
+    """The Drake adapter's coupling law on the tool (force, torque about G; world frame):
+    -kc M (x_tool (-) xh) - 2 zeta sqrt(kc) M (v_tool - v_h), M = diag(m I, R I_B R^T), v_h the
+    handle's velocity by backward difference of its poses (zero at the first tick)."""
+
+    def __init__(self, cfg: dict, m: float, I_B: np.ndarray, dt: float):
+        self.cfg, self.m, self.I_B, self.dt = cfg, float(m), np.asarray(I_B, float), float(dt)
+        self.prev_xh = None
+
+    def wrench(self, p, q, v, omega, xh_p, xh_q) -> np.ndarray:
+        c = self.cfg
+        xh_p, xh_q = np.asarray(xh_p, float), common.unit(np.asarray(xh_q, float))
+        v_h = np.zeros(6) if self.prev_xh is None else pose_difference(xh_p, xh_q, *self.prev_xh) / self.dt
+        self.prev_xh = (xh_p, xh_q)
+        R = rotation_matrices(q)[0]
+        d = pose_difference(p, q, xh_p, xh_q)  # x_tool (-) xh
+        dv = np.concatenate([np.asarray(v, float), np.asarray(omega, float)]) - v_h
+        damp = 2.0 * c["zeta"] * np.sqrt(c["kc"])
+        force = self.m * (-c["kc"] * d[:3] - damp * dv[:3])
+        torque = (R @ self.I_B @ R.T) @ (-c["kc"] * d[3:] - damp * dv[3:])
+        return np.concatenate([force, torque])
 
 
 class RapierEngine:
@@ -77,7 +90,7 @@ class RapierEngine:
         for o in scene.obstacles:
             col = r.Collider.trimesh(np.asarray(o.V, np.float64), np.asarray(o.F, np.uint32), friction=c["friction"],
                                      restitution=0.0)
-            col.position((tuple(map(float, o.p)), r.Rotation3(*map(float, common.unit(o.q)))))
+            col = col.position((tuple(map(float, o.p)), r.Rotation3(*map(float, common.unit(o.q)))))
             w.add_collider(col, parent=ground)
         parts = common.convex_parts(scene.tool.V, scene.tool.F, f"{scene.name}:tool")
         moments, q_BI = _principal(scene.inertia_G_B)
@@ -91,8 +104,7 @@ class RapierEngine:
                                             restitution=0.0) for V, _ in parts]
         self.tool = w.add_body(body, colliders=colliders)
         self.tool_colliders = set(w.rigid_bodies[self.tool].colliders)
-        self.m = float(scene.mass)
-        self.I_B = np.asarray(scene.inertia_G_B, float)
+        self.coupling = Coupling(c, scene.mass, scene.inertia_G_B, 1.0 / scene.rate_hz)
 
     def pose(self) -> tuple[np.ndarray, np.ndarray]:
         b = self.world.rigid_bodies[self.tool]
@@ -100,11 +112,10 @@ class RapierEngine:
         return np.array([t.x, t.y, t.z], float), np.array([q.w, q.i, q.j, q.k], float)
 
     def step(self, t: float, xh_p, xh_q) -> EngineStep:
-        c = self.cfg
         start = time.perf_counter()
         b = self.world.rigid_bodies[self.tool]
         p, q = self.pose()
-        F = coupling_wrench(c, self.m, self.I_B, p, q, list(b.linvel), list(b.angvel), xh_p, xh_q)
+        F = self.coupling.wrench(p, q, list(b.linvel), list(b.angvel), xh_p, xh_q)
         force, torque = F[:3], F[3:]
         b.reset_forces()
         b.reset_torques()
