@@ -47,14 +47,18 @@ def scene_script(scene_path) -> tuple[str, str]:
         name = tomllib.load(f).get("device", {}).get("script", "")
     if not name:
         raise ValueError(f"{scene_path}: device.script is not set: give --script")
-    return script_text(name, scene_path)
+    return script_text(name, scene_path, relative_to_scene=True)
 
 
-def script_text(name: str, scene_path) -> tuple[str, str]:
-    """A script by name (datasets_generated/scripts/NAME.json, beside the scene's folder) or path."""
-    path = Path(name)
-    if not path.suffix == ".json" or not path.exists():
-        path = Path(scene_path).resolve().parent.parent / "scripts" / f"{name}.json"
+def script_text(name: str, scene_path, relative_to_scene: bool = False) -> tuple[str, str]:
+    """A hand script by name (NAME: scripts/NAME.json beside the scene's folder) or by a .json path:
+    the scene's device.script relative to the scene file's folder, as the C++ loader reads it
+    (harness/src/scenario.cpp, load_scene_script); a --script path relative to the working folder."""
+    scene_dir = Path(scene_path).resolve().parent
+    if name.endswith(".json"):
+        path = scene_dir / name if relative_to_scene else Path(name)
+    else:
+        path = scene_dir.parent / "scripts" / f"{name}.json"
     if not path.exists():
         raise ValueError(f"{name}: no such hand script ({path})")
     from .paths import read_input_text  # a regular file (not a FIFO or a device), bounded
