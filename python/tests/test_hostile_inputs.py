@@ -26,6 +26,7 @@ import pytest
 from gauss6 import LoadError, logs, paths, trace
 from gauss6.cli import MAX_RUN_SECONDS, main
 from gauss6.trace import DTYPES, Trace, TraceFormatError, read_trace, trace_metadata, write_trace
+from gauss6.validate import EXIT_USAGE
 
 from test_certify import PEG, peg_run  # noqa: F401  (a 1.5 s peg run, shared)
 
@@ -41,8 +42,13 @@ def _trace(t, **columns) -> Trace:
 
 
 def _exit(argv, capsys) -> tuple[int, str]:
-    """main(argv)'s exit status (parse-time refusals included: 2) and its stderr."""
+    """main(argv)'s exit status (parse-time refusals included) and its stderr."""
     return main(argv), capsys.readouterr().err
+
+
+def refused(code: int, argv) -> bool:
+    """A command's refusal of its input: argparse's 2, or validate's usage code (its 2 means the engine failed)."""
+    return code == (EXIT_USAGE if argv[0] == "validate" else 2)
 
 
 # ---------------------------------------------------------------------------------------------
@@ -76,7 +82,7 @@ def test_certify_validate_and_view_refuse_a_run_without_ticks(tmp_path, capsys, 
         code, err = _exit(["certify", str(run), "--scene", str(PEG), "--out", str(tmp_path / "c"), "--quiet"], capsys)
         assert code == 2 and "holds no ticks" in err, err
         code, err = _exit(["validate", str(run), "--scene", str(PEG), "--out", str(tmp_path / "v"), "--quiet"], capsys)
-        assert code == 2 and "holds no ticks" in err, err
+        assert code == EXIT_USAGE and "holds no ticks" in err, err
     assert not (tmp_path / "c" / "certify.json").exists() and not (tmp_path / "v" / "validation.json").exists()
 
 
@@ -151,7 +157,7 @@ def test_positions_beyond_the_coordinate_bound_are_refused_by_name(tmp_path, cap
     for argv in (["validate", str(path), "--scene", str(PEG), "--out", str(tmp_path / "v"), "--quiet"],
                  ["certify", str(path), "--scene", str(PEG), "--out", str(tmp_path / "c"), "--quiet"]):
         code, err = _exit(argv, capsys)
-        assert code == 2 and f"tick 17" in err and column in err and "beyond 1e+12" in err, err
+        assert refused(code, argv) and f"tick 17" in err and column in err and "beyond 1e+12" in err, err
 
 
 @pytest.mark.parametrize("column", ["xs_q", "xh_q"])
@@ -161,7 +167,7 @@ def test_offline_validate_refuses_a_zero_quaternion_by_tick(tmp_path, capsys, pe
     ticks[column][23] = 0.0
     path = write_trace(Trace(**{**tr.__dict__, "ticks": ticks}), tmp_path / "zero.g6trace")
     code, err = _exit(["validate", str(path), "--scene", str(PEG), "--out", str(tmp_path / "v"), "--quiet"], capsys)
-    assert code == 2 and f"tick 23 (t = {float(ticks['t'][23])!r}): {column} is the zero quaternion" in err, err
+    assert code == EXIT_USAGE and f"tick 23 (t = {float(ticks['t'][23])!r}): {column} is the zero quaternion" in err, err
 
 
 def test_the_coordinate_bound_is_the_cpp_one():
@@ -214,7 +220,7 @@ def test_commands_refuse_what_is_not_a_regular_file(tmp_path, fifo):
     for argv, kind in cases:
         done = subprocess.run([sys.executable, "-m", "gauss6.cli", *argv], capture_output=True, text=True,
                               timeout=60)
-        assert done.returncode == 2 and kind in done.stderr and "Traceback" not in done.stderr, (argv, done.stderr)
+        assert refused(done.returncode, argv) and kind in done.stderr and "Traceback" not in done.stderr, (argv, done.stderr)
 
 
 def _scene_naming(tmp_path, source: str, target: str, path) -> object:
@@ -447,7 +453,7 @@ def test_counts_and_durations_out_of_range_are_refused_at_parse_time(tmp_path, c
     needs = {"validate": ["--scene", str(PEG)], "replay": ["--scene", str(PEG)], "reproduce": []}
     argv += needs.get(argv[0], []) + ["--out", str(tmp_path / "out")]
     code, err = _exit(argv, capsys)
-    assert code == 2 and "Traceback" not in err and ("must be" in err or "duration" in err), err
+    assert refused(code, argv) and "Traceback" not in err and ("must be" in err or "duration" in err), err
     assert not (tmp_path / "out").exists()
 
 
@@ -463,7 +469,7 @@ def test_a_hand_script_spanning_more_than_a_run_can_last_is_refused(tmp_path, ca
     (tmp_path / "long.json").write_text(json.dumps(script))
     code, err = _exit(["validate", "--engine", "gauss6", "--scene", str(PEG), "--script", str(tmp_path / "long.json"),
                        "--out", str(tmp_path / "v"), "--quiet"], capsys)
-    assert code == 2 and "the hand script spans 1e+09 s" in err, err
+    assert code == EXIT_USAGE and "the hand script spans 1e+09 s" in err, err
 
 
 def _outputs(tmp_path):
@@ -499,7 +505,7 @@ def test_out_paths_that_cannot_be_written_are_refused_cleanly(tmp_path, capsys, 
         cases.append((["certify", str(peg_run), "--scene", str(PEG), "--out", str(locked / "c")], "not writable"))
     for argv, message in cases:
         code, err = _exit(argv, capsys)
-        assert code == 2 and message in err and "Traceback" not in err, (argv, err)
+        assert refused(code, argv) and message in err and "Traceback" not in err, (argv, err)
 
 
 def test_a_scene_path_that_is_not_utf8_is_refused_by_name(tmp_path):
