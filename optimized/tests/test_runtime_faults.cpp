@@ -588,8 +588,10 @@ TEST_CASE("faults: invalid handle poses give zero force and an event, invalid se
     far.obstacles[0].pose.p.x() = 2e30;
     CHECK_THROWS_AS(RuntimeModel(far, RuntimeSettings{}), RuntimeError);
     // A delta the CCD cannot serve: denormal, below kMinDeltaPerExtent of the
-    // scene's extent (here ~1.06) or above kMaxDeltaPerExtent of it.
-    for (double bad : {1e-310, 1e-16, 5e-15, 1e-9, 1e-6, 0.5, 1e300}) {
+    // scene's extent or above kMaxDeltaPerExtent of it.
+    const double extent = scene_extent(make_scene());
+    for (double bad : {1e-310, 1e-16, 5e-15, 1e-9, 0.9 * kMinDeltaPerExtent * extent,
+                       1.1 * kMaxDeltaPerExtent * extent, 0.5, 1e300}) {
       Scene tiny = make_scene();
       tiny.contact.delta = bad;
       INFO("delta " << bad);
