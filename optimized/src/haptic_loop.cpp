@@ -21,7 +21,9 @@ bool all_finite(const Vec6& v) { return v.allFinite(); }
 }  // namespace
 
 Vec6 make_safe_wrench(const Vec6& F, double max_force, double max_torque, uint32_t* events) noexcept {
-  if (!all_finite(F)) {
+  // A limit that is not >= 0 (negative or NaN) would reverse the wrench into the
+  // obstacle: no force, as for a non-finite wrench.
+  if (!all_finite(F) || !(max_force >= 0) || !(max_torque >= 0)) {
     *events |= bit(RuntimeEventKind::kNonFiniteForce);
     return Vec6::Zero();
   }

@@ -39,9 +39,13 @@
 //   b_p - r^T b_W exceeds the feasibility tolerance, else the row (violated by
 //   at most that threshold times |A_k| |y| plus rounding) is skipped until a
 //   partial step changes the face. Always so for b = 0, whose feasible set is
-//   never empty. Components of r at rounding level (kRoundoff cond(R) max|r|)
-//   count as zero: exchanges on noise could cycle (seen on rows perturbed by
-//   1e-10 until the iteration cap).
+//   never empty. Components of r at rounding level count as zero: exchanges
+//   on noise could cycle (seen on rows perturbed by 1e-10 until the iteration
+//   cap). Each is measured as the length r_i |A_i| of its row's part of n,
+//   against kRoundoff cond(R) max_j |r_j| |A_j|: r_i itself is in units of
+//   1 / |A_i|, so comparing the bare r_i of rows of different norms made the
+//   answer depend on how the rows were scaled (rows whose norms span 16 orders
+//   of magnitude were answered "optimal" up to 97% off).
 // - Refinement: with rows at a sine s of each other in W, the final solve has
 //   an error of about eps / s (1e-6 for s = 1e-10). When cond(R) > 1e3 the
 //   final KKT point gets two passes of iterative refinement with residuals in
@@ -100,6 +104,17 @@ constexpr double kRefinementCondition = 1e3;
 constexpr int kRefinementPasses = 2;
 // Rounding of a computed sine per unit of cond(R) (see dependence_threshold).
 constexpr double kSineRounding = 64 * std::numeric_limits<double>::epsilon();
+// The problem's lengths in y-space (|au|_M, each row's |J_k|_{M^-1}, each
+// offset's distance |b_k| / |J_k|_{M^-1}) must be 0 or in [kMinLength,
+// kMaxLength], else the input is refused (kBadInput): then every product of two
+// of them, their squares and these times the tolerances (1e-13) and eps stay
+// between 1e-230 and 1e200, clear of overflow and of subnormal numbers (below
+// 2.2e-308), so no test of the method loses its meaning (a norm |au|_M whose
+// square overflows made every row look met). Units and row scales move the
+// lengths by factors, not the answer: any sensible choice lies deep inside.
+constexpr double kMaxLength = 1e100;
+constexpr double kMinLength = 1e-100;
+static_assert(kMaxLength == 1e100 && kMinLength == 1e-100, "the refusals' messages state them");
 // Cap on the additions and drops of recover_multipliers (each O(6 m) flops):
 // the least-squares active-set method needs about one per row of its answer.
 constexpr int kMaxRecoverySteps = 8 * kMaxActive;
@@ -111,29 +126,30 @@ bool all_finite(const double* p, int n) noexcept {
 }
 
 // Validates M and J and refreshes the cached L, A, row norms when either
-// changed (bytewise). Returns false when M is not finite/symmetric/SPD or J is
-// not finite.
-bool update_cache(const ProjectionProblem& pb, ProjectionWorkspace& ws) noexcept {
+// changed (bytewise). Returns nullptr, or what is wrong (M not finite,
+// symmetric or SPD; J not finite or a row's norm |A_k| out of range).
+const char* update_cache(const ProjectionProblem& pb, ProjectionWorkspace& ws) noexcept {
   const Mat6& M = *pb.M;
   const int m = pb.num_rows;
   const bool same_M = ws.has_M && std::memcmp(M.data(), ws.M.data(), sizeof(double) * 36) == 0;
   const bool same_J = same_M && ws.num_rows == m &&
                       (m == 0 || std::memcmp(pb.J, ws.J.data(), sizeof(double) * 6 * m) == 0);
-  if (same_J) return true;
+  if (same_J) return nullptr;
 
   ws.factor_matches_cache = false;
   if (!same_M) {
     ws.has_M = false;
     ws.num_rows = -1;
-    if (!all_finite(M.data(), 36)) return false;
+    if (!all_finite(M.data(), 36)) return "M: an entry is not finite";
     const double max_entry = M.cwiseAbs().maxCoeff();
-    if ((M - M.transpose()).cwiseAbs().maxCoeff() > kSymmetryTol * max_entry) return false;
+    if ((M - M.transpose()).cwiseAbs().maxCoeff() > kSymmetryTol * max_entry) return "M: not symmetric";
     Eigen::LLT<Mat6> llt(M);
-    if (llt.info() != Eigen::Success) return false;
+    if (llt.info() != Eigen::Success) return "M: not positive definite";
     const Mat6 L = llt.matrixL();
     const double max_diag = M.diagonal().maxCoeff();
     for (int i = 0; i < 6; ++i)
-      if (!(L(i, i) * L(i, i) > kMinPivotRatio * max_diag)) return false;
+      if (!(L(i, i) * L(i, i) > kMinPivotRatio * max_diag))
+        return "M: not positive definite (condition number beyond 1e14)";
     ws.M = M;
     ws.L = L;
     // L^-1, lower triangular, column by column (forward substitution on e_j).
@@ -148,22 +164,23 @@ bool update_cache(const ProjectionProblem& pb, ProjectionWorkspace& ws) noexcept
     }
     ws.has_M = true;
   }
-  if (m > 0 && !all_finite(pb.J, 6 * m)) {
-    ws.num_rows = -1;
-    return false;
-  }
+  ws.num_rows = -1;  // until every row is checked
+  if (m > 0 && !all_finite(pb.J, 6 * m)) return "J: an entry is not finite";
   // A_k^T = L^-1 J_k^T (a product with the cached inverse: no dependency chain).
   for (int k = 0; k < m; ++k) {
     Eigen::Map<Vec6> Ak(ws.A.data() + 6 * k);
     Ak.noalias() = ws.L_inv * Eigen::Map<const Vec6>(pb.J + 6 * k);  // dense 6x6: fastest here
     const double norm2 = Ak.squaredNorm();
+    const bool zero_row = Eigen::Map<const Vec6>(pb.J + 6 * k).isZero(0);
+    if (!zero_row && !(norm2 >= kMinLength * kMinLength && norm2 <= kMaxLength * kMaxLength))
+      return "J: a row's norm |J_k|_{M^-1} is outside [1e-100, 1e100] (neither 0)";
     ws.row_norm[k] = std::sqrt(norm2);
     ws.inv_row_norm[k] = norm2 > 0 ? 1.0 / ws.row_norm[k] : 1.0;
     for (int j = 0; j < 6; ++j) ws.A_t[static_cast<size_t>(ws.capacity) * j + k] = Ak[j];
   }
   if (m > 0) std::memcpy(ws.J.data(), pb.J, sizeof(double) * 6 * m);
   ws.num_rows = m;
-  return true;
+  return nullptr;
 }
 
 // The m x 6 matrix A stored column by column with stride ws.capacity.
@@ -581,12 +598,14 @@ bool recover_multipliers(ProjectionWorkspace& ws, const Vec6& y, const Vec6& yu,
 
 bool valid_settings(const ProjectionSettings& s) noexcept {
   return std::isfinite(s.dependence_tol) && s.dependence_tol >= 0 && s.dependence_tol < 1 &&
-         std::isfinite(s.feasibility_tol) && s.feasibility_tol >= 0 && s.max_iterations >= 0;
+         std::isfinite(s.feasibility_tol) && s.feasibility_tol >= 0 && s.max_iterations >= 0 &&
+         s.certificate_tol > 0 && s.certificate_tol < 1;
 }
 
 // A result that makes no force: ac = au (or 0 when au is not finite).
 ProjectionStatus zero_force_result(const ProjectionProblem& pb, ProjectionStatus status,
                                    int iterations, ProjectionResult* res) noexcept {
+  res->problem = nullptr;
   res->ac = all_finite(pb.au.data(), 6) ? pb.au : Vec6::Zero();
   std::fill(res->lambda.begin(), res->lambda.end(), 0.0);
   res->num_active = 0;
@@ -594,7 +613,31 @@ ProjectionStatus zero_force_result(const ProjectionProblem& pb, ProjectionStatus
   res->iterations = iterations;
   res->stationarity = res->primal_infeasibility = 0;
   res->dual_infeasibility = res->complementarity = 0;
+  res->kkt_relative = 0;
   return status;
+}
+
+ProjectionStatus bad_input(const ProjectionProblem& pb, const char* problem, ProjectionResult* res) noexcept {
+  zero_force_result(pb, ProjectionStatus::kBadInput, 0, res);
+  res->problem = problem;
+  return ProjectionStatus::kBadInput;
+}
+
+// What is out of range among the problem's lengths in y-space: |y_u| and each
+// offset's distance |b_k| / |A_k|, neither 0, must lie in [kMinLength,
+// kMaxLength]; nullptr when all do.
+const char* length_problem(const Vec6& yu, const double* b, const ProjectionWorkspace& ws, int m) noexcept {
+  const auto out_of_range = [](double length) {
+    return length != 0 && !(length >= kMinLength && length <= kMaxLength);
+  };
+  // |y_u| from its largest entry first: its square may overflow or underflow.
+  const double largest = yu.cwiseAbs().maxCoeff();
+  if (out_of_range(largest) || (largest != 0 && out_of_range((yu / largest).norm() * largest)))
+    return "au: |au|_M is outside [1e-100, 1e100] (neither 0)";
+  for (int k = 0; b != nullptr && k < m; ++k)
+    if (ws.row_norm[k] > 0 && out_of_range(std::abs(b[k]) / ws.row_norm[k]))
+      return "b: an offset's distance |b_k| / |J_k|_{M^-1} is outside [1e-100, 1e100] (neither 0)";
+  return nullptr;
 }
 
 void compute_residuals(const ProjectionProblem& pb, ProjectionResult* res) noexcept {
@@ -618,6 +661,45 @@ void compute_residuals(const ProjectionProblem& pb, ProjectionResult* res) noexc
   res->complementarity = comp;
 }
 
+// J_k a, for row k of the problem.
+inline double Jk_dot(const ProjectionProblem& pb, int k, const Vec6& a) noexcept {
+  return Eigen::Map<const Vec6>(pb.J + 6 * k).dot(a);
+}
+
+// The answer's KKT conditions measured in a form that no positive scaling of a
+// row, of b or of units changes (see ProjectionResult::kkt_relative). Lengths
+// are in y-space (the M^-1 norm of a force, the M norm of a motion): row k's
+// slack over its scale |A_k| y_scale + |b_k|; its multiplier as the length of
+// its correction lambda_k |A_k|, over the sum of all the lengths the
+// stationarity residual adds up (y_scale + sum |lambda_k| |A_k|: multipliers of
+// a jammed body reach 1e10 times the force, and their rounding with them);
+// complementarity as the smaller of the two (a row is tight or carries no
+// force); the stationarity residual's M^-1 norm over that sum. |A_k| =
+// |J_k|_{M^-1} is the cached row norm; y_scale = max(|ac|_M, |au|_M).
+double relative_kkt(const ProjectionProblem& pb, const ProjectionWorkspace& ws, const ProjectionResult& res) noexcept {
+  const int m = pb.num_rows;
+  const double y_scale = std::max((ws.L.transpose() * res.ac).norm(), (ws.L.transpose() * pb.au).norm());
+  Vec6 g = (*pb.M) * (res.ac - pb.au);
+  double terms = y_scale;
+  for (int k = 0; k < m; ++k) {
+    const double lam = res.lambda[k];
+    if (lam == 0) continue;
+    g -= lam * Eigen::Map<const Vec6>(pb.J + 6 * k);
+    terms += std::abs(lam) * ws.row_norm[k];
+  }
+  if (!(terms > 0)) return 0;  // au = 0 and no force: ac = 0 exactly
+  double worst = (ws.L_inv * g).norm() / terms;  // |g|_{M^-1} = |L^-1 g|
+  for (int k = 0; k < m; ++k) {
+    const double bk = pb.b ? pb.b[k] : 0.0;
+    const double scale = ws.row_norm[k] * y_scale + std::abs(bk);
+    const double slack = Jk_dot(pb, k, res.ac) - bk;
+    const double correction = res.lambda[k] * ws.row_norm[k] / terms;
+    const double violation = scale > 0 ? slack / scale : 0.0;
+    worst = std::max({worst, -violation, -correction, std::min(std::abs(correction), std::abs(violation))});
+  }
+  return worst;
+}
+
 }  // namespace
 
 const char* to_string(ProjectionStatus status) noexcept {
@@ -626,6 +708,7 @@ const char* to_string(ProjectionStatus status) noexcept {
     case ProjectionStatus::kIterationCap: return "iteration cap";
     case ProjectionStatus::kInfeasibleOffsets: return "infeasible offsets";
     case ProjectionStatus::kBadInput: return "bad input";
+    case ProjectionStatus::kUncertified: return "uncertified";
   }
   return "unknown";
 }
@@ -657,14 +740,20 @@ ProjectionStatus project(const ProjectionProblem& pb, const ProjectionSettings& 
                          ProjectionWorkspace* workspace, ProjectionResult* res) noexcept {
   if (res == nullptr) return ProjectionStatus::kBadInput;
   const int m = pb.num_rows;
-  if (workspace == nullptr || !valid_settings(settings) || pb.M == nullptr || m < 0 ||
-      m > workspace->capacity || m > res->max_rows() || (m > 0 && pb.J == nullptr) || !all_finite(pb.au.data(), 6) ||
-      (pb.b != nullptr && !all_finite(pb.b, m)))
-    return zero_force_result(pb, ProjectionStatus::kBadInput, 0, res);
+  const char* problem = nullptr;
+  if (workspace == nullptr) problem = "workspace: null";
+  else if (!valid_settings(settings)) problem = "settings: out of range";
+  else if (pb.M == nullptr) problem = "M: null";
+  else if (m < 0 || m > workspace->capacity || m > res->max_rows())
+    problem = "num_rows: negative or beyond the workspace's or the result's max_rows";
+  else if (m > 0 && pb.J == nullptr) problem = "J: null with rows";
+  else if (!all_finite(pb.au.data(), 6)) problem = "au: an entry is not finite";
+  else if (pb.b != nullptr && !all_finite(pb.b, m)) problem = "b: an entry is not finite";
+  if (problem) return bad_input(pb, problem, res);
   ProjectionWorkspace& ws = *workspace;
-  if (!update_cache(pb, ws)) {
+  if ((problem = update_cache(pb, ws)) != nullptr) {
     ws.num_active = 0;
-    return zero_force_result(pb, ProjectionStatus::kBadInput, 0, res);
+    return bad_input(pb, problem, res);
   }
   const double* b = pb.b;
   const double dep_tol = settings.dependence_tol;
@@ -672,6 +761,9 @@ ProjectionStatus project(const ProjectionProblem& pb, const ProjectionSettings& 
 
   // Target in Cholesky coordinates: y_u = L^T au.
   const Vec6 yu = ws.L.transpose() * pb.au;
+  // The problem's lengths (y-space) within range (see kMaxLength): |y_u| and each
+  // offset's distance |b_k| / |A_k| (an offset on a zero row is a bare sign test).
+  if ((problem = length_problem(yu, b, ws, m)) != nullptr) return bad_input(pb, problem, res);
   const double yu_norm = yu.norm();
 
   // Starting working set: empty (cold) or the previous one, whose factors are
@@ -749,15 +841,16 @@ ProjectionStatus project(const ProjectionProblem& pb, const ProjectionSettings& 
         r[i] = v / ws.R(i, i);
       }
       // Components of r at the rounding of the solve with R (about eps cond(R)
-      // of its largest) have no sign: a partial step on one would exchange a row
-      // for p on noise, and such exchanges can cycle.
+      // of its largest, each as the length r_i |A_i|: see the top of this file)
+      // have no sign: a partial step on one would exchange a row for p on
+      // noise, and such exchanges can cycle.
       double r_max = 0;
-      for (int i = 0; i < q; ++i) r_max = std::max(r_max, std::abs(r[i]));
+      for (int i = 0; i < q; ++i) r_max = std::max(r_max, std::abs(r[i]) * ws.row_norm[ws.active[i]]);
       const double r_noise = kRoundoff * working_set_condition(ws) * r_max;
       double t1 = kInf;
       int block = -1;
       for (int i = 0; i < q; ++i) {
-        if (r[i] <= r_noise) continue;
+        if (r[i] * ws.row_norm[ws.active[i]] <= r_noise) continue;
         const double ratio = ws.lambda_active[i] / r[i];
         if (ratio < t1 || (ratio == t1 && ws.active[i] < ws.active[block])) {
           t1 = ratio;
@@ -797,7 +890,7 @@ ProjectionStatus project(const ProjectionProblem& pb, const ProjectionSettings& 
       // Components at rounding level count as zero here too (as in the ratio
       // test): moved by t r_i, a small multiplier would go negative.
       for (int i = 0; i < q; ++i)
-        if (std::abs(r[i]) > r_noise) ws.lambda_active[i] -= t * r[i];
+        if (std::abs(r[i]) * ws.row_norm[ws.active[i]] > r_noise) ws.lambda_active[i] -= t * r[i];
       lambda_p += t;
       if (!dependent) {
         // Primal step along z = Q(:, q:6) d(q:6), the part of n orthogonal to W.
@@ -849,7 +942,12 @@ ProjectionStatus project(const ProjectionProblem& pb, const ProjectionSettings& 
   }
   res->num_active = q;
   res->status = status;
+  res->problem = nullptr;
   res->iterations = iterations;
+  // "optimal" only with the scale-free certificate (kkt_relative) met.
+  res->kkt_relative = relative_kkt(pb, ws, *res);
+  if (status == ProjectionStatus::kOptimal && !(res->kkt_relative <= settings.certificate_tol))
+    res->status = status = ProjectionStatus::kUncertified;
   if (settings.compute_residuals) {
     compute_residuals(pb, res);
   } else {

@@ -96,7 +96,8 @@ inline void store_pose(const Pose& x, double p[3], double q[4]) {
 inline bool read_handle(const RuntimeChannels& ch, HandleSample* sample) { return ch.handle.try_read(sample); }
 
 inline bool projection_failed(ProjectionStatus s) {
-  return s == ProjectionStatus::kBadInput || s == ProjectionStatus::kIterationCap;
+  return s == ProjectionStatus::kBadInput || s == ProjectionStatus::kIterationCap ||
+         s == ProjectionStatus::kUncertified;
 }
 
 }  // namespace gauss6::detail

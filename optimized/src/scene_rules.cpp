@@ -4,8 +4,10 @@
 // runtime model applies the same rules to a scene built in code.
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <limits>
 
+#include "gauss6/coupling.h"
 #include "gauss6/scene.h"
 
 namespace gauss6 {
@@ -43,11 +45,18 @@ namespace {
 bool finite_above(double x, double lo) { return std::isfinite(x) && x > lo; }
 bool finite_below(double x, double hi) { return std::isfinite(x) && x < hi; }
 
+// A length for a message: six significant digits, any magnitude.
+std::string format_number(double x) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%.6g", x);
+  return text;
+}
+
 }  // namespace
 
 SettingsProblem check_gains(const Gains& g) {
   if (!(finite_above(g.ks, 0) && g.ks <= 1)) return {"gains", "ks", "must be in (0, 1]"};
-  if (!finite_above(g.kh, 0)) return {"gains", "kh", "must be > 0"};
+  if (!valid_coupling_gain(g.kh)) return {"gains", "kh", "must be > 0"};
   return {};
 }
 
@@ -94,13 +103,17 @@ double scene_extent(const Scene& scene) {
 }
 
 SettingsProblem check_delta_scale(const Scene& scene) {
-  static_assert(kMinDeltaPerExtent == 1e-14 && kMinDelta == 1e-150, "the message below states them");
+  static_assert(kMinDeltaPerExtent == 1e-6 && kMaxDeltaPerExtent == 1e-2 && kMinDelta == 1e-150,
+                "the messages below state them");
   const double extent = scene_extent(scene), delta = scene.contact.delta;
+  const std::string where = " of the scene's extent (" + format_number(extent) + ", the farthest vertex from the origin)";
   if (!(delta >= kMinDelta && delta >= kMinDeltaPerExtent * extent))
     return {"contact", "delta",
-            "must be at least 1e-14 of the scene's extent (" + std::to_string(extent) +
-                ", the farthest vertex from the origin) and at least 1e-150: smaller, it "
-                "nears the coordinates' rounding and the CCD cannot keep its stop distance inside the contact band"};
+            "must be at least 1e-6" + where + " and at least 1e-150: smaller, the rounding of squared "
+            "coordinates nears delta^2 and the god-object stops sliding along surfaces"};
+  if (!(delta <= kMaxDeltaPerExtent * extent))
+    return {"contact", "delta",
+            "must be at most 1e-2" + where + ": larger, the contact band swallows the scene"};
   return {};
 }
 

@@ -6,6 +6,8 @@
 #include <limits>
 
 #include "gauss6/coupling.h"
+#include "gauss6/haptic_loop.h"
+#include "gauss6/runtime_events.h"
 #include "mass_matrices.h"
 
 namespace {
@@ -43,4 +45,30 @@ TEST_CASE("coupling force is zero on non-finite input", "[coupling]") {
   Mat6 Mbad = M;
   Mbad(0, 0) = std::numeric_limits<double>::infinity();
   CHECK(gauss6::coupling_force(Mbad, au, Vec6::Zero(), 1.0) == Vec6::Zero());
+}
+
+TEST_CASE("a coupling gain that is not > 0 makes no force, and the safety stage no reversed one", "[coupling]") {
+  // kh < 0 reversed Fc = kh M (ac - au) into the obstacle; a negative device limit
+  // did the same in make_safe_wrench (scaled by limit / |F| < 0).
+  const Mat6 M = box_mass_matrix();
+  const Vec6 au = (Vec6() << 0, 0, -0.01, 0, 0, 0).finished();
+  const Vec6 ac = Vec6::Zero();
+  CHECK(gauss6::coupling_force(M, au, ac, 100.0)[2] > 0);  // pushes the hand back out
+  constexpr double kInf = std::numeric_limits<double>::infinity();
+  for (const double kh : {-100.0, 0.0, -0.0, std::nan(""), kInf, -kInf}) {
+    INFO("kh " << kh);
+    CHECK_FALSE(gauss6::valid_coupling_gain(kh));
+    CHECK(gauss6::coupling_force(M, au, ac, kh).isZero(0));
+  }
+  const Vec6 F = (Vec6() << 0, 0, 50, 1, 0, 0).finished();
+  for (const auto& [max_force, max_torque] : {std::pair{-20.0, 1.0}, std::pair{20.0, -1.0}, std::pair{std::nan(""), 1.0}}) {
+    uint32_t events = 0;
+    INFO("limits " << max_force << ", " << max_torque);
+    CHECK(gauss6::make_safe_wrench(F, max_force, max_torque, &events).isZero(0));
+    CHECK((events & (1u << static_cast<int>(gauss6::RuntimeEventKind::kNonFiniteForce))) != 0);
+  }
+  uint32_t events = 0;
+  const Vec6 safe = gauss6::make_safe_wrench(F, 20.0, 0.0, &events);
+  CHECK(safe[2] == Approx(20.0));
+  CHECK(safe.tail<3>().isZero(0));
 }

@@ -236,6 +236,34 @@ TEST_CASE("Mesh files whose headers are broken or whose counts lie are refused b
   }
 }
 
+TEST_CASE("Mesh files holding more records than their headers state are refused, naming the line", "[meshio]") {
+  // The readers stop at the stated counts: the rest of the file (faces, vertices,
+  // values, facets) was dropped silently, a mesh other than the file's.
+  const TempDir dir;
+  require_file_error(dir.write("extra_face.off", "OFF\n4 1 0\n0 0 0\n1 0 0\n0 1 0\n0 0 1\n3 0 1 2\n3 0 1 3\n"),
+                     "line 8: more records than the header states (4 vertices, 1 faces)");
+  require_file_error(dir.write("extra_after_comment.off", "OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n# end\n3 0 1 2\n"),
+                     "line 8: more records");
+  // Comments and blank lines after the last face are no records.
+  CHECK(read_mesh(dir.write("trailing_comment.off", "OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n# end\n\n")).F.rows() == 1);
+  const std::string header = "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
+                             "property float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n";
+  require_file_error(dir.write("extra_face.ply", header + "0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n3 0 2 1\n"),
+                     "line 14: more values than the header's elements state");
+  CHECK(read_mesh(dir.write("trailing_space.ply", header + "0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n\n  \n")).F.rows() == 1);
+  {
+    std::string ply = "ply\nformat binary_little_endian 1.0\nelement face 1\n"
+                      "property list uchar int vertex_indices\nend_header\n";
+    const std::string face = std::string("\x03", 1) + std::string(12, '\0');
+    require_file_error(dir.write("extra_binary.ply", ply + face + face), "13 bytes after the header's elements");
+  }
+  {
+    std::string stl(80, ' ');
+    stl += std::string("\x01\0\0\0", 4) + std::string(100, '\0');  // 1 facet stated, 2 held
+    require_file_error(dir.write("extra.stl", stl), "the header states 1 facets, the file holds 2");
+  }
+}
+
 // OBJ `vn` normals reach the vertices through the face corners that reference
 // them; NOFF normals follow each vertex's coordinates. Exact comparisons: the
 // values are short decimals read from text into doubles, copied unchanged.

@@ -587,21 +587,26 @@ TEST_CASE("faults: invalid handle poses give zero force and an event, invalid se
     far = make_scene();
     far.obstacles[0].pose.p.x() = 2e30;
     CHECK_THROWS_AS(RuntimeModel(far, RuntimeSettings{}), RuntimeError);
-    // A delta the CCD cannot serve: denormal, or below 1e-14 of the scene's extent (here ~1.06).
-    for (double bad : {1e-310, 1e-16, 5e-15}) {
+    // A delta the CCD cannot serve: denormal, below kMinDeltaPerExtent of the
+    // scene's extent or above kMaxDeltaPerExtent of it.
+    const double extent = scene_extent(make_scene());
+    for (double bad : {1e-310, 1e-16, 5e-15, 1e-9, 0.9 * kMinDeltaPerExtent * extent,
+                       1.1 * kMaxDeltaPerExtent * extent, 0.5, 1e300}) {
       Scene tiny = make_scene();
       tiny.contact.delta = bad;
       INFO("delta " << bad);
       CHECK_THROWS_WITH(RuntimeModel(tiny, RuntimeSettings{}), Catch::Contains("contact.delta"));
     }
     Scene small = make_scene();
-    small.contact.delta = 2e-14;
+    small.contact.delta = 2 * kMinDeltaPerExtent;
+    CHECK_NOTHROW(RuntimeModel(small, RuntimeSettings{}));
+    small.contact.delta = 0.5 * kMaxDeltaPerExtent;
     CHECK_NOTHROW(RuntimeModel(small, RuntimeSettings{}));
     // Below kMinDelta (1e-150) whatever the scene's size: the whole scene shrunk
-    // by 1e-170, delta 1e-14 of its extent; at 1e-145 it is served.
+    // so that delta is about 2 kMinDeltaPerExtent of its extent; at 1e-145 it is served.
     for (const double d : {1e-160, 1e-145}) {
       Scene shrunk = make_scene();
-      const double scale = d / 1e-14;
+      const double scale = d / (2 * kMinDeltaPerExtent);
       for (Body& b : shrunk.obstacles) b.mesh.V *= scale, b.pose.p *= scale;
       shrunk.god_object.mesh.V *= scale;
       shrunk.god_object.pose.p *= scale;

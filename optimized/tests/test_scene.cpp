@@ -329,6 +329,28 @@ TEST_CASE("the settings rules are one function per table and the loader uses the
              Contains("device.rate_hz: must be in [100, 10000]"));
 }
 
+TEST_CASE("contact.delta is refused outside its range of the scene's extent", "[scene][delta]") {
+  using Catch::Matchers::Contains;
+  // The test scene's extent: the god-object's far corner, rotated about x at (0, 0, 1).
+  const double extent = scene_extent(load_scene(TempScene(kScene).path()));
+  REQUIRE(extent > 1);
+  // Below kMinDeltaPerExtent of it the god-object stopped sliding (scene.h), and the
+  // delta of 1e-9..1e-14 that did so were accepted; above kMaxDeltaPerExtent the band
+  // swallows the scene (0.5 and 1e300 were accepted).
+  for (const char* bad : {"1e-9", "1e-12", "1e-14", "2e-6"})
+    CHECK_THAT(load_error(edited("delta = 1e-5", std::string("delta = ") + bad)),
+               Contains("contact.delta: must be at least 1e-6 of the scene's extent"));
+  for (const char* bad : {"0.5", "1e300", "0.1"})
+    CHECK_THAT(load_error(edited("delta = 1e-5", std::string("delta = ") + bad)),
+               Contains("contact.delta: must be at most 1e-2 of the scene's extent"));
+  // The bounds themselves are accepted (the rule and the loader are one function).
+  for (const double ok : {kMinDeltaPerExtent * extent * (1 + 1e-15), kMaxDeltaPerExtent * extent * (1 - 1e-15)}) {
+    Scene s = load_scene(TempScene(kScene).path());
+    s.contact.delta = ok;
+    CHECK_FALSE(check_delta_scale(s));
+  }
+}
+
 TEST_CASE("the loader refuses what the runtime cannot represent, and names it", "[scene]") {
   // A 64-bit integer is not narrowed: 2^32 + 1 is not version 1.
   CHECK_THAT(load_error(edited("version = 1", "version = 4294967297")), Catch::Contains("unsupported version 4294967297"));

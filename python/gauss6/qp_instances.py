@@ -6,6 +6,12 @@ M (6, 6) the god-object's generalised mass (world frame), J (m, 6) the contact r
 au (6,) the unconstrained step, b (m,) the offsets. `load_family("box")` returns the
 instances of datasets_generated/qp/box.json; `check_all()` regenerates every family in a
 temporary directory and compares it with MANIFEST.json.
+
+One family is derived from the files rather than stored: `row_scaled` (ROW_SCALED), each
+instance of the other families (but ROW_SCALED_LEFT_OUT) twice, its rows scaled by positive
+factors whose norms span 16 orders of magnitude, then the same rows rescaled by another
+such draw (see row_scaled()). The feasible cone, hence the exact answer, is the same for
+every positive scaling of a row: the projection must give it either way.
 """
 from __future__ import annotations
 
@@ -25,6 +31,15 @@ FAMILIES_DIR = DATASETS_DIR / "qp"
 FORMAT = "gauss6-qp-instances"
 FORMAT_VERSION = 1
 PUSH_LABELS = ("all", "some", "none")
+ROW_SCALED = "row_scaled"
+# Row factors 10^U(-ROW_SCALE_DECADES, ROW_SCALE_DECADES): well inside the projection's
+# range of lengths (quasistatics.cpp: kMinLength, kMaxLength) for every stored family.
+ROW_SCALE_DECADES = 8
+ROW_SCALED_SEED = 1201
+# Families row_scaled does not draw from: warm (its steps are a sequence, solved warm) and
+# inertia, whose accuracy M's condition sets (2e-11 against the exact answer with its rows
+# as stored; eps sqrt(cond M)): row_scaled is held to 1e-12, the rows' part alone.
+ROW_SCALED_LEFT_OUT = ("warm", "inertia")
 
 
 @dataclass
@@ -50,6 +65,39 @@ def family_names() -> list[str]:
     """The families listed in MANIFEST.json, in generation order."""
     manifest = json.loads((FAMILIES_DIR / "MANIFEST.json").read_text())
     return [Path(f).stem for f in manifest["outputs"]]
+
+
+def crosscheck_family_names() -> list[str]:
+    """The families `gauss6 crosscheck qp` checks by default: the stored ones, then row_scaled."""
+    return family_names() + [ROW_SCALED]
+
+
+def row_scaled(instances: list[Instance], rng: np.random.Generator) -> list[Instance]:
+    """Each instance with rows twice: J_k, b_k scaled by s_k = 10^U(-D, D) (row norms
+    spanning 2 D orders of magnitude; D = ROW_SCALE_DECADES), then by another draw t_k
+    (ids "<id>/rows-a", "<id>/rows-b"). With offsets (b != 0) the factors are powers of
+    two over the same range, so that the scaled rows are exactly the given ones times s_k:
+    the offsets family's infeasible instances (a row and its exact opposite) stay exactly
+    infeasible, where a rounded factor would tilt one row by an ulp and make them feasible."""
+    out = []
+    for inst in instances:
+        J, b = inst.J, inst.b
+        exact = bool(np.any(b != 0))
+        for tag in ("a", "b"):
+            s = 10.0 ** rng.uniform(-ROW_SCALE_DECADES, ROW_SCALE_DECADES, inst.num_rows)
+            if exact:
+                s = np.exp2(np.round(np.log2(s)))
+            J, b = J * s[:, None], b * s
+            out.append(Instance(id=f"{inst.id}/rows-{tag}", M=inst.M, au=inst.au, J=J, b=b, push=inst.push,
+                                tags=dict(inst.tags, row_scaled=tag)))
+    return out
+
+
+def row_scaled_family() -> list[Instance]:
+    """The derived family: row_scaled() of every stored family but ROW_SCALED_LEFT_OUT, in turn."""
+    rng = np.random.default_rng(ROW_SCALED_SEED)
+    return [x for name in family_names() if name not in ROW_SCALED_LEFT_OUT
+            for x in row_scaled(load_family(name), rng)]
 
 
 def _family_path(name_or_path: str | Path) -> Path:
@@ -84,6 +132,8 @@ def load_family(name_or_path: str | Path) -> list[Instance]:
     """The instances of one family: a name ('box', 'peg', ...) or a path to a family file.
 
     Raises ValueError naming the file and the problem for a malformed file."""
+    if name_or_path == ROW_SCALED:
+        return row_scaled_family()
     path = _family_path(name_or_path)
     try:
         doc = json.loads(path.read_text())

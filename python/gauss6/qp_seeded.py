@@ -16,6 +16,10 @@ Beyond the files' families, many simultaneous contacts (METHOD.md: any number):
   rows (exact duplicates, scaled copies, copies perturbed by a relative 1e-6..1e-12,
   averages of two rows), shuffled.
 
+And row_scaled (qp_instances.row_scaled): chunk j draws size // 2 instances of the files'
+families but qp_instances.ROW_SCALED_LEFT_OUT (family j mod 6, its chunk j // 6) and gives each twice, its rows scaled
+by positive factors spanning 16 orders of magnitude, then rescaled.
+
 Instance ids: "F-sS-cINDEX-NNNN".
 """
 from __future__ import annotations
@@ -28,7 +32,8 @@ import sys
 import numpy as np
 from numpy.random import PCG64, Generator
 
-from .qp_instances import FAMILIES_DIR, Instance, from_record
+from .qp_instances import (FAMILIES_DIR, ROW_SCALED, ROW_SCALED_LEFT_OUT, ROW_SCALED_SEED, Instance, from_record,
+                           row_scaled)
 
 CHUNK_SIZE = 360      # a multiple of 36 (m 1..12 x 3 labels), 24 (redundant), 10 (offsets), 4 (inertia)
 WARM_STEPS = 50
@@ -65,8 +70,15 @@ MANY_ROWS = {"m200": (1101, 200), "m1000": (1102, 1000), "redundant_m200": (1103
 
 
 def family_names() -> list[str]:
-    """Every family: the files' and the many-row ones."""
-    return list(generator().SEEDS) + list(MANY_ROWS)
+    """Every family: the files', the many-row ones and row_scaled."""
+    return list(generator().SEEDS) + list(MANY_ROWS) + [ROW_SCALED]
+
+
+def _row_scaled_chunk(seed: int, index: int, size: int) -> list[Instance]:
+    """Chunk `index` of row_scaled (see the top of this file)."""
+    bases = [f for f in generator().SEEDS if f not in ROW_SCALED_LEFT_OUT]
+    base = chunk_instances(bases[index % len(bases)], seed, index // len(bases), max(size // 2, 1))
+    return row_scaled(base, Generator(PCG64([seed, ROW_SCALED_SEED, index])))
 
 
 def default_family_names() -> list[str]:
@@ -123,6 +135,8 @@ def chunk_instances(family: str, seed: int, index: int, size: int = CHUNK_SIZE) 
     params = dict(gen.family_params()[family]) if family in gen.SEEDS else {}
     if size < 1:
         raise ValueError(f"a chunk of {size} instances")
+    if family == ROW_SCALED:
+        return _row_scaled_chunk(seed, index, size)
     params["count"] = chunk_size(family, size)
     if family == "warm":
         params.update(sequences=params["count"] // WARM_STEPS, steps=WARM_STEPS)
@@ -139,5 +153,7 @@ def chunk_instances(family: str, seed: int, index: int, size: int = CHUNK_SIZE) 
 
 
 def chunk_size(family: str, size: int = CHUNK_SIZE) -> int:
-    """Instances in a chunk of `size` of the family (warm: whole sequences)."""
+    """Instances in a chunk of `size` of the family (warm: whole sequences; row_scaled: pairs)."""
+    if family == ROW_SCALED:
+        return 2 * max(size // 2, 1)
     return max(size // WARM_STEPS, 1) * WARM_STEPS if family == "warm" else size

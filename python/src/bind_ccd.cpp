@@ -12,6 +12,7 @@
 #include <pybind11/stl.h>
 
 #include <chrono>
+#include <cmath>
 #include <memory>
 #include <optional>
 #include <stdexcept>
@@ -47,6 +48,12 @@ CcdQuery::Kind kind_from(const std::string& kind) {
 // the queries whose rationals are not all doubles (none in the shared data).
 py::dict run_query_file(const std::string& path, const std::string& kind, const std::string& impl,
                         double time_tolerance) {
+  // The optimized CCD refuses a query under a tolerance that is not > 0 (an
+  // invalid-input status, no hit): refused here first, by name, so that no
+  // refusal is counted as a miss.
+  if (!(std::isfinite(time_tolerance) && time_tolerance > 0))
+    throw py::value_error("time_tolerance must be finite and > 0 (the u-width of an accepted interval), not " +
+                          py::repr(py::float_(time_tolerance)).cast<std::string>());
   const std::vector<CcdQuery> queries = read_ccd_queries(path, kind_from(kind));
   const size_t n = queries.size();
   std::vector<bool> hit(n), expected(n);
@@ -89,6 +96,9 @@ py::dict run_query_file(const std::string& path, const std::string& kind, const 
         q.edge_b = {{{x[2], x[3]}, {x[6], x[7]}}};
         ccd_linear_edge_edge(q, settings, &ws, &r);
       }
+      if (r.status == CcdStatus::kInvalidInput)
+        throw py::value_error(path + ":" + std::to_string(line[i]) + ": the optimized CCD refused the query (" +
+                              to_string(r.status) + ")");
       hit[i] = r.hit;
     }
     seconds = seconds_since(t0);

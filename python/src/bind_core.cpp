@@ -62,7 +62,11 @@ void bind_core(py::module_& m) {
           const CcdSettings ccd;
           py::dict d;
           d["contact"] = py::dict(py::arg("offset_eps_per_delta") = kDefaultOffsetEpsPerDelta,
-                                  py::arg("offset_time") = contact.offset_time);
+                                  py::arg("offset_time") = contact.offset_time,
+                                  // delta's range (check_delta_scale): these times the scene's extent, and kMinDelta
+                                  py::arg("min_delta_per_extent") = kMinDeltaPerExtent,
+                                  py::arg("max_delta_per_extent") = kMaxDeltaPerExtent,
+                                  py::arg("min_delta") = kMinDelta);
           d["surface"] = py::dict(py::arg("kind") = to_string(surface.kind));
           d["device"] = py::dict(py::arg("rate_hz") = device.rate_hz, py::arg("max_force") = device.max_force,
                                  py::arg("max_torque") = device.max_torque);
@@ -172,6 +176,7 @@ void bind_core(py::module_& m) {
           d["contact"] = py::dict(py::arg("delta") = scene.contact.delta,
                                   py::arg("offset_eps") = scene.contact.offset_eps,
                                   py::arg("offset_time") = scene.contact.offset_time);
+          d["extent"] = scene_extent(scene);  // the length delta's range is stated in (scene.h)
           d["surface"] = to_string(scene.surface.kind);
           d["device"] = to_string(scene.device.kind);
           return d;

@@ -29,8 +29,9 @@ struct PyProjection {
   Eigen::VectorXd lam;
   std::vector<int> active;
   std::string status;
+  std::string problem;  // on "bad_input", what is wrong (quasistatics.h); else empty
   int iterations;
-  double stationarity, primal_infeasibility, dual_infeasibility, complementarity;
+  double stationarity, primal_infeasibility, dual_infeasibility, complementarity, kkt_relative;
 };
 
 // Checks shapes at the edge (the C++ solver takes raw row-major pointers).
@@ -66,14 +67,17 @@ PyProjection run(const Mat6& M, const Vec6& au, const RowsX6& J, const std::opti
   out.ac = r.ac;
   out.lam = Eigen::Map<const Eigen::VectorXd>(r.lambda.data(), J.rows());
   out.active.assign(r.active.begin(), r.active.begin() + r.num_active);
-  // Status names as Python identifiers: "optimal", "iteration_cap", "infeasible_offsets", "bad_input".
+  // Status names as Python identifiers: "optimal", "iteration_cap", "infeasible_offsets", "bad_input",
+  // "uncertified".
   out.status = to_string(r.status);
   std::replace(out.status.begin(), out.status.end(), ' ', '_');
+  out.problem = r.problem ? r.problem : "";
   out.iterations = r.iterations;
   out.stationarity = r.stationarity;
   out.primal_infeasibility = r.primal_infeasibility;
   out.dual_infeasibility = r.dual_infeasibility;
   out.complementarity = r.complementarity;
+  out.kkt_relative = r.kkt_relative;
   return out;
 }
 
@@ -99,6 +103,7 @@ void bind_quasistatics(py::module_& m) {
       .def(py::init<>())
       .def_readwrite("dependence_tol", &ProjectionSettings::dependence_tol)
       .def_readwrite("feasibility_tol", &ProjectionSettings::feasibility_tol)
+      .def_readwrite("certificate_tol", &ProjectionSettings::certificate_tol)
       .def_readwrite("max_iterations", &ProjectionSettings::max_iterations)
       .def_readwrite("warm_start", &ProjectionSettings::warm_start)
       .def_readwrite("compute_residuals", &ProjectionSettings::compute_residuals);
@@ -108,7 +113,7 @@ void bind_quasistatics(py::module_& m) {
         [] {
           const ProjectionSettings s;
           return py::dict(py::arg("dependence_tol") = s.dependence_tol, py::arg("feasibility_tol") = s.feasibility_tol,
-                          py::arg("max_iterations") = s.max_iterations, py::arg("warm_start") = s.warm_start,
+                          py::arg("certificate_tol") = s.certificate_tol, py::arg("max_iterations") = s.max_iterations, py::arg("warm_start") = s.warm_start,
                           py::arg("compute_residuals") = s.compute_residuals);
         },
         "Defaults of ProjectionSettings (quasistatics.h).");
@@ -123,6 +128,8 @@ void bind_quasistatics(py::module_& m) {
       .def_readonly("primal_infeasibility", &PyProjection::primal_infeasibility)
       .def_readonly("dual_infeasibility", &PyProjection::dual_infeasibility)
       .def_readonly("complementarity", &PyProjection::complementarity)
+      .def_readonly("kkt_relative", &PyProjection::kkt_relative)
+      .def_readonly("problem", &PyProjection::problem)
       .def("__repr__", [](const PyProjection& p) {
         return "<Projection status=" + p.status + " active=" + std::to_string(p.active.size()) +
                " iterations=" + std::to_string(p.iterations) + ">";
@@ -138,7 +145,10 @@ void bind_quasistatics(py::module_& m) {
         },
         py::arg("M"), py::arg("au"), py::arg("J"), py::arg("b") = py::none(), py::arg("settings") = py::none(),
         "ac = argmin 1/2 (a-au)^T M (a-au) s.t. J a >= b (b=None: 0). M (6,6) SPD, au (6,), J (m,6).\n"
-        "Returns a Projection with .ac, .lam, .active, .status, .iterations and the KKT residuals.");
+        "Returns a Projection with .ac, .lam, .active, .status, .iterations, the KKT residuals and kkt_relative\n"
+        "(their scale-free form; 'optimal' only when it is within settings.certificate_tol). Input out of the\n"
+        "solver's range (non-finite, M not SPD, a length |au|_M, |J_k|_{M^-1} or |b_k|/|J_k|_{M^-1} outside\n"
+        "[1e-100, 1e100], 0 allowed) is refused: status 'bad_input', .problem names it.");
 
   py::class_<Projector>(m, "Projector", "A projection that keeps its workspace between calls (warm starts).")
       .def(py::init<const ProjectionSettings&>(), py::arg("settings") = ProjectionSettings{})
@@ -176,10 +186,15 @@ void bind_quasistatics(py::module_& m) {
 
   m.def("coupling_force",
         [](const Mat6& M, const Vec6& au, const RowsX6& J, double kh, const std::optional<Eigen::VectorXd>& b) {
+          // coupling_force() makes no force for such a gain (coupling.h); here it is refused by name.
+          if (!valid_coupling_gain(kh))
+            throw py::value_error("kh must be finite and > 0 (the coupling stiffness; a negative one pushes into the "
+                                  "obstacle), not " + py::repr(py::float_(kh)).cast<std::string>());
           ProjectionWorkspace ws(std::max(static_cast<int>(J.rows()), 1));
           ProjectionSettings s;
           s.warm_start = false;
           const PyProjection p = run(M, au, J, b, s, &ws);
+          if (p.status == "bad_input") throw py::value_error("coupling_force: " + p.problem);
           return Vec6(coupling_force(M, au, p.ac, kh));
         },
         py::arg("M"), py::arg("au"), py::arg("J"), py::arg("kh"), py::arg("b") = py::none(),

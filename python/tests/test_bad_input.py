@@ -162,7 +162,7 @@ def test_projection_never_returns_nan(M, au, J):
     J = np.array(J, float).reshape(-1, 6)
     r = _gauss6.project(M, np.array(au, float), J)
     assert np.all(np.isfinite(r.ac))
-    assert r.status in ("optimal", "bad_input", "iteration_cap")
+    assert r.status in ("optimal", "bad_input", "iteration_cap", "uncertified")
 
 
 @settings(max_examples=200, deadline=None)

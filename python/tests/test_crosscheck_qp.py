@@ -23,7 +23,7 @@ def test_crosscheck_qp_json_form_and_verdict():
     assert list(result) == ["ok", "tolerance", "families"]
     assert result["tolerance"] == 1e-9
     names = [f["name"] for f in result["families"]]
-    assert names == qp_instances.family_names()
+    assert names == qp_instances.crosscheck_family_names()
     for f in result["families"]:
         assert list(f) == ["name", "count", "max_rel_err_ac", "max_rel_err_force", "max_kkt_residual",
                            "certificate_failures", "osqp_max_rel_err_ac", "statuses"]

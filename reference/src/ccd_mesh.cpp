@@ -826,7 +826,8 @@ SeparationBracket separation_bracket(const ExactMeshPair& mp, const Pose& X, dou
 }
 
 ExactSeparation separation_distance(const ExactMeshPair& mp, const Pose& X, double max_distance) {
-  if (!(max_distance >= 0)) throw std::invalid_argument("separation_distance: max_distance must be >= 0");
+  if (!(max_distance >= 0 && std::isfinite(max_distance)))
+    throw std::invalid_argument("separation_distance: max_distance must be finite and >= 0");
   const PosedBody posed(mp.god, X);
   using Candidate = SeparationCandidate;
   std::vector<Candidate> close;

@@ -13,8 +13,11 @@ namespace gauss6 {
 
 // Fc = kh M (ac - au): the wrench (force, torque about G; world frame) sent to
 // the user. One gain kh for both parts keeps Fc^T ac = 0 (METHOD.md section 5).
-// Returns zero when any input or the product is not finite: a device never
-// receives NaN or inf.
+// Returns zero when any input or the product is not finite, or when kh is not a
+// valid gain: a device never receives NaN or inf, nor a wrench reversed into the
+// obstacle by a gain kh <= 0.
 Vec6 coupling_force(const Mat6& M, const Vec6& au, const Vec6& ac, double kh) noexcept;
+// The gain's rule: kh finite and > 0 (check_gains in scene.h states it for scenes).
+bool valid_coupling_gain(double kh) noexcept;
 
 }  // namespace gauss6

@@ -57,6 +57,8 @@ bool haptic_tick(const RuntimeModel& model, double t, Device* device, RuntimeCha
 
 // The safety stage alone: returns a finite wrench within the limits; sets the
 // bits of *events (1 << RuntimeEventKind) for kNonFiniteForce and kForceClamped.
+// A non-finite wrench, or a limit that is not >= 0 (negative or NaN), gives zero
+// and kNonFiniteForce.
 Vec6 make_safe_wrench(const Vec6& F, double max_force, double max_torque, uint32_t* events) noexcept;
 
 }  // namespace gauss6

@@ -41,7 +41,7 @@ inline constexpr int kDefaultMaxContacts = 64;
 // Size of a working set: at most 6 linearly independent rows in R^6.
 inline constexpr int kMaxActive = 6;
 
-// Tolerances and limits; defaults suit double-precision haptics. Both
+// Tolerances and limits; defaults suit double-precision haptics. The
 // tolerances are relative (to |A_k| = sqrt(J_k M^-1 J_k^T), |y| = |a|_M,
 // |b_k|): independent of units and row scaling. Why these values: see
 // "Tolerances" at the top of quasistatics.cpp.
@@ -60,6 +60,13 @@ struct ProjectionSettings {
   // rounding of a slack, and small because a nearly parallel row left violated
   // by v moves the answer by v / (their sine).
   double feasibility_tol = 1e-13;
+  // The answer is "optimal" only when its KKT conditions, measured in a
+  // scale-free form (ProjectionResult::kkt_relative), hold to this; else the
+  // status is kUncertified. 1e-8: the method's answers reach at most 1.6e-11
+  // (ill-conditioned M), the wrong active sets of a ratio test that mixed the
+  // rows' units 0.06..0.4 (measured over the instance families with their rows
+  // rescaled by 1e-8..1e8).
+  double certificate_tol = 1e-8;
   // Cap on the add/drop steps of one call (typ. <= 2 m are needed).
   int max_iterations = 200;
   // Start from the previous call's working set (kept in the workspace).
@@ -80,7 +87,14 @@ enum class ProjectionStatus {
                        // ac = au (zero force), lambda = 0.
   kBadInput,           // non-finite data, M not SPD, num_rows out of [0, the
                        // workspace's and the result's max_rows],
-                       // J null with rows, or settings out of range.
+                       // J null with rows, settings out of range, or a length
+                       // out of [1e-100, 1e100] (|au|_M, a row's |J_k|_{M^-1},
+                       // an offset's |b_k| / |J_k|_{M^-1}; 0 is allowed):
+                       // ProjectionResult::problem names it. ac as for
+                       // kInfeasibleOffsets.
+  kUncertified,        // the method ended but its answer fails the scale-free
+                       // KKT certificate (kkt_relative > certificate_tol): ac
+                       // (finite) is not to be taken as the projection.
 };
 const char* to_string(ProjectionStatus status) noexcept;
 
@@ -108,6 +122,9 @@ struct ProjectionResult {
   std::array<int, kMaxActive> active{};
   int num_active = 0;
   ProjectionStatus status = ProjectionStatus::kBadInput;
+  // On kBadInput, what is wrong ("au: an entry is not finite"; a string
+  // literal); else nullptr.
+  const char* problem = nullptr;
   int iterations = 0;  // add/drop steps taken (0 when the warm start was exact;
                        // the multipliers' recovery at a degenerate vertex is
                        // not counted: it is bounded on its own)
@@ -117,6 +134,14 @@ struct ProjectionResult {
   double primal_infeasibility = 0;  // max_k (b_k - J_k ac)+
   double dual_infeasibility = 0;    // max_k (-lambda_k)+
   double complementarity = 0;       // max_k |lambda_k (J_k ac - b_k)|
+  // The same conditions in a scale-free form (always filled), with y =
+  // max(|ac|_M, |au|_M) and T = y + sum |lambda_k| |J_k|_{M^-1} (the sizes of
+  // the terms stationarity sums): the largest of each row's violation over its
+  // scale |J_k|_{M^-1} y + |b_k|, each negative lambda_k |J_k|_{M^-1} over T,
+  // each complementarity pair as the smaller of the two, and
+  // |M (ac - au) - J^T lambda|_{M^-1} over T. No positive scaling of a row, of
+  // b or of the units changes it.
+  double kkt_relative = 0;
 };
 
 // Caller-owned state of project(): every buffer is preallocated here. One

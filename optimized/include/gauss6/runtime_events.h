@@ -27,7 +27,7 @@ enum class RuntimeEventKind {
   kNonFiniteForce,         // the computed wrench was not finite: zero force
   kForceClamped,           // force or torque above the device's limits: scaled down
   kDeviceEnded,            // the device's script or replay ended: the run stops
-  kProjectionFailed,       // a projection returned kBadInput or kIterationCap
+  kProjectionFailed,       // a projection returned kBadInput, kIterationCap or kUncertified
   kCcdGaveUp,              // the sim step's CCD gave up (hit kept conservatively) or refused its input
   kContactOverflow,        // more contacts than RuntimeSettings::max_contacts: the set was truncated
   kTextureUndersampled,    // a textured contact moved more than half the texture's shortest wavelength in one

@@ -137,12 +137,24 @@ SettingsProblem check_surface_settings(const SurfaceSettings& surface);  // text
                                                                          // axis; height map: an image of
                                                                          // >= 2 x 2 values in [0, 1]
 SettingsProblem check_crease_angle(double degrees);                      // [[obstacle]]: 0 <= crease_angle <= 180
-// delta against the scene's size: delta at least kMinDelta and at least
-// kMinDeltaPerExtent of scene_extent(scene), the largest distance from the origin
-// any vertex reaches (obstacles where they stand, the god-object at its initial
-// pose). Below it delta nears the rounding of the coordinates (1e-14 is ~45 ulps)
-// and the CCD's stop distance can no longer be kept inside the contact band.
-inline constexpr double kMinDeltaPerExtent = 1e-14;
+// delta against the scene's size: delta at least kMinDelta and within
+// [kMinDeltaPerExtent, kMaxDeltaPerExtent] of scene_extent(scene), the largest
+// distance from the origin any vertex reaches (obstacles where they stand, the
+// god-object at its initial pose).
+// The floor: the distance and CCD tests square coordinate differences, whose
+// rounding (eps extent^2) reaches delta^2 at delta = sqrt(eps) extent = 1.5e-8
+// extent; the god-object then no longer slides along a surface (it stays put with
+// no sideways force: the faceted cylinder, extent 0.05, from delta = 5e-9, 1e-7
+// of its extent, while it slides at 7e-9). 1e-6 keeps eps extent^2 below 2.2e-4
+// delta^2, a factor 7 above that edge.
+inline constexpr double kMinDeltaPerExtent = 1e-6;
+// The ceiling: delta is the unfelt separation kept before contact (the paper's
+// scenes use 1e-5 of their size). A band of 1e-2 of the scene's extent is already
+// coarse; beyond it the band swallows the scene (the proximity cache's margins of
+// 64..256 delta span it many times over, the god-object stops far off the
+// surfaces, and delta = 0.5 in a 5 cm scene ran 27 times slower than real time
+// with the god-object stuck).
+inline constexpr double kMaxDeltaPerExtent = 1e-2;
 // And delta at least kMinDelta, whatever the scene's size: the CCD's rounded
 // bounds widen values near zero by up to 2^-599 (4.8e-181) absolute
 // (rounding.h); 1e-150 keeps that 30 orders of magnitude below delta.

@@ -139,6 +139,11 @@ void check_off_structure(const std::string& path, const std::string& bytes) {
                        " has corner '" + std::string(t[c]) + "', not a vertex number below " + std::to_string(nv));
     }
   }
+  // A file holding more than its header states (CGAL stops at the counts and
+  // would drop the rest silently).
+  if (lines.next(&t))
+    fail(path, "cannot parse as OFF: line " + std::to_string(lines.line()) + ": more records than the header states (" +
+                   std::to_string(nv) + " vertices, " + std::to_string(nf) + " faces)");
 }
 
 namespace {
@@ -351,6 +356,10 @@ void check_ply_structure(const std::string& path, const std::string& bytes) {
           }
         }
     }
+    // A file holding more than its header states (the reader stops at the counts).
+    if (std::string_view extra; next_token(&extra))
+      fail(path, "cannot parse as PLY: line " + std::to_string(1 + std::count(all.begin(), all.begin() + pos, '\n')) +
+                     ": more values than the header's elements state ('" + std::string(extra.substr(0, 32)) + "')");
   } else {
     const bool big = format == "binary_big_endian";
     const auto* data = reinterpret_cast<const unsigned char*>(all.data());
@@ -380,6 +389,12 @@ void check_ply_structure(const std::string& path, const std::string& bytes) {
           pos += n * static_cast<uint64_t>(p.value_size);
         }
     }
+    // A file holding more than its header states; trailing white space (a
+    // writer's final newline) is no record.
+    while (pos < size && is_space(all[pos])) ++pos;
+    if (pos < size)
+      fail(path, "cannot parse as PLY: " + std::to_string(size - pos) +
+                     " bytes after the header's elements (the file holds more than it states)");
   }
 }
 
@@ -391,7 +406,9 @@ void check_stl_structure(const std::string& path, const std::string& bytes) {
   std::memcpy(&n, bytes.data() + 80, 4);  // little-endian (checked by the trace writer's build too)
   const bool binary_size = bytes.size() == 84 + 50 * static_cast<uint64_t>(n);
   if (bytes.compare(0, 5, "solid") == 0 && !binary_size) return;  // ASCII
-  if (static_cast<uint64_t>(n) > (bytes.size() - 84) / 50)
+  // The facets the file holds must be those it states: fewer cannot be read, and
+  // more would be dropped silently (a trailing part of a facet is no facet).
+  if (static_cast<uint64_t>(n) != (bytes.size() - 84) / 50)
     fail(path, "cannot parse as STL: the header states " + std::to_string(n) + " facets, the file holds " +
                    std::to_string((bytes.size() - 84) / 50));
 }
