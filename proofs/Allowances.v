@@ -206,7 +206,91 @@ Proof.
   apply next_up_ge.
 Qed.
 
+
+(* ---- kRelativeRounding at its norm sites ----
+   round_up(v.norm() * (1 + kRelativeRounding)): Eigen's norm of a double
+   3-vector, sqrt of the sum of the three rounded squares (summed in any
+   order: the statement is symmetric in x, y, z), times the double
+   1 + kRelativeRounding (the compiler folds it, rounding to nearest), rounded
+   up, is at least the exact norm, provided |v|^2 >= 2^-1000: below that the
+   squares underflow and the bound can fall below |v| (proofs/README.md).
+   Sites: StartFrame::set (omega_norm, omega a double vector) and the same
+   form at SweptObbFrame::pose (|half|); not the shift of Displacement, whose
+   components are rounded differences. *)
+(* allowance kRelativeRounding = 1e-15 *)
+Definition kRelativeRounding := fl (/ 1000000000000000).
+
+Lemma fl_lower z : 0 <= z -> (1 - u) * z - eta <= fl z.
+Proof.
+  intros Hz. pose proof (fl_err z) as H. rewrite (Rabs_pos_eq z Hz) in H.
+  unfold Rabs in H; destruct Rcase_abs; lra.
+Qed.
+Lemma fl_upper z : 0 <= z -> fl z <= (1 + u) * z + eta.
+Proof.
+  intros Hz. pose proof (fl_err z) as H. rewrite (Rabs_pos_eq z Hz) in H.
+  unfold Rabs in H; destruct Rcase_abs; lra.
+Qed.
+
+Lemma one_plus_rel : 1 + 7 * u <= fl (1 + kRelativeRounding).
+Proof.
+  pose proof eta_pos. pose proof eta_small.
+  assert (bpow radix2 (-1022) <= / 1000000000000000000) by (simpl; lra).
+  assert (Hk : (1 - u) * / 1000000000000000 - eta <= kRelativeRounding) by (apply fl_lower; lra).
+  assert (0 <= kRelativeRounding) by (apply fl_nonneg; lra).
+  pose proof (fl_lower (1 + kRelativeRounding) ltac:(lra)).
+  unfold u in *. lra.
+Qed.
+
+(* covers optimized/src/motion_bounds.cpp "void StartFrame::set(const CcdMotion& m, double u, double rho_in)" sha256:d727ef1e2605b2dd *)
+Theorem norm_relative_rounding x y z :
+  bpow radix2 (-1000) <= x * x + y * y + z * z ->
+  let s := fl (fl (fl (x * x) + fl (y * y)) + fl (z * z)) in
+  sqrt (x * x + y * y + z * z) <= next_up (fl (fl (sqrt s) * fl (1 + kRelativeRounding))).
+Proof.
+  intros HS s. pose proof eta_pos. pose proof eta_small. assert (Hu : 0 < u) by (unfold u; lra).
+  set (S := x * x + y * y + z * z) in *.
+  assert (E1 : 1000000 * eta <= u * bpow radix2 (-1000)).
+  { unfold eta, u. replace (/ 9007199254740992) with (bpow radix2 (-53)) by (simpl; lra).
+    rewrite <- bpow_plus. apply Rle_trans with (bpow radix2 22 * bpow radix2 (-1075)).
+    - apply Rmult_le_compat_r; [apply bpow_ge_0 | simpl; lra].
+    - rewrite <- bpow_plus. apply bpow_le. lia. }
+  assert (HeS : 1000000 * eta <= u * S)
+    by (apply Rle_trans with (u * bpow radix2 (-1000)); [exact E1 | apply Rmult_le_compat_l; lra]).
+  assert (X := fl_lower (x * x) ltac:(nra)); assert (Y := fl_lower (y * y) ltac:(nra));
+  assert (Z := fl_lower (z * z) ltac:(nra)).
+  assert (0 <= fl (x * x)) by (apply fl_nonneg; nra); assert (0 <= fl (y * y)) by (apply fl_nonneg; nra);
+  assert (0 <= fl (z * z)) by (apply fl_nonneg; nra).
+  assert (T := fl_lower (fl (x * x) + fl (y * y)) ltac:(lra)).
+  assert (0 <= fl (fl (x * x) + fl (y * y))) by (apply fl_nonneg; lra).
+  assert (Hs := fl_lower (fl (fl (x * x) + fl (y * y)) + fl (z * z)) ltac:(lra)). fold s in Hs.
+  assert (Hs' : (1 - 4 * u) * S <= s).
+  { unfold S in *. assert (0 <= x * x) by nra. assert (0 <= y * y) by nra. assert (0 <= z * z) by nra.
+    unfold u in *. nra. }
+  assert (HS0 : 0 < S) by (pose proof (bpow_gt_0 radix2 (-1000)); lra).
+  assert (Hr : (1 - 4 * u) * sqrt S <= sqrt s).
+  { apply Rle_trans with (sqrt ((1 - 4 * u) * S)); [|apply sqrt_le_1_alt; exact Hs'].
+    rewrite sqrt_mult by (unfold u; lra). apply Rmult_le_compat_r; [apply sqrt_pos|].
+    assert (0 <= 1 - 4 * u <= 1) by (unfold u; lra).
+    rewrite <- (sqrt_Rsqr (1 - 4 * u)) at 1 by lra. apply sqrt_le_1_alt. unfold Rsqr. nra. }
+  assert (Hn := fl_lower (sqrt s) (sqrt_pos s)).
+  assert (HsS : eta <= u * sqrt S).
+  { (* sqrt S >= S when S <= 1, and sqrt S >= 1 >= S... : use sqrt S >= S / sqrt S... simply: *)
+    destruct (Rle_or_lt S 1).
+    - assert (S <= sqrt S).
+      { rewrite <- (sqrt_Rsqr S) at 1 by lra. apply sqrt_le_1_alt. unfold Rsqr. nra. }
+      nra.
+    - assert (1 <= sqrt S) by (rewrite <- sqrt_1; apply sqrt_le_1_alt; lra).
+      unfold eta in *. apply Rle_trans with (bpow radix2 (-1075)); [lra|].
+      apply Rle_trans with u; [|nra]. unfold u. replace (/ 9007199254740992) with (bpow radix2 (-53)) by (simpl; lra).
+      apply bpow_le; lia. }
+  pose proof one_plus_rel.
+  assert (0 <= sqrt S) by apply sqrt_pos.
+  assert (Hn' : (1 - 6 * u) * sqrt S <= fl (sqrt s)) by (unfold u in *; nra).
+  apply up_ge. unfold u in *. nra.
+Qed.
+
 (* The theorems, each answered by tools/check_proofs.sh. *)
 Print Assumptions linear_corner_rounding.
 Print Assumptions linear_corner_selection.
 Print Assumptions linear_corner_error_bound.
+Print Assumptions norm_relative_rounding.

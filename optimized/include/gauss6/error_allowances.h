@@ -25,6 +25,11 @@ namespace gauss6 {
 // Sites: |omega| and the step's rounding (StartFrame::set, ::obb_frame), the
 // shift |p_b - p_a| (Displacement), |half| (SweptObbFrame::pose), and a
 // corner's |r_B| (StartFrame::radius).
+// Machine-checked for the norm of a double vector (|omega| in StartFrame::set,
+// |half|): proofs/Allowances.v, norm_relative_rounding, which needs |v|^2 >=
+// 2^-1000 or v = 0: below that the squares underflow and round_up(|v| (1 +
+// kRelativeRounding)) may fall below |v| (proofs/README.md); the other sites'
+// arguments are not machine-checked yet.
 constexpr double kRelativeRounding = 1e-15;
 
 // The same roundings of a norm (or of a sum of two norms, its own rounding
