@@ -16,7 +16,10 @@ namespace gauss6 {
 // coefficients of every polynomial with coefficients in given intervals, in
 // doubles with a certified rounding bound.
 //
-// Proof. On [u0, u1] (0 <= u0 <= u1 <= 1) a polynomial sum_j k_j u^j of degree
+// Proof (over the reals machine-checked in proofs/Bernstein.v:
+// bernstein_certificate, from bernstein_positive, bernstein_blossom and
+// bernstein_end_rows; the doubles' part, kBernsteinRounding, argued below and
+// not yet machine-checked). On [u0, u1] (0 <= u0 <= u1 <= 1) a polynomial sum_j k_j u^j of degree
 // N is sum_i b_i B_i(t), t = (u - u0) / (u1 - u0), with B_i >= 0 summing to 1
 // (the Bernstein basis), so it is >= min_i b_i there, and b_i = sum_j k_j w_ij
 // with w_ij = e_j(u0 repeated N - i times, u1 i times) / C(N, j) (the blossom

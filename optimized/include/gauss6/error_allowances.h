@@ -25,6 +25,11 @@ namespace gauss6 {
 // Sites: |omega| and the step's rounding (StartFrame::set, ::obb_frame), the
 // shift |p_b - p_a| (Displacement), |half| (SweptObbFrame::pose), and a
 // corner's |r_B| (StartFrame::radius).
+// Machine-checked for the norm of a double vector (|omega| in StartFrame::set,
+// |half|): proofs/Allowances.v, norm_relative_rounding, which needs |v|^2 >=
+// 2^-1000 or v = 0: below that the squares underflow and round_up(|v| (1 +
+// kRelativeRounding)) may fall below |v| (proofs/README.md); the other sites'
+// arguments are not machine-checked yet.
 constexpr double kRelativeRounding = 1e-15;
 
 // The same roundings of a norm (or of a sum of two norms, its own rounding
@@ -136,19 +141,12 @@ constexpr double kUnderflowFloor = 1e-300;
 
 // A corner value of F = (w + a ea) - b eb for linearly moving points (the
 // narrow phase's enclose_linear, ccd.cpp), every input coordinate bounded by M
-// and u, a, b in [0, 1]; each rounded operation adds at most u times its
-// result's magnitude (plus 2^-1075 if it underflows):
-//   dx = x1 - x0          |dx| <= 2M    error <= 2uM
-//   p = x0 + u dx         |p|  <= 3M    error <= 2uM + 2uM + 3uM = 7uM
-//   w, e1, e2 = p - p'    |.|  <= 6M    error <= 14uM + 6uM = 20uM
-//   a e1, b e2            |.|  <= 6M    error <= 20uM + 6uM = 26uM
-//   (w - a e1) - b e2     |.|  <= 18M   error <= 20 + 26 + 12 + 26 + 18 = 102uM
-// so 128 u M + 64 2^-1022 (underflows) bounds the error of every corner value
-// (a margin of 1.25). The underflow term counts each underflow at 2^-1022, not
-// 2^-1075: a result flushed to zero on a thread with FTZ set errs by up to the
-// least normal (rounding.h), and the term itself stays normal (a subnormal
-// operand costs a microcode assist on Intel cores). A fused multiply-add, if a
-// compiler contracted one, rounds once instead of twice: within the same bound.
+// and u, a, b in [0, 1], is computed within 128 u M + 64 2^-1022 of the exact
+// one (69 u M + 44 2^-1075 proved): proofs/Allowances.v, linear_corner_rounding
+// (and linear_corner_selection, linear_corner_error_bound for the min / max
+// taken and the bound rounded up). The proof models gradual underflow; the
+// underflow term counts 2^-1022 per operation so that it also covers a thread
+// that flushes subnormals to zero (rounding.h), which the proof does not model.
 constexpr double kLinearCornerRounding = 0x1p-46;  // 128 u
 constexpr double kLinearCornerUnderflow = 64 * std::numeric_limits<double>::min();  // 2^-1016
 

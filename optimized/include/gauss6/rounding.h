@@ -17,7 +17,12 @@ namespace gauss6 {
 // ---------------------------------------------------------------------------
 // Interval arithmetic with outward rounding.
 //
-// Proof of enclosure. Every operation below computes its double result(s) in the
+// Proof of enclosure, machine-checked in proofs/Rounding.v (Flocq, binary64,
+// round to nearest, finite results, gradual underflow): next_up_ge,
+// next_down_le (and next_up_ge_fma for the contracted forms); each operation's
+// theorem is named above it. The argument, and what the theorems leave to it
+// (overflow, NaN, flush to zero):
+// Every operation below computes its double result(s) in the
 // default round-to-nearest mode (IEEE 754, SSE2 on x86-64: no excess precision)
 // and then widens the lower bound down and the upper bound up, branch-free:
 //   next_up(r) = fl(r' + t),  r' = max(r, -DBL_MAX),  t = fl(|r'| 2^-52 + 2^-600).
@@ -57,12 +62,14 @@ namespace gauss6 {
 // their call sites as calls (measured: Interval products were ~18% of a step).
 #define GAUSS6_ALWAYS_INLINE [[gnu::always_inline]] inline
 
+// Rounding.v: next_up_ge, next_up_ge_fma.
 GAUSS6_ALWAYS_INLINE double next_up(double x) {
   constexpr double kMax = std::numeric_limits<double>::max();
   constexpr double kUlp = 0x1p-52, kTiny = 0x1p-600;  // (the proof above)
   const double r = x < -kMax ? -kMax : x;  // maxsd; keeps a NaN (the comparison is false)
   return r + (std::abs(r) * kUlp + kTiny);
 }
+// Rounding.v: next_down_le.
 GAUSS6_ALWAYS_INLINE double next_down(double x) { return -next_up(-x); }
 
 // A closed interval [lo, hi] of reals; lo <= hi unless a NaN crept in.
@@ -73,6 +80,10 @@ struct Interval {
   bool contains(double x) const { return lo <= x && x <= hi; }
 };
 
+// Rounding.v: interval_point_encloses (point), interval_add_encloses,
+// interval_sub_encloses, interval_neg_encloses, interval_mul_encloses,
+// interval_scale_encloses, interval_div_positive_encloses,
+// interval_sqr_encloses, interval_hull_encloses, in the order below.
 GAUSS6_ALWAYS_INLINE Interval operator+(Interval a, Interval b) { return {next_down(a.lo + b.lo), next_up(a.hi + b.hi)}; }
 GAUSS6_ALWAYS_INLINE Interval operator-(Interval a, Interval b) { return {next_down(a.lo - b.hi), next_up(a.hi - b.lo)}; }
 GAUSS6_ALWAYS_INLINE Interval operator-(Interval a) { return {-a.hi, -a.lo}; }  // exact
@@ -132,6 +143,11 @@ struct Lower {
   double v = 0;
 };
 
+// Rounding.v: round_up_bounds, round_down_bounds; upper_add, upper_sub,
+// upper_mul, upper_scale, upper_div (its Lower divisor's double must be > 0,
+// not only its real), upper_div_scalar, upper_sqr, upper_sqrt, upper_max,
+// upper_min; lower_add, lower_sub, lower_div, lower_sqr (its operand's double
+// must be >= 0, not only its real), lower_sqrt; lower_gt_upper.
 GAUSS6_ALWAYS_INLINE Upper round_up(double x) { return {next_up(x)}; }
 GAUSS6_ALWAYS_INLINE Lower round_down(double x) { return {next_down(x)}; }
 
@@ -156,6 +172,8 @@ GAUSS6_ALWAYS_INLINE Lower sqrt(Lower a) { return {next_down(std::sqrt(a.v))}; }
 
 GAUSS6_ALWAYS_INLINE bool operator>(Lower a, Upper b) { return a.v > b.v; }  // false on NaN
 
+// Rounding.v: interval_widen_encloses, magnitude_bounds, distance_from_bounds,
+// norm_upper_bounds.
 // [lo - e, hi + e] for e >= 0, rounded outward.
 GAUSS6_ALWAYS_INLINE Interval widen(Interval a, Upper e) { return {next_down(a.lo - e.v), next_up(a.hi + e.v)}; }
 // Bounds read off an interval: the largest magnitude of its points (exact),

@@ -1,0 +1,123 @@
+// Tests of the theorems of proofs/Allowances.v: the rounding error of each
+// proved allowance's expression, evaluated as its site evaluates it (the same
+// operations in the same order; the site's code is tied to the theorem by the
+// hash tools/check_proofs.sh compares), against the exact value in rationals
+// (GMP), on random and adversarial inputs: signed zeros, subnormals, inputs at
+// the largest coordinate the CCD accepts (1e30), parameters at 0 and 1.
+#include <catch2/catch.hpp>
+
+#include <gmpxx.h>
+
+#include <Eigen/Dense>
+
+#include <array>
+#include <cmath>
+#include <limits>
+#include <random>
+
+#include "gauss6/error_allowances.h"
+#include "gauss6/rounding.h"
+
+using namespace gauss6;
+
+namespace {
+
+mpq_class Q(double x) { return mpq_class(x); }
+
+// A coordinate of every scale up to 1e30, or an adversarial one.
+double coordinate(std::mt19937_64& rng) {
+  static const std::array<double, 8> kSpecial = {0.0, -0.0, std::numeric_limits<double>::denorm_min(),
+                                                 -std::numeric_limits<double>::min(), 1e30, -1e30,
+                                                 1.0 + 0x1p-52, -0x1p-1000};
+  std::uniform_int_distribution<int> ex(-1074, 99), pick(0, 15);
+  std::uniform_real_distribution<double> mant(-1, 1);
+  const int k = pick(rng);
+  return k < 8 ? kSpecial[static_cast<size_t>(k)] : std::ldexp(mant(rng), ex(rng));
+}
+// A parameter in [0, 1]: 0, 1, or random (of every scale).
+double parameter(std::mt19937_64& rng) {
+  std::uniform_int_distribution<int> pick(0, 3), ex(-1074, 0);
+  std::uniform_real_distribution<double> mant(0, 1);
+  const int k = pick(rng);
+  return k == 0 ? 0.0 : k == 1 ? 1.0 : k == 2 ? std::ldexp(mant(rng), ex(rng)) : mant(rng);
+}
+
+}  // namespace
+
+// linear_corner_rounding: ccd.cpp's make_linear_points (dx = x1 - x0) and
+// enclose_linear (p = x0 + t dx, w / ea / eb differences of points, the corner
+// value (w + a ea) - b eb) stay within kLinearCornerRounding M +
+// kLinearCornerUnderflow of the exact corner value of the exact points.
+TEST_CASE("linear corner values within kLinearCornerRounding (Allowances.v linear_corner_rounding)",
+          "[proved]") {
+  std::mt19937_64 rng(45);
+  double worst = 0;  // the largest error seen, in units of the allowance
+  for (int n = 0; n < 20000; ++n) {
+    std::array<double, 6> x0, x1;
+    double M = 0;
+    for (int k = 0; k < 6; ++k) {
+      x0[k] = coordinate(rng), x1[k] = coordinate(rng);
+      M = std::max({M, std::abs(x0[k]), std::abs(x1[k])});
+    }
+    const double t = parameter(rng), a = parameter(rng), b = parameter(rng);
+    double p[6];
+    mpq_class P[6];
+    for (int k = 0; k < 6; ++k) {
+      const double dx = x1[k] - x0[k];
+      p[k] = x0[k] + t * dx;
+      P[k] = Q(x0[k]) + Q(t) * (Q(x1[k]) - Q(x0[k]));
+    }
+    const double w = p[0] - p[1], ea = p[2] - p[3], eb = p[4] - p[5];
+    const double c = (w + a * ea) - b * eb;
+    const mpq_class F = (P[0] - P[1]) + Q(a) * (P[2] - P[3]) - Q(b) * (P[4] - P[5]);
+    const mpq_class allowance = Q(kLinearCornerRounding) * Q(M) + Q(kLinearCornerUnderflow);
+    const mpq_class err = abs(Q(c) - F);
+    REQUIRE(err <= allowance);
+    worst = std::max(worst, mpq_class(err / allowance).get_d());
+  }
+  // The proof's bound, 69 u M + 44 2^-1075, is 0.54 of the allowance.
+  CHECK(worst <= 0.54);
+}
+
+// linear_corner_selection: the least of the four corner values is the one at
+// the least a ea and the largest b eb, as enclose_linear takes it.
+TEST_CASE("the least and largest corner values as enclose_linear selects them (Allowances.v "
+          "linear_corner_selection)",
+          "[proved]") {
+  std::mt19937_64 rng(4545);
+  for (int n = 0; n < 20000; ++n) {
+    const double w = coordinate(rng), ea = coordinate(rng), eb = coordinate(rng);
+    const double a[2] = {parameter(rng), parameter(rng)}, b[2] = {parameter(rng), parameter(rng)};
+    const double pa0 = a[0] * ea, pa1 = a[1] * ea, pb0 = b[0] * eb, pb1 = b[1] * eb;
+    const double least = (w + std::min(pa0, pa1)) - std::max(pb0, pb1);
+    const double most = (w + std::max(pa0, pa1)) - std::min(pb0, pb1);
+    double lo = std::numeric_limits<double>::infinity(), hi = -lo;
+    for (const double pa : {pa0, pa1})
+      for (const double pb : {pb0, pb1}) lo = std::min(lo, (w + pa) - pb), hi = std::max(hi, (w + pa) - pb);
+    REQUIRE(least == lo);
+    REQUIRE(most == hi);
+  }
+}
+
+// norm_relative_rounding: round_up(|v| (1 + kRelativeRounding)), |v| by
+// Eigen's norm(), bounds the exact Euclidean norm of the double vector v from
+// above whenever |v|^2 >= 2^-1000 (the theorem's hypothesis), checked
+// exactly (squares of rationals) from |v|^2 = 2^-1000 up to 2^1020 in
+// magnitude, with zero and signed-zero components.
+TEST_CASE("norms rounded up with kRelativeRounding bound the exact norm (Allowances.v "
+          "norm_relative_rounding)",
+          "[proved]") {
+  std::mt19937_64 rng(454545);
+  std::uniform_real_distribution<double> mant(-1, 1);
+  std::uniform_int_distribution<int> ex(-499, 509), pick(0, 4);
+  for (int n = 0; n < 20000; ++n) {
+    const int e = ex(rng);
+    Eigen::Vector3d v(std::ldexp(mant(rng), e), std::ldexp(mant(rng), e), std::ldexp(mant(rng), e));
+    const int k = pick(rng);
+    if (k < 3) v[k] = k == 0 ? 0.0 : -0.0;
+    const mpq_class S = Q(v.x()) * Q(v.x()) + Q(v.y()) * Q(v.y()) + Q(v.z()) * Q(v.z());
+    if (S < Q(0x1p-1000)) continue;
+    const double up = round_up(v.norm() * (1 + kRelativeRounding)).v;
+    REQUIRE(Q(up) * Q(up) >= S);
+  }
+}
