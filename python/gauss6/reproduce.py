@@ -176,7 +176,7 @@ def run_scenario(name: str, out: Path, threaded: bool = False, duration: float =
 
     s, extra = run_scene(SCENES[name], out, name=name, title=TITLES[name], threaded=threaded, duration=duration,
                          lockstep_sim_period=lockstep_sim_period, show_progress=show_progress,
-                         check_poses=check_poses, figure=figure)
+                         check_poses=check_poses, figure=figure, force_axes="YZ")  # the paper's figures' rows
     more, more_extra = scenario_checks(name, read_trace(out / f"{name}.g6trace"), extra["let_go_time"])
     s, extra = {**s, **more}, {**extra, **more_extra}
     _check_keys(name, s)

@@ -7,7 +7,7 @@ repeatable bit for bit; --threaded: real threads and the wall clock), and writes
 NAME the scene file's stem (or --name):
 
     NAME.g6trace          the run's trace (docs/trace-format.md)
-    figure_NAME.png/.svg  force computation time, update time, contacts and the force over time,
+    figure_NAME.png/.svg  force computation time, update time, contacts and the force (X, Y, Z) over time,
                           the script's phases shaded and named, the let-go marked (figures.py)
     view_NAME.html        the run in 3D with its timeline and plots (gauss6 view; opens from file://)
     certify_NAME.md/.json the exact certification of every pose and every motion (gauss6 certify)
@@ -167,7 +167,7 @@ def _rss_bytes() -> int:
 def run_scene(scene: Path, out: Path, name: str | None = None, title: str | None = None, script: Path | None = None,
               threaded: bool = False, duration: float = -1.0, lockstep_sim_period: int = 1,
               show_progress: bool = True, check_poses: bool = True, figure: bool = True,
-              extra_json: dict | None = None) -> tuple[dict, dict]:
+              extra_json: dict | None = None, force_axes: str = "XYZ") -> tuple[dict, dict]:
     """Runs one scene (with `script`, a hand script file, instead of the scene's when given), writes its trace,
     certification, figure and viewer page into out; returns (summary entry: COMMON_KEYS, details).
     gauss6.LoadError for a scene or hand script that does not load (before anything runs)."""
@@ -222,6 +222,7 @@ def run_scene(scene: Path, out: Path, name: str | None = None, title: str | None
     extra["scene"], extra["script"], extra["title"] = str(scene), hand["origin"], title
     geometry = runtime.scene_geometry(str(scene))
     extra["triangles"] = int(len(geometry["god_F"]) + sum(len(F) for _, _, F in geometry["obstacles"]))
+    extra["mass_kg"], extra["coupling_stiffness_n_per_m"] = geometry["mass"], geometry["kh"] * geometry["mass"]
     extra["memory"] = memory
     extra["pose_check_s"] = check_seconds
     if least is not None:
@@ -239,7 +240,8 @@ def run_scene(scene: Path, out: Path, name: str | None = None, title: str | None
         from .figures import plot_run
         from .view import write_view
 
-        extra["figures"] = [p.name for p in plot_run(trace, title, out / f"figure_{name}", run["let_go_time"])]
+        extra["figures"] = [p.name for p in plot_run(trace, title, out / f"figure_{name}", run["let_go_time"],
+                                                      force_axes)]
         extra["figures"].append(write_view([trace_path], scene, out / f"view_{name}.html", labels=[name],
                                            title=f"gauss6: {title}").name)
     return summary, extra
@@ -327,6 +329,9 @@ def report_section(name: str, s: dict, d: dict, paper: dict | None = None) -> li
     row("device-port passivity observer max(W + V) (J); final",
         f"{_fmt(d['port_energy_max_j'])}; {_fmt(d['port_energy_final_j'])}")
     row("max force (N)", _fmt(d["max_force_n"]))
+    if "mass_kg" in d:
+        row("god-object mass (kg); the coupling's stiffness kh M (N/m: the force is about kh M ks times how far the "
+            "hand is past the contact)", f"{_fmt(d['mass_kg'])}; {_fmt(d['coupling_stiffness_n_per_m'])}")
     if "memory" in d and "triangles" in d:
         m, n = d["memory"], d["triangles"]
         grown = m["peak_rss_bytes"] - m["rss_before_run_bytes"]
