@@ -149,6 +149,19 @@ def test_a_users_scene_runs_to_a_certified_report(table_run):
     assert "updates over 1 ms" in report
 
 
+def test_the_validation_driver_reads_a_script_table(scene_dir):
+    """gauss6 validate's driver takes the scene's [device.script] table as the runs do."""
+    from gauss6 import driver
+    from gauss6._gauss6 import device, runtime
+
+    text, origin = driver.scene_script(scene_dir / "scene.toml")
+    assert origin.endswith("scene.toml: device.script")
+    dev = device.SimulatedDevice(text, origin=origin)
+    hand = runtime.hand_script(str(scene_dir / "scene.toml"))
+    assert dev.end_time == hand["end_time"] == 1.0
+    assert [name for name, _ in dev.phases] == [name for name, _ in hand["phases"]] == ["press", "slide", "lift"]
+
+
 def test_a_script_file_replaces_the_scenes(scene_dir, tmp_path):
     script = tmp_path / "tap.json"
     script.write_text(json.dumps({"keys": [{"t": 0.0, "p": [0.0, 0.0, 0.03]}, {"t": 0.3, "p": [0.0, 0.0, 0.008]}],
