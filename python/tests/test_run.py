@@ -202,6 +202,7 @@ def test_bad_script_files_are_refused_naming_the_file_and_the_key(scene_dir, tmp
     ("[device.script]\nkeys = [{ t = nan, p = [0.0, 0.0, 0.03] }]\n",
      f"scene.toml:{SCENE.split('{device_script}')[0].count(chr(10)) + 2}:15: device.script.keys[0].t: must be finite"),
     ("script = 3\n", "device.script: must be a script's name"),
+    ("", "device.script: missing (a script's name, a .json file or a [device.script] table"),
 ])
 def test_bad_script_tables_are_refused_naming_the_scene_and_the_key(tmp_path, scene_dir, table, message):
     for mesh in ("cube.off", "plate.off"):

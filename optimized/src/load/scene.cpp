@@ -465,6 +465,8 @@ Scene load_scene(const std::string& path) {
         d.script_json = json.str();
       } else if (script && !script->is_string()) {
         r.fail(script->source(), "script", "must be a script's name, a .json file or a table (the script itself)");
+      } else if (!script) {
+        r.fail_missing("script", "a script's name, a .json file or a [device.script] table: docs/scene-format.md");
       } else {
         d.script = r.string("script");
       }
