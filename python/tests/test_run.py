@@ -222,3 +222,15 @@ def test_script_names_and_files(tmp_path):
     (tmp_path / "script.txt").write_text("{}")
     with pytest.raises(ValueError, match="ends in .json"):
         run_mod.script_path(str(tmp_path / "script.txt"))
+
+
+def test_threaded_without_certification_says_so(scene_dir, tmp_path):
+    r = run_cli("run", str(scene_dir / "scene.toml"), "--out", str(tmp_path), "--threaded", "--no-certify",
+                "--duration", "0.3", "--quiet")
+    assert r.returncode == 0, r.stderr
+    summary = json.loads((tmp_path / "summary.json").read_text())["scene"]
+    assert summary["penetrating_poses"] == -1  # not checked, and not passed off as 0
+    details = json.loads((tmp_path / "details.json").read_text())["scene"]
+    assert details["mode"] == "threaded" and "update_least" not in details and "certify" not in details
+    report = (tmp_path / "report.md").read_text()
+    assert "not run (--no-certify)" in report and "not checked" in report
