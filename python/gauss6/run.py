@@ -338,8 +338,9 @@ def report_section(name: str, s: dict, d: dict, paper: dict | None = None) -> li
     if "memory" in d and "triangles" in d:
         m, n = d["memory"], d["triangles"]
         grown = m["peak_rss_bytes"] - m["rss_before_run_bytes"]
-        row(f"memory: peak resident (MB) after the runs; its growth over the run per triangle ({n} triangles) (bytes)",
-            f"{m['peak_rss_bytes'] / 2**20:.0f}; {grown / n:.0f}")
+        row(f"memory: the process's peak resident (MB); its growth over the runs (MB), per triangle of the scene's {n} "
+            "(bytes; a small scene's is mostly fixed costs)",
+            f"{m['peak_rss_bytes'] / 2**20:.0f}; {grown / 2**20:.0f}, {grown / n:.0f}")
     return lines + [""]
 
 
