@@ -136,7 +136,7 @@ double free_travel(const RuntimeModel& s, const Pose& x, const Vec3& dir, double
   cs.narrow.time_tolerance = 1e-9;
   CcdStepWorkspace ws;
   CcdStepResult r;
-  ccd_step(s.obstacles.data(), static_cast<int>(s.obstacles.size()), s.god, x, {x.p + reach * dir, x.q}, cs, &ws,
+  ccd_step(s.obstacles.data(), static_cast<int>(s.obstacles.size()), s.god, {x, {x.p + reach * dir, x.q}}, cs, &ws,
            &r);
   return r.hit ? reach * r.u_hit : reach;
 }
@@ -262,7 +262,7 @@ void time_steps(benchmark::State& state, const RuntimeModel& model, const std::v
       const double cpu_ns = thread_cpu_ns() - cpu0;
       cpu.add(cpu_ns);
       benchmark::DoNotOptimize(sim.contacts.num_contacts);
-      const CcdStepResult& r = sim.ccd;  // the step's last leg
+      const CcdStepResult& r = sim.step4.leg.ccd;  // the leg the step ended on
       over_1ms += cpu_ns > 1e6;
       over_100us += cpu_ns > 1e5;
       if (cpu_ns > slowest_ns) {
@@ -282,6 +282,15 @@ void time_steps(benchmark::State& state, const RuntimeModel& model, const std::v
                      info.num_shortenings, int(r.cache_filled), int(r.cache_refilled));
       counters.add("hits", info.status == SimStepStatus::kContact);
       counters.add("settling_legs", info.settled);
+      // Step 4's paths (docs/sim-step.md's table: these means times `steps`).
+      const StepPaths& paths = sim.step4.paths;
+      counters.add("path_grazes", paths.grazed);
+      counters.add("path_graze_lifts", paths.lifted);
+      counters.add("path_settles", paths.settles);
+      counters.add("path_refused_settles", paths.refused);
+      counters.add("path_shortenings", info.num_shortenings);
+      counters.add("path_keep_halvings", paths.keep_halvings);
+      counters.add("path_stays", paths.stayed);
       counters.add("gave_up", info.ccd != CcdStatus::kOk);
       counters.add("pair_tests", r.num_pair_tests);
       counters.add("boxes", static_cast<double>(r.num_box_iterations));

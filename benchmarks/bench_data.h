@@ -133,7 +133,7 @@ inline void run_set_step(const CcdSet& set, const CcdSetStep& step, const CcdSte
                          CcdStepWorkspace* ws, CcdStepResult* r) {
   const CcdMeshPair& p = *set.pairs[step.pair];
   const CcdBody obstacle = p.obstacle_body();
-  ccd_step(&obstacle, 1, p.god_body(), step.x0, step.x1, settings, ws, r);
+  ccd_step(&obstacle, 1, p.god_body(), {step.x0, step.x1}, settings, ws, r);
 }
 
 // Runs ccd_step at the set's delta over every step of the set, in order, and

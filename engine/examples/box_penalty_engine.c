@@ -22,6 +22,7 @@
 #include <string.h>
 
 #include "gauss6/engine.h"
+#include "gauss6/engine_config.h"
 
 typedef struct box {
   double lo[3], hi[3];
@@ -64,8 +65,16 @@ static void* create(const char* config, char* error, size_t error_size) {
     return NULL;
   }
   e->stiffness = 2000;
-  const char* k = config ? strstr(config, "stiffness=") : NULL;
-  if (k) e->stiffness = strtod(k + strlen("stiffness="), NULL);
+  static const char* const keys[] = {"stiffness", NULL};
+  if (gauss6_config_check(config, keys, "box penalty engine", error, error_size) != 0) {
+    free(e);
+    return NULL;
+  }
+  char value[64], *end = value;
+  if (gauss6_config_value(config, "stiffness", value, sizeof value)) {
+    e->stiffness = strtod(value, &end);
+    if (end == value || *end) e->stiffness = -1;
+  }
   if (!(e->stiffness > 0) || !isfinite(e->stiffness)) {
     set_error(error, error_size, "box penalty engine: stiffness must be a positive number");
     free(e);

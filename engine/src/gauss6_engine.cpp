@@ -12,7 +12,8 @@
 // are the sim loop's current set (point on the god-object, normal out of the
 // obstacle, separation); step_seconds is the wall time of the call.
 //
-// Config text: "sim_period=N" (haptic ticks per sim step, default 1).
+// Config text: "sim_period=N" (haptic ticks per sim step, default 1); any other key is
+// refused (gauss6/engine_config.h).
 // Scene: the gauss6 scene file when scene_path is set (every setting of the file),
 // otherwise a scene built from the description (offset_eps -10 delta, offset_time
 // 0.05 s: the scene format's defaults).
@@ -24,6 +25,7 @@
 #include <string>
 
 #include "gauss6/engine.h"
+#include "gauss6/engine_config.h"
 #include "gauss6/runtime.h"
 #include "gauss6/scene.h"
 
@@ -123,10 +125,16 @@ Scene scene_from_description(const gauss6_scene_desc& d) {
 
 void* create(const char* config, char* error, size_t error_size) {
   auto e = std::make_unique<Engine>();
-  const char* p = config ? std::strstr(config, "sim_period=") : nullptr;
-  if (p) e->sim_period = std::atoi(p + std::strlen("sim_period="));
+  static const char* const keys[] = {"sim_period", nullptr};
+  if (gauss6_config_check(config, keys, "gauss6 engine", error, error_size) != 0) return nullptr;
+  char value[32];
+  if (gauss6_config_value(config, "sim_period", value, sizeof value)) {
+    char* end = nullptr;
+    const long n = std::strtol(value, &end, 10);
+    e->sim_period = end != value && *end == 0 && n >= 1 && n <= 1000000 ? static_cast<int>(n) : 0;
+  }
   if (e->sim_period < 1) {
-    set_error(error, error_size, "gauss6 engine: sim_period must be >= 1");
+    set_error(error, error_size, "gauss6 engine: config sim_period must be an integer >= 1");
     return nullptr;
   }
   return e.release();
@@ -194,13 +202,29 @@ const char* last_error(void* handle) { return static_cast<Engine*>(handle)->erro
 
 void destroy(void* handle) { delete static_cast<Engine*>(handle); }
 
-const gauss6_engine_v1 kTable = {
-    GAUSS6_ENGINE_ABI_VERSION, sizeof(gauss6_engine_v1), sizeof(gauss6_scene_desc), sizeof(gauss6_step_out),
-    "gauss6 (god-object, lockstep tick)", create, reset, step, last_error, destroy,
-};
+// With its sim step every sim_period ticks, the god-object and its contacts are updated at
+// 1 / sim_period of the haptic rate: a crossing of a new constraint is answered up to
+// 2 (sim_period - 1) ticks later than at sim_period 1, which the engine declares.
+int declare(void* handle, gauss6_declarations* out) {
+  const auto* e = static_cast<const Engine*>(handle);
+  if (e->sim_period > 1) {
+    out->flags |= GAUSS6_DECLARE_LATENCY;
+    out->latency_ticks = 2 * (e->sim_period - 1);
+  }
+  return GAUSS6_ENGINE_OK;
+}
+
+#define GAUSS6_ENGINE_V1_FIELDS(version, size) \
+  version, size, sizeof(gauss6_scene_desc), sizeof(gauss6_step_out), "gauss6 (god-object, lockstep tick)", \
+      create, reset, step, last_error, destroy
+
+const gauss6_engine_v1 kTable = {GAUSS6_ENGINE_V1_FIELDS(GAUSS6_ENGINE_ABI_VERSION, sizeof(gauss6_engine_v1))};
+const gauss6_engine_v2 kTable2 = {
+    {GAUSS6_ENGINE_V1_FIELDS(GAUSS6_ENGINE_ABI_VERSION_2, sizeof(gauss6_engine_v2))}, declare};
 
 }  // namespace
 
 extern "C" __attribute__((visibility("default"))) const void* gauss6_engine_get(uint32_t abi_version) {
+  if (abi_version == GAUSS6_ENGINE_ABI_VERSION_2) return &kTable2;
   return abi_version == GAUSS6_ENGINE_ABI_VERSION ? &kTable : nullptr;
 }

@@ -34,6 +34,7 @@
 #include <string.h>
 
 #include "gauss6/engine.h"
+#include "gauss6/engine_config.h"
 
 enum fault { kNone, kPenetrate, kTangential, kDistance, kEnergy, kNan, kTunnel };
 
@@ -57,32 +58,15 @@ static void set_error(char* error, size_t size, const char* text) {
   if (error && size) snprintf(error, size, "%s", text);
 }
 
-/* The value of "key=" in config, up to ';', into out (size n); 0 when absent. */
-static int option(const char* config, const char* key, char* out, size_t n) {
-  const size_t k = strlen(key);
-  for (const char* p = config; p && *p;) {
-    if (strncmp(p, key, k) == 0 && p[k] == '=') {
-      const char* v = p + k + 1;
-      const char* end = strchr(v, ';');
-      const size_t len = end ? (size_t)(end - v) : strlen(v);
-      if (len + 1 > n) return 0;
-      memcpy(out, v, len);
-      out[len] = 0;
-      return 1;
-    }
-    p = strchr(p, ';');
-    if (p) ++p;
-  }
-  return 0;
-}
-
 static void* create(const char* config, char* error, size_t error_size) {
   char path[1024] = "", name[64] = "none", value[128];
-  if (!option(config, "inner", path, sizeof path)) {
+  static const char* const keys[] = {"inner", "fault", "at", "jump", NULL};
+  if (gauss6_config_check(config, keys, "fault engine", error, error_size) != 0) return NULL;
+  if (!gauss6_config_value(config, "inner", path, sizeof path)) {
     set_error(error, error_size, "fault engine: config needs inner=PATH");
     return NULL;
   }
-  option(config, "fault", name, sizeof name);
+  gauss6_config_value(config, "fault", name, sizeof name);
   engine* e = (engine*)calloc(1, sizeof(engine));
   if (!e) return NULL;
   static const char* const names[] = {"none", "penetrate", "tangential", "distance", "energy", "nan", "tunnel"};
@@ -94,9 +78,9 @@ static void* create(const char* config, char* error, size_t error_size) {
     free(e);
     return NULL;
   }
-  if (option(config, "at", value, sizeof value)) e->at = strtod(value, NULL);
+  if (gauss6_config_value(config, "at", value, sizeof value)) e->at = strtod(value, NULL);
   e->jump[2] = -0.18;
-  if (option(config, "jump", value, sizeof value) &&
+  if (gauss6_config_value(config, "jump", value, sizeof value) &&
       sscanf(value, "%lf,%lf,%lf", &e->jump[0], &e->jump[1], &e->jump[2]) != 3) {
     set_error(error, error_size, "fault engine: jump must be X,Y,Z");
     free(e);

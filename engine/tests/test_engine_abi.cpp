@@ -2,7 +2,8 @@
 // version 1 table from gauss6_engine_get, check the struct sizes, create, reset on a scene
 // description (meshes in memory, no scene file), step a few hundred ticks, destroy. Run on
 // the example engine (C) and on gauss6's own engine, with the same scene and hand motion:
-// a 2 cm cube tool lowered onto a 10 cm cube obstacle and pressed 1 cm past its top.
+// a 2 cm cube tool lowered onto a 10 cm cube obstacle and pressed 1 cm past its top. And the
+// version 2 table: a version 2 engine's declarations; a version 1 engine answers NULL for 2.
 #include <dlfcn.h>
 
 #include <catch2/catch.hpp>
@@ -134,4 +135,66 @@ TEST_CASE("gauss6's engine, loaded by path, stops the tool on the box and pushes
   // hand 1 cm past it feels the coupling's force up: kh ks m * 1 cm = 1.26 N (at least 0.5 N).
   for (double z : run.xs_z) REQUIRE(z - 0.01 > 0.05);
   REQUIRE(run.fz.back() > 0.5);
+}
+
+TEST_CASE("a version 2 table declares, and a version 1 engine answers NULL for version 2", "[engine][abi]") {
+  void* probe = dlopen(GAUSS6_PROBE_ENGINE_PATH, RTLD_NOW | RTLD_LOCAL);
+  REQUIRE(probe);
+  auto get = reinterpret_cast<gauss6_engine_get_fn>(dlsym(probe, GAUSS6_ENGINE_ENTRY));
+  REQUIRE(get);
+  REQUIRE(get(GAUSS6_ENGINE_ABI_VERSION) == nullptr);  // it speaks 2 only
+  const auto* t = static_cast<const gauss6_engine_v2*>(get(GAUSS6_ENGINE_ABI_VERSION_2));
+  REQUIRE(t);
+  REQUIRE(t->v1.abi_version == GAUSS6_ENGINE_ABI_VERSION_2);
+  REQUIRE(t->v1.table_size == sizeof(gauss6_engine_v2));
+  REQUIRE(t->declare);
+  char error[256] = "";
+  void* engine = t->v1.create("declare_mu=0.3;declare_latency=2", error, sizeof error);
+  INFO("create: " << error);
+  REQUIRE(engine);
+  gauss6_declarations d{};
+  d.struct_size = sizeof d;
+  REQUIRE(t->declare(engine, &d) == GAUSS6_ENGINE_OK);
+  REQUIRE(d.flags == (GAUSS6_DECLARE_FRICTION | GAUSS6_DECLARE_LATENCY));
+  REQUIRE(d.friction_mu == 0.3);
+  REQUIRE(d.latency_ticks == 2);
+  t->v1.destroy(engine);
+  // An unknown config key is refused, named.
+  REQUIRE(t->v1.create("declare_nu=0.3", error, sizeof error) == nullptr);
+  REQUIRE(std::string(error).find("'declare_nu=0.3'") != std::string::npos);
+  dlclose(probe);
+
+  void* v1 = dlopen(GAUSS6_BOX_PENALTY_ENGINE_PATH, RTLD_NOW | RTLD_LOCAL);
+  REQUIRE(v1);
+  auto get1 = reinterpret_cast<gauss6_engine_get_fn>(dlsym(v1, GAUSS6_ENGINE_ENTRY));
+  REQUIRE(get1);
+  REQUIRE(get1(GAUSS6_ENGINE_ABI_VERSION_2) == nullptr);
+  REQUIRE(get1(GAUSS6_ENGINE_ABI_VERSION) != nullptr);
+  dlclose(v1);
+}
+
+TEST_CASE("gauss6's engine speaks both versions and declares the latency of a slower sim step", "[engine][abi]") {
+  void* lib = dlopen(GAUSS6_ENGINE_PATH, RTLD_NOW | RTLD_LOCAL);
+  REQUIRE(lib);
+  auto get = reinterpret_cast<gauss6_engine_get_fn>(dlsym(lib, GAUSS6_ENGINE_ENTRY));
+  REQUIRE(get);
+  REQUIRE(get(GAUSS6_ENGINE_ABI_VERSION) != nullptr);
+  const auto* t = static_cast<const gauss6_engine_v2*>(get(GAUSS6_ENGINE_ABI_VERSION_2));
+  REQUIRE(t);
+  REQUIRE(t->v1.table_size == sizeof(gauss6_engine_v2));
+  REQUIRE(t->declare);
+  char error[256] = "";
+  for (int period : {1, 2, 8}) {
+    void* engine = t->v1.create(("sim_period=" + std::to_string(period)).c_str(), error, sizeof error);
+    INFO("sim_period " << period << ": " << error);
+    REQUIRE(engine);
+    gauss6_declarations d{};
+    d.struct_size = sizeof d;
+    REQUIRE(t->declare(engine, &d) == GAUSS6_ENGINE_OK);
+    // At sim_period 1 nothing is declared; above it, the crossing is answered 2 (period - 1) ticks later.
+    REQUIRE(d.flags == (period > 1 ? GAUSS6_DECLARE_LATENCY : 0u));
+    if (period > 1) REQUIRE(d.latency_ticks == 2 * (period - 1));
+    t->v1.destroy(engine);
+  }
+  dlclose(lib);
 }

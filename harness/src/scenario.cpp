@@ -4,6 +4,8 @@
 // property_observers.h).
 #include "gauss6/scenario.h"
 
+#include "gauss6/regular_file.h"
+
 #include <atomic>
 #include <chrono>
 #include <cmath>
@@ -162,6 +164,8 @@ void on_event(void* user, const RuntimeEvent& e) {
 }
 
 std::string read_text(const std::filesystem::path& path) {
+  if (const std::string problem = regular_file_problem(path.string(), uint64_t(1) << 26); !problem.empty())
+    throw ScenarioError(path.string() + ": the hand script: " + problem);
   std::ifstream in(path);
   if (!in) throw ScenarioError(path.string() + ": cannot open the hand script");
   std::ostringstream ss;

@@ -57,14 +57,13 @@ double step_time_tolerance(const CcdMotion& motion, const CcdBody& god, const Cc
   return bound < settings.narrow.time_tolerance ? bound : settings.narrow.time_tolerance;  // NaN, 0 travel: settings'
 }
 
-// The lead pieces (CcdStepSettings::lead_sweep): k pieces ahead of the first
+// The lead pieces (CcdStepRequest::lead_sweep): k pieces ahead of the first
 // sub-interval's last quarter, each a quarter of the next, k the least that
 // makes the first sweep at most lead_sweep reaches (the nominal motion's travel
 // and turn at the god-object's radius; a heuristic: any partition of [0, 1]
-// is searched alike), at most kMaxLead. A settling leg stops 0.0003-0.06 into
-// its motion (the replays' 5th-95th percentiles on the bunnies), where the
-// swept boxes of its whole motion, a turn of 0.02-0.03 rad, reached 900-2,000
-// node pairs on the full bunnies.
+// is searched alike), at most kMaxLead. A settling leg stops soon after its
+// start, where the swept boxes of its whole motion would reach far more node
+// pairs than the first piece's.
 constexpr int kMaxLead = 6;
 int plan_lead(const CcdMotion& motion, const CcdBody& god, int n, double reach, double lead_sweep) {
   if (!(lead_sweep > 0)) return 0;
@@ -96,7 +95,7 @@ bool among(const FeaturePair* hints, int count, int gf, int of, int o) {
 }
 
 // The hints' triangle pairs first, over the whole step (each distinct pair once;
-// from known_free, as every search of the step).
+// from s->searched, as every search of the step).
 // A pair searched here over [0, e] needs no second search: every later
 // window [u0, end()] ends at or before e (end() only shrinks), and the
 // search returned the pair's first contact in [0, e], if any. The sliding
@@ -106,9 +105,9 @@ void search_hints(StepState* s) {
   const int num_hints = s->num_hints;
   if (!(hints && num_hints > 0)) return;
   PairTester& tester = s->tester;
-  enclose_motion(s->motion, {s->settings.known_free, 1}, &s->e);
+  enclose_motion(s->motion, {s->searched, 1}, &s->e);
   s->ws->swept.next_interval();
-  tester.u0 = s->settings.known_free;
+  tester.u0 = s->searched;
   tester.u1 = 1;
   // The hint on the triangle pair that stopped the workspace's last step, if
   // any, goes first (CcdStepWorkspace::last_hit); the others keep their
@@ -216,8 +215,8 @@ bool search_sub_intervals(StepState* s) {
   for (int j = 0; j < s->n + s->lead && !answered(*s); ++j) {
     double u0 = 0, u1 = 1;
     plan_piece(j, s->lead, s->n, &u0, &u1);
-    u0 = std::max({u0, s->u_cached, s->settings.known_free});
-    if (!(u0 < u1)) continue;  // inside the cached range, or known free
+    u0 = std::max(u0, s->searched);
+    if (!(u0 < u1)) continue;  // searched already
     if (result->hit && result->u_hit - s->settings.narrow.time_tolerance <= u0) break;  // nothing left to search
     enclose_motion(s->motion, {u0, std::min(u1, result->u_hit)}, &s->e);
     s->start.set(s->motion, u0, god.bvh->radius);
@@ -262,6 +261,21 @@ bool search_sub_intervals(StepState* s) {
   return true;
 }
 
+// The settings a request's question runs with: a check of contact itself
+// (CcdQuestion::kFreeOfContact) at min_separation 0, without near pairs or a
+// cache of its own; a call that does not go on with the background fill
+// (CcdStepRequest::fill_cache), with no fill budget.
+CcdStepSettings settings_asked(const CcdStepRequest& request, const CcdStepSettings& settings) {
+  CcdStepSettings asked = settings;
+  if (request.question == CcdQuestion::kFreeOfContact) {
+    asked.narrow.min_separation = 0;
+    asked.near_distance = 0;
+    asked.cache.margin = asked.cache.margin_max = 0;
+  }
+  if (request.question == CcdQuestion::kFreeOfContact || !request.fill_cache) asked.cache.fill_budget = 0;
+  return asked;
+}
+
 // The step's answer: pairs were searched only up to u_b - tol
 // (PairTester::end), so a hit stops there.
 void finish(StepState* s) {
@@ -279,7 +293,7 @@ void finish(StepState* s) {
 
 bool searched(const StepState& s, int gf, int of, int o) { return among(s.hints, s.num_searched, gf, of, o); }
 
-bool answered(const StepState& s) { return s.settings.any_hit && s.result->hit; }
+bool answered(const StepState& s) { return s.any_hit && s.result->hit; }
 
 // Earliest-first: each hit shortens the windows of the pairs after it, and
 // once a pair's bound passes the best u so far, so do all the rest.
@@ -320,42 +334,47 @@ const char* ccd_step_settings_problem(const CcdStepSettings& s) {
   if (!positive(s.sub_interval_angle) || !positive(s.sub_interval_travel))
     return "ccd.sub_interval_angle and ccd.sub_interval_travel must be > 0 and finite";
   if (!non_negative(s.near_distance)) return "ccd.near_distance must be >= 0 and finite";
-  if (!non_negative(s.lead_sweep)) return "ccd.lead_sweep must be >= 0 and finite";
-  if (!(s.known_free >= 0 && s.known_free < 1)) return "ccd.known_free must be in [0, 1)";
   if (!valid_proximity_cache_settings(s.cache)) return "ccd.cache: the proximity cache's settings are not valid";
   return nullptr;
 }
 
-void ccd_step(const CcdBody* obstacles, int num_obstacles, const CcdBody& god, const Pose& X0, const Pose& X1,
-              const CcdStepSettings& settings, CcdStepWorkspace* ws, CcdStepResult* result, const FeaturePair* hints,
-              int num_hints) noexcept {
+const char* ccd_step_request_problem(const CcdStepRequest& r) {
+  if (!(r.known_free >= 0 && r.known_free < 1)) return "known_free must be in [0, 1)";
+  if (!(r.lead_sweep >= 0 && std::isfinite(r.lead_sweep))) return "lead_sweep must be >= 0 and finite";
+  return nullptr;
+}
+
+void ccd_step(const CcdBody* obstacles, int num_obstacles, const CcdBody& god, const CcdStepRequest& request,
+              const CcdStepSettings& settings, CcdStepWorkspace* ws, CcdStepResult* result) noexcept {
   using namespace detail;
   *result = CcdStepResult{};
   // Validate the input; make the motion and its enclosure (METHOD.md section 4).
-  if (!inputs_valid(obstacles, num_obstacles, god, settings, ws)) {
+  if (!inputs_valid(obstacles, num_obstacles, god, settings, ws) || ccd_step_request_problem(request)) {
     result->status = CcdStatus::kInvalidInput;
     return;
   }
-  const MotionStatus ms = make_ccd_motion(X0, X1, &result->motion);
+  const MotionStatus ms = make_ccd_motion(request.X0, request.X1, &result->motion);
   if (ms != MotionStatus::kOk) {
     result->status = ms == MotionStatus::kHalfTurn ? CcdStatus::kHalfTurn : CcdStatus::kInvalidInput;
     return;
   }
-  CcdStepSettings step_settings = settings;
-  step_settings.narrow.time_tolerance = step_time_tolerance(result->motion, god, settings);
-  if (!(step_settings.narrow.time_tolerance > 0)) step_settings.narrow.time_tolerance = settings.narrow.time_tolerance;
-  StepState s(obstacles, num_obstacles, god, X0, step_settings, ws, result, hints, num_hints);
+  CcdStepSettings step_settings = settings_asked(request, settings);
+  const double asked_tolerance = step_settings.narrow.time_tolerance;
+  step_settings.narrow.time_tolerance = step_time_tolerance(result->motion, god, step_settings);
+  if (!(step_settings.narrow.time_tolerance > 0)) step_settings.narrow.time_tolerance = asked_tolerance;
+  StepState s(obstacles, num_obstacles, god, request, step_settings, ws, result);
+  s.searched = request.known_free;
   if (!ws->front.carry) ws->front.clear();  // the last step's cut serves only when carried (DescentFront)
   // Plan the sub-intervals.
-  s.n = plan_sub_intervals(s.motion, god, settings);
-  s.lead = plan_lead(s.motion, god, s.n, s.reach, settings.lead_sweep);
+  s.n = plan_sub_intervals(s.motion, god, step_settings);
+  s.lead = plan_lead(s.motion, god, s.n, s.reach, request.lead_sweep);
   result->num_sub_intervals = s.n + s.lead;
   // The hints and the proximity cache both start from the god-object at u = 0.
-  const bool cached = settings.cache.margin > 0;
+  const bool cached = step_settings.cache.margin > 0;
   const bool borrowing = !cached && ws->borrowed != nullptr;
-  if ((hints && num_hints > 0) || cached || borrowing) s.start.set(s.motion, 0.0, god.bvh->radius);
-  // Search the hints over the whole step (a hit among them answers a yes/no
-  // step: settings.any_hit).
+  if ((s.hints && s.num_hints > 0) || cached || borrowing) s.start.set(s.motion, 0.0, god.bvh->radius);
+  // Search the hints over the whole step (a hit among them answers a check:
+  // CcdQuestion::kFreeOfContact).
   search_hints(&s);
   if (!answered(s)) {
     // Serve the step's start from the proximity cache, refilled first if worth it

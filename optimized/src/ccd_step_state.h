@@ -21,18 +21,19 @@
 namespace gauss6::detail {
 
 struct StepState {
-  StepState(const CcdBody* obstacles_in, int num_obstacles_in, const CcdBody& god_in, const Pose& X0_in,
-            const CcdStepSettings& settings_in, CcdStepWorkspace* ws_in, CcdStepResult* result_in,
-            const FeaturePair* hints_in, int num_hints_in)
+  StepState(const CcdBody* obstacles_in, int num_obstacles_in, const CcdBody& god_in, const CcdStepRequest& request,
+            const CcdStepSettings& settings_in, CcdStepWorkspace* ws_in, CcdStepResult* result_in)
       : obstacles(obstacles_in),
         num_obstacles(num_obstacles_in),
         god(god_in),
-        X0(X0_in),
+        X0(request.X0),
         settings(settings_in),
         ws(ws_in),
         result(result_in),
-        hints(hints_in),
-        num_hints(num_hints_in),
+        hints(request.hints),
+        num_hints(request.num_hints),
+        lead_sweep(request.lead_sweep),
+        any_hit(request.question == CcdQuestion::kFreeOfContact),
         motion(result_in->motion),
         // The boxes and the pairs' time bounds take the larger of d and the near
         // distance: the candidates are then the near pairs too (a pair that cannot
@@ -54,6 +55,8 @@ struct StepState {
   CcdStepResult* result;
   const FeaturePair* hints;
   int num_hints;
+  double lead_sweep;        // > 0: a motion expected to stop early (CcdStepRequest::lead_sweep)
+  bool any_hit;             // the first hit found answers (CcdQuestion::kFreeOfContact)
 
   const CcdMotion& motion;  // result->motion: the enclosed motion from X0
   const double reach;       // max(min_separation, near_distance)
@@ -63,8 +66,13 @@ struct StepState {
   MotionEnclosure e;        // the motion over the range being searched
   StartFrame start;         // the god-object at that range's start
   PairTester tester;        // tests on [tester.u0, tester.end()], earliest hit in *result
+  // The part of [0, 1] that needs no more search, for every pair: the caller's
+  // proof (CcdStepRequest::known_free), then the range the proximity list
+  // answered (search_cached_pairs). The hints' pairs, searched over the whole
+  // rest of the step first, are the exception a pair at a time (num_searched).
+  double searched = 0;
   int num_searched = 0;     // hints[0 .. num_searched) were searched (valid or not)
-  double u_cached = 0;      // [0, u_cached] was searched from the proximity cache (0: not used)
+  double u_cached = 0;      // the proximity list covers [0, u_cached] (0: not used)
   // The proximity cache's list is for this step's meshes and settings, and
   // how far a point may have moved from its pose to X0 (infinite: unknown).
   bool cache_keyed = false;
@@ -74,7 +82,7 @@ struct StepState {
 // The triangle pair was searched over the whole step among the hints (then it
 // needs no second search: ccd_step.cpp, search_hints).
 bool searched(const StepState& s, int gf, int of, int o);
-// A yes/no step (settings.any_hit) has its answer: a hit.
+// A check (CcdQuestion::kFreeOfContact) has its answer: a hit.
 bool answered(const StepState& s);
 // Tests cand[0 .. num_cand) earliest-first (ws->candidates), skipping the
 // pairs searched with the hints.

@@ -160,7 +160,7 @@ struct CacheRanges {
   double u_probe;  // over [0, u_probe] no point moves a quarter of the margin
   int n;           // sub-intervals
   double max_probe;  // a first search is shorter than this many sub-intervals (max_probe_sub_intervals)
-  bool stops_early;  // a leg expected to stop early (CcdStepSettings::lead_sweep > 0): any range serves
+  bool stops_early;  // a leg expected to stop early (CcdStepRequest::lead_sweep > 0): any range serves
   // [0, u] keeps every point within m of a list's pose, the points `moved`
   // from there by X0 (0: none).
   double range(double moved, double m) const {
@@ -243,7 +243,7 @@ void refill_if_worth(StepState* s, const CacheRanges& r, Displacement* since) {
   }
 }
 
-// [0, u_cached] (from known_free on: CcdStepSettings) from the list's pairs:
+// [searched, u_cached] from the list's pairs (then [0, u_cached] is searched):
 // each pair's own certificate first (its gap at the cache's pose less how far
 // its points can move from there by u_cached: a few flops); the time bound
 // only for the pairs it does not keep beyond the reach; then the candidates'
@@ -252,7 +252,8 @@ void search_cached_pairs(StepState* s, const ProximityCache& pc, const Displacem
   CcdStepResult* result = s->result;
   PairTester& tester = s->tester;
   CcdStepWorkspace::Candidate* const cand = s->ws->candidates.data();
-  const double u0 = s->settings.known_free;  // the caller's proof covers [0, u0]
+  const double u0 = s->searched;
+  s->searched = std::max(u0, s->u_cached);
   if (!(u0 < std::min(s->u_cached, result->u_hit))) return;
   enclose_motion(s->motion, {u0, std::min(s->u_cached, result->u_hit)}, &s->e);
   s->ws->swept.next_interval();
@@ -292,13 +293,10 @@ void search_cached_pairs(StepState* s, const ProximityCache& pc, const Displacem
 // sweeping the boxes over the whole step). A range covering only part of a
 // step would search the pairs near X0 twice (the list, then the descents of
 // the rest): not used, but by a leg expected to stop early (a settling leg,
-// CcdStepSettings::lead_sweep > 0), which stops at u 0.0003-0.06 of its motion
-// and so most often inside the list's range: the list then answers its lead
-// pieces, where each of them descended the trees to the same standing
-// proximity (the peg's wedge: 1,700-3,900 node pairs a settling leg; over the
-// replays' 150 slowest steps 6% fewer instructions on both scenes, the peg's
-// slowest step 15.4 -> 13.7 M, the whole replays within 1%: docs/benchmarks.md,
-// issue 20, eleventh session). The cache is refilled
+// CcdStepRequest::lead_sweep > 0), which stops soon after its start and so
+// most often inside the list's range: the list then answers its lead pieces,
+// where each of them would descend the trees to the same standing proximity.
+// The cache is refilled
 // at X0 when its own range cannot be used for this step and a fresh one's
 // would (a step that moves less than the margin, or a short first search).
 void serve_proximity_cache(StepState* s) {
@@ -316,7 +314,7 @@ void serve_proximity_cache(StepState* s) {
                       speed > 0 ? round_down(policy(*s).slow_fraction * margin / speed).v : 1.0,
                       s->n,
                       policy(*s).max_probe_sub_intervals,
-                      s->settings.lead_sweep > 0};
+                      s->lead_sweep > 0};
   const bool keyed = s->cache_keyed;
   Displacement since(keyed ? pc.ref : s->X0, s->X0);
   s->cache_moved = keyed ? since.bound(s->rho) : std::numeric_limits<double>::infinity();

@@ -177,7 +177,7 @@ TEST_CASE("CCD regression: peg-in-hole steps that used to give up finish, fast a
   for (const CapturedStep& step : kPegSteps) {
     const Pose x0 = pose_of(step.x0), x1 = pose_of(step.x1);
     CcdStepResult r;
-    ccd_step(model.obstacles.data(), static_cast<int>(model.obstacles.size()), model.god, x0, x1, settings, &ws, &r);
+    ccd_step(model.obstacles.data(), static_cast<int>(model.obstacles.size()), model.god, {x0, x1}, settings, &ws, &r);
     const double u_end = r.hit ? r.u_hit : 1.0;
     INFO("step " << index << ": hit " << r.hit << " u_hit " << r.u_hit << " boxes " << r.num_box_iterations);
     CHECK(r.status == CcdStatus::kOk);

@@ -114,7 +114,7 @@ TEST_CASE("BVH: every truly colliding triangle pair is a candidate, ccd_step agr
     // u*, each within its tolerance; 1e-5 bounds their difference).
     CcdBody ob_body{&om, &obvh};
     CcdStepResult r;
-    ccd_step(&ob_body, 1, {&god, &gb}, x0, x1, settings, &ws, &r);
+    ccd_step(&ob_body, 1, {&god, &gb}, {x0, x1}, settings, &ws, &r);
     REQUIRE(r.status == CcdStatus::kOk);
     CHECK(r.hit == bf.hit);
     if (r.hit && bf.hit) {
@@ -124,7 +124,7 @@ TEST_CASE("BVH: every truly colliding triangle pair is a candidate, ccd_step agr
     // Without a candidate buffer the pairs are tested in traversal order, not
     // earliest-first: the same first contact (same 1e-5 bound).
     CcdStepResult r_unordered;
-    ccd_step(&ob_body, 1, {&god, &gb}, x0, x1, settings, &ws_unordered, &r_unordered);
+    ccd_step(&ob_body, 1, {&god, &gb}, {x0, x1}, settings, &ws_unordered, &r_unordered);
     CHECK(r_unordered.hit == r.hit);
     if (r.hit && r_unordered.hit) CHECK(std::abs(r.u_hit - r_unordered.u_hit) <= 1e-5);
     // With hints (a hitting pair when there is one, a random pair, invalid
@@ -148,20 +148,20 @@ TEST_CASE("BVH: every truly colliding triangle pair is a candidate, ccd_step agr
     CcdStepSettings probing = settings;
     probing.cache.margin = i % 3 == 0 ? 0.0 : 0.01;
     CcdStepResult r_hinted;
-    ccd_step(&ob_body, 1, {&god, &gb}, x0, x1, probing, &ws, &r_hinted, hints.data(), static_cast<int>(hints.size()));
+    ccd_step(&ob_body, 1, {&god, &gb}, {x0, x1, hints.data(), static_cast<int>(hints.size())}, probing, &ws, &r_hinted);
     REQUIRE(r_hinted.status == CcdStatus::kOk);
     CHECK(r_hinted.hit == bf.hit);
     if (r_hinted.hit && bf.hit) CHECK(std::abs(r_hinted.u_hit - bf.u_hit) <= 1e-5);
-    // The first sub-interval searched in lead pieces (CcdStepSettings::lead_sweep,
+    // The first sub-interval searched in lead pieces (CcdStepRequest::lead_sweep,
     // with and without a reach to scale it): other windows, the same first
     // contact (same 1e-5 bound). Every motion here sweeps far more than the
     // first piece may, so pieces are planned.
     CcdStepSettings leading = i % 3 == 0 ? settings : probing;
     leading.narrow.min_separation = i % 2 ? 0.0 : 1e-4;
-    leading.lead_sweep = i % 3 == 0 ? 1.0 : (i % 3 == 1 ? 4.0 : 16.0);
+    CcdStepRequest lead_request{x0, x1, i % 2 ? hints.data() : nullptr, i % 2 ? static_cast<int>(hints.size()) : 0};
+    lead_request.lead_sweep = i % 3 == 0 ? 1.0 : (i % 3 == 1 ? 4.0 : 16.0);
     CcdStepResult r_lead;
-    ccd_step(&ob_body, 1, {&god, &gb}, x0, x1, leading, &ws, &r_lead, i % 2 ? hints.data() : nullptr,
-             i % 2 ? static_cast<int>(hints.size()) : 0);
+    ccd_step(&ob_body, 1, {&god, &gb}, lead_request, leading, &ws, &r_lead);
     REQUIRE(r_lead.status == CcdStatus::kOk);
     CHECK(r_lead.num_sub_intervals > r.num_sub_intervals);
     if (leading.narrow.min_separation == 0) {
@@ -226,14 +226,14 @@ TEST_CASE("ccd_step: a hint's pair is not searched twice, and a pair sharing one
     }
     CcdStepResult r;
     ws.last_hit = FeaturePair{};
-    ccd_step(&ob_body, 1, {&god, &gb}, x0, x1, settings, &ws, &r, hints.data(), static_cast<int>(hints.size()));
+    ccd_step(&ob_body, 1, {&god, &gb}, {x0, x1, hints.data(), static_cast<int>(hints.size())}, settings, &ws, &r);
     INFO("step " << i << ", " << hints.size() << " hints");
     REQUIRE(r.status == CcdStatus::kOk);
     CHECK(r.hit);
     CHECK(std::abs(r.u_hit - bf.u_hit) <= 1e-5);
     for (const size_t lead : {size_t{0}, hints.size() / 2, hints.size() - 1}) {
       ws.last_hit = hints[lead];
-      ccd_step(&ob_body, 1, {&god, &gb}, x0, x1, settings, &ws, &r, hints.data(), static_cast<int>(hints.size()));
+      ccd_step(&ob_body, 1, {&god, &gb}, {x0, x1, hints.data(), static_cast<int>(hints.size())}, settings, &ws, &r);
       INFO("last hit: hint " << lead);
       REQUIRE(r.status == CcdStatus::kOk);
       CHECK(r.hit);
@@ -282,8 +282,8 @@ TEST_CASE("ccd_step: steps served by the proximity cache find the first contact 
     target.p.x() = std::clamp(target.p.x(), -0.3, 0.3);
     target.p.y() = std::clamp(target.p.y(), -1.0, 1.0);
     CcdStepResult r, r_plain;
-    ccd_step(&obstacle, 1, {&god, &gb}, x, target, settings, &ws, &r, hints.data(), static_cast<int>(hints.size()));
-    ccd_step(&obstacle, 1, {&god, &gb}, x, target, plain, &ws_plain, &r_plain);
+    ccd_step(&obstacle, 1, {&god, &gb}, {x, target, hints.data(), static_cast<int>(hints.size())}, settings, &ws, &r);
+    ccd_step(&obstacle, 1, {&god, &gb}, {x, target}, plain, &ws_plain, &r_plain);
     INFO("step " << k);
     CcdMotion m;
     REQUIRE(make_ccd_motion(x, target, &m) == MotionStatus::kOk);
@@ -376,7 +376,7 @@ TEST_CASE("ccd_step: a ball sliding on a slab into a wall, its cache refilled in
   for (; steps < 100 && !met_wall; ++steps) {
     const Pose target{x.p + Vec3(margin_max > 0 ? 0.008 : 0.004, 0, 0), x.q};
     CcdStepResult r;
-    ccd_step(&obstacle, 1, {&god, &gb}, x, target, settings, &ws, &r, &hint, 1);
+    ccd_step(&obstacle, 1, {&god, &gb}, {x, target, &hint, 1}, settings, &ws, &r);
     INFO("step " << steps);
     REQUIRE(r.status == CcdStatus::kOk);
     CcdMotion m;
@@ -434,7 +434,7 @@ TEST_CASE("ccd_step: a ball wandering among blocks, lists filled ahead of it in 
     if (std::abs(p.x()) > 1.5 || std::abs(p.y()) > 1.5) heading += 3.0, p = x.p;  // keep over the slab
     const Pose target{p, normalized(quat_exp(Vec3(0, 0, 0.02 * U(rng))) * x.q)};
     CcdStepResult r;
-    ccd_step(&obstacle, 1, {&god, &gb}, x, target, settings, &ws, &r, &hint, 1);
+    ccd_step(&obstacle, 1, {&god, &gb}, {x, target, &hint, 1}, settings, &ws, &r);
     INFO("step " << k);
     CcdMotion m;
     REQUIRE(make_ccd_motion(x, target, &m) == MotionStatus::kOk);
@@ -495,7 +495,7 @@ TEST_CASE("ccd_step: a step served read-only from another workspace's list agree
   // of its own, and must leave the borrowed list as it was. Served: when
   // the list is for the same bodies, a reach at least the check's, and a
   // margin that covers the check's motion; a list for another reach or
-  // another mesh is never served. Asked as a yes/no question (any_hit), the
+  // another mesh is never served. Asked as a yes/no question (kFreeOfContact), the
   // check gives the same answer with no more work.
   const TriangleMesh god = make_icosphere(1, 0.5);
   const TriangleMesh slab = concatenate(make_box(3, 3, 1, Vec3(0, 0, -0.5)), make_box(0.4, 0.4, 0.6, Vec3(0.6, 0, 0.3)));
@@ -524,7 +524,7 @@ TEST_CASE("ccd_step: a step served read-only from another workspace's list agree
     target.p.x() = std::clamp(target.p.x(), -0.3, 0.3);
     target.p.y() = std::clamp(target.p.y(), -1.0, 1.0);
     CcdStepResult leg;
-    ccd_step(&obstacle, 1, {&god, &gb}, x, target, legs, &ws, &leg, hints.data(), static_cast<int>(hints.size()));
+    ccd_step(&obstacle, 1, {&god, &gb}, {x, target, hints.data(), static_cast<int>(hints.size())}, legs, &ws, &leg);
     // The check: from the leg's start to its end moved a little further
     // down (into the slab on some steps), or far away on every fifth.
     const Pose end = make_stop_pose(leg.motion, leg.u_hit, gb.radius).pose;
@@ -534,8 +534,8 @@ TEST_CASE("ccd_step: a step served read-only from another workspace's list agree
     const Pose list_pose = ws.cache.ref;
     const int list_uses = ws.cache.uses;
     CcdStepResult r, r_alone;
-    ccd_step(&obstacle, 1, {&god, &gb}, x, to, check, &ws_check, &r, hints.data(), static_cast<int>(hints.size()));
-    ccd_step(&obstacle, 1, {&god, &gb}, x, to, check, &ws_alone, &r_alone, hints.data(), static_cast<int>(hints.size()));
+    ccd_step(&obstacle, 1, {&god, &gb}, {x, to, hints.data(), static_cast<int>(hints.size())}, check, &ws_check, &r);
+    ccd_step(&obstacle, 1, {&god, &gb}, {x, to, hints.data(), static_cast<int>(hints.size())}, check, &ws_alone, &r_alone);
     INFO("step " << k);
     CHECK(ws.cache.num_pairs == listed);
     CHECK(ws.cache.uses == list_uses);
@@ -554,12 +554,13 @@ TEST_CASE("ccd_step: a step served read-only from another workspace's list agree
       REQUIRE(r.hit == r_alone.hit);
       if (r.hit) CHECK(std::abs(r.u_hit - bf.u_hit) <= 1e-5);
     }
-    // The same check as a yes/no question (any_hit, as the runtime asks it):
-    // the same answer, stopped at the first hit it finds.
-    CcdStepSettings yes_no = check;
-    yes_no.any_hit = true;
+    // The same check as a yes/no question (CcdQuestion::kFreeOfContact, as the
+    // runtime asks it, with the legs' settings): the same answer, stopped at
+    // the first hit it finds.
+    CcdStepRequest yes_no{x, to, hints.data(), static_cast<int>(hints.size())};
+    yes_no.question = CcdQuestion::kFreeOfContact;
     CcdStepResult r_any;
-    ccd_step(&obstacle, 1, {&god, &gb}, x, to, yes_no, &ws_any, &r_any, hints.data(), static_cast<int>(hints.size()));
+    ccd_step(&obstacle, 1, {&god, &gb}, yes_no, legs, &ws_any, &r_any);
     CHECK(r_any.hit == r.hit);
     CHECK((r_any.status == CcdStatus::kOk) == (r.status == CcdStatus::kOk));
     CHECK(r_any.num_node_pairs <= r.num_node_pairs);
@@ -572,11 +573,11 @@ TEST_CASE("ccd_step: a step served read-only from another workspace's list agree
     CcdStepSettings wider = check;
     wider.narrow.min_separation = 2 * legs.near_distance;
     CcdStepResult r_wide;
-    ccd_step(&obstacle, 1, {&god, &gb}, x, to, wider, &ws_check, &r_wide);
+    ccd_step(&obstacle, 1, {&god, &gb}, {x, to}, wider, &ws_check, &r_wide);
     CHECK(r_wide.u_cached == 0);
     const CcdBody swapped{&other, &ob};
     CcdStepResult r_other;
-    ccd_step(&swapped, 1, {&god, &gb}, x, to, check, &ws_check, &r_other);
+    ccd_step(&swapped, 1, {&god, &gb}, {x, to}, check, &ws_check, &r_other);
     CHECK(r_other.u_cached == 0);
     x = make_stop_pose(leg.motion, leg.u_hit, gb.radius).pose;
     x.p.z() += 3e-4;
@@ -606,7 +607,7 @@ TEST_CASE("ccd_step: a workspace without room to descend is never served an empt
     INFO("cache_margin " << margin);
     CcdStepWorkspace ws(1 << 14, /*stack_capacity=*/0);
     CcdStepResult r;
-    ccd_step(&obstacle, 1, {&god, &gb}, x0, x1, background_fill_settings(margin, 0, 0), &ws, &r, &hint, 1);
+    ccd_step(&obstacle, 1, {&god, &gb}, {x0, x1, &hint, 1}, background_fill_settings(margin, 0, 0), &ws, &r);
     CHECK(r.status == CcdStatus::kWorkspaceFull);
     CHECK(r.hit);
     CHECK(r.u_hit == 0);
@@ -642,12 +643,12 @@ TEST_CASE("ccd_step: the proximity cache is not served for another mesh behind t
     CcdStepWorkspace ws;
     CcdBody obstacle{&slab, &sb};
     CcdStepResult r;
-    ccd_step(&obstacle, 1, {&god, &gb}, x0, x1, settings, &ws, &r, &hint, 1);
+    ccd_step(&obstacle, 1, {&god, &gb}, {x0, x1, &hint, 1}, settings, &ws, &r);
     REQUIRE(r.status == CcdStatus::kOk);
     CHECK(r.cache_filled);
     CHECK_FALSE(r.hit);
     if (swap) obstacle = {&slab_cube, &scb};
-    ccd_step(&obstacle, 1, {&god, &gb}, x1, x2, settings, &ws, &r, &hint, 1);
+    ccd_step(&obstacle, 1, {&god, &gb}, {x1, x2, &hint, 1}, settings, &ws, &r);
     REQUIRE(r.status == CcdStatus::kOk);
     CcdMotion m;
     REQUIRE(make_ccd_motion(x1, x2, &m) == MotionStatus::kOk);
@@ -680,8 +681,8 @@ TEST_CASE("ccd_step: the proximity cache's keys never grow, and its settings are
   const size_t capacity = narrow.cache.obstacles.capacity();
   CcdStepResult r_roomy, r_narrow;
   for (int step = 0; step < 3; ++step) {
-    ccd_step(obstacles, 2, {&god, &gb}, x0, x1, settings, &roomy, &r_roomy, &hint, 1);
-    ccd_step(obstacles, 2, {&god, &gb}, x0, x1, settings, &narrow, &r_narrow, &hint, 1);
+    ccd_step(obstacles, 2, {&god, &gb}, {x0, x1, &hint, 1}, settings, &roomy, &r_roomy);
+    ccd_step(obstacles, 2, {&god, &gb}, {x0, x1, &hint, 1}, settings, &narrow, &r_narrow);
     REQUIRE(r_roomy.status == CcdStatus::kOk);
     REQUIRE(r_narrow.status == CcdStatus::kOk);
     CHECK(r_roomy.hit);
@@ -705,16 +706,16 @@ TEST_CASE("ccd_step: the proximity cache's keys never grow, and its settings are
     spoil(&bad.cache);
     CHECK_FALSE(valid_proximity_cache_settings(bad.cache));
     CcdStepResult r;
-    ccd_step(obstacles, 1, {&god, &gb}, x0, x1, bad, &roomy, &r, &hint, 1);
+    ccd_step(obstacles, 1, {&god, &gb}, {x0, x1, &hint, 1}, bad, &roomy, &r);
     CHECK(r.status == CcdStatus::kInvalidInput);
   }
   CHECK(valid_proximity_cache_settings(ProximityCacheSettings{}));
   for (double lead : {-1.0, std::numeric_limits<double>::infinity(), std::numeric_limits<double>::quiet_NaN()}) {
-    CcdStepSettings bad = settings;
+    CcdStepRequest bad{x0, x1, &hint, 1};
     bad.lead_sweep = lead;
-    CHECK(ccd_step_settings_problem(bad) != nullptr);
+    CHECK(ccd_step_request_problem(bad) != nullptr);
     CcdStepResult r;
-    ccd_step(obstacles, 1, {&god, &gb}, x0, x1, bad, &roomy, &r, &hint, 1);
+    ccd_step(obstacles, 1, {&god, &gb}, bad, settings, &roomy, &r);
     CHECK(r.status == CcdStatus::kInvalidInput);
   }
 }
@@ -722,21 +723,22 @@ TEST_CASE("ccd_step: the proximity cache's keys never grow, and its settings are
 TEST_CASE("ccd_step: lead pieces find a first contact in whichever piece it falls", "[ccd_step]") {
   // A unit box falling flat by 3 onto a slab: its bottom face (G - 1/2) meets
   // z = 0 at u* = (z0 - 1/2) / 3, put in each of the pieces [0, 4^-6], ...,
-  // [1/4, 1] (CcdStepSettings::lead_sweep; reach 0: the most pieces) and at
+  // [1/4, 1] (CcdStepRequest::lead_sweep; reach 0: the most pieces) and at
   // their ends. Every piece must be searched, from its start: the box is
   // through the slab by the next one.
   const TriangleMesh god = make_box(1, 1, 1);
   const TriangleMesh slab = make_box(4, 4, 1, Vec3(0, 0, -0.5));  // top face z = 0
   const Bvh gb = build_bvh(god), sb = build_bvh(slab);
   const CcdBody obstacle{&slab, &sb}, body{&god, &gb};
-  CcdStepSettings plain, leading;
-  leading.lead_sweep = 1;
+  CcdStepSettings plain;
   CcdStepWorkspace ws;
   for (double u_star : {1e-4, 0.000244140625, 5e-4, 2e-3, 1e-2, 0.04, 0.0625, 0.1, 0.2, 0.25, 0.3, 0.45, 0.6, 0.9}) {
     const Pose x0{Vec3(0.1, 0.2, 0.5 + 3 * u_star), Quat{}}, x1{Vec3(0.1, 0.2, 0.5 + 3 * u_star - 3), Quat{}};
     CcdStepResult r_plain, r_lead;
-    ccd_step(&obstacle, 1, body, x0, x1, plain, &ws, &r_plain);
-    ccd_step(&obstacle, 1, body, x0, x1, leading, &ws, &r_lead);
+    ccd_step(&obstacle, 1, body, {x0, x1}, plain, &ws, &r_plain);
+    CcdStepRequest leading{x0, x1};
+    leading.lead_sweep = 1;
+    ccd_step(&obstacle, 1, body, leading, plain, &ws, &r_lead);
     REQUIRE(r_lead.status == CcdStatus::kOk);
     CHECK(r_lead.num_sub_intervals == r_plain.num_sub_intervals + 6);
     // (z0 is rounded: u* is within 1e-15 of the value written.)
@@ -748,9 +750,9 @@ TEST_CASE("ccd_step: lead pieces find a first contact in whichever piece it fall
 }
 
 TEST_CASE("ccd_step: a step told its first part is free searches only the rest", "[ccd_step]") {
-  // CcdStepSettings::known_free: the caller proved [0, known_free] free (the
+  // CcdStepRequest::known_free: the caller proved [0, known_free] free (the
   // runtime: a settling step's direct motion, its first part within
-  // min_separation of the first leg, sim_loop.cpp proven_prefix). A unit box
+  // min_separation of the first leg, sim_step4.cpp proven_prefix). A unit box
   // falling flat onto a slab meets it at u*: told less than u*, the step finds
   // the same first contact as a plain one, through each way it searches (the
   // hints, a borrowed list, the descents, lead pieces). Settings outside
@@ -766,27 +768,28 @@ TEST_CASE("ccd_step: a step told its first part is free searches only the rest",
     for (double u_star : {0.01, 0.2, 0.45, 0.8}) {
       for (double known : {0.0, 0.5 * u_star, 0.99 * u_star}) {
         const Pose x0{Vec3(0.1, 0.2, 0.5 + 0.5 * u_star), Quat{}}, x1{Vec3(0.1, 0.2, 0.5 + 0.5 * u_star - 0.5), Quat{}};
-        CcdStepSettings plain, told;
-        if (way == 3) plain.lead_sweep = 1;
-        told = plain;
-        told.known_free = known;
+        CcdStepSettings plain;
         CcdStepWorkspace ws, ws_told, ws_list;
         std::vector<FeaturePair> hints;
         if (way == 1) {  // the bottom face's pairs as hints: a contact searched first
           CcdStepResult full;
-          ccd_step(&obstacle, 1, body, x0, x1, plain, &ws, &full);
+          ccd_step(&obstacle, 1, body, {x0, x1}, plain, &ws, &full);
           REQUIRE(full.hit);
           hints.push_back(full.pair);
         }
         if (way == 2) {  // a list filled at x0 in another workspace, borrowed
           CcdStepResult r_fill;
-          ccd_step(&obstacle, 1, body, x0, x0, cached, &ws_list, &r_fill);
+          ccd_step(&obstacle, 1, body, {x0, x0}, cached, &ws_list, &r_fill);
           REQUIRE(ws_list.cache.num_pairs > 0);
           ws.borrowed = ws_told.borrowed = &ws_list.cache;
         }
         CcdStepResult r_plain, r_told;
-        ccd_step(&obstacle, 1, body, x0, x1, plain, &ws, &r_plain, hints.data(), static_cast<int>(hints.size()));
-        ccd_step(&obstacle, 1, body, x0, x1, told, &ws_told, &r_told, hints.data(), static_cast<int>(hints.size()));
+        CcdStepRequest request{x0, x1, hints.data(), static_cast<int>(hints.size())};
+        if (way == 3) request.lead_sweep = 1;
+        CcdStepRequest told = request;
+        told.known_free = known;
+        ccd_step(&obstacle, 1, body, request, plain, &ws, &r_plain);
+        ccd_step(&obstacle, 1, body, told, plain, &ws_told, &r_told);
         INFO("way " << way << " u* " << u_star << " known_free " << known);
         REQUIRE(r_plain.status == CcdStatus::kOk);
         REQUIRE(r_told.status == CcdStatus::kOk);
@@ -805,21 +808,22 @@ TEST_CASE("ccd_step: a step told its first part is free searches only the rest",
     const Bvh ob = build_bvh(obstacles);
     const CcdBody both{&obstacles, &ob};
     const Pose x0{Vec3(0.1, 0.2, 0.5 + 1.6), Quat{}}, x1{Vec3(0.1, 0.2, 0.5 + 1.6 - 2), Quat{}};
-    CcdStepSettings plain, told;
+    CcdStepSettings plain;
+    CcdStepRequest told{x0, x1};
     told.known_free = 0.75;
     CcdStepWorkspace ws;
     CcdStepResult r_plain, r_told;
-    ccd_step(&both, 1, body, x0, x1, plain, &ws, &r_plain);
-    ccd_step(&both, 1, body, x0, x1, told, &ws, &r_told);
+    ccd_step(&both, 1, body, {x0, x1}, plain, &ws, &r_plain);
+    ccd_step(&both, 1, body, told, plain, &ws, &r_told);
     REQUIRE(r_plain.hit);
     REQUIRE(r_told.hit);
     CHECK(std::abs(r_plain.u_hit - 0.195) <= 1e-5);
     CHECK(std::abs(r_told.u_hit - 0.8) <= 1e-5);
   }
   for (double bad : {-0.1, 1.0, 1.5, std::numeric_limits<double>::quiet_NaN()}) {
-    CcdStepSettings s;
-    s.known_free = bad;
-    CHECK(ccd_step_settings_problem(s) != nullptr);
+    CcdStepRequest r;
+    r.known_free = bad;
+    CHECK(ccd_step_request_problem(r) != nullptr);
   }
 }
 
@@ -834,7 +838,7 @@ TEST_CASE("ccd_step: a box falling flat onto a slab, and one tipping onto it", "
   CcdStepResult r;
 
   SECTION("falling: the bottom face (z = G - 1/2) reaches z = 0 at u = 1/3") {
-    ccd_step(&obstacle, 1, body, {Vec3(0.1, 0.2, 1.5), Quat{}}, {Vec3(0.1, 0.2, -1.5), Quat{}}, settings, &ws, &r);
+    ccd_step(&obstacle, 1, body, {{Vec3(0.1, 0.2, 1.5), Quat{}}, {Vec3(0.1, 0.2, -1.5), Quat{}}}, settings, &ws, &r);
     REQUIRE(r.status == CcdStatus::kOk);
     REQUIRE(r.hit);
     CHECK(mpq_class(r.u_hit) <= mpq_class(1, 3));
@@ -842,7 +846,7 @@ TEST_CASE("ccd_step: a box falling flat onto a slab, and one tipping onto it", "
     // Stop pose with min separation: the exact separation stays >= d - deviation > 0.
     CcdStepSettings sep = settings;
     sep.narrow.min_separation = 1e-5;
-    ccd_step(&obstacle, 1, body, {Vec3(0.1, 0.2, 1.5), Quat{}}, {Vec3(0.1, 0.2, -1.5), Quat{}}, sep, &ws, &r);
+    ccd_step(&obstacle, 1, body, {{Vec3(0.1, 0.2, 1.5), Quat{}}, {Vec3(0.1, 0.2, -1.5), Quat{}}}, sep, &ws, &r);
     REQUIRE(r.hit);
     const StopPose sp = make_stop_pose(r.motion, r.u_hit, gb.radius);
     CHECK(sp.deviation < 1e-12);
@@ -858,7 +862,7 @@ TEST_CASE("ccd_step: a box falling flat onto a slab, and one tipping onto it", "
     // With a 90 degree step, u* = tan(theta* / 2) / tan(45 deg).
     const double theta = std::asin(1.2 / std::sqrt(2.0)) - M_PI / 4;
     const double u_star = std::tan(theta / 2);
-    ccd_step(&obstacle, 1, body, {Vec3(0, 0, 0.6), Quat{}}, {Vec3(0, 0, 0.6), quat_exp(Vec3(M_PI / 2, 0, 0))},
+    ccd_step(&obstacle, 1, body, {{Vec3(0, 0, 0.6), Quat{}}, {Vec3(0, 0, 0.6), quat_exp(Vec3(M_PI / 2, 0, 0))}},
              settings, &ws, &r);
     REQUIRE(r.status == CcdStatus::kOk);
     REQUIRE(r.hit);
@@ -868,14 +872,14 @@ TEST_CASE("ccd_step: a box falling flat onto a slab, and one tipping onto it", "
                 u_star, r.num_sub_intervals, r.num_triangle_pairs, r.num_pair_tests);
   }
   SECTION("moving away: no hit; bad poses and half turns are statuses") {
-    ccd_step(&obstacle, 1, body, {Vec3(0, 0, 0.6), Quat{}}, {Vec3(0.3, 0, 2), quat_exp(Vec3(0, 0, 1))}, settings, &ws,
+    ccd_step(&obstacle, 1, body, {{Vec3(0, 0, 0.6), Quat{}}, {Vec3(0.3, 0, 2), quat_exp(Vec3(0, 0, 1))}}, settings, &ws,
              &r);
     CHECK(r.status == CcdStatus::kOk);
     CHECK_FALSE(r.hit);
     CHECK(r.u_hit == 1.0);
-    ccd_step(&obstacle, 1, body, {Vec3(0, 0, NAN), Quat{}}, {Vec3(0, 0, 2), Quat{}}, settings, &ws, &r);
+    ccd_step(&obstacle, 1, body, {{Vec3(0, 0, NAN), Quat{}}, {Vec3(0, 0, 2), Quat{}}}, settings, &ws, &r);
     CHECK(r.status == CcdStatus::kInvalidInput);
-    ccd_step(&obstacle, 1, body, {Vec3(0, 0, 2), Quat{}}, {Vec3(0, 0, 2), quat_exp(Vec3(0, 0, 3.1))}, settings, &ws,
+    ccd_step(&obstacle, 1, body, {{Vec3(0, 0, 2), Quat{}}, {Vec3(0, 0, 2), quat_exp(Vec3(0, 0, 3.1))}}, settings, &ws,
              &r);
     CHECK(r.status == CcdStatus::kHalfTurn);
   }
@@ -896,7 +900,7 @@ TEST_CASE("ccd_step: a pair test that refuses its input is a conservative hit, n
   for (const bool cached : {false, true}) {
     CcdStepSettings settings;
     if (!cached) settings.cache.margin = 0;
-    ccd_step(&obstacle, 1, body, {Vec3(0.1, 0.2, 1.5), Quat{}}, {Vec3(0.1, 0.2, -1.5), Quat{}}, settings, &ws, &r);
+    ccd_step(&obstacle, 1, body, {{Vec3(0.1, 0.2, 1.5), Quat{}}, {Vec3(0.1, 0.2, -1.5), Quat{}}}, settings, &ws, &r);
     INFO("proximity cache " << cached);
     CHECK(r.status == CcdStatus::kInvalidInput);
     CHECK(r.hit);
@@ -907,7 +911,7 @@ TEST_CASE("ccd_step: a pair test that refuses its input is a conservative hit, n
   bad.narrow.time_tolerance = 0;
   REQUIRE(ccd_step_settings_problem(bad) != nullptr);
   CHECK(std::string(ccd_step_settings_problem(bad)).find("time_tolerance") != std::string::npos);
-  ccd_step(&obstacle, 1, body, {Vec3(0.1, 0.2, 1.5), Quat{}}, {Vec3(0.1, 0.2, -1.5), Quat{}}, bad, &ws, &r);
+  ccd_step(&obstacle, 1, body, {{Vec3(0.1, 0.2, 1.5), Quat{}}, {Vec3(0.1, 0.2, -1.5), Quat{}}}, bad, &ws, &r);
   CHECK(r.status == CcdStatus::kInvalidInput);
   CHECK(r.num_pair_tests == 0);
   CHECK(ccd_step_settings_problem(CcdStepSettings{}) == nullptr);
@@ -952,14 +956,14 @@ TEST_CASE("ccd_step: a bar pivoting about its lowest corner over a slab agrees w
     const BruteForce bf = brute_force(god, gb, slab, sb, m, settings.narrow);
     INFO("step " << i << ", gap " << gap);
     CcdStepResult r;
-    ccd_step(&obstacle, 1, {&god, &gb}, x0, x1, settings, &ws, &r);
+    ccd_step(&obstacle, 1, {&god, &gb}, {x0, x1}, settings, &ws, &r);
     REQUIRE(r.status == CcdStatus::kOk);
     CHECK(r.hit == bf.hit);
     if (r.hit && bf.hit) CHECK(std::abs(r.u_hit - bf.u_hit) <= 1e-5);
     hits += bf.hit;
     // Hinted by a pair of faces near the pivot, through the proximity cache.
     const FeaturePair hint{PairKind::kEdgeEdge, 0, 0, 0, 2, 0};
-    ccd_step(&obstacle, 1, {&god, &gb}, x0, x1, cached, &ws_cached, &r, &hint, 1);
+    ccd_step(&obstacle, 1, {&god, &gb}, {x0, x1, &hint, 1}, cached, &ws_cached, &r);
     REQUIRE(r.status == CcdStatus::kOk);
     CHECK(r.hit == bf.hit);
     if (r.hit && bf.hit) CHECK(std::abs(r.u_hit - bf.u_hit) <= 1e-5);
@@ -988,7 +992,7 @@ TEST_CASE("ccd_step timing on spheres", "[ccd_step][timing]") {
     const Pose x0{1.6 * dir, Quat{}};
     const Pose x1{(1.45 + 0.1 * U(rng)) * dir + 0.02 * Vec3(U(rng), U(rng), U(rng)), quat_exp(0.05 * Vec3(U(rng), U(rng), U(rng)))};
     const auto t0 = std::chrono::steady_clock::now();
-    ccd_step(&obstacle, 1, {&god, &gb}, x0, x1, settings, &ws, &r);
+    ccd_step(&obstacle, 1, {&god, &gb}, {x0, x1}, settings, &ws, &r);
     const double dt = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     total += dt;
     worst = std::max(worst, dt);
@@ -1016,7 +1020,6 @@ TEST_CASE("ccd_step: a descent's cut serves only the trees it was made for", "[c
   const Bvh gb = build_bvh(god, 2), bb = build_bvh(box, 2), sb = build_bvh(ball, 2);
   const CcdBody both[2] = {{&ball, &sb}, {&box, &bb}};
   CcdStepSettings settings;
-  settings.lead_sweep = 4;  // pieces: several descents a step
   std::mt19937 rng(5);
   std::uniform_real_distribution<double> U(-1, 1);
   CcdStepWorkspace carried;
@@ -1028,11 +1031,13 @@ TEST_CASE("ccd_step: a descent's cut serves only the trees it was made for", "[c
     const Pose x1{Vec3(U(rng), U(rng), 0.2 * U(rng)), normalized(quat_exp(0.5 * Vec3(U(rng), U(rng), U(rng))) * x0.q)};
     const CcdBody* obstacles = i % 3 == 0 ? &both[0] : &both[1];
     const int n = i % 3 == 2 ? 1 : (i % 3 == 0 ? 2 : 1);
+    CcdStepRequest request{x0, x1};
+    request.lead_sweep = 4;  // pieces: several descents a step
     CcdStepWorkspace fresh;
     CcdStepResult r_fresh, r_carried;
-    ccd_step(obstacles, n, {&god, &gb}, x0, x1, settings, &fresh, &r_fresh);
+    ccd_step(obstacles, n, {&god, &gb}, request, settings, &fresh, &r_fresh);
     const bool same_trees = carried.front.keyed({&god, &gb}, obstacles, n);
-    ccd_step(obstacles, n, {&god, &gb}, x0, x1, settings, &carried, &r_carried);
+    ccd_step(obstacles, n, {&god, &gb}, request, settings, &carried, &r_carried);
     REQUIRE(r_fresh.status == CcdStatus::kOk);
     REQUIRE(r_carried.status == CcdStatus::kOk);
     CHECK(r_carried.hit == r_fresh.hit);
@@ -1047,7 +1052,7 @@ TEST_CASE("ccd_step: a descent's cut serves only the trees it was made for", "[c
     CcdStepWorkspace& plain = i % 2 ? carried : fresh;
     plain.front.carry = false;
     CcdStepResult r_plain;
-    ccd_step(obstacles, n, {&god, &gb}, x0, x1, settings, &plain, &r_plain);
+    ccd_step(obstacles, n, {&god, &gb}, request, settings, &plain, &r_plain);
     CHECK(r_plain.u_hit == r_fresh.u_hit);
     CHECK(r_plain.num_node_pairs == r_fresh.num_node_pairs);
     carried.front.carry = true;

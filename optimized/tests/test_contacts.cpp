@@ -145,7 +145,7 @@ TEST_CASE("contacts: the CCD's near pairs give the same set as the descent", "[c
     const Pose x1{p0 + Vec3(0.01 * U(rng), 0.01 * U(rng), kDelta * (U(rng) - 0.5)),
                   normalized(quat_exp(1e-6 * Vec3(U(rng), U(rng), U(rng))) * q0)};
     CcdStepResult r;
-    ccd_step(&obstacle, 1, god, x0, x1, settings, &ccd_ws, &r);
+    ccd_step(&obstacle, 1, god, {x0, x1}, settings, &ccd_ws, &r);
     REQUIRE(r.status == CcdStatus::kOk);
     const double u = r.hit ? r.u_hit : 1.0;
     const StopPose stop = make_stop_pose(r.motion, u, gb.radius);

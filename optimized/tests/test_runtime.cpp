@@ -10,10 +10,14 @@
 #include <array>
 #include <atomic>
 #include <cmath>
+#include <cstdio>
 #include <cstring>
+#include <fstream>
 #include <functional>
 #include <memory>
 #include <mutex>
+#include <sstream>
+#include <string>
 #include <thread>
 #include <vector>
 
@@ -482,10 +486,12 @@ double lowest_over_crease_along(const RuntimeModel& model, const Pose& a, const 
   return h;
 }
 
-TEST_CASE("runtime: a step that lifts off a convex crease settles back onto the surface", "[runtime]") {
-  // The tip rests on the flat part, kDelta (1 + gap_factor) above it, just
-  // before the crease; the step slides it along +x (the command projected on
-  // the flat face's contact), over the slope and out of the contact band.
+TEST_CASE("runtime: step 4's paths: settle, refused settle, shortening, keep_a_contact, graze lift", "[runtime]") {
+  // Each path of step 4 (docs/sim-step.md), named by the section that takes it
+  // and checked by what it is for (each fails with its path removed). The tip
+  // rests on the flat part, kDelta (1 + gap_factor) above it, before the
+  // crease; the step slides it along +x (the command projected on the flat
+  // face's contact), over the slope and out of the contact band.
   const RuntimeModel model(make_crease_scene(), RuntimeSettings{});
   const double gap = kDelta * (1 + model.settings.gap_factor);
   const Vec6 pressing = (Vec6() << 0, 0, -0.005, 0, 0, 0).finished();  // what the flat face's rows withheld
@@ -504,11 +510,12 @@ TEST_CASE("runtime: a step that lifts off a convex crease settles back onto the 
     advance_god_object(model, x0, x1, Vec6::Zero(), &s, &info);
     CHECK(info.status == SimStepStatus::kFree);
     CHECK_FALSE(info.settled);
+    CHECK(s.step4.paths.settles == 0);
     CHECK(info.num_contacts == 0);
     CHECK(s.xs.p.x() == Approx(x1.p.x()).margin(1e-12));
     CHECK(height_over_crease(model, s.xs) > 50 * kDelta);
   }
-  SECTION("the pressing part withheld, a short step: it settles on the slope in the same step") {
+  SECTION("settle: the pressing part withheld, a short step settles on the slope in the same step") {
     // 1 delta before the crease, 4 delta along: 2.5 delta from the slope at
     // the first leg's end (out of the band, 1.5 delta); the settled end is 0.4
     // delta below the flat part's plane, and the direct motion to it passes
@@ -519,6 +526,8 @@ TEST_CASE("runtime: a step that lifts off a convex crease settles back onto the 
     advance_god_object(model, x0, x1, pressing, &s, &info);
     CHECK(info.settled);
     CHECK(info.num_shortenings == 0);
+    CHECK(s.step4.paths.settles == 1);
+    CHECK(s.step4.paths.refused == 0);
     CHECK(info.status == SimStepStatus::kContact);
     CHECK(info.ccd == CcdStatus::kOk);
     CHECK(info.num_contacts > 0);
@@ -541,7 +550,7 @@ TEST_CASE("runtime: a step that lifts off a convex crease settles back onto the 
     // Property 5: the motion between the step's two poses is free of contact.
     CHECK(lowest_over_crease_along(model, x0, s.xs) > 0.5 * kDelta);
   }
-  SECTION("the pressing part withheld, a long step: the settled end is refused (the direct motion cuts the crease)") {
+  SECTION("refused settle, shortening: a long step's settled end is refused (the direct motion cuts the crease)") {
     // 1 mm before the crease, 3 mm along: the first leg ends 0.73 mm (73 delta)
     // over the slope; settling there would put the tip 2 mm along the slope,
     // and the straight motion from x0 to it passes 0.23 mm (23 delta) under the
@@ -554,16 +563,18 @@ TEST_CASE("runtime: a step that lifts off a convex crease settles back onto the 
     advance_god_object(model, x0, x1, pressing, &s, &info);
     CHECK(info.settled);
     CHECK(info.num_shortenings == 2);
+    CHECK(s.step4.paths.refused == 2);
+    CHECK(s.step4.paths.keep_halvings == 0);
     CHECK(info.status == SimStepStatus::kFree);
     CHECK(info.num_contacts > 0);
     CHECK(s.xs.p.x() == Approx(x0.p.x() + 0.003 / 4).margin(1e-12));
     // Property 5, the check that failed before the refusal (-23 delta: through the crease).
     CHECK(lowest_over_crease_along(model, x0, s.xs) > 0.5 * kDelta);
     // The shortened tries' contacts came from the first leg's near pairs, kept
-    // before the settling legs ran (SimState::proven_near): the same set as a
+    // before the settling legs ran (GodObjectStep::proven_near): the same set as a
     // full descent at the published pose.
-    CHECK(s.near_is_proven);
-    CHECK(s.num_proven_near > 0);
+    CHECK(s.step4.leg.near.pairs == s.step4.proven_near.data());
+    CHECK(s.step4.leg.near.num_pairs > 0);
     ContactSet full(s.capacity);
     ContactWorkspace full_ws(model.god_mesh_B);
     REQUIRE(generate_contacts(model.obstacles.data(), static_cast<int>(model.obstacles.size()), model.god, s.xs,
@@ -576,6 +587,45 @@ TEST_CASE("runtime: a step that lifts off a convex crease settles back onto the 
                 s.contacts.contacts[j].separation == full.contacts[k].separation;
       CHECK(same == 1);
     }
+  }
+  SECTION("keep_a_contact: every settle refused, the first leg halved on until its end keeps a contact") {
+    // 1 mm before the crease, 12 mm along: the first leg's end at 1, 1/2, 1/4
+    // and 1/8 of the slide lies 11 to 0.5 mm past the crease, out of the
+    // band, and each settled end is refused (the direct motion to the slope
+    // dips under the crease's top); at 1/16 (0.75 mm) the tip is still on the
+    // flat part, in contact. Without the halvings the step would publish an
+    // empty set while the user presses (a force dropout).
+    const Pose x0{Vec3(-0.001, 0, kHalf + gap), Quat{}};
+    const Pose x1{x0.p + Vec3(0.012, 0, 0), Quat{}};
+    start_at(x0);
+    advance_god_object(model, x0, x1, pressing, &s, &info);
+    CHECK(info.settled);
+    CHECK(info.num_shortenings == kMaxSettleShortenings);
+    CHECK(s.step4.paths.refused == kMaxSettleShortenings + 1);
+    CHECK(s.step4.paths.keep_halvings == 1);
+    CHECK_FALSE(s.step4.paths.stayed);
+    CHECK(info.num_contacts > 0);
+    CHECK(s.xs.p.x() == Approx(x0.p.x() + 0.012 / 16).margin(1e-12));
+    CHECK(lowest_over_crease_along(model, x0, s.xs) > 0.5 * kDelta);
+  }
+  SECTION("graze lift: a contact left in the CCD's band does not hold the god-object back") {
+    // The tip 1.05 delta over the flat part (inside the CCD's band, delta to
+    // 1.1 delta), sliding 1 mm along it and closing in by 0.15 delta: the CCD
+    // accepts the pair it starts with at once (u_hit 0), though the tip would
+    // reach delta only a third of the way along. Lifted to delta (1 +
+    // gap_factor) first, the leg slides until the tip comes back into the
+    // band, 43-71% of the way; that end is kept, the direct motion from x0
+    // being free.
+    const Pose x0{Vec3(-0.004, 0, kHalf + 1.05 * kDelta), Quat{}};
+    const Pose x1{x0.p + Vec3(0.001, 0, -0.15 * kDelta), Quat{}};
+    start_at(x0);
+    advance_god_object(model, x0, x1, Vec6::Zero(), &s, &info);
+    CHECK(s.step4.paths.grazed);
+    CHECK(s.step4.paths.lifted);
+    CHECK(s.xs.p.x() - x0.p.x() > 0.0004);  // without the lift: u_hit 0
+    CHECK(height_over_crease(model, s.xs) >= kDelta * (1 - 1e-3));
+    CHECK(info.num_contacts > 0);
+    CHECK(lowest_over_crease_along(model, x0, s.xs) > 0.5 * kDelta);
   }
 }
 
@@ -668,9 +718,10 @@ TEST_CASE("runtime: a run's recorded CCD inputs replay its collision work exactl
     // fill (its budget is per sim step): an accepted settling leg, the last
     // leg run, filled only if it refilled the list at once or finished a
     // fill it needed.
-    if (info.settled && info.num_shortenings == 0 && replay.ccd.motion.nominal.p0 != sim.x_start.p &&
-        !replay.ccd.cache_filled && !replay.ccd.cache_refilled) {
-      CHECK(replay.ccd.num_fill_node_pairs == 0);
+    const CcdStepResult& last = replay.step4.leg.ccd;  // the leg the step ended on
+    if (info.settled && info.num_shortenings == 0 && last.motion.nominal.p0 != sim.x_start.p && !last.cache_filled &&
+        !last.cache_refilled) {
+      CHECK(last.num_fill_node_pairs == 0);
       ++num_settling_legs;
     }
     ++num_replayed;
@@ -860,4 +911,20 @@ TEST_CASE("runtime: a pushing hand gets rows and force at every delta down to th
                   delta, last.num_contacts, r.rec.ticks.back().F_sent[2], expected, lowest, lowest / delta);
     }
   }
+}
+
+TEST_CASE("runtime: docs/sim-step.md states step 4's constants as the code defines them", "[runtime]") {
+  std::ifstream in(std::string(GAUSS6_SOURCE_DIR) + "/docs/sim-step.md");
+  REQUIRE(in);
+  std::stringstream text;
+  text << in.rdbuf();
+  const auto stated = [&](const char* name, double value) {
+    char line[96];
+    std::snprintf(line, sizeof line, "`%s` = %g", name, value);
+    INFO(line);
+    CHECK(text.str().find(line) != std::string::npos);
+  };
+  stated("kMaxSettleShortenings", kMaxSettleShortenings);
+  stated("kMaxKeepHalvings", kMaxKeepHalvings);
+  stated("kSettleLeadSweep", kSettleLeadSweep);
 }

@@ -24,8 +24,11 @@ judges the poses first shown at its ticks and the motions arriving at them (the 
 from the pose of tick start - 1 belongs to this chunk).
 
 Output: certify.json ({"format": "gauss6-certify", "version": 1, "pass", "scene", "trace", "ticks",
-"counts", "paths", "max_separation_delta", "bound_delta", "first_violation", "violations", "seconds",
-"machine"}) and certify.md. Exit status: 0 certified, 1 a violation, 2 a usage or load error.
+"coverage", "counts", "paths", "max_separation_delta", "bound_delta", "first_violation", "violations",
+"seconds", "machine"}; "ticks" the range certified, "coverage" what the trace held: trace.coverage, its
+ticks, time span, complete or cut, sha256) and certify.md (which says INCOMPLETE for a cut trace).
+A trace without ticks, or a tick range that is empty or beyond the trace, is refused.
+Exit status: 0 certified, 1 a violation, 2 a usage or load error.
 """
 from __future__ import annotations
 
@@ -43,6 +46,7 @@ from pathlib import Path
 import numpy as np
 
 from .exact_checks import ExactScene
+from .trace import coverage_line
 
 FORMAT = "gauss6-certify"
 FORMAT_VERSION = 1
@@ -149,7 +153,7 @@ def certify_range(scene: ExactScene, ticks, start: int, stop: int) -> CertifyRes
                 exact_pairs = 0
                 try:
                     for i in near:
-                        c = scene.pairs[i].exact_first_contact(P[j - 1], Q[j - 1], P[j], Q[j])
+                        c = scene.first_contact(i, P[j - 1], Q[j - 1], P[j], Q[j])
                         res.pairs["candidate"] += c.num_candidate_pairs
                         res.pairs["filtered"] += c.num_filtered_pairs
                         res.pairs["exact"] += c.num_exact_pairs
@@ -180,10 +184,42 @@ def _scene(scene_path: str) -> ExactScene:
 
 
 @functools.lru_cache(maxsize=4)
-def _ticks(trace_path: str, mtime_ns: int):
-    from .trace import read_trace
+def _trace(trace_path: str, mtime_ns: int):
+    """The trace as certified: read (a cut trace with its warnings recorded in Trace.warnings, not
+    printed), ticks in time order, positions within the coordinate bound, quaternions rescaled
+    (trace.checked_poses)."""
+    import warnings
 
-    return read_trace(trace_path).ticks
+    from .trace import TraceWarning, checked_poses, read_trace
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", TraceWarning)  # stated in the outputs (coverage), not only printed
+        return checked_poses(read_trace(trace_path))
+
+
+def _ticks(trace_path: str, mtime_ns: int):
+    return _trace(trace_path, mtime_ns).ticks
+
+
+def load_trace(trace_path):
+    """The trace certify judges (cached per process, as certify_chunk's workers read it)."""
+    trace_path = Path(trace_path)
+    return _trace(str(trace_path), trace_path.stat().st_mtime_ns)
+
+
+def tick_range_problem(tick_range: tuple[int, int] | None, n: int) -> str:
+    """'' when [a, b) is a non-empty range of the trace's n ticks (None: all of them, which must
+    not be empty), else what is wrong with it."""
+    if n == 0:
+        return "the trace holds no ticks: there is no run to certify"
+    if tick_range is None:
+        return ""
+    a, b = tick_range
+    if not 0 <= a < b:
+        return f"the tick range {a}:{b} is empty or negative (give A:B with 0 <= A < B)"
+    if b > n:
+        return f"the tick range {a}:{b} goes beyond the trace's {n} ticks"
+    return ""
 
 
 def certify_chunk(scene_path, trace_path, start: int, stop: int) -> CertifyResult:
@@ -201,10 +237,13 @@ def chunks(n: int, size: int) -> list[tuple[int, int]]:
 
 def certify(scene_path, trace_path, chunk_ticks: int = 2000, tick_range: tuple[int, int] | None = None,
             progress=None) -> CertifyResult:
-    """Certify a recorded run, chunk by chunk (serially; see certify_range to run chunks elsewhere)."""
-    n = len(_ticks(str(trace_path), Path(trace_path).stat().st_mtime_ns))
+    """Certify a recorded run, chunk by chunk (serially; see certify_range to run chunks elsewhere).
+    ValueError for a trace without ticks and a tick range that is empty or beyond the trace."""
+    n = len(load_trace(trace_path).ticks)
+    problem = tick_range_problem(tick_range, n)
+    if problem:
+        raise ValueError(f"{trace_path}: {problem}")
     a, b = tick_range or (0, n)
-    a, b = max(a, 0), min(b, n)
     results = []
     for lo, hi in chunks(b - a, chunk_ticks):
         results.append(certify_chunk(scene_path, trace_path, a + lo, a + hi))
@@ -218,11 +257,13 @@ def _machine() -> dict:
             "cpus": os.cpu_count(), "python": platform.python_version()}
 
 
-def to_json(res: CertifyResult, scene_path, trace_path) -> dict:
+def to_json(res: CertifyResult, scene_path, trace_path, coverage: dict | None = None) -> dict:
+    """certify.json; coverage (trace.coverage of the whole trace) says what the run held: its ticks,
+    time span, complete or cut, and its digest, beside the tick range certified ("ticks")."""
     delta, bound = res.delta, res.bound
     first = res.first_violation()
     return {"format": FORMAT, "version": FORMAT_VERSION, "pass": res.passed, "scene": str(scene_path),
-            "trace": str(trace_path), "ticks": [res.start, res.stop],
+            "trace": str(trace_path), "ticks": [res.start, res.stop], "coverage": coverage,
             "counts": {"poses": res.poses, "motions": res.motions, "separations": res.separations},
             "paths": dict(res.paths), "pairs": dict(res.pairs), "separation_paths": dict(res.separation_paths),
             "max_separation_delta": res.max_separation / delta if delta else 0.0,
@@ -237,6 +278,9 @@ def to_markdown(doc: dict) -> str:
     lines = [f"# Certification of `{doc['trace']}`", "",
              f"Scene `{doc['scene']}`, ticks [{doc['ticks'][0]}, {doc['ticks'][1]}): "
              f"**{'certified' if doc['pass'] else 'NOT certified'}** ({doc['seconds']:.1f} s).", "",
+             *([f"The trace: {coverage_line(doc['coverage'])}."] if doc.get("coverage") else []),
+             *(["**Only part of the run was certified**: the trace is cut; what it lost is not judged.", ""]
+               if doc.get("coverage") and not doc["coverage"]["complete"] else [""] if doc.get("coverage") else []),
              "| property (METHOD.md s.5) | checked | by | result |", "| --- | --- | --- | --- |",
              f"| 5: every pose exactly free | {c['poses']} distinct poses | reference count_intersecting_pairs "
              f"(CGAL filtered predicate: intervals, Gmpq when undecided) | {doc['violations']['counts']['pose']} "
@@ -258,29 +302,59 @@ def to_markdown(doc: dict) -> str:
     return "\n".join(lines)
 
 
-def write_report(res: CertifyResult, scene_path, trace_path, out: Path, name: str = "certify") -> dict:
+def write_report(res: CertifyResult, scene_path, trace_path, out: Path, name: str = "certify",
+                 coverage: dict | None = None) -> dict:
     """Writes OUT/<name>.json and OUT/<name>.md; returns the JSON document."""
-    doc = to_json(res, scene_path, trace_path)
-    out.mkdir(parents=True, exist_ok=True)
+    from .paths import check_output_dir
+
+    if coverage is None:
+        from .trace import coverage as trace_coverage
+
+        coverage = trace_coverage(load_trace(trace_path))
+    doc = to_json(res, scene_path, trace_path, coverage)
+    check_output_dir(out)
     (out / f"{name}.json").write_text(json.dumps(doc, indent=2) + "\n")
     (out / f"{name}.md").write_text(to_markdown(doc))
     return doc
 
 
+def cmd_witness(args: argparse.Namespace) -> int:
+    """`gauss6 certify --witness FILE [--scene SCENE]`: re-check a validate witness exactly (witness.recheck);
+    exit 0 when the violation stands, 1 when it does not, 2 on a bad file."""
+    from .paths import read_input_text
+    from .witness import recheck
+
+    try:
+        doc = json.loads(read_input_text(args.witness))
+        stands, text = recheck(doc, args.scene)
+    except (OSError, ValueError, KeyError, TypeError, RuntimeError) as e:
+        print(f"gauss6 certify: {args.witness}: {e}", file=sys.stderr)
+        return 2
+    print(text)
+    return 0 if stands else 1
+
+
+def tick_range_arg(text: str) -> tuple[int, int]:
+    """--ticks A:B: two integers, 0 <= A < B (whether B is within the trace is checked once it is read)."""
+    try:
+        a, b = (int(x) for x in text.split(":"))
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"--ticks must be A:B (integers), not {text!r}") from None
+    if not 0 <= a < b:
+        raise argparse.ArgumentTypeError(f"{text}: the tick range is empty or negative (give A:B with 0 <= A < B)")
+    return a, b
+
+
 def cmd_certify(args: argparse.Namespace) -> int:
+    from .trace import coverage
+
+    if args.witness:
+        return cmd_witness(args)
+    if not args.trace or not args.scene:
+        print("gauss6 certify: give a TRACE and --scene SCENE (or --witness FILE)", file=sys.stderr)
+        return 2
     trace, scene = Path(args.trace), Path(args.scene)
-    for p, what in ((trace, "trace"), (scene, "scene")):
-        if not p.is_file():
-            print(f"gauss6 certify: no {what} file {p}", file=sys.stderr)
-            return 2
-    tick_range = None
-    if args.ticks:
-        try:
-            a, b = (int(x) for x in args.ticks.split(":"))
-        except ValueError:
-            print(f"gauss6 certify: --ticks must be A:B (integers), not {args.ticks!r}", file=sys.stderr)
-            return 2
-        tick_range = (a, b)
+    tick_range = args.ticks
 
     def progress(done: int, total: int) -> None:
         if not args.quiet:
@@ -288,13 +362,21 @@ def cmd_certify(args: argparse.Namespace) -> int:
 
     try:
         res = certify(scene, trace, tick_range=tick_range, progress=progress)
+        cov = coverage(load_trace(trace))
     except (ValueError, RuntimeError, OSError) as e:
         print(f"\ngauss6 certify: {e}", file=sys.stderr)
         return 2
     if not args.quiet:
         print(file=sys.stderr)
+    if not cov["complete"]:
+        print(f"gauss6 certify: warning: {trace}: the trace is incomplete ({'; '.join(cov['cut']) or 'not closed'}); "
+              "only the ticks it holds are certified (certify.json: coverage)", file=sys.stderr)
     out = Path(args.out) if args.out else trace.parent
-    doc = write_report(res, scene, trace, out)
+    try:
+        doc = write_report(res, scene, trace, out, coverage=cov)
+    except (ValueError, OSError) as e:
+        print(f"gauss6 certify: {e}", file=sys.stderr)
+        return 2
     print(json.dumps(doc, indent=2) if args.json else to_markdown(doc))
     return 0 if res.passed else 1
 
@@ -303,10 +385,14 @@ def register(subparsers) -> None:
     p = subparsers.add_parser("certify", help="exactly certify a recorded run: every pose free, every motion "
                                               "between poses free of contact, separations within the bound "
                                               "(exit 1 on a violation)")
-    p.add_argument("trace", help="a .g6trace")
-    p.add_argument("--scene", required=True, help="the run's scene TOML file")
-    p.add_argument("--out", help="directory for certify.json and certify.md (default: the trace's)")
-    p.add_argument("--ticks", help="only the ticks A:B (a chunk, as a campaign runs it)")
+    from .cli import input_file, output_dir
+
+    p.add_argument("trace", nargs="?", type=input_file("trace"), help="a .g6trace")
+    p.add_argument("--scene", type=input_file("scene"), help="the run's scene TOML file (a witness names its own)")
+    p.add_argument("--witness", type=input_file("witness"),
+                   help="re-check a witness file of `gauss6 validate` exactly instead (exit 0: the violation stands)")
+    p.add_argument("--out", type=output_dir, help="directory for certify.json and certify.md (default: the trace's)")
+    p.add_argument("--ticks", type=tick_range_arg, help="only the ticks A:B (a chunk, as a campaign runs it)")
     p.add_argument("--json", action="store_true", help="print certify.json instead of the table")
     p.add_argument("--quiet", action="store_true", help="no progress on stderr")
     p.set_defaults(func=cmd_certify)

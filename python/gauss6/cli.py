@@ -37,6 +37,99 @@ SCENES = {
 }
 
 
+# ---------------------------------------------------------------------------------------------
+# Argument types every subcommand shares: a bad value is refused at parse time (exit 2, the
+# option named), never turned into a traceback, a hang or a run without end.
+
+MAX_RUN_SECONDS = 86400.0  # the longest run a command drives or replays: one day of run time
+
+
+def _arg_error(message: str) -> argparse.ArgumentTypeError:
+    return argparse.ArgumentTypeError(message)
+
+
+def run_seconds(text: str) -> float:
+    """--duration: a finite number of seconds in (0, MAX_RUN_SECONDS]."""
+    try:
+        value = float(text)
+    except ValueError:
+        raise _arg_error(f"not a number of seconds: {text!r}") from None
+    if not 0 < value <= MAX_RUN_SECONDS:  # NaN fails too
+        raise _arg_error(f"{text}: a duration must be a finite number of seconds in (0, {MAX_RUN_SECONDS:g}]")
+    return value
+
+
+def check_run_span(seconds: float, what: str) -> None:
+    """A recording or hand script's span, bounded as --duration is (ValueError naming it)."""
+    if not seconds <= MAX_RUN_SECONDS:
+        raise ValueError(f"{what} spans {seconds:g} s, more than a run can last ({MAX_RUN_SECONDS:g} s); "
+                         "give --duration to run a part of it")
+
+
+def _integer(text: str, lo: int, what: str) -> int:
+    try:
+        value = int(text)
+    except ValueError:
+        raise _arg_error(f"not an integer: {text!r}") from None
+    if value < lo:
+        raise _arg_error(f"{text}: {what} must be an integer >= {lo}")
+    return value
+
+
+def positive_int(text: str) -> int:
+    """A count that must be at least 1 (--max-frames, --chunk-size, --seeded)."""
+    return _integer(text, 1, "the value")
+
+
+def nonnegative_int(text: str) -> int:
+    """A count that may be 0 (--workers: 0 runs serially)."""
+    return _integer(text, 0, "the value")
+
+
+def _utf8(text: str) -> str:
+    """A path given on the command line whose bytes are not UTF-8 (legal on Linux) reaches
+    Python with surrogate escapes, which the C++ core cannot take: refused, named."""
+    try:
+        text.encode("utf-8")
+    except UnicodeEncodeError:
+        raise _arg_error(f"{text.encode('utf-8', 'surrogateescape')!r}: the path holds bytes that are not "
+                         "UTF-8; rename the file") from None
+    return text
+
+
+def input_file(what: str, directory_ok: bool = False):
+    """An argparse type: an existing regular file (paths.check_input_file: not a FIFO, a device
+    or a directory; a directory too when directory_ok), its path UTF-8."""
+    def check(text: str) -> str:
+        try:
+            if not (directory_ok and Path(_utf8(text)).is_dir()):
+                paths.check_input_file(_utf8(text), what)
+        except paths.PathError as e:
+            raise _arg_error(str(e)) from None
+        return text
+    check.__name__ = what  # argparse names the type in "invalid <name> value"
+    return check
+
+
+def _writable(text: str, want_dir: bool, what: str) -> str:
+    problem = paths.output_problem(_utf8(text), want_dir, what)
+    if problem:
+        raise _arg_error(problem)
+    return text
+
+
+def output_dir(text: str) -> str:
+    """An argparse type: a directory to write into (created later; an existing file, a path
+    under a file or an unwritable place is refused)."""
+    return _writable(text, True, "output directory")
+
+
+def output_file(text: str) -> str:
+    """An argparse type: a file to write (an existing directory, a path under a file or an
+    unwritable place is refused)."""
+    return _writable(text, False, "output file")
+
+
 def _error(message: str) -> int:
     print(f"gauss6: error: {message}", file=sys.stderr)
     return 2
@@ -114,14 +207,18 @@ def run_seeded_campaign(args: argparse.Namespace, what: str) -> int:
                            show_progress=not args.json)
     except (ValueError, CampaignError) as e:
         return _error(str(e))
+    for problem in run.recomputed:
+        print(f"gauss6: warning: chunk file {problem}", file=sys.stderr)
     result, failures, reports = run.summary
     result = {**result, "seed": args.seed, "chunks": len(campaign.chunks), "chunks_run": run.chunks_run,
-              "chunks_resumed": run.chunks_resumed, "workers": run.workers, "seconds": run.seconds}
+              "chunks_resumed": run.chunks_resumed, "chunks_recomputed": run.recomputed, "workers": run.workers,
+              "seconds": run.seconds}
     if args.json:
         print(json.dumps(result))
     else:
         print(format_table(result, reports))
-        print(f"{len(campaign.chunks)} chunks ({run.chunks_resumed} resumed from {args.out}), "
+        print(f"{len(campaign.chunks)} chunks ({run.chunks_resumed} resumed from {args.out}"
+              + (f", {len(run.recomputed)} damaged chunk files recomputed" if run.recomputed else "") + "), "
               f"{run.workers or 'serial, no'} workers, {run.seconds:.1f} s")
     for f in failures[:50]:
         print(f"FAIL {f}", file=sys.stderr)
@@ -177,7 +274,7 @@ def build_parser() -> argparse.ArgumentParser:
 
     scene = sub.add_parser("scene", help="scene files").add_subparsers(dest="action", required=True)
     info = scene.add_parser("info", help="per body: triangles, closed, manifold, mass, inertia, bbox; the effective settings")
-    info.add_argument("scene", help="scene TOML file")
+    info.add_argument("scene", type=input_file("scene"), help="scene TOML file")
     info.add_argument("--json", action="store_true", help="machine-readable output")
     info.add_argument("--settings", action="store_true",
                       help="with --json: add the effective settings (always in the text output)")
@@ -203,12 +300,12 @@ def build_parser() -> argparse.ArgumentParser:
     ccq.add_argument("--json", action="store_true", help="machine-readable output")
     ccq.add_argument("--tolerance", type=float, default=1e-9, help="max relative error in the M-norm (default 1e-9)")
     ccq.add_argument("--no-osqp", action="store_true", help="skip the OSQP cross-check")
-    ccq.add_argument("--seeded", type=int, metavar="N",
+    ccq.add_argument("--seeded", type=positive_int, metavar="N",
                      help="instead of the stored families: a campaign of at least N instances generated from "
                           "--seed on the fly (qp_seeded.py), on Dask (--workers, --scheduler, --out)")
     ccq.add_argument("--seed", type=int, default=1, help="with --seeded: the campaign's seed (default 1)")
     ccq.add_argument("--osqp", action="store_true", help="with --seeded: add the OSQP cross-check (off by default)")
-    ccq.add_argument("--chunk-size", type=int, default=None,
+    ccq.add_argument("--chunk-size", type=positive_int, default=None,
                      help="with --seeded: instances a chunk (default 360, a multiple of every family's cycle)")
     add_campaign_arguments(ccq)
     ccq.set_defaults(func=cmd_crosscheck_qp)
@@ -216,7 +313,7 @@ def build_parser() -> argparse.ArgumentParser:
     ccc.add_argument("--set", dest="set_name", help="one step set of datasets_generated/ccd/ (default: all)")
     ccc.add_argument("--json", action="store_true", help="machine-readable output")
     ccc.add_argument("--peers", action="store_true", help="print FCL's misses and time (JSON) instead")
-    ccc.add_argument("--seeded", type=int, metavar="N",
+    ccc.add_argument("--seeded", type=positive_int, metavar="N",
                      help="instead of the stored sets: a campaign of N steps generated from --seed on the fly "
                           "(ccd_seeded.py), on Dask (--workers, --scheduler, --out)")
     ccc.add_argument("--seed", type=int, default=1, help="with --seeded: the campaign's seed (default 1)")
@@ -238,7 +335,7 @@ def build_parser() -> argparse.ArgumentParser:
 
     report = sub.add_parser("report", help="speed against error reports").add_subparsers(dest="what", required=True)
     rq = report.add_parser("qp", help="projection solvers: time against error on the same instances")
-    rq.add_argument("--out", required=True, help="output directory")
+    rq.add_argument("--out", required=True, type=output_dir, help="output directory")
     rq.add_argument("--family", help="one instance family (default: all but warm)")
     rq.set_defaults(func=cmd_report_qp)
     from . import peers  # CCD and projection peers, in one run
@@ -285,7 +382,12 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def main(argv: list[str] | None = None) -> int:
-    args = build_parser().parse_args(argv)
+    """The command's exit status: argparse's own (0 for --help and --version, 2 for an argument
+    refused at parse time, its message on stderr) or the subcommand's."""
+    try:
+        args = build_parser().parse_args(argv)
+    except SystemExit as e:
+        return 0 if e.code is None else e.code if isinstance(e.code, int) else 2
     return args.func(args)
 
 

@@ -507,7 +507,7 @@ def seeded_campaign(count: int, seed: int = 1, families: list[str] | None = None
     names = [f for f in ccd_seeded.FAMILIES if families is None or f in families]
     params = {"count": count, "seed": seed, "families": names}
     return Campaign("crosscheck-ccd", chunks, run_seeded_chunk, functools.partial(merge_seeded, names=names),
-                    params)
+                    params, sources=("gauss6.ccd_seeded",))
 
 
 _MESHES = Meshes()  # per process: the MeshPairs of the chunks it ran

@@ -318,6 +318,8 @@ def seeded_campaign(count: int, seed: int = 1, families: list[str] | None = None
     from .campaign import Campaign
 
     names = families or qp_seeded.default_family_names()
+    if chunk_size is not None and (isinstance(chunk_size, bool) or not isinstance(chunk_size, int) or chunk_size < 1):
+        raise ValueError(f"chunk_size must be an integer >= 1, not {chunk_size!r}")
     size = chunk_size or qp_seeded.CHUNK_SIZE
     if count < 1 or size < 1:
         raise ValueError(f"a campaign of {count} instances in chunks of {size}: both must be >= 1")
@@ -333,7 +335,7 @@ def seeded_campaign(count: int, seed: int = 1, families: list[str] | None = None
     params = {"count": count, "seed": seed, "families": names, "osqp": with_osqp,
               "chunk_size": size}
     merge = functools.partial(merge_seeded, names=names, tolerance=tolerance)
-    return Campaign("crosscheck-qp", chunks, run_seeded_chunk, merge, params)
+    return Campaign("crosscheck-qp", chunks, run_seeded_chunk, merge, params, sources=("gauss6.qp_seeded",))
 
 
 def run_seeded_chunk(chunk: dict) -> dict:

@@ -21,6 +21,9 @@ Generation is deterministic: the same parameters give byte-identical files, so
   Figure 8 and 9 analogues (cylinder_slide.json, texture_slow.json, texture_fast.json), the
   height map bumps.png with its bump list bumps.json, from
   datasets_generated/generators/surfaces.py (Python, numpy, Pillow; reuses the peg generator).
+- battery: the conformance battery's meshes and hand scripts (docs/conformance-battery.md), one
+  scene each in datasets_generated/scenes/ (BATTERY_SCENES), from
+  datasets_generated/generators/battery.py (Python, numpy; reuses the peg generator).
 - bunny_x4, bunny_x16 (ON_DEMAND: not in DATASETS, not committed, tens of MB): bunny_full's
   bunny.off with each triangle split into 4 or 16 (the same surface), from
   datasets_generated/generators/subdivide.py; `gauss6 datasets generate --only NAME`.
@@ -40,8 +43,10 @@ from tqdm import tqdm
 
 from . import paths
 
-DATASETS = ("peg_in_hole", "bunny", "bunny_full", "surfaces")
+DATASETS = ("peg_in_hole", "bunny", "bunny_full", "surfaces", "battery")
 GENERATORS_DIR = paths.DATASETS_DIR / "generators"
+# The conformance battery's scenes (datasets_generated/scenes/NAME.toml), one failure mode each.
+BATTERY_SCENES = ("thin_wall", "slot", "wedge", "pry_hook", "knife_vertex", "dense_plate", "cup", "lever")
 
 # The bunny: the Stanford bunny as glmark2-data ships it (34,835 vertices, 69,666
 # triangles, arbitrary units, Y up), decimated and scaled to 15 cm along Y.
@@ -123,28 +128,31 @@ def _generate_bunny(out: Path, target_faces: int = BUNNY_TARGET_FACES) -> dict:
     return _write_manifest(out, source, gen.GENERATOR_VERSION, parameters, ["bunny.off"])
 
 
-def _generate_surfaces(out: Path) -> dict:
-    gen = peg_in_hole_generator()  # loaded first: the surfaces generator reuses its meshes and header
-    del gen
-    source = GENERATORS_DIR / "surfaces.py"
-    name = "gauss6_generators_surfaces"
+def _generator_module(stem: str) -> ModuleType:
+    """A Python generator that reuses the peg generator (datasets_generated/generators/STEM.py)."""
+    peg_in_hole_generator()  # loaded first: the others reuse its meshes and header
+    source = GENERATORS_DIR / f"{stem}.py"
+    name = f"gauss6_generators_{stem}"
     module = sys.modules.get(name)
     if module is None:
         spec = importlib.util.spec_from_file_location(name, source)
         module = importlib.util.module_from_spec(spec)
         sys.modules[name] = module  # dataclasses look their module up there
         spec.loader.exec_module(module)
-    params = module.SurfacesParams()
+    return module
+
+
+def _generate_python(out: Path, stem: str, params_class: str) -> dict:
+    module = _generator_module(stem)
+    params = getattr(module, params_class)()
     files = module.generate(out, params)
-    return _write_manifest(out, source, module.GENERATOR_VERSION, params.to_json(), list(files))
+    return _write_manifest(out, GENERATORS_DIR / f"{stem}.py", module.GENERATOR_VERSION, params.to_json(), list(files))
 
 
 def _generate_subdivided(out: Path, levels: int) -> dict:
     gen = peg_in_hole_generator()  # owns the OFF provenance header's format
     source = GENERATORS_DIR / "subdivide.py"
-    spec = importlib.util.spec_from_file_location("gauss6_generators_subdivide", source)
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
+    module = _generator_module("subdivide")
     full = paths.DATASETS_DIR / "bunny_full" / "bunny.off"
     parameters = {"input": _relative(full), "input_sha256": sha256_file(full), "levels": levels}
     V, F = module.subdivide(*module.read_off(full), levels)
@@ -156,12 +164,13 @@ def _generate_subdivided(out: Path, levels: int) -> dict:
 
 
 def generate(name: str, out_dir: Path) -> dict:
-    """Generates dataset `name` ("peg_in_hole" or "bunny") into out_dir/<name>/ (its files
+    """Generates dataset `name` (one of DATASETS) into out_dir/<name>/ (its files
     and MANIFEST.json); returns the manifest. Raises ValueError for an unknown name,
     FileNotFoundError when the bunny tool is not built, RuntimeError when a generator's
     own checks fail."""
     makers = {"peg_in_hole": _generate_peg_in_hole, "bunny": _generate_bunny,
-              "bunny_full": lambda out: _generate_bunny(out, BUNNY_FULL_TARGET_FACES), "surfaces": _generate_surfaces,
+              "bunny_full": lambda out: _generate_bunny(out, BUNNY_FULL_TARGET_FACES), "surfaces": lambda out: _generate_python(out, "surfaces", "SurfacesParams"),
+              "battery": lambda out: _generate_python(out, "battery", "BatteryParams"),
               **{n: (lambda out, levels=levels: _generate_subdivided(out, levels)) for n, levels in ON_DEMAND.items()}}
     if name not in makers:
         raise ValueError(f"unknown dataset {name!r}; expected one of {', '.join([*DATASETS, *ON_DEMAND])}")

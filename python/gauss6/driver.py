@@ -7,14 +7,20 @@ Tick k at t = k / rate_hz (the schedule of run_lockstep, runtime.h):
   step = engine.step(t, xh)            the engine's displayed pose, wrench, contacts, step time
   device.write(t, safe(step.wrench))   what the handle feels: zero if not finite, each part
                                        scaled to the device's limit (as a device saturates)
-The run stops at the script's end (or `duration`). Every engine feels the same hand, and a run
-is repeatable: the device's state depends only on the sequence of (t, wrench).
+The run stops at the script's end (or `duration`), or at the engine's failure (a crash, an exit,
+a hang, an exception, a malformed output: gauss6.engine_host), whose trace then holds the ticks
+up to the last good one. Every engine feels the same hand, and a run is repeatable: the device's
+state depends only on the sequence of (t, wrench).
 
-The trace records, per tick, the engine's own wrench (not the saturated one: a NaN stays a NaN,
-an over-limit wrench stays over), its displayed pose, its contact count and its step time
-(force_time, s), the flags gripped and force_clamped; one step row per tick (update_time: the
-step time) with the engine's contacts; the script's phases and the let-go as events. Its
-metadata's "extra" names the engine and its config.
+The engine is served by a host (gauss6.engine_host: in a child process, or inline), which times
+every step call itself. The trace records, per tick, the engine's own wrench (not the saturated
+one: a NaN stays a NaN, an over-limit wrench stays over), its displayed pose, its contact count
+and its own reported step time (force_time, s; NaN when it reports none), the flags gripped and
+force_clamped; one step row per tick with the driver's timing of the call (update_time: wall s,
+update_cpu_time: CPU s) and the engine's contacts; the script's phases and the let-go as events.
+Its metadata's "extra" names the engine and its config, and holds "isolation" (the host's mode and
+the transport's cost per tick, us), "declarations" (what the engine declares: {} when nothing)
+and, when the engine failed, "engine_failure" {kind, detail, tick: the last good tick, -1: none}.
 """
 from __future__ import annotations
 
@@ -26,7 +32,8 @@ from pathlib import Path
 import numpy as np
 
 from . import trace as trace_mod
-from .engine import EngineScene
+from .engine import EngineFailure, EngineScene
+from .engine_host import Host, InlineHost
 
 SATURATION_SLACK = 1e-12  # relative: a wrench part within this of the limit is within it (no rescale)
 
@@ -42,17 +49,23 @@ def scene_script(scene_path) -> tuple[str, str]:
         return json.dumps(name), f"{scene_path}: device.script"
     if not name:
         raise ValueError(f"{scene_path}: device.script is not set: give --script")
-    return script_text(name, scene_path)
+    return script_text(name, scene_path, relative_to_scene=True)
 
 
-def script_text(name: str, scene_path) -> tuple[str, str]:
-    """A script by name (datasets_generated/scripts/NAME.json, beside the scene's folder) or path."""
-    path = Path(name)
-    if not path.suffix == ".json" or not path.exists():
-        path = Path(scene_path).resolve().parent.parent / "scripts" / f"{name}.json"
+def script_text(name: str, scene_path, relative_to_scene: bool = False) -> tuple[str, str]:
+    """A hand script by name (NAME: scripts/NAME.json beside the scene's folder) or by a .json path:
+    the scene's device.script relative to the scene file's folder, as the C++ loader reads it
+    (harness/src/scenario.cpp, load_scene_script); a --script path relative to the working folder."""
+    scene_dir = Path(scene_path).resolve().parent
+    if name.endswith(".json"):
+        path = scene_dir / name if relative_to_scene else Path(name)
+    else:
+        path = scene_dir.parent / "scripts" / f"{name}.json"
     if not path.exists():
         raise ValueError(f"{name}: no such hand script ({path})")
-    return path.read_text(), str(path)
+    from .paths import read_input_text  # a regular file (not a FIFO or a device), bounded
+
+    return read_input_text(path, "hand script", 1 << 26), str(path)
 
 
 def safe_wrench(F: np.ndarray, max_force: float, max_torque: float) -> tuple[np.ndarray, bool]:
@@ -73,14 +86,19 @@ def safe_wrench(F: np.ndarray, max_force: float, max_torque: float) -> tuple[np.
 
 def drive(engine, scene: EngineScene, script_json: str, out_path, duration: float | None = None,
           progress=None, extra: dict | None = None) -> trace_mod.Trace:
-    """Runs `engine` (the Python protocol, gauss6.engine) on `scene` with the simulated device on
-    the hand script `script_json`, writes the trace to out_path and returns it."""
+    """Runs `engine` (a host of gauss6.engine_host, started here; or an engine object of the Python
+    protocol, served inline) on `scene` with the simulated device on the hand script `script_json`,
+    writes the trace to out_path and returns it. An engine's failure ends the run (the trace's
+    extra["engine_failure"]); the caller closes a host it made."""
     from ._gauss6 import device as _device
 
+    host = engine if isinstance(engine, Host) else InlineHost(engine)
     dev = _device.SimulatedDevice(script_json, rate_hz=scene.rate_hz, max_force=scene.max_force,
                                   max_torque=scene.max_torque)
-    engine.reset(scene)
     end = dev.end_time if duration is None or duration < 0 else duration
+    from .cli import check_run_span  # a script spanning 1e9 s would be a run without end
+
+    check_run_span(end, "the hand script")
     num_ticks = int(math.floor(end * scene.rate_hz + 1e-9)) + 1
     ticks = np.zeros(num_ticks, dtype=trace_mod.DTYPES["ticks"])
     steps = np.zeros(num_ticks, dtype=trace_mod.DTYPES["steps"])
@@ -91,33 +109,40 @@ def drive(engine, scene: EngineScene, script_json: str, out_path, duration: floa
     t = 0.0
     wall = time.perf_counter()
     last_progress = wall
-    for k in range(num_ticks):
-        t = k / scene.rate_hz
-        p, q, gripped, status = dev.read(t)
-        if status == "ended":
-            break
-        step = engine.step(t, p, q)
-        F = np.asarray(step.wrench, dtype=float)
-        F_safe, clamped = safe_wrench(F, scene.max_force, scene.max_torque)
-        dev.write(t, F_safe)
-        row = ticks[n]
-        row["t"], row["xh_p"], row["xh_q"] = t, p, q
-        row["xs_p"], row["xs_q"], row["wrench"] = step.xs_p, step.xs_q, F
-        m = -1 if step.contacts is None else len(step.contacts)
-        row["num_contacts"] = max(m, 0)
-        row["force_time"] = step.step_seconds if step.step_seconds is not None else 0.0
-        row["flags"] = (flags_gripped if gripped else 0) | (flags_clamped if clamped else 0)
-        steps[n] = (n, t, row["force_time"], max(m, 0), 0, np.nan)  # CPU time not measured
-        if m > 0:
-            c = np.asarray(step.contacts, dtype=float)
-            block = np.zeros(m, dtype=trace_mod.DTYPES["contacts"])
-            block["step"], block["t"] = n, t
-            block["point"], block["normal"], block["separation"] = c[:, 0:3], c[:, 3:6], c[:, 6]
-            contact_rows.append(block)
-        n += 1
-        if progress and time.perf_counter() - last_progress > 0.2:
-            last_progress = time.perf_counter()
-            progress(t, end)
+    failure = None
+    try:
+        host.start()
+        host.reset(scene)
+        for k in range(num_ticks):
+            t = k / scene.rate_hz
+            p, q, gripped, status = dev.read(t)
+            if status == "ended":
+                break
+            stepped = host.step(t, p, q)
+            step = stepped.step
+            F = np.asarray(step.wrench, dtype=float)
+            F_safe, clamped = safe_wrench(F, scene.max_force, scene.max_torque)
+            dev.write(t, F_safe)
+            row = ticks[n]
+            row["t"], row["xh_p"], row["xh_q"] = t, p, q
+            row["xs_p"], row["xs_q"], row["wrench"] = step.xs_p, step.xs_q, F
+            m = -1 if step.contacts is None else len(step.contacts)
+            row["num_contacts"] = max(m, 0)
+            row["force_time"] = step.step_seconds if step.step_seconds is not None else np.nan
+            row["flags"] = (flags_gripped if gripped else 0) | (flags_clamped if clamped else 0)
+            steps[n] = (n, t, stepped.wall, max(m, 0), 0, stepped.cpu)
+            if m > 0:
+                c = np.asarray(step.contacts, dtype=float)
+                block = np.zeros(m, dtype=trace_mod.DTYPES["contacts"])
+                block["step"], block["t"] = n, t
+                block["point"], block["normal"], block["separation"] = c[:, 0:3], c[:, 3:6], c[:, 6]
+                contact_rows.append(block)
+            n += 1
+            if progress and time.perf_counter() - last_progress > 0.2:
+                last_progress = time.perf_counter()
+                progress(t, end)
+    except EngineFailure as e:
+        failure = e
     dev.write(t, np.zeros(6))
     if progress:
         progress(t, end)
@@ -128,11 +153,15 @@ def drive(engine, scene: EngineScene, script_json: str, out_path, duration: floa
         events.append((dev.let_go_time, 2, 0))
     events_arr = np.array(sorted(events), dtype=trace_mod.DTYPES["events"]) if events else \
         np.zeros(0, dtype=trace_mod.DTYPES["events"])
+    info = {"engine": host.name or getattr(host, "spec", "") or type(engine).__name__,
+            "wall_seconds": time.perf_counter() - wall, "isolation": host.isolation(),
+            "declarations": host.declarations}
+    if failure is not None:
+        info["engine_failure"] = failure.to_json(n - 1)
     meta = trace_mod.trace_metadata(
         scene=scene.name, device={"name": "simulated (validation driver)", "rate_hz": scene.rate_hz,
                                   "renders_force": True},
-        phases=phases, extra={"engine": getattr(engine, "name", type(engine).__name__),
-                              "wall_seconds": time.perf_counter() - wall, **(extra or {})})
+        phases=phases, extra={**info, **(extra or {})})
     contacts = np.concatenate(contact_rows) if contact_rows else np.zeros(0, dtype=trace_mod.DTYPES["contacts"])
     tr = trace_mod.Trace(path=Path(out_path), version=trace_mod.VERSION, meta=meta, ticks=ticks[:n],
                          steps=steps[:n], contacts=contacts, events=events_arr, complete=True)

@@ -1,7 +1,9 @@
 """Exact checks of recorded god-object poses against a scene, shared by the figures of
 `gauss6 reproduce` (reproduce.py, reproduce_surfaces.py) and `gauss6 certify` (certify.py): the
 distinct poses of a trace and how many of them exactly intersect an obstacle (the reference's CGAL
-test, through the bindings), with a progress bar; a scene's exact mesh pairs (ExactScene)."""
+test, through the bindings), with a progress bar; a scene's exact mesh pairs (ExactScene), the one
+path by which both `gauss6 validate` (oracle.py) and `gauss6 certify` (certify.py, and its
+--witness re-check) decide a pose, a motion or a separation."""
 from __future__ import annotations
 
 import math
@@ -69,6 +71,52 @@ class ExactScene:
 
     def intersecting_pairs(self, p, q) -> int:
         return sum(int(mp.count_intersecting_pairs(p, q)) for mp in self.pairs)
+
+    def first_contact(self, i: int, p0, q0, p1, q1):
+        """The exact first contact of the in-between motion (METHOD.md s.4) from (p0, q0) to (p1, q1)
+        with obstacle i (reference mesh_first_contact: .hit, .lower, .upper, .pairs). ValueError when
+        there is no Cayley motion (an exact half turn): undecided."""
+        return self.pairs[i].exact_first_contact(p0, q0, p1, q1)
+
+    def motion_hits(self, p0, q0, p1, q1, obstacles=None) -> list:
+        """The obstacles (among `obstacles`, default those near the motion) that the motion from
+        (p0, q0) to (p1, q1) touches, each as (index, exact first contact); [] when it is free."""
+        found = []
+        for i in (self.near(p0, p1) if obstacles is None else obstacles):
+            c = self.first_contact(i, p0, q0, p1, q1)
+            if c.hit:
+                found.append((i, c))
+        return found
+
+    def separation(self, p, q, max_distance: float) -> float:
+        """The exact minimum distance (its lower double bracket) if <= max_distance, else +inf."""
+        best = math.inf
+        for mp in self.pairs:
+            s = mp.separation(p, q, max_distance)
+            if s["within"]:
+                best = min(best, float(s["lower"]))
+        return best
+
+    def separation_side(self, p, q, bound: float, free_space: float) -> tuple[float, bool]:
+        """The separation at a pose as far as a verdict against `bound` and `free_space` needs it: a
+        value whose side of each is the exact separation's (<= bound; in (bound, free_space]; +inf
+        beyond free_space), and whether the exact path was needed. The reference's certified bracket
+        lower <= d <= upper decides when neither threshold lies inside it (the value is then its
+        lower end); otherwise the exact separation decides."""
+        lower, upper = math.inf, math.inf
+        for mp in self.pairs:
+            lo, hi = mp.separation_bracket(p, q, 2 * free_space)
+            lower, upper = min(lower, lo), min(upper, hi)
+        if upper <= bound:
+            return lower, False
+        if lower > bound and upper <= free_space:
+            return lower, False
+        if lower > free_space:
+            return math.inf, False
+        s = self.separation(p, q, bound)
+        if not math.isfinite(s):
+            s = self.separation(p, q, free_space)
+        return s, True
 
     def separation_within(self, p, q, max_distance: float) -> tuple[float, bool]:
         """(a certified upper bound of the exact minimum distance if it is <= max_distance, else +inf;

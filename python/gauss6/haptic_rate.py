@@ -122,14 +122,17 @@ def register(subparsers) -> None:
     p = subparsers.add_parser("rate", help="a threaded run at a high haptic rate (10 kHz): deadline misses, jitter")
     p.add_argument("--scene", choices=sorted(SCENES), default="peg")
     p.add_argument("--rate-hz", type=float, default=10000.0)
-    p.add_argument("--duration", type=float, default=60.0, help="s of run time (the hand holds still after the script)")
+    from .cli import output_dir, run_seconds
+
+    p.add_argument("--duration", type=run_seconds, default=60.0,
+                   help="s of run time (the hand holds still after the script)")
     p.add_argument("--priority", type=int, default=80, help="SCHED_FIFO priority of the haptic loop")
     p.add_argument("--no-realtime", action="store_true", help="leave the default scheduling policy")
     p.add_argument("--no-pin", action="store_true", help="no CPU affinity")
     p.add_argument("--spin-us", type=float, default=None,
                    help="us of each haptic period waited busily before the tick (RuntimeSettings::spin_wait; "
                         "default: one period when pinned, else 0)")
-    p.add_argument("--out", type=Path, required=True)
+    p.add_argument("--out", type=lambda text: Path(output_dir(text)), required=True)
     p.set_defaults(func=run_cli)
 
 

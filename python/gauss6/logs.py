@@ -19,7 +19,11 @@ export here writes each double's shortest repr, which reads back exactly.
 
 A malformed log raises LogFormatError (a gauss6.LoadError) naming FILE:LINE:COLUMN and the
 problem: an unknown column name, a wrong number of values, a value that is not a finite
-number, a time that does not increase.
+number, a time that does not increase, an integer column (BUTTONS, flags, status, event
+codes, counts) holding a value that is not an integer in its range, a position beyond the
+coordinate bound, a line longer than MAX_LINE bytes (refused before the rest of it is read),
+metadata (meta.json) whose fields have the wrong type. Every field is checked where it
+enters, so that what import writes, the trace reader, replay, view and validate accept.
 """
 from __future__ import annotations
 
@@ -32,8 +36,9 @@ from pathlib import Path
 import numpy as np
 
 from ._gauss6 import LoadError
-from .trace import (COLUMNS, DTYPES, TICK_FLAGS, Trace, TraceWarning, export_csv, read_trace, trace_metadata,
-                    write_trace)
+from .paths import PathError, read_input_lines, read_input_text
+from .trace import (COLUMNS, DTYPES, INTEGER_COLUMNS, MAX_COORDINATE, MAX_COUNT, TICK_FLAGS, Trace, TraceWarning,
+                    check_streams, export_csv, metadata_problem, read_trace, trace_metadata, write_trace)
 
 # HAPI DeviceLog columns and their widths (values per column).
 HAPI_WIDTHS = {"TIME": 1, "POSITION": 3, "ORIENTATION": 4, "VELOCITY": 3, "FORCE": 3, "TORQUE": 3, "BUTTONS": 1,
@@ -41,6 +46,8 @@ HAPI_WIDTHS = {"TIME": 1, "POSITION": 3, "ORIENTATION": 4, "VELOCITY": 3, "FORCE
                "TIMESTAMP": 1}
 HAPI_EXPORT_COLUMNS = ["TIME", "POSITION", "ORIENTATION", "FORCE", "TORQUE", "BUTTONS"]
 _NUMBER = re.compile(r"[+-]?(\d+\.?\d*|\.\d+)([eE][+-]?\d+)?")
+MAX_LINE = 1 << 16  # bytes: a row of these formats (at most 35 numbers) never comes near it
+MAX_META = 1 << 24  # bytes of a CSV export's meta.json
 
 
 class LogFormatError(LoadError):
@@ -92,12 +99,26 @@ def _tokens(line: str, sep: str | None):
 
 
 def _lines(path: Path) -> list[str]:
+    """The file's lines (paths.read_input_lines: a regular file, no line over MAX_LINE bytes, UTF-8)."""
     try:
-        return path.read_text(encoding="utf-8").splitlines()
-    except OSError as e:
-        raise LogFormatError(f"{path}: cannot open the file: {e.strerror}") from None
-    except UnicodeDecodeError:
-        raise LogFormatError(f"{path}: not a text file (not UTF-8)") from None
+        return read_input_lines(path, "log", MAX_LINE)
+    except PathError as e:
+        raise LogFormatError(str(e)) from None
+
+
+def _check_values(path: Path, values: np.ndarray, line_numbers: list, col_of, name: str, lo: float, hi: float,
+                  integer: bool, meaning: str = "") -> None:
+    """Each value of a column in [lo, hi] (an integer when `integer`): else FILE:LINE:COL naming
+    the field. col_of(row index) -> the value's character column on its line."""
+    v = np.asarray(values, dtype=float)
+    with np.errstate(invalid="ignore"):
+        ok = (v >= lo) & (v <= hi) & ((np.trunc(v) == v) if integer else True)
+    bad = np.nonzero(~ok)[0]
+    if len(bad):
+        k = int(bad[0])
+        what = f"an integer in [{lo:.0f}, {hi:.0f}]" if integer else f"within [{lo:g}, {hi:g}]"
+        what = f"{meaning} ({what})" if meaning else what
+        raise LogFormatError(f"{path}:{line_numbers[k]}:{col_of(k)}: {name} {float(v[k])!r} is not {what}")
 
 
 def _read_table(path: Path, sep: str | None, names_of, lines: list[str] | None = None):
@@ -215,7 +236,8 @@ def read_hapi(path, scene: str = "") -> Trace:
             offset += HAPI_WIDTHS[name]
         return offset
 
-    header, values, line_numbers = _read_table(path, None, names_of)
+    lines = _lines(path)
+    header, values, line_numbers = _read_table(path, None, names_of, lines)
 
     def column(name):
         off, w = layout[name]
@@ -223,13 +245,18 @@ def read_hapi(path, scene: str = "") -> Trace:
 
     t = column("TIME")[:, 0]
     _check_times(path, t, line_numbers, layout["TIME"][0], None)
+
+    def col_of(name, k, i=0):  # the character column of value i of column `name` on row k
+        return _tokens(lines[line_numbers[k] - 1], None)[layout[name][0] + i][0]
+
+    for name in ("POSITION", "RAW_POSITION"):
+        for i in range(3 if name in layout else 0):
+            _check_values(path, column(name)[:, i], line_numbers, lambda k: col_of(name, k, i), name,
+                          -MAX_COORDINATE, MAX_COORDINATE, False)
     if "BUTTONS" in layout:
         b = column("BUTTONS")[:, 0]
-        bad = np.nonzero((b < 0) | (b != np.floor(b)))[0]
-        if len(bad):
-            col = next(c for c, n in header if n == "BUTTONS")
-            raise LogFormatError(f"{path}:{line_numbers[bad[0]]}: BUTTONS (header column {col}): "
-                                 f"{float(b[bad[0]])!r} is not a button mask (an integer >= 0)")
+        _check_values(path, b, line_numbers, lambda k: col_of("BUTTONS", k), "BUTTONS", 0, 2 ** 32 - 1, True,
+                      "a button mask")
     else:
         b = np.zeros(len(t))
     q = axis_angle_to_quaternion(column("ORIENTATION")) if "ORIENTATION" in layout else np.tile([1.0, 0, 0, 0],
@@ -274,6 +301,26 @@ def _read_stream_csv(path: Path, name: str, required: list[str]) -> np.ndarray:
         flat[:, k] = values[:, j]
     if name == "ticks":
         _check_times(path, flat[:, 0], line_numbers, [tok for _, tok in header].index("t"), ",")
+    names = [tok for _, tok in header]
+
+    def col_of(j):
+        return lambda k: _tokens(lines[line_numbers[k] - 1], ",")[j][0]
+
+    checks = [(c, lo, hi, True) for stream, c, lo, hi in INTEGER_COLUMNS if stream == name]
+    if name == "ticks":
+        checks += [(f"{c}_{i}", -MAX_COORDINATE, MAX_COORDINATE, False) for c in ("xh_p", "xs_p") for i in range(3)]
+    for column, lo, hi, integer in checks:
+        if column in names:
+            j = names.index(column)
+            _check_values(path, values[:, j], line_numbers, col_of(j), column, lo, hi, integer)
+    for q in ("xh_q", "xs_q") if name == "ticks" else ():  # replay and validate refuse a zero rotation
+        if f"{q}_0" in names:
+            at = known.index(f"{q}_0")
+            zero = np.nonzero(np.all(flat[:, at:at + 4] == 0, axis=1))[0]
+            if len(zero):
+                k = int(zero[0])
+                raise LogFormatError(f"{path}:{line_numbers[k]}:{col_of(names.index(f'{q}_0'))(k)}: {q} is the "
+                                     "zero quaternion (no rotation)")
     return np.ascontiguousarray(flat).view(DTYPES[name]).reshape(-1)
 
 
@@ -291,7 +338,7 @@ def read_csv_dir(path, scene: str = "") -> Trace:
     if not files["ticks"].exists():
         raise LogFormatError(f"{files['ticks']}: cannot open the file: no such file")
     ticks = _read_stream_csv(files["ticks"], "ticks", ["t", "xh_p_0", "xh_p_1", "xh_p_2"])
-    header = files["ticks"].read_text(encoding="utf-8").splitlines()[0].split(",")
+    header = next(line for line in _lines(files["ticks"]) if line.strip()).split(",")
     header = [h.strip() for h in header]
     if "xh_q_0" not in header:
         ticks["xh_q"] = [1.0, 0.0, 0.0, 0.0]
@@ -303,22 +350,48 @@ def read_csv_dir(path, scene: str = "") -> Trace:
         ticks["flags"] = TICK_FLAGS["gripped"]
     streams = {name: _read_stream_csv(files[name], name, ["t"]) if name in files else _empty(name)
                for name in ("steps", "contacts", "events")}
-    if "steps" in files and "update_cpu_time" not in files["steps"].read_text(encoding="utf-8").split("\n", 1)[0]:
+    if "steps" in files and "update_cpu_time" not in (_lines(files["steps"]) or [""])[0]:
         streams["steps"]["update_cpu_time"] = np.nan  # not measured (a version 1 trace's export)
     meta_path = path / "meta.json" if path.is_dir() else None
     dropped: dict = {}
     if meta_path is not None and meta_path.exists():
-        try:
-            meta = json.loads(meta_path.read_text(encoding="utf-8"))
-        except json.JSONDecodeError as e:
-            raise LogFormatError(f"{meta_path}:{e.lineno}:{e.colno}: not valid JSON: {e.msg}") from None
-        meta.pop("complete", None)
-        dropped = meta.pop("dropped", {}) or {}
+        meta, dropped = _read_meta(meta_path)
     else:
         meta = trace_metadata(scene=scene, device={"name": f"csv: {path.name}", "rate_hz": _rate(ticks["t"]),
                                                    "renders_force": False},
                               extra={"imported_from": {"format": "csv", "file": str(path)}})
     return Trace(path=path, version=1, meta=meta, ticks=ticks, complete=True, dropped=dropped, **streams)
+
+
+def _read_meta(meta_path: Path) -> tuple[dict, dict]:
+    """A CSV export's meta.json: (metadata, dropped counts), each field checked as the trace
+    reader checks it (LogFormatError naming the file and the field)."""
+    try:
+        text = read_input_text(meta_path, "metadata file", MAX_META)
+    except PathError as e:
+        raise LogFormatError(str(e)) from None
+    try:
+        meta = json.loads(text)
+    except json.JSONDecodeError as e:
+        raise LogFormatError(f"{meta_path}:{e.lineno}:{e.colno}: not valid JSON: {e.msg}") from None
+    except (ValueError, RecursionError):
+        raise LogFormatError(f"{meta_path}: not valid JSON (a number too long or nesting too deep)") from None
+    if not isinstance(meta, dict):
+        raise LogFormatError(f"{meta_path}: not a JSON object of trace metadata")
+    meta.pop("complete", None)
+    dropped = meta.pop("dropped", {}) or {}
+    problem = metadata_problem(meta)
+    if problem:
+        raise LogFormatError(f"{meta_path}: {problem}")
+    if not isinstance(dropped, dict) or not all(
+            k in ("ticks", "steps", "contacts", "events") and not isinstance(v, bool) and isinstance(v, int)
+            and 0 <= v <= MAX_COUNT for k, v in dropped.items()):
+        raise LogFormatError(f"{meta_path}: dropped is not an object of stream -> count (an integer in [0, 2^53])")
+    try:
+        json.dumps(meta, allow_nan=False)
+    except ValueError:
+        raise LogFormatError(f"{meta_path}: a metadata number is not finite (NaN or Infinity)") from None
+    return meta, dropped
 
 
 # ---------------------------------------------------------------------------------------------
@@ -327,6 +400,9 @@ def read_csv_dir(path, scene: str = "") -> Trace:
 def import_log(path, fmt: str, out, scene: str = "") -> tuple[Path, Trace]:
     """Reads a HAPI log or CSV and writes it as a gauss6 trace at out. Returns (out, the trace)."""
     trace = read_hapi(path, scene) if fmt == "hapi" else read_csv_dir(path, scene)
+    problem = check_streams(trace)  # what the trace reader would refuse is never written
+    if problem:
+        raise LogFormatError(f"{path}: {problem}")
     return write_trace(trace, out), trace
 
 

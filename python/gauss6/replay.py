@@ -9,6 +9,7 @@ its own, which `gauss6 view` shows, alone or beside the recording.
 from __future__ import annotations
 
 import argparse
+import math
 import sys
 from pathlib import Path
 
@@ -25,9 +26,15 @@ def replay(recording, scene, out, threaded: bool = False, duration: float = -1.0
     gauss6.LoadError for a bad scene or recording, ValueError when the run cannot start."""
     from ._gauss6 import runtime
 
+    from .cli import check_run_span
+
     tr = read_trace(recording)
     phases = [(str(p["name"]), float(p["start"])) for p in tr.meta.get("phases", [])]
     end = float(tr.ticks["t"][-1]) if len(tr.ticks) else 0.0
+    if not (duration < 0 or math.isfinite(duration)):
+        raise ValueError(f"duration {duration!r} s is not finite")
+    if duration < 0:  # the whole recording: bounded as --duration is
+        check_run_span(end, f"{recording}: the recording")
     total = duration if duration >= 0 else end
     with tqdm(total=round(total, 3), unit="s", desc="replay", disable=quiet,
               bar_format="{desc}: {percentage:3.0f}%|{bar}| {n:.1f}/{total:.1f} s [{elapsed}<{remaining}]") as bar:
@@ -59,10 +66,15 @@ def cmd_replay(args: argparse.Namespace) -> int:
 def register(subparsers) -> None:
     """Adds `replay` to the gauss6 command's subparsers."""
     rp = subparsers.add_parser("replay", help="a recorded session (trace, or imported HAPI/CSV log) drives a scene")
-    rp.add_argument("recording", help="the recorded session, a trace (gauss6 trace import makes one from a log)")
-    rp.add_argument("--scene", required=True, help="the scene file (.toml) to run")
-    rp.add_argument("--out", required=True, help="the trace of the replayed run to write (.g6trace)")
+    from .cli import input_file, output_file, run_seconds
+
+    rp.add_argument("recording", type=input_file("recording"),
+                    help="the recorded session, a trace (gauss6 trace import makes one from a log)")
+    rp.add_argument("--scene", required=True, type=input_file("scene"), help="the scene file (.toml) to run")
+    rp.add_argument("--out", required=True, type=output_file,
+                    help="the trace of the replayed run to write (.g6trace)")
     rp.add_argument("--threaded", action="store_true", help="real threads and the wall clock (default: lockstep)")
-    rp.add_argument("--duration", type=float, default=-1.0, help="s of run time (default: the recording's)")
+    rp.add_argument("--duration", type=run_seconds, default=-1.0,
+                    help="s of run time (default: the recording's; at most a day)")
     rp.add_argument("--quiet", action="store_true", help="no progress bar")
     rp.set_defaults(func=cmd_replay)

@@ -265,7 +265,7 @@ def cmd_trace_export(args: argparse.Namespace) -> int:
         return 2
     try:
         print(export_trace(args.trace, hapi=args.hapi, csv=args.csv))
-    except (LoadError, ValueError) as e:
+    except (LoadError, ValueError, OSError) as e:
         print(f"gauss6: error: {e}", file=sys.stderr)
         return 2
     return 0
@@ -277,7 +277,7 @@ def cmd_trace_import(args: argparse.Namespace) -> int:
 
     try:
         out, tr = import_log(args.file, args.format, args.out, scene=args.scene or "")
-    except LoadError as e:
+    except (LoadError, ValueError, OSError) as e:
         print(f"gauss6: error: {e}", file=sys.stderr)
         return 2
     print(f"{args.file}: {len(tr.ticks)} ticks ({args.format}), {tr.ticks['t'][0]:g} to {tr.ticks['t'][-1]:g} s "
@@ -291,22 +291,26 @@ def register(subparsers) -> None:
     rep.add_argument("scenario", choices=["peg", "bunny", "bunny_full", "surfaces", "all", "engines"],
                      help="all: peg, bunny and surfaces; bunny_full (the full-resolution bunnies) and engines (gauss6, MuJoCo, "
                           "PyBullet, Drake side by side: reproduce_engines.py) run alone")
-    rep.add_argument("--out", required=True, help="output directory")
+    from .cli import input_file, output_dir, output_file, run_seconds
+
+    rep.add_argument("--out", required=True, type=output_dir, help="output directory")
     rep.add_argument("--threaded", action="store_true", help="real threads and the wall clock (default: lockstep)")
     rep.add_argument("--quiet", action="store_true", help="no progress bars")
-    rep.add_argument("--slice", type=float, default=None,
+    rep.add_argument("--slice", type=run_seconds, default=None,
                      help="engines: run only the first S seconds of each script (default: whole)")
     rep.set_defaults(func=cmd_reproduce)
     tr = subparsers.add_parser("trace", help="run traces").add_subparsers(dest="action", required=True)
     ex = tr.add_parser("export", help="write a trace as CSV files (one per stream) and/or a HAPI device log")
-    ex.add_argument("trace", help="trace file (.g6trace)")
-    ex.add_argument("--csv", help="output directory (ticks.csv, steps.csv, contacts.csv, events.csv, meta.json)")
-    ex.add_argument("--hapi", help="output HAPI DeviceLog, ASCII (TIME POSITION ORIENTATION FORCE TORQUE BUTTONS)")
+    ex.add_argument("trace", type=input_file("trace"), help="trace file (.g6trace)")
+    ex.add_argument("--csv", type=output_dir,
+                    help="output directory (ticks.csv, steps.csv, contacts.csv, events.csv, meta.json)")
+    ex.add_argument("--hapi", type=output_file,
+                    help="output HAPI DeviceLog, ASCII (TIME POSITION ORIENTATION FORCE TORQUE BUTTONS)")
     ex.set_defaults(func=cmd_trace_export)
     im = tr.add_parser("import", help="a HAPI device log or CSV recorded elsewhere -> a trace for replay")
-    im.add_argument("file", help="HAPI DeviceLog (ASCII), or a CSV directory (to_csv's files) or ticks CSV")
+    im.add_argument("file", type=input_file("log", directory_ok=True), help="HAPI DeviceLog (ASCII), or a CSV directory (to_csv's files) or ticks CSV")
     im.add_argument("--format", required=True, choices=["hapi", "csv"])
-    im.add_argument("--out", required=True, help="the trace to write (.g6trace)")
+    im.add_argument("--out", required=True, type=output_file, help="the trace to write (.g6trace)")
     im.add_argument("--scene", help="scene name to record in the trace's metadata (for gauss6 view)")
     im.set_defaults(func=cmd_trace_import)
 

@@ -405,14 +405,16 @@ def cmd_run(args: argparse.Namespace) -> int:
 
 def register(subparsers) -> None:
     """Adds `run` to the gauss6 command's subparsers."""
+    from .cli import input_file, output_dir, run_seconds
+
     p = subparsers.add_parser("run", help="run a scene with a hand script: trace, figure, certification, "
                                           "viewer page and report (as `gauss6 reproduce` runs the paper's)")
-    p.add_argument("scene", help="the scene's TOML file (docs/scene-format.md)")
+    p.add_argument("scene", type=input_file("scene"), help="the scene's TOML file (docs/scene-format.md)")
     p.add_argument("--script", help="the hand script: a shipped one's name (bunny, peg_in_hole) or a JSON file "
                                     "(default: the scene's [device] script)")
-    p.add_argument("--out", required=True, help="output directory")
+    p.add_argument("--out", required=True, type=output_dir, help="output directory")
     p.add_argument("--threaded", action="store_true", help="real threads and the wall clock (default: lockstep)")
-    p.add_argument("--duration", type=float, default=-1.0,
+    p.add_argument("--duration", type=run_seconds, default=-1.0,
                    help="run only the first S seconds of the script (default: all of it)")
     p.add_argument("--name", help="the run's name in the output files (default: the scene file's stem)")
     p.add_argument("--no-certify", action="store_true",

@@ -7,11 +7,14 @@
     to_csv(tr, "out/")                 (ticks.csv, steps.csv, contacts.csv, events.csv, meta.json)
 
 Pure Python and numpy: no extension needed. A file cut mid-chunk (a crash) reads up to
-its last complete chunk with a TraceWarning; a malformed file raises TraceFormatError
-naming the file and the problem.
+its last complete chunk with a TraceWarning (and Trace.complete False: `coverage(tr)` states
+what a trace covers, for verdicts to say so); a malformed file raises TraceFormatError naming
+the file and the problem: among them ticks whose times repeat or go back, and a path that is
+not a regular file (paths.check_input_file: a FIFO or a device is never read).
 """
 from __future__ import annotations
 
+import hashlib
 import json
 import math
 import struct
@@ -75,6 +78,7 @@ class Trace:
     complete: bool = False  # the end chunk was found: the writer closed the file
     dropped: dict = field(default_factory=dict)
     warnings: list = field(default_factory=list)
+    sha256: str = ""        # of the file read (read_trace); "" for a trace built in memory
 
     def event_names(self) -> list[str]:
         codes = {int(k): v for k, v in self.meta.get("event_codes", {}).items()} or EVENT_CODES
@@ -83,11 +87,13 @@ class Trace:
 
 def read_trace(path) -> Trace:
     """Reads a trace; see the module docstring for truncated and malformed files."""
+    from .paths import PathError, read_input_bytes
+
     path = Path(path)
     try:
-        data = path.read_bytes()
-    except OSError as e:
-        raise TraceFormatError(f"{path}: cannot open the file: {e.strerror}") from None
+        data = read_input_bytes(path, "trace")
+    except PathError as e:
+        raise TraceFormatError(str(e)) from None
 
     def fail(problem: str) -> TraceFormatError:
         return TraceFormatError(f"{path}: {problem}")
@@ -107,17 +113,9 @@ def read_trace(path) -> Trace:
         raise fail("the metadata block is not valid JSON") from None
     if not isinstance(meta, dict):
         raise fail("the metadata block is not a JSON object")
-    codes = meta.get("event_codes", {})
-    if not isinstance(codes, dict) or not all(
-            isinstance(k, str) and k.isdigit() and len(k) < 10 and isinstance(v, str) for k, v in codes.items()):
-        raise fail("metadata: event_codes is not an object of code -> name")
-    phases = meta.get("phases", [])
-    if not isinstance(phases, list) or not all(
-            isinstance(p, dict) and isinstance(p.get("name"), str) and _finite_number(p.get("start"))
-            for p in phases):
-        raise fail("metadata: phases is not a list of {name: string, start: finite number}")
-    if not isinstance(meta.get("scene", ""), str) or not isinstance(meta.get("device", {}), dict):
-        raise fail("metadata: scene must be a string and device an object")
+    problem = metadata_problem(meta)
+    if problem:
+        raise fail(f"metadata: {problem}")
 
     parts: dict[str, list[np.ndarray]] = {name: [] for name in COLUMNS}
     widths = {name: sum(w for _, w in cols) for name, cols in COLUMNS.items()}
@@ -172,11 +170,32 @@ def read_trace(path) -> Trace:
 
     tr = Trace(path=path, version=version, meta=meta, ticks=table("ticks"), steps=table("steps"),
                contacts=table("contacts"), events=table("events"), complete=complete,
-               dropped=dropped, warnings=notes)
-    problem = _check_integer_columns(tr)
+               dropped=dropped, warnings=notes, sha256=hashlib.sha256(data).hexdigest())
+    problem = check_streams(tr)
     if problem:
         raise fail(problem)
     return tr
+
+
+def metadata_problem(meta: dict) -> str:
+    """'' when the metadata's typed fields are well-formed (event_codes an object of code ->
+    name, codes integers in [0, 2^32 - 1]; phases a list of {name: string, start: finite
+    number}; scene a string; device an object), else the first problem (the field named)."""
+    codes = meta.get("event_codes", {})
+    if not isinstance(codes, dict) or not all(
+            isinstance(k, str) and k.isdigit() and len(k) < 10 and int(k) <= 2 ** 32 - 1 and isinstance(v, str)
+            for k, v in codes.items()):
+        return "event_codes is not an object of code (an integer in [0, 2^32 - 1], as a string) -> name"
+    phases = meta.get("phases", [])
+    if not isinstance(phases, list) or not all(
+            isinstance(p, dict) and isinstance(p.get("name"), str) and _finite_number(p.get("start"))
+            for p in phases):
+        return "phases is not a list of {name: string, start: finite number}"
+    if not isinstance(meta.get("scene", ""), str):
+        return "scene is not a string"
+    if not isinstance(meta.get("device", {}), dict):
+        return "device is not an object"
+    return ""
 
 
 def _finite_number(x) -> bool:
@@ -199,22 +218,82 @@ def _integers_in(values: np.ndarray, lo: float, hi: float) -> bool:
         return bool(np.all((v >= lo) & (v <= hi) & (np.trunc(v) == v)))
 
 
-def _check_integer_columns(tr: Trace) -> str:
-    """The columns that stand for integers hold integers in range (the C++ reader's
-    check_integer_columns): '' when they do, else the first problem."""
-    checks = [
-        ("ticks", "num_contacts", 0, 2 ** 31 - 1), ("ticks", "status", 0, max(DEVICE_STATUS)),
-        ("ticks", "flags", 0, 2 ** 32 - 1), ("ticks", "buttons", 0, 2 ** 32 - 1),
-        ("steps", "step", 0, MAX_COUNT), ("steps", "num_contacts", 0, 2 ** 31 - 1),
-        ("steps", "status", -2 ** 31, 2 ** 31 - 1), ("contacts", "step", 0, MAX_COUNT),
-        ("events", "code", 0, 2 ** 32 - 1),
-    ]
-    if not np.all(np.isfinite(tr.ticks["t"])):
+# The columns that stand for integers, with their ranges (the C++ reader's check_integer_columns).
+INTEGER_COLUMNS = [
+    ("ticks", "num_contacts", 0, 2 ** 31 - 1), ("ticks", "status", 0, max(DEVICE_STATUS)),
+    ("ticks", "flags", 0, 2 ** 32 - 1), ("ticks", "buttons", 0, 2 ** 32 - 1),
+    ("steps", "step", 0, MAX_COUNT), ("steps", "num_contacts", 0, 2 ** 31 - 1),
+    ("steps", "status", -2 ** 31, 2 ** 31 - 1), ("contacts", "step", 0, MAX_COUNT),
+    ("events", "code", 0, 2 ** 32 - 1),
+]
+
+
+def check_streams(tr: Trace) -> str:
+    """'' when tr's streams hold what read_trace accepts: tick times finite and increasing, the
+    columns that stand for integers holding integers in range (the C++ reader's
+    check_integer_columns); else the first problem."""
+    t = tr.ticks["t"]
+    if not np.all(np.isfinite(t)):
         return "ticks: t is not finite"
-    for stream, column, lo, hi in checks:
+    back = np.nonzero(np.diff(t) <= 0)[0]
+    if len(back):
+        k = int(back[0]) + 1
+        return (f"ticks: tick {k} has t = {float(t[k])!r}, {'the same as' if t[k] == t[k - 1] else 'before'} "
+                f"tick {k - 1}'s {float(t[k - 1])!r} (ticks repeated or out of time order)")
+    for stream, column, lo, hi in INTEGER_COLUMNS:
         if not _integers_in(getattr(tr, stream)[column], lo, hi):
             return f"{stream}: {column} is not an integer in [{lo}, {hi}]"
     return ""
+
+
+MAX_COORDINATE = 1e12  # the C++ kMaxSceneCoordinate (scene.h): positions beyond it are refused
+
+
+def coverage(tr: Trace) -> dict:
+    """What a trace covers, for a verdict or a certificate to state: its ticks, their time span,
+    whether it is complete (closed by its writer) and why not, and a digest of the run (the
+    file's sha256, or of the tick rows for a trace read from CSV)."""
+    t = tr.ticks["t"]
+    digest = tr.sha256 or hashlib.sha256(np.ascontiguousarray(tr.ticks).tobytes()).hexdigest()
+    return {"ticks": int(len(t)), "t_first": float(t[0]) if len(t) else None,
+            "t_last": float(t[-1]) if len(t) else None, "span": float(t[-1] - t[0]) if len(t) else 0.0,
+            "complete": bool(tr.complete), "cut": list(tr.warnings), "dropped": dict(tr.dropped),
+            "sha256": digest, "digest_of": "file" if tr.sha256 else "tick rows"}
+
+
+def coverage_line(cov: dict) -> str:
+    """coverage() in one sentence for a report."""
+    span = (f"t = {cov['t_first']:.6g} to {cov['t_last']:.6g} s ({cov['span']:.6g} s)" if cov["ticks"]
+            else "no time")
+    state = "complete" if cov["complete"] else "**INCOMPLETE** (" + "; ".join(cov["cut"] or ["not closed"]) + ")"
+    return f"{cov['ticks']} ticks, {span}, {state}; sha256 {cov['sha256'][:16]}... of the {cov['digest_of']}"
+
+
+def checked_poses(tr: Trace) -> Trace:
+    """The trace with its quaternions (xh_q, xs_q) scaled by powers of two to a largest
+    component in [0.5, 1) (exact: the same rotation; a pose's meaning does not depend on the
+    quaternion's size, and 1e300 or 1e-300 would overflow or underflow a norm); TraceFormatError
+    for a finite position beyond MAX_COORDINATE (tick and column named). Non-finite and zero
+    poses are left for the verdicts to judge."""
+    ticks = tr.ticks.copy()
+    for column in ("xh_p", "xs_p"):
+        v = ticks[column]
+        with np.errstate(invalid="ignore"):
+            far = np.nonzero(np.any(np.isfinite(v) & (np.abs(v) > MAX_COORDINATE), axis=1))[0]
+        if len(far):
+            k = int(far[0])
+            raise TraceFormatError(f"{tr.path}: tick {k} (t = {float(ticks['t'][k])!r}): {column} "
+                                   f"{v[k].tolist()} is beyond {MAX_COORDINATE:g}, the largest coordinate "
+                                   f"gauss6 takes ({len(far)} such ticks)")
+    for column in ("xh_q", "xs_q"):
+        q = ticks[column]
+        with np.errstate(invalid="ignore"):
+            big = np.max(np.where(np.isfinite(q), np.abs(q), 0.0), axis=1)
+        _, e = np.frexp(big)
+        ok = np.all(np.isfinite(q), axis=1) & (big > 0)
+        ticks[column] = np.where(ok[:, None], np.ldexp(q, -np.where(ok, e, 0)[:, None]), q)
+    out = Trace(**{**tr.__dict__, "ticks": ticks})
+    return out
 
 
 def _flat(arr: np.ndarray, name: str) -> tuple[list[str], np.ndarray]:

@@ -5,27 +5,33 @@ run it recorded itself (docs/engine-contract.md).
     gauss6 validate RUN --scene SCENE [--script NAME] --out DIR      (RUN: a .g6trace, or a ticks CSV)
 
 ENGINE: a shared library that exports the C ABI (gauss6/engine.h), by path; a built one by name
-(gauss6, box-penalty, fault); or a Python engine as `python:MODULE:FACTORY` (FACTORY(config)
-returns an object with reset(scene) and step(t, xh_p, xh_q), gauss6.engine). --config passes
-the engine its config text.
+(gauss6, box-penalty, fault); or a Python engine as `python:MODULE:FACTORY` (MODULE importable)
+or `python:path/to/file.py:FACTORY` (FACTORY(config) returns an object with reset(scene) and
+step(t, xh_p, xh_q), gauss6.engine). --config passes the engine its config text. The engine runs
+in a child process (--isolation process, the default; gauss6.engine_host) under a per-step and a
+per-run watchdog (--step-timeout, --run-timeout); its crash, exit, hang, exception or malformed
+output ends the run with the check `engine_failure` and exit status 2, the trace holding the
+ticks up to the last good one.
 
 DIR receives: run.g6trace (the driven run), report.md (the verdict table, the plots, the
 machine), validation.png/.svg (penetration depth or separation, distance from the force cone,
 port energy over time, the script's phases marked) and validation.json:
 
     {"format": "gauss6-validation", "version": 1, "pass": bool, "failed": [names],
-     "engine": {"name", "library", "config"} or null, "run": path of the judged trace,
+     "engine": {"name", "library", "config", "isolation", "declarations"} or null,
+     "engine_failure": {"kind", "detail", "tick"} or null, "run": path of the judged trace,
      "scene": path, "script": path or null, "ticks": int, "duration": s,
+     "coverage": a recorded RUN's trace.coverage (ticks, time span, complete or cut, sha256) or null,
      "thresholds": {"file": path, "version": int},
      "verdicts": [{"name", "title", "pass", "count", "worst", "unit", "first_time", "note", "details"}],
      "machine": {"platform", "processor", "cpus", "python"}}
 
-Exit status: 0 when every check passes, 1 when one fails, 2 on a usage or load error.
+Exit status (EXIT_CODES; docs/engine-contract.md): 0 a complete run, every check passed; 1 a check
+failed; 2 the engine failed (nothing else gives 0 or 1 then); 3 a usage error.
 """
 from __future__ import annotations
 
 import argparse
-import importlib
 import json
 import os
 import platform
@@ -36,17 +42,15 @@ from pathlib import Path
 import numpy as np
 
 from . import oracle as oracle_mod
-from .engine import EngineError, EngineScene, load_engine
+from .engine import EngineError, EngineScene, check_spec
+from .engine_host import RUN_TIMEOUT, STEP_TIMEOUT, InlineHost, ProcessHost
+from .trace import coverage_line
 
 FORMAT_VERSION = 1
 
-
-def make_engine(spec: str, config: str = ""):
-    """An engine by spec: python:MODULE:FACTORY, a built engine's name, or a library path."""
-    if spec.startswith("python:"):
-        _, module, factory = spec.split(":", 2)
-        return getattr(importlib.import_module(module), factory)(config)
-    return load_engine(spec, config)
+EXIT_PASS, EXIT_CHECK_FAILED, EXIT_ENGINE_FAILED, EXIT_USAGE = 0, 1, 2, 3
+EXIT_CODES = {EXIT_PASS: "every check passed on a complete run", EXIT_CHECK_FAILED: "a check failed",
+              EXIT_ENGINE_FAILED: "the engine failed", EXIT_USAGE: "usage error"}
 
 
 def machine() -> dict:
@@ -127,37 +131,107 @@ def verdict_table(verdicts) -> str:
     return "\n".join(rows)
 
 
-def write_outputs(result, out: Path, info: dict) -> dict:
+def failure_verdict(failure: dict, rate_hz: float) -> oracle_mod.Verdict:
+    """The check engine_failure of a run the engine ended (the trace's extra["engine_failure"])."""
+    return oracle_mod.Verdict("engine_failure", "0. engine failure", False, 1, None, "",
+                              (failure["tick"] + 1) / rate_hz, f"{failure['kind']}: {failure['detail']}",
+                              {"kind": failure["kind"], "last_good_tick": failure["tick"]})
+
+
+def engine_lines(engine: dict) -> list[str]:
+    """The report's lines on how the engine ran: its isolation and what it declared."""
+    iso = engine["isolation"]
+    cost = ", ".join(f"{k} {_fmt(v)}" for k, v in iso["round_trip_us"].items())
+    return [f"- isolation: {iso['mode']} (transport per tick, us: {cost})",
+            f"- declared: {json.dumps(engine['declarations']) if engine['declarations'] else 'nothing'}"]
+
+
+def write_outputs(result, out: Path, info: dict, witnesses: str = "") -> dict:
     title = f"{info.get('engine_name') or 'recorded run'} on {Path(info['scene']).stem}"
-    plot(result, out, title)
+    plotted = len(result.series.get("t", ())) > 0
+    if plotted:
+        plot(result, out, title)
+    failure = info.get("engine_failure")
     doc = {"format": "gauss6-validation", "version": FORMAT_VERSION, "pass": result.passed, "failed": result.failed(),
-           "engine": info.get("engine"), "run": info["run"], "scene": info["scene"], "script": info.get("script"),
-           "ticks": info["ticks"], "duration": info["duration"],
+           "engine": info.get("engine"), "engine_failure": failure, "run": info["run"], "scene": info["scene"],
+           "script": info.get("script"),
+           "ticks": info["ticks"], "duration": info["duration"], "coverage": info.get("coverage"),
            "thresholds": {"file": info["thresholds"], "version": info["thresholds_version"]},
            "verdicts": [v.to_json() for v in result.verdicts], "machine": machine()}
     (out / "validation.json").write_text(json.dumps(doc, indent=2) + "\n")
     lines = [f"# Validation: {title}", "",
              f"Verdict: **{'PASS' if result.passed else 'FAIL'}**"
              + ("" if result.passed else f" ({', '.join(result.failed())})"), "",
-             f"- run: `{info['run']}` ({info['ticks']} ticks, {info['duration']:.3f} s)",
+             f"- run: `{info['run']}` ({info['ticks']} ticks, {info['duration']:.3f} s)"
+             + (f"; the trace: {coverage_line(info['coverage'])}" if info.get("coverage") else ""),
              f"- scene: `{info['scene']}`" + (f", script `{info['script']}`" if info.get("script") else ""),
              f"- engine: {info.get('engine_name') or 'recorded offline'}"
              + (f" (`{info['engine']['library']}`, config `{info['engine']['config']}`)" if info.get("engine") else ""),
+             *(engine_lines(info["engine"]) if info.get("engine") else []),
+             *([f"- **the engine failed** ({failure['kind']}) after tick {failure['tick']}: {failure['detail']}"]
+               if failure else []),
              f"- thresholds: `{info['thresholds']}` (version {info['thresholds_version']})",
              f"- machine: {machine()['processor']}, {machine()['cpus']} cpus, {machine()['platform']}", "",
              verdict_table(result.verdicts), "",
              "Geometric verdicts are exact (gauss6's reference, CGAL); depths are estimates; lengths in units of "
              "the scene's delta. Definitions and thresholds: docs/engine-contract.md, harness/oracle.toml.", "",
-             "![validation](validation.png)", ""]
+             *(["![validation](validation.png)"] if plotted else []), "",
+             *([witnesses] if witnesses else [])]
     (out / "report.md").write_text("\n".join(lines))
     return doc
 
 
-def validate(args) -> int:
-    from .trace import read_trace
+def witness_section(result, trace, oracle, out: Path) -> str:
+    """Writes the witnesses of the failed checks (witness.py) and, when there are any, the viewer page
+    they link to (run.html, opened at each witness's tick); returns the report's section ('' if none)."""
+    from .view import write_view
+    from .witness import report_witnesses
 
-    out = Path(args.out)
-    out.mkdir(parents=True, exist_ok=True)
+    if not len(trace.ticks):
+        return ""
+    section = report_witnesses(result, trace, oracle, out, viewer_page="run.html")
+    if section:
+        write_view([trace.path], scene=oracle.scene_path, out=out / "run.html")
+    return section
+
+
+def read_run(run, scene) -> tuple:
+    """A recorded RUN as judged offline: (trace, path). A .g6trace (a cut one read up to its
+    last complete chunk, the cut stated by trace.coverage in the outputs, and warned of on
+    stderr) or a ticks CSV; positions beyond the coordinate bound refused, quaternions
+    rescaled (trace.checked_poses); a run without ticks refused (ValueError naming it)."""
+    import warnings
+
+    from .trace import TraceWarning, checked_poses, read_trace
+
+    run_path = Path(run)
+    if run_path.suffix == ".g6trace":
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always", TraceWarning)
+            trace = read_trace(run_path)
+        for w in caught:
+            print(f"gauss6 validate: warning: {w.message}; judged on the ticks it holds "
+                  "(validation.json: coverage)", file=sys.stderr)
+    else:
+        from .logs import read_csv_dir
+
+        trace = read_csv_dir(run_path, scene=str(scene))
+    if len(trace.ticks) == 0:
+        raise ValueError(f"{run_path}: the run holds no ticks: there is nothing to judge")
+    for column in ("xh_q", "xs_q"):  # a zero quaternion is no rotation: the oracle cannot judge it
+        zero = np.nonzero(np.all(trace.ticks[column] == 0, axis=1))[0]
+        if len(zero):
+            k = int(zero[0])
+            raise ValueError(f"{run_path}: tick {k} (t = {float(trace.ticks['t'][k])!r}): {column} is the zero "
+                             f"quaternion, which is no rotation ({len(zero)} such ticks)")
+    return checked_poses(trace), run_path
+
+
+def validate(args) -> int:
+    from .paths import check_output_dir
+    from .trace import coverage
+
+    out = check_output_dir(args.out)
     thresholds_path = Path(args.thresholds) if args.thresholds else oracle_mod.THRESHOLDS
     thresholds = oracle_mod.load_thresholds(thresholds_path)
     run_progress, judge_progress = _progress(args.quiet)
@@ -165,69 +239,110 @@ def validate(args) -> int:
             "thresholds_version": thresholds.get("version")}
     from .driver import drive, scene_script, script_text
 
+    failure = None
     if args.engine:
-        engine = make_engine(args.engine, args.config)
+        check_spec(args.engine)
         scene = EngineScene.from_scene_file(args.scene)
         text, script_path = script_text(args.script, args.scene) if args.script else scene_script(args.scene)
         run_path = out / "run.g6trace"
-        trace = drive(engine, scene, text, run_path, args.duration, run_progress,
-                      extra={"engine_config": args.config, "script": script_path})
+        host = ProcessHost(args.engine, args.config, args.step_timeout, args.run_timeout) \
+            if args.isolation == "process" else InlineHost.of(args.engine, args.config)
+        try:
+            trace = drive(host, scene, text, run_path, args.duration, run_progress,
+                          extra={"engine_config": args.config, "script": script_path})
+        finally:
+            host.close()
         if run_progress:
             print(file=sys.stderr)
-        info.update(engine={"name": engine.name, "library": getattr(engine, "path", args.engine),
-                            "config": args.config}, engine_name=engine.name, script=script_path, run=str(run_path))
+        extra = trace.meta["extra"]
+        failure = extra.get("engine_failure")
+        info.update(engine={"name": extra["engine"], "library": str(host.library), "config": args.config,
+                            "isolation": extra["isolation"], "declarations": extra["declarations"]},
+                    engine_name=extra["engine"], script=script_path, run=str(run_path), engine_failure=failure)
     else:
-        run_path = Path(args.run)
-        if run_path.suffix == ".g6trace":
-            trace = read_trace(run_path)
-        else:
-            from .logs import read_csv_dir
-
-            trace = read_csv_dir(run_path, scene=str(args.scene))
+        trace, run_path = read_run(args.run, args.scene)
+        info["coverage"] = coverage(trace)
         if args.script:
             from .driver import script_phases
 
             text, script_path = script_text(args.script, args.scene)
             trace.meta["phases"] = [{"name": n, "start": s} for n, s in script_phases(text)]
             info["script"] = script_path
-        info.update(run=str(run_path), engine_name=trace.meta.get("extra", {}).get("engine"))
+        # A driven run that ended in the engine's failure stays one when judged again.
+        failure = trace.meta.get("extra", {}).get("engine_failure")
+        info.update(run=str(run_path), engine_name=trace.meta.get("extra", {}).get("engine"), engine_failure=failure)
     ticks = trace.ticks
     info.update(ticks=len(ticks), duration=float(ticks["t"][-1] - ticks["t"][0]) if len(ticks) else 0.0)
-    result = oracle_mod.Oracle(args.scene, thresholds).judge(trace, judge_progress)
+    oracle = oracle_mod.Oracle(args.scene, thresholds)
+    if failure is None:
+        result = oracle.judge(trace, judge_progress)
+    else:
+        # What ran is judged as well when it can be (two ticks at least); the failure is the verdict.
+        result = oracle_mod.OracleResult([], {}, [(p["name"], float(p["start"])) for p in trace.meta.get("phases", [])])
+        if len(ticks) >= 2:
+            try:
+                result = oracle.judge(trace, judge_progress)
+            except Exception as e:  # a partial run the checks cannot take: the failure alone is reported
+                print(f"gauss6 validate: the partial run was not judged ({type(e).__name__}: {e})", file=sys.stderr)
+        result.verdicts.insert(0, failure_verdict(failure, trace.meta["device"]["rate_hz"]))
     if judge_progress:
         print("\r" + " " * 60 + "\r", end="", file=sys.stderr)
-    doc = write_outputs(result, out, info)
+    doc = write_outputs(result, out, info, witness_section(result, trace, oracle, out))
     if args.json:
         print(json.dumps(doc, indent=2))
     else:
         print(verdict_table(result.verdicts))
         print(f"\n{'PASS' if result.passed else 'FAIL'}: {out / 'report.md'}")
-    return 0 if result.passed else 1
+        if failure is not None:
+            print(f"gauss6 validate: the engine failed ({failure['kind']}): {failure['detail']}", file=sys.stderr)
+    if failure is not None:
+        return EXIT_ENGINE_FAILED
+    return EXIT_PASS if result.passed and len(ticks) > 0 else EXIT_CHECK_FAILED
 
 
 def cmd_validate(args: argparse.Namespace) -> int:
     if bool(args.engine) == bool(args.run):
         print("gauss6 validate: give either --engine ENGINE or a recorded RUN (not both)", file=sys.stderr)
-        return 2
+        return EXIT_USAGE
     try:
         return validate(args)
     except (EngineError, ValueError, FileNotFoundError) as e:
         print(f"gauss6 validate: {e}", file=sys.stderr)
-        return 2
+        return EXIT_USAGE
 
 
 def register(subparsers) -> None:
+    from .cli import input_file, output_dir, run_seconds
+
     p = subparsers.add_parser("validate", help="drive an engine with the simulated device and judge its run, or "
-                                               "judge a recorded run (exit 1 on a failed check)")
-    p.add_argument("run", nargs="?", help="a recorded run to judge: a .g6trace, or a ticks CSV (docs/engine-contract.md)")
-    p.add_argument("--engine", help="engine library path, a built engine (gauss6, box-penalty, fault), or "
-                                    "python:MODULE:FACTORY")
+                                               "judge a recorded run (exit 1: a check failed, 2: the engine "
+                                               "failed, 3: usage)")
+    p.add_argument("run", nargs="?", type=input_file("run", directory_ok=True),
+                   help="a recorded run to judge: a .g6trace, or a ticks CSV (docs/engine-contract.md)")
+    p.add_argument("--engine", help="engine library path, a built engine (gauss6, box-penalty, fault), "
+                                    "python:MODULE:FACTORY or python:path/to/file.py:FACTORY")
+    p.add_argument("--isolation", choices=("process", "inline"), default="process",
+                   help="run the engine in a child process (default; a crash or hang is reported) or inline")
+    p.add_argument("--step-timeout", type=run_seconds, default=STEP_TIMEOUT, metavar="S",
+                   help=f"per-step watchdog: a step with no answer in S s is a hang "
+                        f"(default {STEP_TIMEOUT:g})")
+    p.add_argument("--run-timeout", type=run_seconds, default=RUN_TIMEOUT, metavar="S",
+                   help=f"per-run watchdog: a run (create and reset included) not done S s after the engine's start "
+                        f"is a hang "
+                        f"(default {RUN_TIMEOUT:g})")
     p.add_argument("--config", default="", help="the engine's config text (default: empty)")
-    p.add_argument("--scene", required=True, help="scene TOML file")
+    p.add_argument("--scene", required=True, type=input_file("scene"), help="scene TOML file")
     p.add_argument("--script", help="hand script name or .json path (default: the scene's device.script)")
-    p.add_argument("--duration", type=float, default=None, help="run only the first S seconds of the script")
-    p.add_argument("--out", required=True, help="output directory")
-    p.add_argument("--thresholds", help="thresholds file (default harness/oracle.toml)")
+    p.add_argument("--duration", type=run_seconds, default=None, help="run only the first S seconds of the script")
+    p.add_argument("--out", required=True, type=output_dir, help="output directory")
+    p.add_argument("--thresholds", type=input_file("thresholds file"),
+                   help="thresholds file (default harness/oracle.toml)")
     p.add_argument("--json", action="store_true", help="print validation.json instead of the table")
     p.add_argument("--quiet", action="store_true", help="no progress on stderr")
     p.set_defaults(func=cmd_validate)
+
+    def usage_error(message):  # argparse's own errors exit 2, which here means "the engine failed"
+        p.print_usage(sys.stderr)
+        print(f"gauss6 validate: error: {message}", file=sys.stderr)
+        sys.exit(EXIT_USAGE)
+    p.error = usage_error

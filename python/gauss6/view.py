@@ -10,6 +10,11 @@ registry, pinned in viewer/package-lock.json; `npm ci && npm run build` in viewe
 tools/setup.sh runs) and the run data are inlined. Runs longer than MAX_FRAMES ticks are
 down-sampled for the page (evenly spaced ticks, the page says so); so are their sim steps.
 The page's script exposes window.gauss6View (seek(t), play(), pause(), state(k), canvasStats()).
+
+Non-finite values (the run of an engine that returned NaN, an event value or a metadata number
+that is NaN or infinite) never reach the inlined JSON, which a browser could not parse: numbers
+in it are finite or null (`_finite_json`), the arrays carry NaN and infinities in their bytes,
+and the page draws them as gaps in the plots, a hidden body and "NaN"/"inf" in its readout.
 """
 from __future__ import annotations
 
@@ -43,8 +48,28 @@ class ViewerBuildError(RuntimeError):
 
 def _array(values, dtype: str) -> dict:
     """A numeric array for the page: little-endian bytes, base64 ({"__a": dtype, "b": ...})."""
-    a = np.ascontiguousarray(np.asarray(values), dtype={"f4": "<f4", "f8": "<f8", "u4": "<u4"}[dtype])
+    with np.errstate(over="ignore", invalid="ignore"):  # a double beyond float32's range is inf in the page
+        a = np.ascontiguousarray(np.asarray(values), dtype={"f4": "<f4", "f8": "<f8", "u4": "<u4"}[dtype])
     return {"__a": dtype, "b": base64.b64encode(a.tobytes()).decode("ascii")}
+
+
+def _finite_json(value):
+    """value with every float that is NaN or infinite replaced by None (JSON null): JSON has no
+    such numbers, and a page holding them does not load."""
+    if isinstance(value, float):
+        return value if np.isfinite(value) else None
+    if isinstance(value, dict):
+        return {k: _finite_json(v) for k, v in value.items()}
+    if isinstance(value, (list, tuple)):
+        return [_finite_json(v) for v in value]
+    return value
+
+
+def _finite_max(values) -> float:
+    """The largest finite value (0 when there is none)."""
+    v = np.asarray(values, dtype=float)
+    v = v[np.isfinite(v)]
+    return float(v.max()) if len(v) else 0.0
 
 
 def pick(n: int, max_n: int) -> np.ndarray:
@@ -126,11 +151,20 @@ def run_data(trace, label: str, max_frames: int = MAX_FRAMES) -> dict:
         },
         "contacts": {"point": _array(kept["point"], "f4"), "normal": _array(kept["normal"], "f4")},
         "max_contacts": int(counts.max()) if len(counts) else 0,
-        "max_force": float(np.max(np.linalg.norm(ticks["wrench"][:, :3], axis=1))) if len(ticks) else 0.0,
-        "max_torque": float(np.max(np.linalg.norm(ticks["wrench"][:, 3:], axis=1))) if len(ticks) else 0.0,
+        "max_force": _finite_max(_norms(ticks["wrench"][:, :3])),
+        "max_torque": _finite_max(_norms(ticks["wrench"][:, 3:])),
+        "non_finite": {"wrench_ticks": int(np.sum(~np.all(np.isfinite(ticks["wrench"]), axis=1))),
+                       "pose_ticks": int(np.sum(~(np.all(np.isfinite(ticks["xs_p"]), axis=1)
+                                                  & np.all(np.isfinite(ticks["xs_q"]), axis=1))))},
         "rows": {"ticks": [int(len(ticks)), int(len(ti))], "steps": [int(len(steps)), int(len(si))],
                  "contacts": [int(len(contacts)), int(len(kept))]},
     }
+
+
+def _norms(v: np.ndarray) -> np.ndarray:
+    """Row norms, without overflow warnings (an infinite or huge row's norm is inf)."""
+    with np.errstate(over="ignore", invalid="ignore"):
+        return np.linalg.norm(np.asarray(v, dtype=float).reshape(len(v), -1), axis=1)
 
 
 def _label(trace, path: Path, taken: set) -> str:
@@ -167,6 +201,8 @@ def write_view(traces, scene=None, out=None, labels=None, title: str | None = No
         with warnings.catch_warnings():
             warnings.simplefilter("ignore", TraceWarning)  # a cut trace shows what it has
             loaded.append(read_trace(p))
+        if len(loaded[-1].ticks) == 0:
+            raise ValueError(f"{p}: the trace holds no ticks: there is no run to view")
     if scene is None:
         scene = default_scene(loaded[0])
         if scene is None:
@@ -182,17 +218,26 @@ def write_view(traces, scene=None, out=None, labels=None, title: str | None = No
         if k_t < n_t or k_s < n_s:
             line += (f"; down-sampled for this page to {k_t} ticks and {k_s} sim steps, evenly spaced "
                      f"(the trace holds every one)")
+        bad = r["non_finite"]
+        if bad["wrench_ticks"] or bad["pose_ticks"]:
+            line += (f"; non-finite wrench at {bad['wrench_ticks']} ticks, non-finite god-object pose at "
+                     f"{bad['pose_ticks']} ticks (drawn as gaps)")
         notes.append(line)
-    data = {"scene": scene_data(scene), "runs": runs}
+    data = _finite_json({"scene": scene_data(scene), "runs": runs})
     title = title or "gauss6 run: " + " | ".join(r["label"] for r in runs)
     page = TEMPLATE.read_text(encoding="utf-8")
     # Inline the data and the script; "</" inside them could end their <script> element early.
     page = page.replace("@@TITLE@@", html.escape(title)).replace("@@NOTE@@", html.escape("; ".join(notes)))
-    page = page.replace("@@DATA@@", json.dumps(data, separators=(",", ":")).replace("</", "<\\/"))
+    page = page.replace("@@DATA@@", json.dumps(data, separators=(",", ":"), allow_nan=False).replace("</", "<\\/"))
     page = page.replace("@@SCRIPT@@", bundle_script().replace("</script", "<\\/script"))
-    out = Path(out) if out else paths_in[0].with_suffix(".html")
+    if max_frames < 1:
+        raise ValueError(f"max_frames must be at least 1, not {max_frames}")
+    out = paths.check_output_file(Path(out) if out else paths_in[0].with_suffix(".html"), "page")
     out.parent.mkdir(parents=True, exist_ok=True)
-    out.write_text(page, encoding="utf-8")
+    try:
+        out.write_text(page, encoding="utf-8")
+    except OSError as e:
+        raise paths.PathError(f"{out}: cannot write the page: {e.strerror or e}") from None
     return out
 
 
@@ -212,11 +257,16 @@ def cmd_view(args: argparse.Namespace) -> int:
 def register(subparsers) -> None:
     """Adds `view` to the gauss6 command's subparsers."""
     v = subparsers.add_parser("view", help="a self-contained web page of one or more runs (3D, timeline, plots)")
-    v.add_argument("traces", nargs="+", help="trace file(s) (.g6trace); several are drawn side by side")
-    v.add_argument("--trace", action="append", help="another trace to draw beside the first (repeatable)")
-    v.add_argument("--scene", help="scene TOML (default: the generated scene the trace's metadata names)")
-    v.add_argument("--out", help="the page to write (default: the first trace with .html)")
+    from .cli import input_file, output_file, positive_int
+
+    v.add_argument("traces", nargs="+", type=input_file("trace"),
+                   help="trace file(s) (.g6trace); several are drawn side by side")
+    v.add_argument("--trace", action="append", type=input_file("trace"),
+                   help="another trace to draw beside the first (repeatable)")
+    v.add_argument("--scene", type=input_file("scene"),
+                   help="scene TOML (default: the generated scene the trace's metadata names)")
+    v.add_argument("--out", type=output_file, help="the page to write (default: the first trace with .html)")
     v.add_argument("--label", action="append", help="a run's label, in the order of the traces (repeatable)")
-    v.add_argument("--max-frames", type=int, default=MAX_FRAMES,
+    v.add_argument("--max-frames", type=positive_int, default=MAX_FRAMES,
                    help=f"ticks (and sim steps) per run kept in the page (default {MAX_FRAMES}); more are down-sampled")
     v.set_defaults(func=cmd_view)

@@ -321,7 +321,7 @@ class CcdMeshPair {
     double best = 0;
     for (int i = 0; i < std::max(repeats, 1); ++i) {
       const auto t0 = Clock::now();
-      ccd_step(&obstacle, 1, god, X0, X1, settings, &ws_, &r);
+      ccd_step(&obstacle, 1, god, {X0, X1}, settings, &ws_, &r);
       const double s = seconds_since(t0);
       if (i == 0 || s < best) best = s;
     }

@@ -31,7 +31,15 @@ def bunnies():
     return EngineScene.from_scene_file(BUNNIES)
 
 
-@pytest.mark.parametrize("name", ENGINES)
+# Rapier pushes the peg while it is 6 mm or more above the box (its contact manifolds with the
+# box's triangle mesh, at 0.3 s of this motion): the wrench is then off by 0.24 N and 9.5 mN m.
+# Without the box its wrench is the inertial reaction to 1e-4 (python/tests/test_battery.py).
+FREE_MOTION_ENGINES = [pytest.param(p.values[0], marks=[*p.marks, pytest.mark.xfail(
+    reason="Rapier's contact force at a distance from the box", strict=True)]) if p.values[0] == "rapier" else p
+    for p in ENGINES]
+
+
+@pytest.mark.parametrize("name", FREE_MOTION_ENGINES)
 def test_free_motion_wrench_is_the_tools_inertial_reaction(name, peg):
     """In free space the handle accelerates (1 m/s^2 along x) and turns (2 rad/s^2 about an
     oblique axis); the tool follows, and the wrench the user feels is -(M a + w x I w) of the

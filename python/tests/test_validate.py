@@ -147,7 +147,11 @@ def test_each_planted_fault_is_caught_by_its_check_alone(tmp_path, peg_oracle, f
     inner = engine_library("gauss6")
     engine = load_engine("fault", f"inner={inner};fault={fault};at={at}")
     result = peg_oracle.judge(_run(tmp_path, engine))
-    assert result.failed() == [check], [v.to_json() for v in result.verdicts if not v.passed]
+    # The tunnel's pose below the box is shown while the handle is in free space: it does not follow
+    # the handle there either (the tracking check), a second true finding.
+    also = {"tunnel": ["tracking"]}.get(fault, [])
+    assert [c for c in result.failed() if c not in also] == [check], \
+        [v.to_json() for v in result.verdicts if not v.passed]
     v = result.verdict(check)
     assert v.first_time is not None and v.first_time >= at
 
@@ -182,4 +186,4 @@ def test_validate_command_exit_codes_and_offline_runs(tmp_path):
     bad = tmp_path / "penalty"
     assert main(["validate", "--engine", "box-penalty", "--scene", str(PEG), "--duration", "1.0", "--out", str(bad),
                  "--quiet"]) == 1
-    assert main(["validate", "--scene", str(PEG), "--out", str(bad), "--quiet"]) == 2
+    assert main(["validate", "--scene", str(PEG), "--out", str(bad), "--quiet"]) == 3  # usage

@@ -186,3 +186,36 @@ def test_browser_shows_two_runs_side_by_side(browser, tmp_path):
     np.testing.assert_allclose(sb["god_position"][1] - sa["god_position"][1], 0.01, atol=1e-12)
     labels = browser.execute_script("return [...document.querySelectorAll('.run-label')].map(d => d.textContent)")
     assert [s.split(":")[0] for s in labels] == ["engine A", "engine B"]
+
+
+def test_browser_shows_the_run_of_a_nan_returning_engine(browser, tmp_path):
+    """The fault engine returns a NaN force from 0.5 s (gauss6's engine inside it); to its run
+    are added an event whose value is NaN, an infinite one and metadata numbers that are NaN, and
+    a god-object pose that is NaN. The page loads (its JSON parses), draws, shows "NaN" in the
+    readout at a NaN tick with no force arrow, and the god-object again after it."""
+    from gauss6.driver import drive, scene_script
+    from gauss6.engine import EngineScene, engine_library, load_engine
+
+    engine = load_engine("fault", f"inner={engine_library('gauss6')};fault=nan;at=0.5")
+    text, _ = scene_script(PEG_SCENE)
+    run = drive(engine, EngineScene.from_scene_file(PEG_SCENE), text, tmp_path / "nan.g6trace", 0.8)
+    nan_ticks = np.nonzero(~np.all(np.isfinite(run.ticks["wrench"]), axis=1))[0]
+    assert len(nan_ticks), "the fault engine returned no NaN"
+    ticks = run.ticks.copy()
+    ticks["xs_p"][700] = np.nan
+    events = np.zeros(2, dtype=DTYPES["events"])
+    events["t"], events["code"], events["value"] = [0.3, 0.6], [3, 4], [np.nan, np.inf]
+    meta = {**run.meta, "device": {**run.meta["device"], "rate_hz": float("nan")}}
+    path = write_trace(Trace(**{**run.__dict__, "ticks": ticks, "events": events, "meta": meta}),
+                       tmp_path / "nan-plus.g6trace")
+    page = view.write_view([path], PEG_SCENE, tmp_path / "nan.html")
+    _open(browser, page)
+    stats = browser.execute_script("return gauss6View.canvasStats()")
+    assert stats["non_background"] > 0.05 * stats["width"] * stats["height"], stats
+    k = int(nan_ticks[0])
+    state = browser.execute_script(f"gauss6View.seek({float(ticks['t'][k])}); return gauss6View.state(0)")
+    assert state["tick"] == k and not state["force_arrow_visible"] and "NaN" in state["readout"], state
+    state = browser.execute_script("gauss6View.seek(0.7); return gauss6View.state(0)")
+    assert state["tick"] == 700 and not state["god_visible"], state
+    state = browser.execute_script("gauss6View.seek(0.75); return gauss6View.state(0)")
+    assert state["god_visible"] and np.all(np.isfinite(state["god_position"])), state

@@ -38,7 +38,7 @@ int main() {
   gauss6::CcdStepSettings settings;
   gauss6::CcdStepWorkspace ws;
   gauss6::CcdStepResult r;
-  gauss6::ccd_step(&obstacle, 1, body, {Vec3(0.1, 0.2, 1.5), gauss6::Quat{}}, {Vec3(0.1, 0.2, -1.5), gauss6::Quat{}},
+  gauss6::ccd_step(&obstacle, 1, body, {{Vec3(0.1, 0.2, 1.5), gauss6::Quat{}}, {Vec3(0.1, 0.2, -1.5), gauss6::Quat{}}},
                    settings, &ws, &r);
   const double u_star = 1.0 / 3;
   // Conservative (never past the contact) and close to it: time tolerance 1e-6 at speed 3.

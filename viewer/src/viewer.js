@@ -68,7 +68,10 @@ function meshGeometry(V, F) {
 }
 
 function fmt(x, digits = 3) {
-  if (x === undefined || x === null || Number.isNaN(x)) return '-';
+  if (x === undefined || x === null) return '-';
+  // Non-finite values (an engine that returned NaN) are shown as such, never as a number.
+  if (Number.isNaN(x)) return 'NaN';
+  if (!Number.isFinite(x)) return x > 0 ? 'inf' : '-inf';
   if (x === 0) return '0';
   const a = Math.abs(x);
   return a >= 1e4 || a < 1e-3 ? x.toExponential(digits - 1) : x.toPrecision(digits);
@@ -147,6 +150,11 @@ class RunScene {
     this.god.quaternion.copy(quat(r.ticks.xs_q, i));
     this.ghost.position.copy(vec3(r.ticks.xh_p, i));
     this.ghost.quaternion.copy(quat(r.ticks.xh_q, i));
+    // A non-finite pose is not drawn (a gap), rather than drawn somewhere wrong.
+    const finitePose = (o) => [o.position.x, o.position.y, o.position.z, o.quaternion.x, o.quaternion.y,
+      o.quaternion.z, o.quaternion.w].every(Number.isFinite);
+    this.god.visible = finitePose(this.god);
+    this.ghost.visible = finitePose(this.ghost);
     this.god.updateMatrixWorld();
 
     // Arrows: force and torque (wrench = force, torque) at the god-object's G.
@@ -418,6 +426,7 @@ class View {
       const p = r.ticks.xs_p, n = p.length / 3;
       for (let i = 0; i < n; i += Math.max(1, Math.floor(n / 500))) {
         const c = vec3(p, i);
+        if (!Number.isFinite(c.x + c.y + c.z)) continue;  // a non-finite pose: not part of the view
         box.expandByPoint(c.clone().addScalar(godRadius));
         box.expandByPoint(c.clone().addScalar(-godRadius));
       }
@@ -520,7 +529,8 @@ class View {
         const x = X(e.t);
         ctx.strokeStyle = '#b22'; ctx.beginPath(); ctx.moveTo(x, 0); ctx.lineTo(x, h); ctx.stroke();
         ctx.fillStyle = '#b22'; ctx.font = '10px sans-serif'; ctx.textAlign = 'left'; ctx.textBaseline = 'top';
-        ctx.fillText(e.name.replace('_', ' '), x + 2, 1);
+        const value = e.value === null ? ' (non-finite value)' : '';
+        ctx.fillText(e.name.replace('_', ' ') + value, x + 2, 1);
       }
     }
     const x = X(this.time);
@@ -593,7 +603,8 @@ class View {
     return { time: this.time, tick: rs.tick, tick_time: rs.run.ticks.t[rs.tick],
              god_position: [p.x, p.y, p.z], god_quaternion_wxyz: [q.w, q.x, q.y, q.z],
              ghost_position: [g.x, g.y, g.z], contacts_shown: rs.numContactsShown,
-             force_arrow_visible: rs.force.visible, step: rs.step };
+             force_arrow_visible: rs.force.visible, god_visible: rs.god.visible, step: rs.step,
+             readout: this.readout.textContent };
   }
 
   // Pixels of the 3D canvas just drawn: how many differ from the background, and how many colours.
@@ -620,6 +631,9 @@ function main() {
   const raw = JSON.parse(document.getElementById('gauss6-data').textContent);
   const data = decodeArrays(raw);
   const view = new View(data);
+  // A page opened at a time: PAGE#t=SECONDS (the links to validate's witnesses).
+  const at = /(?:^#|&)t=([-+0-9.eE]+)/.exec(window.location.hash);
+  if (at && Number.isFinite(Number(at[1]))) view.seek(Number(at[1]));
   window.gauss6View = {
     get ready() { return view.ready; },
     get framesRendered() { return view.framesRendered; },

@@ -9,6 +9,12 @@
  * compiled with, so that a caller refuses a mismatched engine instead of reading
  * past a struct.
  *
+ * Versions: 1 (gauss6_engine_v1) and 2 (gauss6_engine_v2: version 1's table
+ * followed by an optional `declare`, what the engine renders on purpose). gauss6
+ * asks for 2 first and for 1 when an engine answers NULL, so a version-1 engine
+ * keeps working unchanged; a table whose abi_version is not the one asked for is
+ * refused.
+ *
  * Units and frames: the scene's units (metres, kilograms, seconds in the shipped
  * scenes; length_unit_m says so), world frame W. A pose is (p, q): p in R^3 the
  * position of the body's reference point G, q = (w, x, y, z) a quaternion, not
@@ -32,7 +38,8 @@
 extern "C" {
 #endif
 
-#define GAUSS6_ENGINE_ABI_VERSION 1
+#define GAUSS6_ENGINE_ABI_VERSION 1   /* version 1: gauss6_engine_v1 */
+#define GAUSS6_ENGINE_ABI_VERSION_2 2 /* version 2: gauss6_engine_v2 (declarations) */
 #define GAUSS6_ENGINE_ENTRY "gauss6_engine_get"
 
 /* A pose of a body frame B in the world W: p (scene length units), q = (w, x, y, z). */
@@ -94,7 +101,8 @@ typedef struct gauss6_step_out {
   int32_t num_contacts;             /* contacts written (<= contact_capacity); -1: not reported */
   int32_t contact_capacity;         /* set by the caller */
   gauss6_contact* contacts;         /* set by the caller */
-  double step_seconds;              /* the engine's own wall time for this step (s); < 0: not reported */
+  double step_seconds;              /* the engine's own wall time for this step (s); the caller sets -1:
+                                       left at -1, not reported; NaN or another negative value is refused */
 } gauss6_step_out;
 
 /* Status of a call: 0 is success; anything else is an error whose text the engine
@@ -120,6 +128,31 @@ typedef struct gauss6_engine_v1 {
   const char* (*last_error)(void* engine);
   void (*destroy)(void* engine);
 } gauss6_engine_v1;
+
+/* What an engine renders on purpose (version 2), so that the oracle judges it as
+ * declared (docs/engine-contract.md, "Declarations"): the caller zeroes the struct
+ * and sets struct_size; the engine sets a flag for each field it declares. */
+enum {
+  GAUSS6_DECLARE_FRICTION = 1u << 0, /* Coulomb friction with coefficient friction_mu (>= 0) */
+  GAUSS6_DECLARE_LATENCY = 1u << 1,  /* its force responds latency_ticks (>= 0) haptic ticks late */
+  GAUSS6_DECLARE_SKIN = 1u << 2      /* it keeps a separation of skin (length units, >= 0) from obstacles */
+};
+
+typedef struct gauss6_declarations {
+  uint32_t struct_size;             /* sizeof(gauss6_declarations) of the caller */
+  uint32_t flags;                   /* GAUSS6_DECLARE_* of the fields set */
+  double friction_mu;
+  int32_t latency_ticks;
+  double skin;
+} gauss6_declarations;
+
+/* The version 2 table: version 1's (its abi_version 2, its table_size
+ * sizeof(gauss6_engine_v2)), then `declare`, which may be NULL (nothing declared). */
+typedef struct gauss6_engine_v2 {
+  gauss6_engine_v1 v1;
+  /* Fills *out after create (before any reset); returns GAUSS6_ENGINE_OK. */
+  int (*declare)(void* engine, gauss6_declarations* out);
+} gauss6_engine_v2;
 
 /* The one exported symbol: the table for abi_version, or NULL when the engine
  * does not speak it. The table is static: it lives as long as the library. */

@@ -40,25 +40,50 @@ struct CcdStepSettings {
   ProximityCacheSettings cache;            // coherence between steps (proximity_cache.h; cache.margin 0: off)
   double near_distance = 0;                // also list the triangle pairs that may come within this (>=
                                            // min_separation) by the stop pose: the near pairs (CcdStepResult)
-  double lead_sweep = 0;                   // > 0: a leg expected to stop early (a settling leg) searches its
-                                           // first sub-interval in pieces, [0, 4^-k/n], [4^-k/n, 4^(1-k)/n],
-                                           // ..., [1/(4n), 1/n], the first sweeping about this many times the
-                                           // reach: a first contact met soon ends the search there (0: off)
-  bool any_hit = false;                    // a yes/no question, "is the motion free?": the step stops at the
-                                           // first hit it finds (hit and status are the answer; u_hit and pair
-                                           // are then a hit's, not the first contact's: no stop pose)
-  double known_free = 0;                   // in [0, 1): the caller has proven [0, known_free] of the motion
-                                           // free at narrow.min_separation (motion_distance_bound against a
-                                           // leg already searched): every search starts there (0: none)
 };
 
 // Why the settings cannot serve a step (nullptr when they can): every
 // tolerance positive and finite (time_tolerance below 1, the whole window),
 // min_separation and near_distance finite and >= 0, max_iterations and
-// max_sub_intervals >= 1, the sub-interval bounds positive and finite,
-// lead_sweep finite and >= 0, known_free in [0, 1), the proximity cache's settings valid. ccd_step refuses such a step (kInvalidInput)
+// max_sub_intervals >= 1, the sub-interval bounds positive and finite, the
+// proximity cache's settings valid. ccd_step refuses such a step (kInvalidInput)
 // before any pair test; RuntimeModel refuses them when it is built.
 const char* ccd_step_settings_problem(const CcdStepSettings& settings);
+
+// The question a call of ccd_step answers.
+enum class CcdQuestion {
+  kFirstContact,   // where the motion first comes within narrow.min_separation (u_hit: the stop pose's)
+  kFreeOfContact,  // whether the motion is free of contact itself: searched at min_separation 0, without
+                   // near pairs or a cache of its own (ws->borrowed may serve), stopped at the first hit
+                   // found (hit and status are the answer; u_hit and pair are then a hit's, not the first
+                   // contact's: no stop pose). Filling no cache, it never goes on with a background fill.
+};
+
+// What one call of ccd_step asks, apart from the settings it runs with: the
+// motion, the question, the pairs to test first, what the caller has already
+// proven of it, and how the caller expects it to go.
+struct CcdStepRequest {
+  Pose X0, X1;                             // the Cayley motion X0 -> X1 (poses of G, world frame)
+  const FeaturePair* hints = nullptr;      // hints[0 .. num_hints): pairs likely to touch first (ccd_step)
+  int num_hints = 0;
+  double known_free = 0;                   // in [0, 1): the caller has proven [0, known_free] of the motion
+                                           // free at the separation the question searches for
+                                           // (motion_distance_bound against a leg already searched): no
+                                           // search covers it again (0: none)
+  double lead_sweep = 0;                   // > 0: a motion expected to stop early (a settling leg) searches its
+                                           // first sub-interval in pieces, [0, 4^-k/n], [4^-k/n, 4^(1-k)/n],
+                                           // ..., [1/(4n), 1/n], the first sweeping about this many times the
+                                           // reach: a first contact met soon ends the search there (0: off)
+  CcdQuestion question = CcdQuestion::kFirstContact;
+  bool fill_cache = true;                  // go on with the proximity cache's background fill (cache.fill_budget
+                                           // node pairs); false for the later calls of one update, whose budget
+                                           // the first spent
+};
+
+// Why the request cannot be served (nullptr when it can): known_free in [0, 1)
+// and lead_sweep finite and >= 0 (hints out of range are ignored). ccd_step
+// refuses such a step (kInvalidInput) before any pair test.
+const char* ccd_step_request_problem(const CcdStepRequest& request);
 
 struct CcdStepResult {
   CcdStatus status = CcdStatus::kOk;       // kOk, kHalfTurn (split the step: split_step()),
@@ -71,7 +96,7 @@ struct CcdStepResult {
   FeaturePair pair;                        // the pair that gave u_hit (when hit)
   double time_tolerance_reached = 0, distance_reached = 0;  // of that pair's test
   CcdMotion motion;                        // the enclosed motion used (for make_stop_pose)
-  int num_sub_intervals = 0;               // the sub-intervals planned, lead pieces included (CcdStepSettings::lead_sweep)
+  int num_sub_intervals = 0;               // the sub-intervals planned, lead pieces included (CcdStepRequest::lead_sweep)
   int num_node_pairs = 0, num_triangle_pairs = 0, num_pair_tests = 0;
   int num_axis_culls = 0;                  // triangle pairs dropped whole by a separating-axis time bound (no pair test)
   int num_feature_culls = 0;               // feature pairs dropped by their own time bound (no pair test)
@@ -95,9 +120,8 @@ struct CcdStepResult {
 // obstacle, so that the next descent starts there instead of at the root
 // pair: every leaf pair it could reach lies below exactly one of them. The
 // pieces of a settling leg, and the legs of one god-object update, sweep the
-// same standing proximity (the peg wedged in its hole: 1,500-2,500 node
-// pairs a settling leg, four legs in a refused settle's step), which each
-// descended again from the root. A cut is sound for any motion; starting
+// same standing proximity (a god-object wedged in a hole, the legs of a
+// refused settle's step), which each would descend again from the root. A cut is sound for any motion; starting
 // from it only skips the tests of the pairs above it, so a descent may list
 // a few more candidate triangle pairs than one from the root (and its result
 // may differ from a fresh workspace's within the tolerances). Within one step
@@ -231,12 +255,12 @@ struct CcdStepWorkspace {
 // that cannot touch in time are dropped, the rest are tested earliest-first,
 // each only up to (best u so far) - time_tolerance, and the step reports the
 // best u less time_tolerance (so u* - u_hit grows by at most that tolerance).
-// Inputs: obstacles[0 .. num_obstacles) (world frame), god (body frame), X0, X1
-// (poses of G). Stop pose: make_stop_pose(result.motion, result.u_hit,
-// god.bvh->radius) when hit (u = 1 otherwise); with narrow.min_separation = d
+// Inputs: obstacles[0 .. num_obstacles) (world frame), god (body frame), the
+// request (the motion X0 -> X1, poses of G). Stop pose:
+// make_stop_pose(result.motion, result.u_hit, god.bvh->radius) when hit (u = 1 otherwise); with narrow.min_separation = d
 // its exact separation is >= d - deviation.
 //
-// hints[0 .. num_hints): feature pairs likely to touch first (the runtime
+// request.hints[0 .. num_hints): feature pairs likely to touch first (the runtime
 // passes the contacts at X0); their triangle pairs are tested over the whole
 // step before the descent (and not again after it). A pair pressed against an
 // obstacle then gives a hit near u = 0 at once, and the descent searches only
@@ -253,12 +277,12 @@ struct CcdStepWorkspace {
 // the list in use serves.
 // With settings.cache.margin = 0 and ws->borrowed set, that list serves the
 // step read-only under the same rule (the whole rest of the step or nothing).
-// With settings.any_hit the step answers only whether the motion is free: it
-// stops at the first hit it finds (the hints first), whose u_hit is not the
-// first contact's; hit and status are the same as without it (a hit is never
-// taken back by a later search), so it is for checks, never for a stop pose.
-void ccd_step(const CcdBody* obstacles, int num_obstacles, const CcdBody& god, const Pose& X0, const Pose& X1,
-              const CcdStepSettings& settings, CcdStepWorkspace* ws, CcdStepResult* result,
-              const FeaturePair* hints = nullptr, int num_hints = 0) noexcept;
+// Asked CcdQuestion::kFreeOfContact, the step answers only whether the motion
+// is free: it stops at the first hit it finds (the hints first), whose u_hit is
+// not the first contact's; hit and status are the same as a first contact's at
+// min_separation 0 (a hit is never taken back by a later search), so it is for
+// checks, never for a stop pose.
+void ccd_step(const CcdBody* obstacles, int num_obstacles, const CcdBody& god, const CcdStepRequest& request,
+              const CcdStepSettings& settings, CcdStepWorkspace* ws, CcdStepResult* result) noexcept;
 
 }  // namespace gauss6

@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "gauss6/regular_file.h"
 #include "gauss6/scene.h"
 
 namespace gauss6 {
@@ -16,6 +17,11 @@ constexpr uint64_t kMaxHeightMapPixels = uint64_t(1) << 26;
 }  // namespace
 
 bool read_height_map(const std::string& path, HeightMapImage* out, std::string* error) {
+  // A PNG of 2^26 16-bit pixels with its chunks' overhead stays far below 1 GiB.
+  if (const std::string problem = regular_file_problem(path, uint64_t(1) << 30); !problem.empty()) {
+    *error = path + ": " + problem;
+    return false;
+  }
   png_image image{};
   image.version = PNG_IMAGE_VERSION;
   if (!png_image_begin_read_from_file(&image, path.c_str())) {

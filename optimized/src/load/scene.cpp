@@ -14,6 +14,7 @@
 
 #include "gauss6/mass_properties.h"
 #include "gauss6/mesh_io.h"
+#include "gauss6/regular_file.h"
 #include "gauss6/surface.h"
 
 namespace gauss6 {
@@ -265,6 +266,8 @@ Scene load_scene(const std::string& path) {
   Scene scene;
   scene.path = path;
   toml::table root;
+  if (const std::string problem = regular_file_problem(path, uint64_t(1) << 26); !problem.empty())
+    throw SceneError(path, problem);  // a FIFO or a device is never read
   try {
     root = toml::parse_file(path);
   } catch (const toml::parse_error& e) {

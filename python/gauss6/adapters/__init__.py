@@ -1,5 +1,6 @@
 """Adapters that put engines nobody here wrote behind the engine contract (gauss6.engine):
-MuJoCo (mujoco_engine), PyBullet (pybullet_engine), Drake (drake_engine), each from its
+MuJoCo (mujoco_engine), PyBullet (pybullet_engine), Drake (drake_engine), DART (dart_engine),
+Rapier (rapier_engine), each from its
 pinned wheel, and what they share (geometry: convex parts and mesh files; config text;
 the coupling's pose algebra). docs/engine-adapters.md states what each adapter does and how
 each parameter was chosen.
@@ -30,10 +31,22 @@ def drake(config: str = ""):
     return DrakeEngine(config)
 
 
-FACTORIES = {"mujoco": mujoco, "pybullet": pybullet, "drake": drake}
+def dart(config: str = ""):
+    from .dart_engine import DartEngine
+
+    return DartEngine(config)
+
+
+def rapier(config: str = ""):
+    from .rapier_engine import RapierEngine
+
+    return RapierEngine(config)
+
+
+FACTORIES = {"mujoco": mujoco, "pybullet": pybullet, "drake": drake, "dart": dart, "rapier": rapier}
 
 # The module each framework is imported as (to tell whether it is installed).
-MODULES = {"mujoco": "mujoco", "pybullet": "pybullet", "drake": "pydrake"}
+MODULES = {"mujoco": "mujoco", "pybullet": "pybullet", "drake": "pydrake", "dart": "dartpy", "rapier": "rapier3d"}
 
 
 def available(name: str) -> bool:
