@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <initializer_list>
 #include <stdexcept>
 
 #include <nlohmann/json.hpp>
@@ -11,13 +12,15 @@
 namespace gauss6 {
 
 void validate_hand_script(const HandScript& s) {
-  if (s.keys.empty()) throw std::invalid_argument("hand script: no keyframes");
+  if (s.keys.empty()) throw std::invalid_argument("hand script: keys: no keyframes");
   for (size_t i = 0; i < s.keys.size(); ++i) {
     const HandKeyframe& k = s.keys[i];
-    if (!std::isfinite(k.t)) throw std::invalid_argument("hand script: key " + std::to_string(i) + ": time is not finite");
-    if (!is_valid_pose(k.X_WA)) throw std::invalid_argument("hand script: key " + std::to_string(i) + ": invalid pose");
+    const std::string key = "hand script: keys[" + std::to_string(i) + "]";
+    if (!std::isfinite(k.t)) throw std::invalid_argument(key + ".t: time is not finite");
+    if (!is_valid_pose(k.X_WA)) throw std::invalid_argument(key + ": invalid pose (p finite, q a non-zero quaternion)");
     if (i > 0 && !(k.t > s.keys[i - 1].t))
-      throw std::invalid_argument("hand script: key " + std::to_string(i) + ": times must increase strictly");
+      throw std::invalid_argument(key + ".t: times must increase strictly (the previous key's is " +
+                                  std::to_string(s.keys[i - 1].t) + ")");
   }
   for (size_t i = 0; i < s.phases.size(); ++i)
     if (!std::isfinite(s.phases[i].start))
@@ -29,30 +32,91 @@ void validate_hand_script(const HandScript& s) {
     throw std::invalid_argument("hand script: let_go_time and end_time must be finite (negative: none)");
 }
 
+namespace {
+
+// Reads the JSON form; every problem names the key's path (keys[3].p) and what is wrong. Unknown keys
+// are errors, as in scene files: a misspelt "let_go_time" must not be silently ignored.
+class ScriptReader {
+ public:
+  [[noreturn]] static void fail(const std::string& key, const std::string& what) {
+    throw std::invalid_argument("hand script: " + key + ": " + what);
+  }
+  static void allow_only(const nlohmann::json& object, const std::string& where,
+                         std::initializer_list<const char*> keys) {
+    for (const auto& item : object.items()) {
+      bool known = false;
+      std::string list;
+      for (const char* k : keys) {
+        known |= item.key() == k;
+        list += std::string(list.empty() ? "" : ", ") + k;
+      }
+      if (!known) fail(where + item.key(), "unknown key (allowed here: " + list + ")");
+    }
+  }
+  static double number(const nlohmann::json& v, const std::string& key) {
+    if (!v.is_number()) fail(key, "must be a number");
+    return v.get<double>();
+  }
+  static std::vector<double> numbers(const nlohmann::json& v, const std::string& key, size_t n, const char* what) {
+    if (!v.is_array() || v.size() != n) fail(key, std::string("must be ") + what);
+    std::vector<double> out;
+    for (const auto& x : v) out.push_back(number(x, key));
+    return out;
+  }
+};
+
+}  // namespace
+
 HandScript hand_script_from_json(const std::string& text, const std::string& origin) {
+  using R = ScriptReader;
   HandScript s;
   try {
-    const nlohmann::json j = nlohmann::json::parse(text);
-    for (const auto& k : j.at("keys")) {
+    nlohmann::json j;
+    try {
+      j = nlohmann::json::parse(text);
+    } catch (const nlohmann::json::parse_error& e) {
+      throw std::invalid_argument(std::string("hand script: not valid JSON: ") + e.what());
+    }
+    if (!j.is_object()) R::fail("(top level)", "must be an object with \"keys\"");
+    R::allow_only(j, "", {"description", "keys", "let_go_time", "end_time", "phases"});
+    if (!j.contains("keys"))
+      R::fail("keys", "missing (the keyframes: [{\"t\": 0, \"p\": [x, y, z], \"q\": [w, x, y, z]}, ...])");
+    if (!j["keys"].is_array()) R::fail("keys", "must be an array of keyframes {t, p, q}");
+    for (size_t i = 0; i < j["keys"].size(); ++i) {
+      const nlohmann::json& k = j["keys"][i];
+      const std::string at = "keys[" + std::to_string(i) + "]";
+      if (!k.is_object()) R::fail(at, "must be a keyframe {t, p, q}");
+      R::allow_only(k, at + ".", {"t", "p", "q"});
+      if (!k.contains("t")) R::fail(at + ".t", "missing (the keyframe's time, s)");
+      if (!k.contains("p")) R::fail(at + ".p", "missing (the position of G, [x, y, z])");
       HandKeyframe key;
-      key.t = k.at("t").get<double>();
-      const auto p = k.at("p").get<std::vector<double>>();
-      if (p.size() != 3) throw std::invalid_argument("key 'p' must have 3 numbers");
+      key.t = R::number(k["t"], at + ".t");
+      const auto p = R::numbers(k["p"], at + ".p", 3, "3 numbers [x, y, z]");
       key.X_WA.p = Vec3(p[0], p[1], p[2]);
       if (k.contains("q")) {
-        const auto q = k.at("q").get<std::vector<double>>();
-        if (q.size() != 4) throw std::invalid_argument("key 'q' must have 4 numbers (w, x, y, z)");
+        const auto q = R::numbers(k["q"], at + ".q", 4, "4 numbers [w, x, y, z] (a quaternion)");
         key.X_WA.q = normalized(Quat{q[0], q[1], q[2], q[3]});
       }
       s.keys.push_back(key);
     }
-    s.let_go_time = j.value("let_go_time", -1.0);
-    s.end_time = j.value("end_time", -1.0);
-    if (j.contains("phases"))
-      for (const auto& p : j.at("phases")) s.phases.push_back({p.at("name").get<std::string>(), p.at("start").get<double>()});
+    if (j.contains("let_go_time")) s.let_go_time = R::number(j["let_go_time"], "let_go_time");
+    if (j.contains("end_time")) s.end_time = R::number(j["end_time"], "end_time");
+    if (j.contains("description") && !j["description"].is_string()) R::fail("description", "must be a string");
+    if (j.contains("phases")) {
+      if (!j["phases"].is_array()) R::fail("phases", "must be an array of {name, start}");
+      for (size_t i = 0; i < j["phases"].size(); ++i) {
+        const nlohmann::json& p = j["phases"][i];
+        const std::string at = "phases[" + std::to_string(i) + "]";
+        if (!p.is_object()) R::fail(at, "must be a phase {name, start}");
+        R::allow_only(p, at + ".", {"name", "start"});
+        if (!p.contains("name") || !p["name"].is_string()) R::fail(at + ".name", "must be a string");
+        if (!p.contains("start")) R::fail(at + ".start", "missing (the phase's start time, s)");
+        s.phases.push_back({p["name"].get<std::string>(), R::number(p["start"], at + ".start")});
+      }
+    }
     validate_hand_script(s);
   } catch (const nlohmann::json::exception& e) {
-    throw std::invalid_argument(origin + ": " + e.what());
+    throw std::invalid_argument(origin + ": hand script: " + e.what());
   } catch (const std::invalid_argument& e) {
     throw std::invalid_argument(origin + ": " + e.what());
   }

@@ -177,8 +177,15 @@ std::string read_text(const std::filesystem::path& path) {
 
 HandScript load_scene_script(const Scene& scene) {
   const std::string& name = scene.device.script;
-  if (scene.device.kind != DeviceKind::kSimulated || name.empty())
+  if (scene.device.kind != DeviceKind::kSimulated || (name.empty() && scene.device.script_json.empty()))
     throw ScenarioError("scene '" + scene.path + "': device.kind must be simulated, with a script");
+  if (name.empty()) {  // the [device.script] table
+    try {
+      return hand_script_from_json(scene.device.script_json, scene.path + ": device.script");
+    } catch (const std::invalid_argument& e) {
+      throw ScenarioError(e.what());
+    }
+  }
   const std::filesystem::path dir = std::filesystem::path(scene.path).parent_path();
   const bool is_file = name.size() > 5 && name.compare(name.size() - 5, 5, ".json") == 0;
   const std::filesystem::path path = is_file ? dir / name : dir / ".." / "scripts" / (name + ".json");

@@ -8,6 +8,7 @@
     gauss6 crosscheck ccd [--set NAME] [--json] [--peers] [--seeded N [--seed S] [--family F] [--workers N] ...]
     gauss6 report qp --out DIR
     gauss6 report peers [--out DIR] [--repeats N] [--ccd-only | --qp-only]
+    gauss6 run SCENE [--script NAME|FILE] --out DIR [--threaded]
     gauss6 reproduce peg|bunny|all --out DIR [--threaded]
     gauss6 reproduce engines --out DIR [--slice S]
     gauss6 trace export TRACE [--csv DIR] [--hapi FILE]
@@ -154,6 +155,10 @@ def cmd_scene_info(args: argparse.Namespace) -> int:
 def cmd_datasets(args: argparse.Namespace) -> int:
     from . import datasets, qp_instances
 
+    if args.action == "generate" and args.only:
+        datasets.generate(args.only, paths.DATASETS_DIR)
+        print(f"{args.only} written to {paths.DATASETS_DIR / args.only}")
+        return 0
     if args.action == "generate":
         datasets.generate_all()
         qp_instances.generate()  # sampled on the meshes above: after them
@@ -280,6 +285,10 @@ def build_parser() -> argparse.ArgumentParser:
     ds = sub.add_parser("datasets", help="the seeded dataset generators")
     ds.add_argument("action", choices=["generate", "check"],
                     help="generate: write in place; check: regenerate and compare checksums")
+    from .datasets import DATASETS, ON_DEMAND
+
+    ds.add_argument("--only", choices=[*DATASETS, *ON_DEMAND], help="generate: this dataset only (bunny_x4, bunny_x16: "
+                                                                "large, not committed, made only so)")
     ds.set_defaults(func=cmd_datasets)
 
     cc = sub.add_parser("crosscheck", help="optimized against exact (and peers)").add_subparsers(
@@ -341,6 +350,10 @@ def build_parser() -> argparse.ArgumentParser:
     from .reproduce import register as register_reproduce
 
     register_reproduce(sub)  # reproduce {peg,bunny,all} --out DIR [--threaded]; trace export | import
+
+    from . import run  # any scene, run and reported as the paper's are
+
+    run.register(sub)
 
     from . import replay, view  # a recorded session driving a scene; the web page of runs
 

@@ -24,6 +24,9 @@ Generation is deterministic: the same parameters give byte-identical files, so
 - battery: the conformance battery's meshes and hand scripts (docs/conformance-battery.md), one
   scene each in datasets_generated/scenes/ (BATTERY_SCENES), from
   datasets_generated/generators/battery.py (Python, numpy; reuses the peg generator).
+- bunny_x4, bunny_x16 (ON_DEMAND: not in DATASETS, not committed, tens of MB): bunny_full's
+  bunny.off with each triangle split into 4 or 16 (the same surface), from
+  datasets_generated/generators/subdivide.py; `gauss6 datasets generate --only NAME`.
 """
 from __future__ import annotations
 
@@ -54,6 +57,8 @@ BUNNY_TARGET_FACES = 27000
 BUNNY_FULL_TARGET_FACES = 69666
 BUNNY_HEIGHT = 0.15  # metres
 BUNNY_TOOL = "datasets_generated/gauss6_make_bunny"
+# Generated on demand only (large): name -> levels of midpoint subdivision of bunny_full.
+ON_DEMAND = {"bunny_x4": 1, "bunny_x16": 2}
 
 
 def sha256_file(path: Path) -> str:
@@ -144,6 +149,20 @@ def _generate_python(out: Path, stem: str, params_class: str) -> dict:
     return _write_manifest(out, GENERATORS_DIR / f"{stem}.py", module.GENERATOR_VERSION, params.to_json(), list(files))
 
 
+def _generate_subdivided(out: Path, levels: int) -> dict:
+    gen = peg_in_hole_generator()  # owns the OFF provenance header's format
+    source = GENERATORS_DIR / "subdivide.py"
+    module = _generator_module("subdivide")
+    full = paths.DATASETS_DIR / "bunny_full" / "bunny.off"
+    parameters = {"input": _relative(full), "input_sha256": sha256_file(full), "levels": levels}
+    V, F = module.subdivide(*module.read_off(full), levels)
+    module.write_off(out / "bunny.off", V, F, gen.provenance_header(_relative(source), parameters, sha256_file(source)))
+    r = subprocess.run([str(paths.tool(BUNNY_TOOL)), "--check", str(out / "bunny.off")], capture_output=True, text=True)
+    if r.returncode != 0:
+        raise RuntimeError(f"{out / 'bunny.off'}: the exact checks fail: {r.stderr.strip()}")
+    return _write_manifest(out, source, module.GENERATOR_VERSION, parameters, ["bunny.off"])
+
+
 def generate(name: str, out_dir: Path) -> dict:
     """Generates dataset `name` (one of DATASETS) into out_dir/<name>/ (its files
     and MANIFEST.json); returns the manifest. Raises ValueError for an unknown name,
@@ -151,9 +170,10 @@ def generate(name: str, out_dir: Path) -> dict:
     own checks fail."""
     makers = {"peg_in_hole": _generate_peg_in_hole, "bunny": _generate_bunny,
               "bunny_full": lambda out: _generate_bunny(out, BUNNY_FULL_TARGET_FACES), "surfaces": lambda out: _generate_python(out, "surfaces", "SurfacesParams"),
-              "battery": lambda out: _generate_python(out, "battery", "BatteryParams")}
+              "battery": lambda out: _generate_python(out, "battery", "BatteryParams"),
+              **{n: (lambda out, levels=levels: _generate_subdivided(out, levels)) for n, levels in ON_DEMAND.items()}}
     if name not in makers:
-        raise ValueError(f"unknown dataset {name!r}; expected one of {', '.join(DATASETS)}")
+        raise ValueError(f"unknown dataset {name!r}; expected one of {', '.join([*DATASETS, *ON_DEMAND])}")
     out = Path(out_dir) / name
     out.mkdir(parents=True, exist_ok=True)
     return makers[name](out)

@@ -45,6 +45,8 @@ def scene_script(scene_path) -> tuple[str, str]:
     scene_path = Path(scene_path)
     with open(scene_path, "rb") as f:
         name = tomllib.load(f).get("device", {}).get("script", "")
+    if isinstance(name, dict):  # a [device.script] table: the script itself (docs/scene-format.md)
+        return json.dumps(name), f"{scene_path}: device.script"
     if not name:
         raise ValueError(f"{scene_path}: device.script is not set: give --script")
     return script_text(name, scene_path, relative_to_scene=True)

@@ -1,8 +1,9 @@
 """The Figure 11 / Figure 12 analogues of the paper (METHOD.md section 7), drawn from a run trace.
 
-Five rows over time, phases shaded and labelled: the constraint-based force's computation
+Rows over time, phases shaded and labelled: the constraint-based force's computation
 time (us, per haptic tick), the god-object update time (ms, per sim step), the number of
-contacts (per sim step), and the Y and Z components of the force sent to the user (N).
+contacts (per sim step), and components of the force sent to the user (N): Y and Z as the
+paper's figures show them, or the ones asked for (`gauss6 run`: X, Y and Z).
 """
 from __future__ import annotations
 
@@ -18,7 +19,7 @@ def phase_spans(trace, end_time: float) -> list[tuple[str, float, float]]:
             for i, (name, start) in enumerate(phases)]
 
 
-def plot_run(trace, title: str, out_stem: Path, let_go_time: float | None = None) -> list[Path]:
+def plot_run(trace, title: str, out_stem: Path, let_go_time: float | None = None, force_axes: str = "YZ") -> list[Path]:
     """Writes out_stem.png and out_stem.svg; returns their paths."""
     import matplotlib
 
@@ -31,10 +32,10 @@ def plot_run(trace, title: str, out_stem: Path, let_go_time: float | None = None
         ("force time (us)", ticks["t"], ticks["force_time"] * 1e6, "C0"),
         ("god-object update (ms)", steps["t"], steps["update_time"] * 1e3, "C1"),
         ("contacts", steps["t"], steps["num_contacts"], "C2"),
-        ("force Y (N)", ticks["t"], ticks["wrench"][:, 1], "C3"),
-        ("force Z (N)", ticks["t"], ticks["wrench"][:, 2], "C4"),
+        *[(f"force {axis} (N)", ticks["t"], ticks["wrench"][:, "XYZ".index(axis)], {"X": "C5", "Y": "C3", "Z": "C4"}[axis])
+          for axis in force_axes],
     ]
-    fig, axes = plt.subplots(len(rows), 1, figsize=(10, 9.5), sharex=True)
+    fig, axes = plt.subplots(len(rows), 1, figsize=(10, 1.9 * len(rows)), sharex=True)
     spans = phase_spans(trace, t_end)
     for ax, (label, t, y, color) in zip(axes, rows):
         for i, (_, start, end) in enumerate(spans):

@@ -16,25 +16,10 @@ threads and the wall clock), and writes into DIR:
     figure_shading.*, figure_texture.*   the Figure 8 / Figure 9 analogues
     report.md                our numbers beside the paper's, the figures, the machine
 
-Definitions of the summary's numbers:
-  force_time_us          per haptic tick, the coupling step's wall time (us): median, p99, max
-  update_time_ms         per sim step, the god-object update's wall time (ms): median, p99, max
-  update_cpu_time_ms     per sim step, the sim thread's CPU time in the update (ms; CLOCK_THREAD_CPUTIME_ID:
-                         without the time the thread was preempted, which on a loaded machine is most of
-                         a wall-clock p99 or max): median, p99, max. Lockstep runs are run LOCKSTEP_RUNS
-                         times (each repeat must be the first run tick for tick, or reproduce fails) and
-                         report.md gives beside it each step's least time over them (the benchmarks'
-                         method: the machine's noise, not the step, sets a single run's max)
-  constraint_update_hz   the rate of new constraint sets. Lockstep: the rate a free-running sim loop
-                         would reach, min = 1 / max update time, mean = 1 / mean update time.
-                         Threaded: from the steps' start times, min = 1 / max period, mean = steps / time
-  max_contacts           the largest contact set of a sim step
-  penetrating_poses      god-object poses (every distinct xs of the trace's ticks: in lockstep runs every
-                         pose the sim loop took; in --threaded runs the poses the haptic loop saw) at
-                         which the exact check finds an intersecting triangle pair: must be 0. The
-                         check is `gauss6 certify`'s (certify.py), which also certifies the motion between
-                         successive poses and the separations at the poses with contacts (properties 5
-                         and 6), written to certify_<name>.md/.json; a run it does not certify fails
+Each scenario runs through `gauss6 run`'s path (run.py: the lockstep repeats and each step's least
+time, the certification, the figure, the viewer page; its docstring defines the common numbers:
+force_time_us, update_time_ms, update_cpu_time_ms, constraint_update_hz, max_contacts,
+penetrating_poses, max_rel_force_dot_ac, energy_injected). The paper's scenes add:
   max_abs_fy_outside_cd  peg: max |force Y| (N) over ticks outside phases (c) and (d)
   max_fy_in_c            peg: max force Y (N) during phase (c): the paper's is never positive
   max_rel_force_dot_ac   per coupling step, |Fc . ac| / (|Fc| |ac|) (max; steps with a running offset excluded)
@@ -50,17 +35,17 @@ from __future__ import annotations
 
 import argparse
 import json
-import os
-import platform
 import sys
 import time
-import warnings
 from pathlib import Path
 
 import numpy as np
 
 from . import paths
-from .exact_checks import distinct_poses, progress_bar
+# gauss6 run's path; LOCKSTEP_RUNS, least_update_times and machine are part of this module's interface too.
+from .run import (COMMON_KEYS as RUN_KEYS, DEFINITIONS, LOCKSTEP_RUNS, _fmt, failures,  # noqa: F401
+                  least_update_times, machine, machine_line, report_footer, report_section, run_scene,
+                  summarize as summarize_run)
 
 SCENES = {
     "peg": paths.DATASETS_DIR / "scenes" / "peg_in_hole.toml",
@@ -72,8 +57,7 @@ TITLES = {
     "bunny": "Two bunnies (Figure 12 analogue)",
     "bunny_full": "Two full-resolution bunnies (69,664 triangles each; the bunny script)",
 }
-COMMON_KEYS = ["force_time_us", "update_time_ms", "update_cpu_time_ms", "constraint_update_hz", "max_contacts", "penetrating_poses",
-               "max_rel_force_dot_ac", "energy_injected", "paper"]
+COMMON_KEYS = RUN_KEYS + ["paper"]
 PEG_KEYS = ["max_abs_fy_outside_cd", "max_fy_in_c", "let_go_stable"]
 SUMMARY_KEYS = {"peg": sorted(COMMON_KEYS + PEG_KEYS), "bunny": sorted(COMMON_KEYS),
                 "bunny_full": sorted(COMMON_KEYS)}
@@ -102,8 +86,6 @@ PAPER = {
     },
 }
 
-LOCKSTEP_RUNS = 5  # lockstep runs of each scenario: the first is the trace; all give each step's least time
-
 # Peg scene geometry used by the let-go check (datasets_generated/scenes/peg_in_hole.toml):
 # the hole's axis is the Y axis, the box spans |y| <= 3 cm.
 HOLE_AXIS_TOLERANCE = 5e-4   # m: the peg's centre within this of the axis (clearance is about 0.2 mm)
@@ -111,13 +93,6 @@ BOX_HALF_LENGTH = 0.03       # m
 SETTLE_TIME = 0.5            # s after the let-go before the drift and force are measured
 MAX_DRIFT = 1e-3             # m
 MAX_FINAL_FORCE = 0.05       # N
-
-
-def _stats3(values: np.ndarray, scale: float) -> dict:
-    v = np.asarray(values, dtype=float) * scale
-    if v.size == 0:
-        return {"median": None, "p99": None, "max": None}
-    return {"median": float(np.median(v)), "p99": float(np.percentile(v, 99)), "max": float(v.max())}
 
 
 def _phase_mask(t: np.ndarray, phases: list, names: set) -> np.ndarray:
@@ -149,241 +124,86 @@ def let_go_stable(trace, let_go_time: float) -> tuple[bool, dict]:
                 "final_force_n": final_force, "watchdog": watchdog, "still_gripped": gripped}
 
 
-def update_rate(trace, threaded: bool) -> dict:
-    steps = trace.steps
-    if len(steps) < 2:
-        return {"min": None, "mean": None}
-    if threaded:
-        dt = np.diff(steps["t"])
-        return {"min": float(1 / dt.max()), "mean": float((len(steps) - 1) / (steps["t"][-1] - steps["t"][0]))}
-    u = steps["update_time"]
-    return {"min": float(1 / u.max()), "mean": float(1 / u.mean())}
+def scenario_checks(name: str, trace, let_go_time: float) -> tuple[dict, dict]:
+    """The paper's figures and the scenario's own checks: (summary entries, report details). The peg: the force
+    Y outside and inside phases (c), (d), the let-go, per phase contacts and forces."""
+    s, extra = {"paper": PAPER[name]}, {}
+    if name != "peg":
+        return s, extra
+    ticks = trace.ticks
+    phases = [(p["name"], float(p["start"])) for p in trace.meta.get("phases", [])]
+    fy = ticks["wrench"][:, 1]
+    in_cd = _phase_mask(ticks["t"], phases, {"c", "d"})
+    in_c = _phase_mask(ticks["t"], phases, {"c"})
+    s["max_abs_fy_outside_cd"] = float(np.abs(fy[~in_cd]).max()) if np.any(~in_cd) else 0.0
+    s["max_fy_in_c"] = float(fy[in_c].max()) if np.any(in_c) else 0.0
+    extra["min_fy_in_c"] = float(fy[in_c].min()) if np.any(in_c) else 0.0
+    ok, details = let_go_stable(trace, let_go_time)
+    s["let_go_stable"] = ok
+    extra["let_go"] = details
+    for ph in "abcde":
+        m = _phase_mask(ticks["t"], phases, {ph})
+        extra[f"phase_{ph}"] = {
+            "ticks_with_contacts": int(np.count_nonzero(ticks["num_contacts"][m] > 0)),
+            "max_abs_fy": float(np.abs(fy[m]).max()) if np.any(m) else 0.0,
+            "max_fz": float(ticks["wrench"][m, 2].max()) if np.any(m) else 0.0,
+            "min_fz": float(ticks["wrench"][m, 2].min()) if np.any(m) else 0.0,
+        }
+    return s, extra
+
+
+def _check_keys(name: str, s: dict) -> None:
+    if sorted(s) != SUMMARY_KEYS[name]:
+        raise RuntimeError(f"{name}: summary keys {sorted(s)} differ from {SUMMARY_KEYS[name]}")
 
 
 def summarize(name: str, trace, run: dict, penetrating: int, threaded: bool) -> tuple[dict, dict]:
     """The summary.json entry of one scenario (exactly SUMMARY_KEYS[name]) and extra details for the report."""
-    ticks, steps = trace.ticks, trace.steps
-    phases = [(p["name"], float(p["start"])) for p in trace.meta.get("phases", [])]
-    s = {
-        "force_time_us": _stats3(ticks["force_time"], 1e6),
-        "update_time_ms": _stats3(steps["update_time"], 1e3),
-        "update_cpu_time_ms": _stats3(steps["update_cpu_time"], 1e3),
-        "constraint_update_hz": update_rate(trace, threaded),
-        "max_contacts": int(steps["num_contacts"].max()) if len(steps) else 0,
-        "penetrating_poses": int(penetrating),
-        "max_rel_force_dot_ac": float(run["max_rel_force_dot_ac"]),
-        "energy_injected": float(run["constraint_energy_injected"]),
-        "paper": PAPER[name],
-    }
-    extra = {
-        "ticks": int(len(ticks)), "sim_steps": int(len(steps)), "contact_rows": int(len(trace.contacts)),
-        "run_time_s": run["run_time"], "wall_s": run["wall_seconds"],
-        "orthogonality_checks": run["num_orthogonality_checks"], "offset_steps": run["num_offset_steps"],
-        "constraint_energy_removed_j": run["constraint_energy_removed"],
-        "port_energy_max_j": run["port_energy_max"], "port_energy_final_j": run["port_energy_final"],
-        "rows_dropped": run["rows_dropped"], "events": {k: run[k]["events"] for k in ("haptic", "coupling", "sim")},
-        "ticks_with_contacts": int(np.count_nonzero(ticks["num_contacts"] > 0)),
-        "max_force_n": float(np.max(np.linalg.norm(ticks["wrench"][:, :3], axis=1))) if len(ticks) else 0.0,
-    }
-    fy = ticks["wrench"][:, 1]
-    if name == "peg":
-        in_cd = _phase_mask(ticks["t"], phases, {"c", "d"})
-        in_c = _phase_mask(ticks["t"], phases, {"c"})
-        s["max_abs_fy_outside_cd"] = float(np.abs(fy[~in_cd]).max()) if np.any(~in_cd) else 0.0
-        s["max_fy_in_c"] = float(fy[in_c].max()) if np.any(in_c) else 0.0
-        extra["min_fy_in_c"] = float(fy[in_c].min()) if np.any(in_c) else 0.0
-        ok, details = let_go_stable(trace, run["let_go_time"])
-        s["let_go_stable"] = ok
-        extra["let_go"] = details
-        for ph in "abcde":
-            m = _phase_mask(ticks["t"], phases, {ph})
-            extra[f"phase_{ph}"] = {
-                "ticks_with_contacts": int(np.count_nonzero(ticks["num_contacts"][m] > 0)),
-                "max_abs_fy": float(np.abs(fy[m]).max()) if np.any(m) else 0.0,
-                "max_fz": float(ticks["wrench"][m, 2].max()) if np.any(m) else 0.0,
-                "min_fz": float(ticks["wrench"][m, 2].min()) if np.any(m) else 0.0,
-            }
-    if sorted(s) != SUMMARY_KEYS[name]:
-        raise RuntimeError(f"{name}: summary keys {sorted(s)} differ from {SUMMARY_KEYS[name]}")
+    s, extra = summarize_run(trace, run, penetrating, threaded)
+    more, more_extra = scenario_checks(name, trace, run["let_go_time"])
+    s, extra = {**s, **more}, {**extra, **more_extra}
+    _check_keys(name, s)
     return s, extra
-
-
-def least_update_times(name: str, scene: Path, trace, out: Path, duration: float, lockstep_sim_period: int) -> dict:
-    """The lockstep run again, LOCKSTEP_RUNS - 1 times: each must repeat `trace` tick for tick (handle, god-object,
-    wrench; else RuntimeError), and each step's update time (CPU and wall) is the least over the runs."""
-    from ._gauss6 import runtime
-    from .trace import read_trace
-
-    cpu, wall = [trace.steps["update_cpu_time"]], [trace.steps["update_time"]]
-    repeat_path = out / f".{name}.repeat.g6trace"
-    try:
-        for _ in range(LOCKSTEP_RUNS - 1):
-            runtime.run_scenario(str(scene), str(repeat_path), threaded=False, duration=duration,
-                                 lockstep_sim_period=lockstep_sim_period)
-            again = read_trace(repeat_path)
-            for col in ("xh_p", "xh_q", "xs_p", "xs_q", "wrench"):
-                if not np.array_equal(again.ticks[col], trace.ticks[col]):
-                    raise RuntimeError(f"{name}: a repeat of the lockstep run differs from the first ({col})")
-            cpu.append(again.steps["update_cpu_time"])
-            wall.append(again.steps["update_time"])
-    finally:
-        repeat_path.unlink(missing_ok=True)
-    return {"runs": LOCKSTEP_RUNS, "update_cpu_time_ms": _stats3(np.min(cpu, axis=0), 1e3),
-            "update_time_ms": _stats3(np.min(wall, axis=0), 1e3)}
 
 
 def run_scenario(name: str, out: Path, threaded: bool = False, duration: float = -1.0,
                  lockstep_sim_period: int = 1, show_progress: bool = True, check_poses: bool = True,
                  figure: bool = True) -> tuple[dict, dict]:
-    """Runs one scenario, writes its trace and figure into out; returns (summary entry, details)."""
-    from ._gauss6 import runtime
-    from .trace import TraceWarning, read_trace
+    """Runs one scenario through `gauss6 run`'s path (run.run_scene: the trace, the lockstep repeats, the
+    certification, the figure, the viewer page, in out); returns (summary entry, details) with the paper's
+    figures and the scenario's own checks (scenario_checks)."""
+    from .trace import read_trace
 
-    scene = SCENES[name]
-    out.mkdir(parents=True, exist_ok=True)
-    trace_path = out / f"{name}.g6trace"
-    end = json.loads((paths.DATASETS_DIR / "scripts" / ("peg_in_hole.json" if name == "peg" else "bunny.json"))
-                     .read_text())["end_time"]
-    total = duration if duration >= 0 else end
-    bar = progress_bar(total, f"{name}: {'threaded' if threaded else 'lockstep'} run", "s", show_progress)
-    last = [0.0]
-
-    def progress(t: float) -> None:
-        bar.update(max(0.0, min(t, total) - last[0]))
-        last[0] = max(last[0], min(t, total))
-
-    run = runtime.run_scenario(str(scene), str(trace_path), threaded=threaded, duration=duration,
-                               lockstep_sim_period=lockstep_sim_period,
-                               extra_json=json.dumps({"scenario": name, "mode": "threaded" if threaded else "lockstep"}),
-                               progress=progress)
-    bar.close()
-    with warnings.catch_warnings():
-        warnings.simplefilter("error", TraceWarning)  # the writer closed cleanly: a warning is a bug
-        trace = read_trace(trace_path)
-    least = None if threaded else least_update_times(name, scene, trace, out, duration, lockstep_sim_period)
-    penetrating, check_seconds, cert = -1, 0.0, None
-    if check_poses:
-        # Properties 5 and 6 on every step of the run, exactly (gauss6 certify): its pose check gives
-        # penetrating_poses; certify_<name>.md/.json say what else it certified, by which path.
-        from .certify import certify, write_report as write_certificate
-
-        cbar = progress_bar(len(trace.ticks), f"{name}: certify", "tick", show_progress)
-        cert = certify(scene, trace_path, progress=lambda done, total: cbar.update(done - cbar.n))
-        cbar.close()
-        write_certificate(cert, scene, trace_path, out, name=f"certify_{name}")
-        penetrating, check_seconds = cert.num_violations["pose"], cert.seconds
-    summary, extra = summarize(name, trace, run, penetrating, threaded)
-    extra["pose_check_s"] = check_seconds
-    if least is not None:
-        extra["update_least"] = least
-    if cert is not None:
-        first = cert.first_violation()
-        extra["certify"] = {"certified": cert.passed, "poses": cert.poses, "motions": cert.motions,
-                            "separations": cert.separations, "paths": dict(cert.paths),
-                            "violations": dict(cert.num_violations), "seconds": cert.seconds,
-                            "first_violation": None if first is None else
-                            {"kind": first.kind, "tick": first.tick, "t": first.t, "detail": first.detail}}
-    extra["distinct_poses"] = int(len(distinct_poses(trace)))
-    extra["mode"] = "threaded" if threaded else f"lockstep (sim step every {lockstep_sim_period} tick(s))"
-    if figure:
-        from .figures import plot_run
-
-        extra["figures"] = [p.name for p in plot_run(trace, TITLES[name], out / f"figure_{name}",
-                                                      run["let_go_time"])]
-        from .view import write_view
-
-        extra["figures"].append(write_view([trace_path], scene, out / f"view_{name}.html", labels=[name],
-                                           title=f"gauss6: {TITLES[name]}").name)
-    return summary, extra
-
-
-def machine() -> dict:
-    """CPU model and core count from /proc/cpuinfo (Linux), with the Python platform as fallback."""
-    model, cores = platform.processor() or platform.machine(), os.cpu_count()
-    try:
-        info = Path("/proc/cpuinfo").read_text()
-        models = [line.split(":", 1)[1].strip() for line in info.splitlines() if line.startswith("model name")]
-        if models:
-            model, cores = models[0], len(models)
-    except OSError:
-        pass
-    return {"cpu": model, "cores": cores, "system": f"{platform.system()} {platform.release()}",
-            "python": platform.python_version()}
-
-
-def _fmt(v) -> str:
-    if v is None:
-        return "-"
-    if isinstance(v, bool):
-        return "yes" if v else "no"
-    if isinstance(v, float):
-        return f"{v:.3g}"
-    return str(v)
+    s, extra = run_scene(SCENES[name], out, name=name, title=TITLES[name], threaded=threaded, duration=duration,
+                         lockstep_sim_period=lockstep_sim_period, show_progress=show_progress,
+                         check_poses=check_poses, figure=figure, force_axes="YZ")  # the paper's figures' rows
+    more, more_extra = scenario_checks(name, read_trace(out / f"{name}.g6trace"), extra["let_go_time"])
+    s, extra = {**s, **more}, {**extra, **more_extra}
+    _check_keys(name, s)
+    return s, extra
 
 
 def write_report(out: Path, summary: dict, details: dict, wall: float, surfaces: dict | None = None) -> Path:
-    m = machine()
     lines = ["# gauss6: the paper's scenarios reproduced", "",
-             f"Machine: {m['cpu']}, {m['cores']} cores ({m['system']}, Python {m['python']}). "
-             f"The paper's: {PAPER['peg']['machine']}.", "",
+             f"{machine_line()} The paper's: {PAPER['peg']['machine']}.", "",
              f"Total wall time of the runs and checks: {wall:.0f} s.", ""]
     for name in summary:
-        s, d, p = summary[name], details[name], PAPER[name]
-        lines += [f"## {TITLES[name]}", "", f"Mode: {d['mode']}; {d['ticks']} haptic ticks, {d['sim_steps']} sim "
-                  f"steps, {d['ticks_with_contacts']} ticks with contacts; run {d['run_time_s']:.2f} s in "
-                  f"{d['wall_s']:.1f} s of wall time.", "",
-                  f"![{TITLES[name]}](figure_{name}.png)", "",
-                  *([f"The run in 3D, with its timeline and plots: [view_{name}.html](view_{name}.html) "
-                     "(opens in a web browser from file://).", ""] if f"view_{name}.html" in d.get("figures", []) else []),
-                  "| quantity | ours | paper |", "|---|---|---|"]
-        ft, ut, hz = s["force_time_us"], s["update_time_ms"], s["constraint_update_hz"]
-        pf = p.get("force_time_us", {})
-        lines.append(f"| force computation (us), median / p99 / max | {_fmt(ft['median'])} / {_fmt(ft['p99'])} / "
-                     f"{_fmt(ft['max'])} | < {pf.get('max')} {pf.get('note', '')} |")
-        lines.append(f"| god-object update (ms), median / p99 / max | {_fmt(ut['median'])} / {_fmt(ut['p99'])} / "
-                     f"{_fmt(ut['max'])} | < {p['update_time_ms']['max']} |")
-        uc = s["update_cpu_time_ms"]
-        lines.append(f"| god-object update, the sim thread's CPU time (ms), median / p99 / max | "
-                     f"{_fmt(uc['median'])} / {_fmt(uc['p99'])} / {_fmt(uc['max'])} | - |")
-        if "update_least" in d:
-            lc, lw = d["update_least"]["update_cpu_time_ms"], d["update_least"]["update_time_ms"]
-            lines.append(f"| the same, each step's least over {d['update_least']['runs']} identical lockstep runs: "
-                         f"CPU (ms) median / p99 / max; wall | {_fmt(lc['median'])} / {_fmt(lc['p99'])} / "
-                         f"{_fmt(lc['max'])}; {_fmt(lw['median'])} / {_fmt(lw['p99'])} / {_fmt(lw['max'])} | - |")
-        ph = p.get("constraint_update_hz", {})
-        lines.append(f"| constraint updates (Hz), min / mean | {_fmt(hz['min'])} / {_fmt(hz['mean'])} | "
-                     f"{ph.get('min', '-')} / {ph.get('mean', '-')} |")
-        lines.append(f"| max contacts | {s['max_contacts']} | {p.get('max_contacts', '-')} |")
-        lines.append(f"| penetrating poses (exact check of {d['distinct_poses']} distinct poses in "
-                     f"{d.get('pose_check_s', 0.0):.1f} s) | {s['penetrating_poses']} | 0 |")
-        if "certify" in d:
-            c = d["certify"]
-            lines.append(f"| certified exactly ([certify_{name}.md](certify_{name}.md)): {c['poses']} poses free, "
-                         f"{c['motions']} motions between them free of contact, {c['separations']} separations "
-                         f"with contacts within the bound | {'yes' if c['certified'] else 'NO'} | - |")
-        lines.append(f"| max abs(Fc . ac) / (abs(Fc) abs(ac)), {d['orthogonality_checks']} steps | "
-                     f"{_fmt(s['max_rel_force_dot_ac'])} | 0 (footnote 3) |")
-        lines.append(f"| energy injected by the constraints (J); removed | {_fmt(s['energy_injected'])}; "
-                     f"{_fmt(d['constraint_energy_removed_j'])} | 0 (footnote 4) |")
-        lines.append(f"| device-port passivity observer max(W + V) (J); final | {_fmt(d['port_energy_max_j'])}; "
-                     f"{_fmt(d['port_energy_final_j'])} | - |")
+        s, d = summary[name], details[name]
+        section = report_section(name, s, {"title": TITLES[name], **d}, paper=PAPER[name])
         if name == "peg":
-            lines.append(f"| max abs(force Y) outside phases c, d (N) | {_fmt(s['max_abs_fy_outside_cd'])} | 0 |")
-            lines.append(f"| max force Y in phase c (N); min | {_fmt(s['max_fy_in_c'])}; {_fmt(d['min_fy_in_c'])} "
-                         f"| never positive |")
-            lines.append(f"| stable after let-go in the hole | {_fmt(s['let_go_stable'])} | yes |")
-        lines.append("")
-        if name == "peg":
-            lines += ["Per phase: ticks with contacts, max abs(force Y), force Z range (N):", ""]
+            section.pop()  # the peg's rows join the table
+            section.append(f"| max abs(force Y) outside phases c, d (N) | {_fmt(s['max_abs_fy_outside_cd'])} | 0 |")
+            section.append(f"| max force Y in phase c (N); min | {_fmt(s['max_fy_in_c'])}; {_fmt(d['min_fy_in_c'])} "
+                           f"| never positive |")
+            section.append(f"| stable after let-go in the hole | {_fmt(s['let_go_stable'])} | yes |")
+            section += ["", "Per phase: ticks with contacts, max abs(force Y), force Z range (N):", ""]
             for ph in "abcde":
                 e = d[f"phase_{ph}"]
-                lines.append(f"- ({ph}): {e['ticks_with_contacts']} ticks, {e['max_abs_fy']:.3g}, "
-                             f"[{e['min_fz']:.3g}, {e['max_fz']:.3g}]")
-            lines += ["", f"Let-go details: {json.dumps(d['let_go'])}", ""]
-        lines += [f"Runtime events: {json.dumps(d['events'])}; trace rows dropped: {d['rows_dropped']}.", ""]
-    lines += ["Definitions: see `python/gauss6/reproduce.py`. In lockstep runs the clock is virtual (1 kHz), "
-              "work times are real; the constraint update rate is the rate a free-running sim loop would reach "
-              "(1 / update time).", ""]
+                section.append(f"- ({ph}): {e['ticks_with_contacts']} ticks, {e['max_abs_fy']:.3g}, "
+                               f"[{e['min_fz']:.3g}, {e['max_fz']:.3g}]")
+            section += ["", f"Let-go details: {json.dumps(d['let_go'])}", ""]
+        lines += section + report_footer(d)
+    lines += [DEFINITIONS, ""]
     if surfaces is not None:
         from .reproduce_surfaces import report_lines
 
@@ -420,13 +240,11 @@ def cmd_reproduce(args: argparse.Namespace) -> int:
         return cmd(args)
     summary = reproduce(args.scenario, Path(args.out), threaded=args.threaded, show_progress=not args.quiet)
     print(json.dumps(summary, indent=2))
-    failed = [n for n, s in summary.items() if n != "surfaces" and s["penetrating_poses"] != 0]
     details = json.loads((Path(args.out) / "details.json").read_text())
-    uncertified = [n for n, d in details.items() if not d.get("certify", {}).get("certified", True)]
-    for n in uncertified:
-        print(f"gauss6: error: {n}: not certified (certify_{n}.md: {details[n]['certify']['first_violation']})",
-              file=sys.stderr)
-    failed += [n for n in uncertified if n not in failed]
+    problems = [p for n in details for p in failures(n, summary[n], details[n])]  # gauss6 run's rule
+    for p in problems:
+        print(f"gauss6: error: {p}", file=sys.stderr)
+    failed = []
     for kind, runs in summary.get("surfaces", {}).items():
         # Property 7 at its stated tolerance (runtime_events.h), plain runs included.
         failed += [f"{kind}/{label}" for label, s in runs.items()
@@ -435,7 +253,7 @@ def cmd_reproduce(args: argparse.Namespace) -> int:
         print(f"gauss6: error: {n}: god-object poses interpenetrate or violate the true constraints "
               "(property 7)", file=sys.stderr)
     print(f"written to {args.out}/ (summary.json, report.md, figures, traces)")
-    return 1 if failed else 0
+    return 1 if failed or problems else 0
 
 
 def cmd_trace_export(args: argparse.Namespace) -> int:

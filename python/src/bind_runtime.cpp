@@ -8,6 +8,7 @@
 #include <pybind11/stl.h>
 
 #include <chrono>
+#include <filesystem>
 #include <string>
 #include <utility>
 #include <vector>
@@ -163,22 +164,49 @@ py::dict result_dict(const ScenarioResult& r, const std::vector<HandPhase>& phas
   return d;
 }
 
+// The scene's hand script, or the file `script` (a .json path; empty: the scene's) in its place,
+// which makes the device a simulated one. gauss6.LoadError naming the file and the key.
+HandScript scene_script(Scene& scene, const std::string& script) {
+  if (!script.empty()) {
+    if (script.size() <= 5 || script.compare(script.size() - 5, 5, ".json") != 0)
+      throw py::value_error(script + ": a hand script file's name ends in .json");
+    scene.device.kind = DeviceKind::kSimulated;
+    scene.device.script = std::filesystem::absolute(script).lexically_normal().string();
+    scene.device.script_json.clear();
+  }
+  try {
+    return load_scene_script(scene);
+  } catch (const ScenarioError& e) {
+    throw LoadError(scene.path, e.what());  // a file the scene names: gauss6.LoadError
+  }
+}
+
+py::dict hand_script(const std::string& scene_path, const std::string& script_path) {
+  Scene scene = load(scene_path);
+  const HandScript s = scene_script(scene, script_path);
+  py::dict d;
+  d["origin"] = scene.device.script.empty() ? scene.path + ": device.script" : scene.device.script;
+  d["num_keys"] = s.keys.size();
+  d["start_time"] = s.keys.front().t;
+  d["end_time"] = s.end_time >= 0 ? s.end_time : s.keys.back().t;
+  d["let_go_time"] = s.let_go_time;
+  py::list l;
+  for (const HandPhase& p : s.phases) l.append(py::make_tuple(p.name, p.start));
+  d["phases"] = l;
+  return d;
+}
+
 py::dict run(const std::string& scene_path, const std::string& trace_path, bool threaded, double duration,
              int lockstep_sim_period, const std::string& extra_json, const std::function<void(double)>& progress,
              double rate_hz, int realtime_priority, bool pin_threads, double hold_until, int max_contacts,
-             double spin_wait) {
+             double spin_wait, const std::string& script_path) {
   Scene scene = load(scene_path);
   if (rate_hz != 0) {
     if (!(rate_hz >= 1 && rate_hz <= 1e5)) throw py::value_error("rate_hz must be in [1, 1e5] (0: the scene's)");
     scene.device.rate_hz = rate_hz;
   }
   if (realtime_priority < 0 || realtime_priority > 99) throw py::value_error("realtime_priority must be in [0, 99]");
-  HandScript script;
-  try {
-    script = load_scene_script(scene);
-  } catch (const ScenarioError& e) {
-    throw LoadError(scene.path, e.what());  // a file the scene names: gauss6.LoadError
-  }
+  HandScript script = scene_script(scene, script_path);
   // The hand holds still after its last key until hold_until (s), when later than the script's end.
   if (hold_until > script.end_time) script.end_time = hold_until;
   ScenarioOptions options =
@@ -290,8 +318,8 @@ void bind_runtime(py::module_& parent) {
         py::arg("duration") = -1.0, py::arg("lockstep_sim_period") = 1, py::arg("extra_json") = "{}",
         py::arg("progress") = nullptr, py::arg("rate_hz") = 0.0, py::arg("realtime_priority") = 0,
         py::arg("pin_threads") = false, py::arg("hold_until") = -1.0,
-        py::arg("max_contacts") = kDefaultMaxContacts, py::arg("spin_wait") = 0.0,
-        "Runs the scene with its hand script (lockstep by default, or threaded) and writes the trace. Returns a dict "
+        py::arg("max_contacts") = kDefaultMaxContacts, py::arg("spin_wait") = 0.0, py::arg("script") = "",
+        "Runs the scene with its hand script (or the JSON file `script` in its place) (lockstep by default, or threaded) and writes the trace. Returns a dict "
         "of run statistics and property checks (orthogonality, constraint energy, passivity observer). "
         "progress(run_time_s) is called about every 0.2 s of wall time. rate_hz overrides the scene's haptic rate "
         "(0: the scene's); realtime_priority and pin_threads are RuntimeSettings' (threaded runs; each loop's "
@@ -299,6 +327,10 @@ void bind_runtime(py::module_& parent) {
         "the hand holds still after the script until then. max_contacts: RuntimeSettings::max_contacts, the "
         "contact capacity of the loops (a larger set is truncated and reported as contact_overflow). spin_wait (s, "
         "in [0, 1]): RuntimeSettings::spin_wait, the haptic loop's busy wait before each tick (threaded runs).");
+  m.def("hand_script", &hand_script, py::arg("scene"), py::arg("script") = "",
+        "The hand script a run of the scene follows (the scene's, or the JSON file `script`): a dict of origin (the "
+        "file, or the scene's [device.script] table), num_keys, start_time, end_time, let_go_time (< 0: none) and "
+        "phases [(name, start)]. Raises LoadError naming the file and the key.");
   m.def("replay", &replay, py::arg("scene"), py::arg("recording"), py::arg("trace"),
         py::arg("phases") = std::vector<std::pair<std::string, double>>{}, py::arg("threaded") = false,
         py::arg("duration") = -1.0, py::arg("lockstep_sim_period") = 1, py::arg("extra_json") = "{}",

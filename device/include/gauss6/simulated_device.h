@@ -53,8 +53,9 @@ void validate_hand_script(const HandScript& script);
 
 // A script from JSON text: {"keys": [{"t": 0, "p": [x, y, z], "q": [w, x, y, z]}, ...],
 // "let_go_time": 3.5, "end_time": 6, "phases": [{"name": "a", "start": 0}, ...]}
-// (let_go_time, end_time, phases and q optional). Throws std::invalid_argument
-// naming `origin` (e.g. the file name) and the problem.
+// (let_go_time, end_time, phases, q and a "description" string optional; any
+// other key is an error). Throws std::invalid_argument naming `origin` (e.g.
+// the file name), the key's path (keys[3].p) and the problem.
 HandScript hand_script_from_json(const std::string& text, const std::string& origin = "hand script");
 
 // The hand's pose and velocity (linear, angular; world frame) at time t.

@@ -104,7 +104,9 @@ struct ScenarioResult {
 
 // The hand script named by scene.device.script: the file
 // <scene dir>/../scripts/<name>.json (a path ending in .json is taken as is,
-// relative to the scene's directory). Throws ScenarioError naming the file.
+// relative to the scene's directory), or the one the scene holds
+// (scene.device.script_json, a [device.script] table). Throws ScenarioError
+// naming the file (the scene and "device.script") and the key.
 HandScript load_scene_script(const Scene& scene);
 
 // Runs the scene with a SimulatedDevice following `script` and writes the trace.

@@ -90,7 +90,8 @@ struct DeviceSettings {
   double rate_hz = 1000;   // Hz
   double max_force = 20;   // N: force clamp
   double max_torque = 1;   // N m: torque clamp
-  std::string script;      // simulated: scripted hand trajectory's name
+  std::string script;      // simulated: scripted hand trajectory's name or .json file (empty: script_json)
+  std::string script_json; // simulated: the hand script given in the scene ([device.script] table), as JSON
   std::string trace;       // replay: trace file (resolved)
   int vendor_id = -1, product_id = -1;  // hid: -1 = any
   std::string serial, path;             // hid: empty = any

@@ -7,6 +7,7 @@
 #include <filesystem>
 #include <initializer_list>
 #include <set>
+#include <sstream>
 
 #include <Eigen/Eigenvalues>
 #include <toml++/toml.h>
@@ -245,6 +246,20 @@ void check_god_mass(const TableReader& r, const char* key, const MassProperties&
           "condition number of at most 1e12");
 }
 
+// A value of a table given as JSON (the [device.script] table): floats finite, no dates or times,
+// each refused at its line (JSON has neither).
+void check_json_representable(const TableReader& r, const toml::node& node, const std::string& key) {
+  if (const toml::table* t = node.as_table()) {
+    for (const auto& [k, v] : *t) check_json_representable(r, v, key + "." + std::string(k.str()));
+  } else if (const toml::array* a = node.as_array()) {
+    for (size_t i = 0; i < a->size(); ++i) check_json_representable(r, (*a)[i], key + "[" + std::to_string(i) + "]");
+  } else if (node.is_floating_point()) {
+    if (!std::isfinite(node.as_floating_point()->get())) r.fail(node.source(), key, "must be finite");
+  } else if (node.is_date() || node.is_time() || node.is_date_time()) {
+    r.fail(node.source(), key, "a date or time is not a hand script's value (times are seconds)");
+  }
+}
+
 }  // namespace
 
 Scene load_scene(const std::string& path) {
@@ -443,7 +458,21 @@ Scene load_scene(const std::string& path) {
     std::vector<std::string> own;
     if (kind == "simulated") {
       d.kind = DeviceKind::kSimulated;
-      d.script = r.string("script");
+      const toml::node* script = r.node("script");
+      if (script && script->is_table()) {
+        // The hand script in the scene: checked here for what JSON cannot hold (its key names, types
+        // and times are the device's hand_script_from_json's to check, at run time, naming the key).
+        check_json_representable(r, *script, "script");
+        std::ostringstream json;
+        json << toml::json_formatter{*script->as_table()};
+        d.script_json = json.str();
+      } else if (script && !script->is_string()) {
+        r.fail(script->source(), "script", "must be a script's name, a .json file or a table (the script itself)");
+      } else if (!script) {
+        r.fail_missing("script", "a script's name, a .json file or a [device.script] table: docs/scene-format.md");
+      } else {
+        d.script = r.string("script");
+      }
       own = {"script"};
     } else if (kind == "replay") {
       d.kind = DeviceKind::kReplay;
