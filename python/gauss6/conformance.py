@@ -220,5 +220,5 @@ def cmd_suite(args) -> int:
     except CampaignError as e:
         print(f"gauss6 validate: {e}", file=sys.stderr)
         return EXIT_USAGE
-    print((Path(args.out) / "conformance.md").read_text())
+    print((Path(args.out) / ("conformance.json" if args.json else "conformance.md")).read_text())
     return exit_status(runs)

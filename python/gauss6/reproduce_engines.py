@@ -37,6 +37,7 @@ from . import adapters, paths
 from .driver import drive, scene_script
 from .engine import EngineScene, load_engine
 from .oracle import CHECKS, Oracle
+from .validate import failure_verdict
 
 SCRIPTS = {"peg": "peg_in_hole.toml", "bunny": "bunnies.toml"}
 ENGINES = ("gauss6", "mujoco", "pybullet", "drake", "dart", "rapier", "bullet")
@@ -127,16 +128,28 @@ def run_one(engine_name: str, script: str, out: Path, duration, bar, config: str
             done[0] = time.perf_counter()
             bar.set_postfix_str(f"{label} judging {stage} {n}/{total}")
 
-    result = oracle_for(scene_path).judge(trace, judge_progress,
-                                          nearest_window=FIG13_PHASES if script == FIG13_SCRIPT else None)
+    failure = trace.meta["extra"].get("engine_failure")
     if hasattr(engine, "close"):
         engine.close()
+    if failure is not None and len(trace.ticks) < 2:  # nothing to judge: the engine's failure is the verdict
+        return {"engine": engine_name, "engine_name": engine.name, "config": config, "script": script,
+                "script_path": script_path, "duration": 0.0, "ticks": len(trace.ticks), "run": str(run_path),
+                "drive_seconds": drive_s, "judge_seconds": 0.0, "pass": False,
+                "verdicts": [failure_verdict(failure, scene_rate(trace)).to_json()], "series": None}
+    result = oracle_for(scene_path).judge(trace, judge_progress,
+                                          nearest_window=FIG13_PHASES if script == FIG13_SCRIPT else None)
+    if failure is not None:
+        result.verdicts.insert(0, failure_verdict(failure, scene_rate(trace)))
     return {"engine": engine_name, "engine_name": engine.name, "config": config, "script": script,
             "script_path": script_path, "duration": float(trace.ticks["t"][-1]), "ticks": len(trace.ticks),
             "run": str(run_path), "drive_seconds": drive_s, "judge_seconds": time.perf_counter() - start - drive_s,
             "pass": result.passed, "verdicts": [v.to_json() for v in result.verdicts],
             "series": {k: result.series[k] for k in ("t", "force", "cone_distance", "nearest_tangential", "nearest_rank",
                                                        "separation")}}
+
+
+def scene_rate(trace) -> float:
+    return trace.meta["device"]["rate_hz"]
 
 
 def sweep_point(engine_name: str, key: str, value: float, oracle: Oracle, scene, text, duration) -> dict:
@@ -178,7 +191,7 @@ def fig13_stats(runs: list) -> list[dict]:
     t0, t1 = FIG13_PHASES
     out = []
     for r in runs:
-        if r["script"] != FIG13_SCRIPT:
+        if r["script"] != FIG13_SCRIPT or r["series"] is None:
             continue
         s = r["series"]
         m = (s["t"] >= t0) & (s["t"] <= t1)
@@ -200,7 +213,7 @@ def figure_fig13(runs: list, out: Path) -> list[Path]:
 
     fig, axes = plt.subplots(2, 1, figsize=(10, 7), sharex=True)
     t0, t1 = FIG13_PHASES
-    for i, r in enumerate(x for x in runs if x["script"] == FIG13_SCRIPT):
+    for i, r in enumerate(x for x in runs if x["script"] == FIG13_SCRIPT and x["series"] is not None):
         s = r["series"]
         m = (s["t"] >= t0) & (s["t"] <= t1)
         style = dict(lw=1.4 if r["engine"] == "gauss6" else 0.9, color=f"C{i}", label=r["engine_name"])
@@ -277,7 +290,8 @@ def report(runs: list, sweeps: dict, missing: list, out: Path, slice_s, wall: fl
     rows = [head, "|" + " --- |" * (len(names) + 2)]
     for r in runs:
         cells = {v["name"]: _fmt_verdict(v) for v in r["verdicts"]}
-        rows.append(f"| {r['engine_name']} | {r['script']} ({r['duration']:.1f} s) | "
+        failed = [f"; **the engine failed**: {v['note']}" for v in r["verdicts"] if v["name"] == "engine_failure"]
+        rows.append(f"| {r['engine_name']} | {r['script']} ({r['duration']:.1f} s{''.join(failed)}) | "
                     + " | ".join(cells.get(n, "-") for n in names) + " |")
     m = machine()
     lines = ["# Engines side by side", "",
