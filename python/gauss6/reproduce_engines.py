@@ -1,7 +1,9 @@
 """`gauss6 reproduce engines`: gauss6 and the third-party engines (MuJoCo, PyBullet, Drake,
-python/gauss6/adapters) on the peg and the bunny scripts, each driven by the same simulated
-hand (gauss6.driver) and judged by the same oracle (gauss6.oracle); plus, per adapter, the
-sweep of the one parameter that trades penetration against force.
+DART, Rapier: python/gauss6/adapters; Bullet's C++ library through the C ABI: engines/bullet) on
+the peg and the bunny scripts, each driven by the same simulated hand (gauss6.driver) and judged
+by the same oracle (gauss6.oracle); the conformance battery's summary for every engine
+(gauss6.conformance, on a slice of each scene's script); plus, per adapter, the sweep of the one
+parameter that trades penetration against force.
 
 Writes to OUT:
   engines.json              per run: the engine, its config, the script (and the slice run),
@@ -16,6 +18,8 @@ Writes to OUT:
                             virtual couplings against gauss6's constraint-based force
   figure_sweeps.png|svg     each adapter's trade: penetration depth against force
   runs/ENGINE-SCRIPT.g6trace
+  battery/ENGINE/           the battery on that engine (conformance.md and .json, each scene's
+                            validate outputs); engines.md holds the engine x scene summary
 
 The scripts run whole unless --slice is given (seconds from the start of each script); an
 engine whose framework is not installed is reported as such, not run.
@@ -33,9 +37,17 @@ from . import adapters, paths
 from .driver import drive, scene_script
 from .engine import EngineScene, load_engine
 from .oracle import CHECKS, Oracle
+from .validate import failure_verdict
 
 SCRIPTS = {"peg": "peg_in_hole.toml", "bunny": "bunnies.toml"}
-ENGINES = ("gauss6", "mujoco", "pybullet", "drake")
+ENGINES = ("gauss6", "mujoco", "pybullet", "drake", "dart", "rapier", "bullet")
+# Bullet's C++ library behind the C ABI (engines/bullet), loaded by path from the build tree.
+BULLET_LIBRARY = "engines/bullet/libgauss6_bullet_engine.so"
+# The battery's slice: the first BATTERY_SLICE s of each scene's script (its approach and first
+# contact phase in every scene), so that seven engines x eight scenes fit in `make reproduce`.
+BATTERY_SLICE = 1.2
+KC_SWEEP = [250.0, 1000.0, 4000.0, 16000.0, 64000.0]  # a coupling stiffness per unit mass (1/s^2)
+KC_TRADE = "the coupling stiffness: lower lets the tool lag, higher drives it in"
 
 # The swept parameter of each adapter: (config key, values, unit, what it trades). The other
 # parameters stay at the adapter's defaults (docs/engine-adapters.md).
@@ -44,20 +56,33 @@ SWEEPS = {
                "the weld's time constant (solref[0]): softer lets the tool lag, stiffer drives it in"),
     "pybullet": ("max_force", [2.0, 5.0, 10.0, 20.0, 50.0], "N",
                  "the fixed constraint's force limit: lower lets the tool lag, higher drives it in"),
-    "drake": ("kc", [250.0, 1000.0, 4000.0, 16000.0, 64000.0], "1/s^2",
-              "the coupling stiffness: lower lets the tool lag, higher drives it in"),
+    "drake": ("kc", KC_SWEEP, "1/s^2", KC_TRADE),
+    "dart": ("kc", KC_SWEEP, "1/s^2", KC_TRADE),
+    "rapier": ("kc", KC_SWEEP, "1/s^2", KC_TRADE),
+    "bullet": ("kc", KC_SWEEP, "1/s^2", KC_TRADE),
 }
 SWEEP_SCRIPT, SWEEP_SLICE = "peg", 4.0  # phase a and the start of b: pressing and sliding on the top
 FIG13_SCRIPT, FIG13_PHASES = "peg", (0.0, 6.0)  # the peg's phases a and b (as far as the run goes)
 
 
-def make(name: str, config: str = ""):
+def engine_spec(name: str) -> str:
+    """The engine as `gauss6 validate --engine` takes it: a built library or a Python adapter."""
     if name == "gauss6":
-        return load_engine("gauss6", config)
+        return "gauss6"
+    if name == "bullet":
+        return str(paths.build_dir() / BULLET_LIBRARY)
+    return f"python:gauss6.adapters:{name}"
+
+
+def make(name: str, config: str = ""):
+    if name in ("gauss6", "bullet"):
+        return load_engine(engine_spec(name), config)
     return adapters.FACTORIES[name](config)
 
 
 def _available(name: str) -> bool:
+    if name == "bullet":
+        return (paths.build_dir() / BULLET_LIBRARY).exists()
     return name == "gauss6" or adapters.available(name)
 
 
@@ -103,16 +128,28 @@ def run_one(engine_name: str, script: str, out: Path, duration, bar, config: str
             done[0] = time.perf_counter()
             bar.set_postfix_str(f"{label} judging {stage} {n}/{total}")
 
-    result = oracle_for(scene_path).judge(trace, judge_progress,
-                                          nearest_window=FIG13_PHASES if script == FIG13_SCRIPT else None)
+    failure = trace.meta["extra"].get("engine_failure")
     if hasattr(engine, "close"):
         engine.close()
+    if failure is not None and len(trace.ticks) < 2:  # nothing to judge: the engine's failure is the verdict
+        return {"engine": engine_name, "engine_name": engine.name, "config": config, "script": script,
+                "script_path": script_path, "duration": 0.0, "ticks": len(trace.ticks), "run": str(run_path),
+                "drive_seconds": drive_s, "judge_seconds": 0.0, "pass": False,
+                "verdicts": [failure_verdict(failure, scene_rate(trace)).to_json()], "series": None}
+    result = oracle_for(scene_path).judge(trace, judge_progress,
+                                          nearest_window=FIG13_PHASES if script == FIG13_SCRIPT else None)
+    if failure is not None:
+        result.verdicts.insert(0, failure_verdict(failure, scene_rate(trace)))
     return {"engine": engine_name, "engine_name": engine.name, "config": config, "script": script,
             "script_path": script_path, "duration": float(trace.ticks["t"][-1]), "ticks": len(trace.ticks),
             "run": str(run_path), "drive_seconds": drive_s, "judge_seconds": time.perf_counter() - start - drive_s,
             "pass": result.passed, "verdicts": [v.to_json() for v in result.verdicts],
             "series": {k: result.series[k] for k in ("t", "force", "cone_distance", "nearest_tangential", "nearest_rank",
                                                        "separation")}}
+
+
+def scene_rate(trace) -> float:
+    return trace.meta["device"]["rate_hz"]
 
 
 def sweep_point(engine_name: str, key: str, value: float, oracle: Oracle, scene, text, duration) -> dict:
@@ -154,7 +191,7 @@ def fig13_stats(runs: list) -> list[dict]:
     t0, t1 = FIG13_PHASES
     out = []
     for r in runs:
-        if r["script"] != FIG13_SCRIPT:
+        if r["script"] != FIG13_SCRIPT or r["series"] is None:
             continue
         s = r["series"]
         m = (s["t"] >= t0) & (s["t"] <= t1)
@@ -176,7 +213,7 @@ def figure_fig13(runs: list, out: Path) -> list[Path]:
 
     fig, axes = plt.subplots(2, 1, figsize=(10, 7), sharex=True)
     t0, t1 = FIG13_PHASES
-    for i, r in enumerate(x for x in runs if x["script"] == FIG13_SCRIPT):
+    for i, r in enumerate(x for x in runs if x["script"] == FIG13_SCRIPT and x["series"] is not None):
         s = r["series"]
         m = (s["t"] >= t0) & (s["t"] <= t1)
         style = dict(lw=1.4 if r["engine"] == "gauss6" else 0.9, color=f"C{i}", label=r["engine_name"])
@@ -219,7 +256,33 @@ def figure_sweeps(sweeps: dict, out: Path) -> list[Path]:
     return _save(fig, out / "figure_sweeps")
 
 
-def report(runs: list, sweeps: dict, missing: list, out: Path, slice_s, wall: float, sweep_slice: float) -> str:
+def battery_lines(battery: dict) -> list[str]:
+    """engines.md's battery section: engine x scene, each cell pass or the checks that failed."""
+    from .conformance import MACHINE_CHECKS
+
+    by_engine = battery["runs"]
+    scenes = [r["scene"] for r in next(iter(by_engine.values()), [])]
+    rows = ["| engine | " + " | ".join(scenes) + " |", "|" + " --- |" * (len(scenes) + 1)]
+    for name, runs in by_engine.items():
+        cells = []
+        for r in runs:
+            if r["engine_failure"]:
+                cells.append(f"**engine failed** ({r['engine_failure']['kind']})")
+            else:
+                cells.append("pass" if r["pass"] else "**FAIL** " + ", ".join(r["failed"]))
+        rows.append(f"| {name} | " + " | ".join(cells) + " |")
+    return ["## The conformance battery", "",
+            f"Every engine on the battery's eight scenes (docs/conformance-battery.md), **on a short slice: the first "
+            f"{battery['slice_seconds']:g} s of each scene's script** (the approach and the first contact phase; the "
+            f"whole battery is `gauss6 validate --engine E --suite conformance`). A cell: pass, or the checks that "
+            f"failed ({', '.join(MACHINE_CHECKS)} measures this loaded machine's timing). Each engine's table with "
+            f"the worst values: `battery/ENGINE/conformance.md`; each scene's report and witnesses: "
+            f"`battery/ENGINE/SCENE/`. Ran on {battery['workers'] or 'no'} Dask workers in "
+            f"{battery['wall_seconds']:.0f} s.", "", *rows, ""]
+
+
+def report(runs: list, sweeps: dict, missing: list, out: Path, slice_s, wall: float, sweep_slice: float,
+           battery: dict | None = None) -> str:
     from .validate import machine
 
     names = [c[0] for c in CHECKS]
@@ -227,7 +290,8 @@ def report(runs: list, sweeps: dict, missing: list, out: Path, slice_s, wall: fl
     rows = [head, "|" + " --- |" * (len(names) + 2)]
     for r in runs:
         cells = {v["name"]: _fmt_verdict(v) for v in r["verdicts"]}
-        rows.append(f"| {r['engine_name']} | {r['script']} ({r['duration']:.1f} s) | "
+        failed = [f"; **the engine failed**: {v['note']}" for v in r["verdicts"] if v["name"] == "engine_failure"]
+        rows.append(f"| {r['engine_name']} | {r['script']} ({r['duration']:.1f} s{''.join(failed)}) | "
                     + " | ".join(cells.get(n, "-") for n in names) + " |")
     m = machine()
     lines = ["# Engines side by side", "",
@@ -252,7 +316,7 @@ def report(runs: list, sweeps: dict, missing: list, out: Path, slice_s, wall: fl
         cells = [f"{st[k]:.2g}" if st[k] is not None else "-" for k in ("median", "p90", "max")]
         lines.append(f"| {st['engine']} | {st['with_force']} | {st['measured']} | {st['spanning']} | "
                      + " | ".join(cells) + " |")
-    lines += ["",
+    lines += ["", *(battery_lines(battery) if battery else []),
               "## Each adapter's trade: penetration against force", "",
               f"The peg script's first {sweep_slice:g} s (phase a and the start of b), one parameter swept, the others at "
               "the adapter's defaults. Penetrating poses: every distinct displayed pose, exactly; depth: the "
@@ -274,7 +338,9 @@ def report(runs: list, sweeps: dict, missing: list, out: Path, slice_s, wall: fl
 
 
 def reproduce_engines(out: Path, slice_s: float | None = None, show_progress: bool = True,
-                      engines=ENGINES, sweep: bool = True, sweep_slice: float = SWEEP_SLICE) -> dict:
+                      engines=ENGINES, sweep: bool = True, sweep_slice: float = SWEEP_SLICE,
+                      battery_slice: float | None = BATTERY_SLICE, workers: int | None = None) -> dict:
+    """battery_slice None: no battery; workers: the battery's Dask workers (campaign.run_campaign)."""
     from tqdm import tqdm
 
     out = Path(out)
@@ -305,13 +371,22 @@ def reproduce_engines(out: Path, slice_s: float | None = None, show_progress: bo
                 bar.update(1)
             sweeps[name] = {"key": key, "unit": unit, "what": what, "points": points}
     bar.close()
+    battery = None
+    if battery_slice is not None:
+        from .conformance import run_engines
+
+        battery_runs, meta = run_engines({name: engine_spec(name) for name in present}, out / "battery",
+                                         duration=battery_slice, workers=workers, show_progress=show_progress)
+        battery = {"slice_seconds": battery_slice, "wall_seconds": meta["wall_seconds"], "workers": meta["workers"],
+                   "runs": battery_runs}
     figure_fig13(runs, out)
     if sweeps:
         figure_sweeps(sweeps, out)
     wall = time.perf_counter() - wall
-    report(runs, sweeps, missing, out, slice_s, wall, sweep_slice)
+    report(runs, sweeps, missing, out, slice_s, wall, sweep_slice, battery)
     doc = {"format": "gauss6-engines", "version": 1, "slice_seconds": slice_s, "missing": missing,
            "runs": [{k: v for k, v in r.items() if k != "series"} for r in runs], "sweeps": sweeps,
+           "battery": battery,
            "fig13_tangential": fig13_stats(runs),
            "wall_seconds": wall}
     (out / "engines.json").write_text(json.dumps(doc, indent=2) + "\n")
@@ -326,5 +401,9 @@ def cmd(args) -> int:
         failed = [v["name"] for v in r["verdicts"] if not v["pass"]]
         print(f"gauss6 reproduce engines: gauss6's own engine fails {', '.join(failed)} on {r['script']}",
               file=sys.stderr)
-    print(f"written to {args.out}/ (engines.md, engines.json, figures, runs/)")
+    for r in ((doc["battery"] or {}).get("runs") or {}).get("gauss6", []):
+        if not r["pass"]:
+            print(f"gauss6 reproduce engines: gauss6's own engine fails {', '.join(r['failed'])} on the battery's "
+                  f"{r['scene']}", file=sys.stderr)
+    print(f"written to {args.out}/ (engines.md, engines.json, figures, runs/, battery/)")
     return 0

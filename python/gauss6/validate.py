@@ -3,6 +3,8 @@ run it recorded itself (docs/engine-contract.md).
 
     gauss6 validate --engine ENGINE --scene SCENE [--script NAME] [--duration S] --out DIR
     gauss6 validate RUN --scene SCENE [--script NAME] --out DIR      (RUN: a .g6trace, or a ticks CSV)
+    gauss6 validate --engine ENGINE --suite conformance [--workers N | --scheduler ADDR] --out DIR
+                                            (the battery, scene x check: gauss6.conformance)
 
 ENGINE: a shared library that exports the C ABI (gauss6/engine.h), by path; a built one by name
 (gauss6, box-penalty, fault); or a Python engine as `python:MODULE:FACTORY` (MODULE importable)
@@ -301,8 +303,23 @@ def validate(args) -> int:
 
 
 def cmd_validate(args: argparse.Namespace) -> int:
+    if args.suite and not args.engine:
+        print("gauss6 validate: --suite drives an engine: give --engine ENGINE", file=sys.stderr)
+        return EXIT_USAGE
     if bool(args.engine) == bool(args.run):
         print("gauss6 validate: give either --engine ENGINE or a recorded RUN (not both)", file=sys.stderr)
+        return EXIT_USAGE
+    if args.suite:
+        from .conformance import cmd_suite
+
+        try:
+            check_spec(args.engine)
+        except (EngineError, ValueError) as e:
+            print(f"gauss6 validate: {e}", file=sys.stderr)
+            return EXIT_USAGE
+        return cmd_suite(args)
+    if args.scene is None:
+        print("gauss6 validate: give --scene SCENE (or --suite conformance)", file=sys.stderr)
         return EXIT_USAGE
     try:
         return validate(args)
@@ -312,7 +329,7 @@ def cmd_validate(args: argparse.Namespace) -> int:
 
 
 def register(subparsers) -> None:
-    from .cli import input_file, output_dir, run_seconds
+    from .cli import input_file, nonnegative_int, output_dir, run_seconds
 
     p = subparsers.add_parser("validate", help="drive an engine with the simulated device and judge its run, or "
                                                "judge a recorded run (exit 1: a check failed, 2: the engine "
@@ -331,7 +348,14 @@ def register(subparsers) -> None:
                         f"is a hang "
                         f"(default {RUN_TIMEOUT:g})")
     p.add_argument("--config", default="", help="the engine's config text (default: empty)")
-    p.add_argument("--scene", required=True, type=input_file("scene"), help="scene TOML file")
+    p.add_argument("--scene", type=input_file("scene"), help="scene TOML file (with --suite: run only this scene)")
+    p.add_argument("--suite", choices=("conformance",),
+                   help="run every scene of the suite with its script (conformance: the battery, "
+                        "docs/conformance-battery.md) and write one table, DIR/conformance.md and .json")
+    p.add_argument("--workers", type=nonnegative_int, default=0,
+                   help="with --suite: Dask worker processes of a local cluster (default 0: serial, in this process)")
+    p.add_argument("--scheduler", metavar="ADDRESS",
+                   help="with --suite: run on an existing Dask cluster (tcp://host:port)")
     p.add_argument("--script", help="hand script name or .json path (default: the scene's device.script)")
     p.add_argument("--duration", type=run_seconds, default=None, help="run only the first S seconds of the script")
     p.add_argument("--out", required=True, type=output_dir, help="output directory")
