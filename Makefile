@@ -96,7 +96,7 @@ datasets: setup
 # Regenerates the datasets in place (byte-identical: `gauss6 datasets check`), then runs
 # the paper's scenarios: out/summary.json, out/report.md, the figures and the traces; then
 # the full-resolution bunnies (issue 20's third scenario, about 20 s): out/bunny_full/; then
-# gauss6, MuJoCo, PyBullet and Drake side by side (out/engines/engines.md, docs/engine-adapters.md)
+# gauss6 and the third-party engines side by side, the paper's scenes and the conformance battery (out/engines/engines.md, docs/engine-adapters.md)
 # on ENGINES_SLICE (--slice S: the first S seconds of each script; empty: whole scripts).
 ENGINES_SLICE ?= --slice 4
 reproduce: setup

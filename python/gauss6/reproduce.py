@@ -290,7 +290,7 @@ def register(subparsers) -> None:
     rep = subparsers.add_parser("reproduce", help="run the paper's scenarios and write figures and summaries")
     rep.add_argument("scenario", choices=["peg", "bunny", "bunny_full", "surfaces", "all", "engines"],
                      help="all: peg, bunny and surfaces; bunny_full (the full-resolution bunnies) and engines (gauss6, MuJoCo, "
-                          "PyBullet, Drake side by side: reproduce_engines.py) run alone")
+                          "PyBullet, Drake, DART, Rapier, Bullet side by side: reproduce_engines.py) run alone")
     from .cli import input_file, output_dir, output_file, run_seconds
 
     rep.add_argument("--out", required=True, type=output_dir, help="output directory")
