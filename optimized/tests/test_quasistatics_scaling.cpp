@@ -83,7 +83,7 @@ TEST_CASE("the projection's answer does not depend on positive row scaling", "[q
   std::printf("row scaling: %d instances, max |ac - ac_unscaled|_M / |au|_M = %.3g\n", checked, worst);
 }
 
-TEST_CASE("\"optimal\" is a scale-free KKT certificate", "[qp][scaling]") {
+TEST_CASE("the optimal status is a scale-free KKT certificate", "[qp][scaling]") {
   Mat6 M = Mat6::Identity();
   M.diagonal() << 2, 2, 2, 0.01, 0.02, 0.03;
   Eigen::Matrix<double, 2, 6, Eigen::RowMajor> J;
