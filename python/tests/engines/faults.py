@@ -136,12 +136,26 @@ class OverLimit(Wrapped):
 
 
 class FarPose(Wrapped):
-    """One tick: the displayed pose at 1e300 m (finite, and no pose)."""
-    name = "pose at 1e300"
+    """One tick: the displayed pose `radii` scene radii (the half diagonal of the bodies' box) from the
+    scene's centre: 300 is finite and judgeable, beyond the oracle's pose_extent; 1e300 is no pose
+    at all, which the driver refuses as the engine's failure."""
+
+    def __init__(self, radii: float):
+        super().__init__()
+        self.radii, self.name = radii, f"pose at {radii:g} scene radii"
+
+    def reset(self, scene) -> None:
+        super().reset(scene)
+        # Each body's vertices about its position, unrotated: the scale (within a factor of about 2)
+        # is all this needs, 300 radii lying well inside (100, 1000).
+        points = np.concatenate([np.asarray(b.V, float) + np.asarray(b.p, float)
+                                 for b in [*scene.obstacles, scene.tool] if len(b.V)])
+        lo, hi = points.min(axis=0), points.max(axis=0)
+        self.far = (lo + hi) / 2 + np.array([self.radii * np.linalg.norm(hi - lo) / 2, 0.0, 0.0])
 
     def modify(self, t, xh_p, xh_q, s):
         if self.tick == 200:
-            return EngineStep(np.array([1e300, 0, 0]), s.xs_q, s.wrench, s.contacts, s.step_seconds)
+            return EngineStep(self.far, s.xs_q, s.wrench, s.contacts, s.step_seconds)
         return s
 
 

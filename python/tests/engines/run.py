@@ -30,12 +30,19 @@ class Timed:
         return out
 
 
+def declared(engine) -> dict:
+    """What a test engine declares: its `declarations` dict (the wrapped variants) or the protocol's
+    declarations() method (an engine of gauss6.engine, such as gauss6's own)."""
+    d = getattr(engine, "declarations", {})
+    return dict((d() if callable(d) else d) or {})
+
+
 def run(engine, scene, path, duration: float):
     """The engine's trace on the first `duration` s of the scene's script."""
     text, _ = scene_script(scene)
     timed = Timed(engine)
     tr = drive(timed, EngineScene.from_scene_file(scene), text, path, duration,
-               extra={"declarations": dict(getattr(engine, "declarations", {}) or {})})
+               extra={"declarations": declared(engine)})
     n = len(tr.steps)
     tr.steps["update_time"] = np.asarray(timed.wall[:n])
     tr.steps["update_cpu_time"] = np.asarray(timed.cpu[:n])
