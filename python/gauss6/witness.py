@@ -119,8 +119,9 @@ def report_witnesses(result, trace, oracle, out_dir, viewer_page: str = "run.htm
     if not written:
         return ""
     rows = ["## Witnesses", "",
-            f"Re-check one exactly: `gauss6 certify --witness FILE`. The viewer: `gauss6 view {trace.path} --out "
-            f"{Path(out_dir) / viewer_page}`, then open the links.", "",
+            f"Re-check one exactly: `gauss6 certify --witness FILE`. The viewer page `{viewer_page}`, written "
+            f"beside this report, opens at each witness's tick (or make it: `gauss6 view {trace.path} --out "
+            f"{Path(out_dir) / viewer_page}`).", "",
             "| check | violation | tick | t (s) | witness | viewer |", "| --- | --- | --- | --- | --- | --- |"]
     for w in written:
         rel = Path(w["path"]).relative_to(Path(out_dir))
