@@ -1,4 +1,4 @@
-(* The named error allowances of optimized/include/gauss6/error_allowances.h,
+(* The named error allowances of optimized/include/gauss6/numeric/error_allowances.h,
    proved in Flocq: for each, the rounding error of the expression at its
    sites, evaluated as the code evaluates it (the same operations in the same
    order, each rounded to nearest binary64: Rounding.v's `fl`), is within the
@@ -112,8 +112,8 @@ Proof.
   - unfold u in *; lra.
 Qed.
 
-(* covers optimized/src/ccd.cpp "LinearPoints make_linear_points(" sha256:badaaa4fc2f7da52 *)
-(* covers optimized/src/ccd.cpp "void enclose_linear(" sha256:b914611386face38 *)
+(* covers optimized/src/ccd/ccd.cpp "LinearPoints make_linear_points(" sha256:badaaa4fc2f7da52 *)
+(* covers optimized/src/ccd/ccd.cpp "void enclose_linear(" sha256:b914611386face38 *)
 Theorem linear_corner_rounding M t a b
     xw0 yw0 xw1 yw1 xa0 ya0 xa1 ya1 xb0 yb0 xb1 yb1 :
   0 <= t <= 1 -> 0 <= a <= 1 -> 0 <= b <= 1 ->
@@ -169,7 +169,7 @@ Qed.
    as the least corner value (and the mirror for the largest) instead of all
    four: that value is one of the four computed corner values, and no larger
    than any of them, rounding being monotone. *)
-(* covers optimized/src/ccd.cpp "void enclose_linear(" sha256:b914611386face38 *)
+(* covers optimized/src/ccd/ccd.cpp "void enclose_linear(" sha256:b914611386face38 *)
 Theorem linear_corner_selection w pa0 pa1 pb0 pb1 :
   let corner pa pb := fl (fl (w + pa) - pb) in
   let least := fl (fl (w + Rmin pa0 pa1) - Rmax pb0 pb1) in
@@ -196,7 +196,7 @@ Qed.
 (* make_linear_points' p.error = kLinearCornerRounding * Upper{M} +
    Upper{kLinearCornerUnderflow}, rounded up (Rounding.v): at least the bound
    of linear_corner_rounding. *)
-(* covers optimized/src/ccd.cpp "LinearPoints make_linear_points(" sha256:badaaa4fc2f7da52 *)
+(* covers optimized/src/ccd/ccd.cpp "LinearPoints make_linear_points(" sha256:badaaa4fc2f7da52 *)
 Theorem linear_corner_error_bound M :
   0 <= M ->
   kLinearCornerRounding * M + kLinearCornerUnderflow
@@ -241,7 +241,7 @@ Proof.
   unfold u in *. lra.
 Qed.
 
-(* covers optimized/src/motion_bounds.cpp "void StartFrame::set(const CcdMotion& m, double u, double rho_in)" sha256:d727ef1e2605b2dd *)
+(* covers optimized/src/ccd/motion_bounds.cpp "void StartFrame::set(const CcdMotion& m, double u, double rho_in)" sha256:d727ef1e2605b2dd *)
 Theorem norm_relative_rounding x y z :
   bpow radix2 (-1000) <= x * x + y * y + z * z ->
   let s := fl (fl (fl (x * x) + fl (y * y)) + fl (z * z)) in

@@ -15,8 +15,8 @@
 #include <limits>
 #include <random>
 
-#include "gauss6/error_allowances.h"
-#include "gauss6/rounding.h"
+#include "gauss6/numeric/error_allowances.h"
+#include "gauss6/numeric/rounding.h"
 
 using namespace gauss6;
 

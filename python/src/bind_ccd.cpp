@@ -19,11 +19,11 @@
 #include <string>
 #include <vector>
 
-#include "gauss6/bvh.h"
-#include "gauss6/ccd_step.h"
-#include "gauss6/ccd.h"
-#include "gauss6/ccd_queries.h"
-#include "gauss6/feature_ids.h"
+#include "gauss6/geometry/bvh.h"
+#include "gauss6/step/ccd_step.h"
+#include "gauss6/ccd/ccd.h"
+#include "gauss6/io/ccd_queries.h"
+#include "gauss6/geometry/feature_ids.h"
 #include "gauss6/reference/ccd.h"
 #include "module.h"
 

@@ -3,14 +3,14 @@
 #include <pybind11/eigen.h>
 #include <pybind11/stl.h>
 
-#include "gauss6/ccd.h"
-#include "gauss6/load_error.h"
-#include "gauss6/mass_properties.h"
-#include "gauss6/mesh.h"
-#include "gauss6/mesh_io.h"
-#include "gauss6/pose.h"
-#include "gauss6/qp_instances.h"
-#include "gauss6/scene.h"
+#include "gauss6/ccd/ccd.h"
+#include "gauss6/io/load_error.h"
+#include "gauss6/geometry/mass_properties.h"
+#include "gauss6/geometry/mesh.h"
+#include "gauss6/io/mesh_io.h"
+#include "gauss6/geometry/pose.h"
+#include "gauss6/io/qp_instances.h"
+#include "gauss6/io/scene.h"
 #include "module.h"
 
 namespace py = pybind11;
