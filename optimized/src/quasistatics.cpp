@@ -989,12 +989,14 @@ void final_point(const ProjectionProblem& pb, ProjectionWorkspace& ws, const Loo
     recover_multipliers(ws, y_final, lp.yu, lp.b, lp.m, lp.feas_tol, lp.dep_tol);
 }
 
-// The rest of the result beside ac: the multipliers by row of the first q
-// entries of W, the status ("optimal" only with the scale-free certificate
+// The rest of the result beside ac: the multipliers by row of the working set
+// as it ends (recovered multipliers may be over more or fewer rows than the
+// loop's), the status ("optimal" only with the scale-free certificate
 // kkt_relative met), the iterations and, when asked, the KKT residuals.
 ProjectionStatus write_result(const ProjectionProblem& pb, const ProjectionSettings& settings,
-                              const ProjectionWorkspace& ws, int q, ProjectionStatus status, int iterations,
+                              const ProjectionWorkspace& ws, ProjectionStatus status, int iterations,
                               ProjectionResult* res) noexcept {
+  const int q = ws.num_active;
   std::fill_n(res->lambda.begin(), pb.num_rows, 0.0);
   for (int i = 0; i < q; ++i) {
     res->lambda[ws.active[i]] = ws.lambda_active[i];
@@ -1055,10 +1057,9 @@ ProjectionStatus project(const ProjectionProblem& pb, const ProjectionSettings& 
     ws.factor_matches_cache = false;
     return zero_force_result(pb, status, it.iterations, res);
   }
-  const int q = ws.num_active;
-  if (q == 0) res->ac = pb.au;  // no active row: exactly no force
+  if (ws.num_active == 0) res->ac = pb.au;  // no active row: exactly no force
   else final_point(pb, ws, lp, &it, res);
-  return write_result(pb, settings, ws, q, status, it.iterations, res);
+  return write_result(pb, settings, ws, status, it.iterations, res);
 }
 
 }  // namespace gauss6
