@@ -736,43 +736,33 @@ void ProjectionWorkspace::reset() noexcept {
   std::fill(in_active.begin(), in_active.end(), static_cast<unsigned char>(0));
 }
 
-ProjectionStatus project(const ProjectionProblem& pb, const ProjectionSettings& settings,
-                         ProjectionWorkspace* workspace, ProjectionResult* res) noexcept {
-  if (res == nullptr) return ProjectionStatus::kBadInput;
+namespace {
+
+// What is wrong with a call's arguments (a null pointer, a row count out of the
+// buffers' range, settings out of range, an entry that is not finite); nullptr
+// when nothing is.
+const char* call_problem(const ProjectionProblem& pb, const ProjectionSettings& settings,
+                         const ProjectionWorkspace* workspace, const ProjectionResult& res) noexcept {
   const int m = pb.num_rows;
-  const char* problem = nullptr;
-  if (workspace == nullptr) problem = "workspace: null";
-  else if (!valid_settings(settings)) problem = "settings: out of range";
-  else if (pb.M == nullptr) problem = "M: null";
-  else if (m < 0 || m > workspace->capacity || m > res->max_rows())
-    problem = "num_rows: negative or beyond the workspace's or the result's max_rows";
-  else if (m > 0 && pb.J == nullptr) problem = "J: null with rows";
-  else if (!all_finite(pb.au.data(), 6)) problem = "au: an entry is not finite";
-  else if (pb.b != nullptr && !all_finite(pb.b, m)) problem = "b: an entry is not finite";
-  if (problem) return bad_input(pb, problem, res);
-  ProjectionWorkspace& ws = *workspace;
-  if ((problem = update_cache(pb, ws)) != nullptr) {
-    ws.num_active = 0;
-    return bad_input(pb, problem, res);
-  }
-  const double* b = pb.b;
-  const double dep_tol = settings.dependence_tol;
-  const double feas_tol = settings.feasibility_tol;
+  if (workspace == nullptr) return "workspace: null";
+  if (!valid_settings(settings)) return "settings: out of range";
+  if (pb.M == nullptr) return "M: null";
+  if (m < 0 || m > workspace->capacity || m > res.max_rows())
+    return "num_rows: negative or beyond the workspace's or the result's max_rows";
+  if (m > 0 && pb.J == nullptr) return "J: null with rows";
+  if (!all_finite(pb.au.data(), 6)) return "au: an entry is not finite";
+  if (pb.b != nullptr && !all_finite(pb.b, m)) return "b: an entry is not finite";
+  return nullptr;
+}
 
-  // Target in Cholesky coordinates: y_u = L^T au.
-  const Vec6 yu = ws.L.transpose() * pb.au;
-  // The problem's lengths (y-space) within range (see kMaxLength): |y_u| and each
-  // offset's distance |b_k| / |A_k| (an offset on a zero row is a bare sign test).
-  if ((problem = length_problem(yu, b, ws, m)) != nullptr) return bad_input(pb, problem, res);
-  const double yu_norm = yu.norm();
-
-  // Starting working set: empty (cold) or the previous one, whose factors are
-  // reused when M and J did not change, else rebuilt from its rows.
+// The starting working set: empty (cold) or the previous one, whose factors are
+// reused when M and J did not change, else rebuilt from its rows.
+void start_working_set(ProjectionWorkspace& ws, bool warm_start, int m, double dependence_tol) noexcept {
   std::fill_n(ws.in_active.begin(), m, static_cast<unsigned char>(0));
-  if (!settings.warm_start) {
+  if (!warm_start) {
     ws.num_active = 0;
   } else if (!ws.factor_matches_cache || ws.rotations_since_rebuild > kMaxRotationsBeforeRebuild) {
-    rebuild_factors(ws, ws.num_active, m, dep_tol);
+    rebuild_factors(ws, ws.num_active, m, dependence_tol);
   } else {
     for (int i = 0; i < ws.num_active; ++i) ws.in_active[ws.active[i]] = 1;
   }
@@ -781,161 +771,233 @@ ProjectionStatus project(const ProjectionProblem& pb, const ProjectionSettings& 
     ws.rotations_since_rebuild = 0;
   }
   ws.factor_matches_cache = true;
+}
 
-  int iterations = 0;
-  ProjectionStatus status = ProjectionStatus::kOptimal;
+// The projection as the active-set loop sees it: the target y_u = L^T au in
+// Cholesky coordinates and its norm, the offsets (nullptr: b = 0), the number
+// of rows, and the settings the loop reads.
+struct LoopProblem {
+  const Vec6& yu;
+  double yu_norm;
+  const double* b;
+  int m;
+  double dep_tol;
+  double feas_tol;
+  int max_iterations;
+};
+
+// The loop's iterate: y (the projection of y_u on the working set's face, dual
+// feasible), the iterations spent, and whether some row is skipped
+// (in_active[k] == kSkipped).
+struct LoopIterate {
   Vec6 y;
-  // Make the start dual feasible (a warm start's multipliers may be negative).
-  iterations += drop_until_dual_feasible(ws, yu, yu_norm, b, &y);
+  int iterations = 0;
+  bool has_skipped = false;
+};
 
-  bool has_skipped = false;  // some in_active[k] == kSkipped
+// The most violated row outside the working set: the largest distance to its
+// hyperplane, smallest index on ties, among rows violated beyond the
+// feasibility tolerance of their scale |A_k| y_scale + |b_k|; -1 when none is.
+// Leaves the slacks A y - b in ws.slack.
+int most_violated_row(ProjectionWorkspace& ws, const LoopProblem& lp, const Vec6& y, double y_scale) noexcept {
+  const int m = lp.m;
+  const double* b = lp.b;
+  // Slacks s = A y - b: one matrix-vector product on the column-major copy
+  // of A (Eigen's vectorised kernel; y is contiguous, so no temporary).
+  double* slack = ws.slack.data();
+  {
+    Eigen::Map<Eigen::VectorXd> s_map(slack, m);
+    s_map.noalias() = ColumnsOfA(ws.A_t.data(), m, 6, Eigen::OuterStride<>(ws.capacity)) * y;
+    if (b) s_map -= Eigen::Map<const Eigen::VectorXd>(b, m);
+  }
+  int p = -1;
+  double best = 0;
+  for (int k = 0; k < m; ++k) {
+    const double s = slack[k];
+    if (ws.in_active[k] || s >= 0) continue;
+    const double bk = b ? b[k] : 0.0;
+    if (s < -lp.feas_tol * (ws.row_norm[k] * y_scale + std::abs(bk))) {
+      const double v = -s * ws.inv_row_norm[k];
+      if (v > best) {
+        best = v;
+        p = k;
+      }
+    }
+  }
+  return p;
+}
+
+// Row p seen from the working set W (q rows): d = Q^T A_p; z2 = |d(q:6)|^2,
+// the square of its part orthogonal to W; whether it counts as dependent on W;
+// r = R^-1 d(0:q), how W's rows span it (their multipliers fall as t r when p's
+// grows by t); and r_noise, the rounding level of r's components.
+struct RowDirection {
+  int q;
+  Vec6 d;
+  double z2;
+  bool dependent;
+  std::array<double, kMaxActive> r;
+  double r_noise;
+};
+
+// Row p's RowDirection from the current factors.
+RowDirection direction_of_row(const ProjectionWorkspace& ws, int p, double dep_tol) noexcept {
+  RowDirection dir;
+  const int q = dir.q = ws.num_active;
+  const Eigen::Map<const Vec6> n = row(ws, p);
+  dir.d = ws.Q.transpose() * n;
+  const Vec6& d = dir.d;
+  dir.z2 = tail_squared_norm(d, q);
+  dir.dependent = std::sqrt(dir.z2) <= dependence_threshold(ws, dep_tol) * ws.row_norm[p];
+  // Below the rounding of Q's span, the sine is measured on the rows.
+  if (dir.dependent && std::sqrt(dir.z2) > dep_tol * ws.row_norm[p])
+    dir.dependent = !independent_on_rows(ws, p, d, dep_tol);
+  // r = R^-1 d(0:q) by back substitution.
+  std::array<double, kMaxActive>& r = dir.r;
+  r = {};
+  for (int i = q - 1; i >= 0; --i) {
+    double v = d[i];
+    for (int j = i + 1; j < q; ++j) v -= ws.R(i, j) * r[j];
+    r[i] = v / ws.R(i, i);
+  }
+  // Components of r at the rounding of the solve with R (about eps cond(R)
+  // of its largest, each as the length r_i |A_i|: see the top of this file)
+  // have no sign: a partial step on one would exchange a row for p on
+  // noise, and such exchanges can cycle.
+  double r_max = 0;
+  for (int i = 0; i < q; ++i) r_max = std::max(r_max, std::abs(r[i]) * ws.row_norm[ws.active[i]]);
+  dir.r_noise = kRoundoff * working_set_condition(ws) * r_max;
+  return dir;
+}
+
+// The ratio test: the position in W of the row whose multiplier reaches zero
+// first as the multipliers fall by t r (smallest t, ties to the smallest row
+// index), r's components at rounding level left out; -1 when none falls.
+// *t1 is that t (infinite when none).
+int blocking_row(const ProjectionWorkspace& ws, const RowDirection& dir, double* t1) noexcept {
+  *t1 = kInf;
+  int block = -1;
+  for (int i = 0; i < dir.q; ++i) {
+    if (dir.r[i] * ws.row_norm[ws.active[i]] <= dir.r_noise) continue;
+    const double ratio = ws.lambda_active[i] / dir.r[i];
+    if (ratio < *t1 || (ratio == *t1 && ws.active[i] < ws.active[block])) {
+      *t1 = ratio;
+      block = i;
+    }
+  }
+  return block;
+}
+
+// Whether the offsets are inconsistent at row p, which no step can satisfy:
+// n = A_W^T r + z, |z| <= dependence_tol |n|, with r <= 0. On W's face its
+// slack is r^T b_W - b_p + z^T y, so the offsets are inconsistent when
+// b_p - r^T b_W exceeds the feasibility tolerance; otherwise (always when
+// b = 0) the violation is the small z^T y plus rounding of W's slacks.
+bool offsets_inconsistent(const ProjectionWorkspace& ws, const LoopProblem& lp, const RowDirection& dir, int p,
+                          double y_scale) noexcept {
+  const double* b = lp.b;
+  double gap = b ? b[p] : 0.0;
+  if (b)
+    for (int i = 0; i < dir.q; ++i) gap -= dir.r[i] * b[ws.active[i]];
+  return gap > lp.feas_tol * (ws.row_norm[p] * y_scale + std::abs(b ? b[p] : 0.0));
+}
+
+// A step of length t towards row p: W's multipliers fall by t r (components
+// at rounding level count as zero here too, as in the ratio test: moved by
+// t r_i, a small multiplier would go negative) and, when p is independent of
+// W, y moves along z = Q(:, q:6) d(q:6), the part of p's row orthogonal to W,
+// and p's slack s_p by t |z|^2.
+void take_step(ProjectionWorkspace& ws, const RowDirection& dir, double t, Vec6* y, double* s_p) noexcept {
+  const int q = dir.q;
+  for (int i = 0; i < q; ++i)
+    if (std::abs(dir.r[i]) * ws.row_norm[ws.active[i]] > dir.r_noise) ws.lambda_active[i] -= t * dir.r[i];
+  if (!dir.dependent) {
+    for (int i = q; i < 6; ++i) *y += (t * dir.d[i]) * ws.Q.col(i);
+    *s_p += t * dir.z2;
+  }
+}
+
+// Drops the row at position pos of W (its multiplier reached zero); the face
+// changed, so skipped rows are examined again.
+void drop_blocking_row(ProjectionWorkspace& ws, int pos, int m, bool* has_skipped) noexcept {
+  ws.lambda_active[pos] = 0;
+  factor_drop(ws, pos);
+  if (*has_skipped) {
+    for (int k = 0; k < m; ++k)
+      if (ws.in_active[k] == kSkipped) ws.in_active[k] = 0;
+    *has_skipped = false;
+  }
+}
+
+// Steps towards the violated row p until it is satisfied (a full step: p
+// joins W) or skipped, each partial step on the way dropping the row of W
+// whose multiplier reaches zero first. Returns kOptimal to go on with the
+// loop, else the status that ends it (the iteration cap, inconsistent offsets).
+ProjectionStatus step_to_row(ProjectionWorkspace& ws, const LoopProblem& lp, int p, double y_scale,
+                             LoopIterate* it) noexcept {
+  double s_p = ws.slack[p];
+  double lambda_p = 0;
   for (;;) {
-    // Most violated row (largest distance to its hyperplane, smallest index on ties).
-    const double y_scale = std::max(y.norm(), yu_norm);
-    // Slacks s = A y - b: one matrix-vector product on the column-major copy
-    // of A (Eigen's vectorised kernel; y is contiguous, so no temporary).
-    double* slack = ws.slack.data();
-    {
-      Eigen::Map<Eigen::VectorXd> s_map(slack, m);
-      s_map.noalias() = ColumnsOfA(ws.A_t.data(), m, 6, Eigen::OuterStride<>(ws.capacity)) * y;
-      if (b) s_map -= Eigen::Map<const Eigen::VectorXd>(b, m);
+    if (it->iterations >= lp.max_iterations) return ProjectionStatus::kIterationCap;
+    ++it->iterations;
+    const RowDirection dir = direction_of_row(ws, p, lp.dep_tol);
+    double t1;
+    const int block = blocking_row(ws, dir, &t1);
+    const double t2 = dir.dependent ? kInf : -s_p / dir.z2;
+    // No row of W blocks (block < 0) and no full step (t2 infinite, or NaN
+    // when rounding leaves z2 = 0 on a row not counted dependent): p cannot
+    // be satisfied by a step; never a drop at block -1.
+    if (block < 0 && !(t2 < kInf)) {
+      if (offsets_inconsistent(ws, lp, dir, p, y_scale)) return ProjectionStatus::kInfeasibleOffsets;
+      // Consistent: p is skipped until a partial step changes the face.
+      ws.in_active[p] = kSkipped;
+      it->has_skipped = true;
+      if (lambda_p > 0) {
+        // Exchange steps gave p a multiplier that W cannot carry (W is
+        // ill-conditioned enough that p stayed dependent after a drop): go
+        // back to the projection on W's face, made dual feasible. y did not
+        // move (dependent steps change only multipliers).
+        it->iterations += drop_until_dual_feasible(ws, lp.yu, lp.yu_norm, lp.b, &it->y);
+      }
+      return ProjectionStatus::kOptimal;
     }
-    int p = -1;
-    double best = 0, s_p = 0;
-    for (int k = 0; k < m; ++k) {
-      const double s = slack[k];
-      if (ws.in_active[k] || s >= 0) continue;
-      const double bk = b ? b[k] : 0.0;
-      if (s < -feas_tol * (ws.row_norm[k] * y_scale + std::abs(bk))) {
-        const double v = -s * ws.inv_row_norm[k];
-        if (v > best) {
-          best = v;
-          p = k;
-          s_p = s;
-        }
-      }
+    const double t = std::min(t1, t2);
+    take_step(ws, dir, t, &it->y, &s_p);
+    lambda_p += t;
+    if (t2 <= t1) {
+      ws.lambda_active[dir.q] = lambda_p;
+      factor_add(ws, dir.d, p);
+      return ProjectionStatus::kOptimal;
     }
-    if (p < 0) break;
-
-    // Step towards row p until it is satisfied (full step: p joins W) or a row
-    // of W reaches a zero multiplier (partial step: that row leaves W).
-    double lambda_p = 0;
-    const Eigen::Map<const Vec6> n = row(ws, p);
-    for (;;) {
-      if (iterations >= settings.max_iterations) {
-        status = ProjectionStatus::kIterationCap;
-        break;
-      }
-      ++iterations;
-      const int q = ws.num_active;
-      const Vec6 d = ws.Q.transpose() * n;
-      const double z2 = tail_squared_norm(d, q);
-      bool dependent = std::sqrt(z2) <= dependence_threshold(ws, dep_tol) * ws.row_norm[p];
-      // Below the rounding of Q's span, the sine is measured on the rows.
-      if (dependent && std::sqrt(z2) > dep_tol * ws.row_norm[p]) dependent = !independent_on_rows(ws, p, d, dep_tol);
-      // r = R^-1 d(0:q): how n is spanned by W's rows; multipliers fall as t r.
-      std::array<double, kMaxActive> r{};
-      for (int i = q - 1; i >= 0; --i) {
-        double v = d[i];
-        for (int j = i + 1; j < q; ++j) v -= ws.R(i, j) * r[j];
-        r[i] = v / ws.R(i, i);
-      }
-      // Components of r at the rounding of the solve with R (about eps cond(R)
-      // of its largest, each as the length r_i |A_i|: see the top of this file)
-      // have no sign: a partial step on one would exchange a row for p on
-      // noise, and such exchanges can cycle.
-      double r_max = 0;
-      for (int i = 0; i < q; ++i) r_max = std::max(r_max, std::abs(r[i]) * ws.row_norm[ws.active[i]]);
-      const double r_noise = kRoundoff * working_set_condition(ws) * r_max;
-      double t1 = kInf;
-      int block = -1;
-      for (int i = 0; i < q; ++i) {
-        if (r[i] * ws.row_norm[ws.active[i]] <= r_noise) continue;
-        const double ratio = ws.lambda_active[i] / r[i];
-        if (ratio < t1 || (ratio == t1 && ws.active[i] < ws.active[block])) {
-          t1 = ratio;
-          block = i;
-        }
-      }
-      const double t2 = dependent ? kInf : -s_p / z2;
-      // No row of W blocks (block < 0) and no full step (t2 infinite, or NaN
-      // when rounding leaves z2 = 0 on a row not counted dependent): p cannot
-      // be satisfied by a step; never a drop at block -1.
-      if (block < 0 && !(t2 < kInf)) {
-        // n = A_W^T r + z, |z| <= dependence_tol |n|, with r <= 0: no step
-        // can satisfy row p. On W's face its slack is r^T b_W - b_p + z^T y,
-        // so the offsets are inconsistent when b_p - r^T b_W exceeds the
-        // feasibility tolerance; otherwise (always when b = 0) the violation
-        // is the small z^T y plus rounding of W's slacks, and p is skipped
-        // until a partial step changes the face.
-        double gap = b ? b[p] : 0.0;
-        if (b)
-          for (int i = 0; i < q; ++i) gap -= r[i] * b[ws.active[i]];
-        if (gap > feas_tol * (ws.row_norm[p] * y_scale + std::abs(b ? b[p] : 0.0))) {
-          status = ProjectionStatus::kInfeasibleOffsets;
-          break;
-        }
-        ws.in_active[p] = kSkipped;
-        has_skipped = true;
-        if (lambda_p > 0) {
-          // Exchange steps gave p a multiplier that W cannot carry (W is
-          // ill-conditioned enough that p stayed dependent after a drop): go
-          // back to the projection on W's face, made dual feasible. y did not
-          // move (dependent steps change only multipliers).
-          iterations += drop_until_dual_feasible(ws, yu, yu_norm, b, &y);
-        }
-        break;
-      }
-      const double t = std::min(t1, t2);
-      // Components at rounding level count as zero here too (as in the ratio
-      // test): moved by t r_i, a small multiplier would go negative.
-      for (int i = 0; i < q; ++i)
-        if (std::abs(r[i]) * ws.row_norm[ws.active[i]] > r_noise) ws.lambda_active[i] -= t * r[i];
-      lambda_p += t;
-      if (!dependent) {
-        // Primal step along z = Q(:, q:6) d(q:6), the part of n orthogonal to W.
-        for (int i = q; i < 6; ++i) y += (t * d[i]) * ws.Q.col(i);
-        s_p += t * z2;
-      }
-      if (t2 <= t1) {
-        ws.lambda_active[q] = lambda_p;
-        factor_add(ws, d, p);
-        break;
-      }
-      ws.lambda_active[block] = 0;
-      factor_drop(ws, block);
-      if (has_skipped) {
-        // The face changed: skipped rows are examined again.
-        for (int k = 0; k < m; ++k)
-          if (ws.in_active[k] == kSkipped) ws.in_active[k] = 0;
-        has_skipped = false;
-      }
-    }
-    if (status != ProjectionStatus::kOptimal) break;
+    drop_blocking_row(ws, block, lp.m, &it->has_skipped);
   }
+}
 
-  if (status == ProjectionStatus::kInfeasibleOffsets) {
-    ws.num_active = 0;
-    ws.factor_matches_cache = false;
-    return zero_force_result(pb, status, iterations, res);
-  }
+// The answer ac (in res) of a working set that is not empty, recomputed from
+// the working set (removes the drift of the incremental updates) and back in
+// a-space, L^T ac = y; refined when W is ill-conditioned, and with
+// nonnegative multipliers sought when W's own are not.
+void final_point(const ProjectionProblem& pb, ProjectionWorkspace& ws, const LoopProblem& lp, LoopIterate* it,
+                 ProjectionResult* res) noexcept {
+  if (it->iterations > 0) solve_working_set(ws, lp.yu, lp.b, &it->y);  // else y is already fresh
+  res->ac.noalias() = ws.L_inv.transpose() * it->y;  // ac = L^-T y
+  if (working_set_condition(ws) > kRefinementCondition) refine_kkt_point(pb, ws, &res->ac);
+  // At a degenerate vertex the working set's own multipliers may be negative
+  // though ac is optimal: nonnegative ones over the tight rows replace them.
+  const Vec6 y_final = ws.L.transpose() * res->ac;
+  if (has_negative_multiplier(ws, std::max(y_final.norm(), lp.yu_norm), lp.b))
+    recover_multipliers(ws, y_final, lp.yu, lp.b, lp.m, lp.feas_tol, lp.dep_tol);
+}
 
-  // Final iterate recomputed from the working set (removes the drift of the
-  // incremental updates), back to a-space: L^T ac = y.
+// The rest of the result beside ac: the multipliers by row of the working set
+// as it ends (recovered multipliers may be over more or fewer rows than the
+// loop's), the status ("optimal" only with the scale-free certificate
+// kkt_relative met), the iterations and, when asked, the KKT residuals.
+ProjectionStatus write_result(const ProjectionProblem& pb, const ProjectionSettings& settings,
+                              const ProjectionWorkspace& ws, ProjectionStatus status, int iterations,
+                              ProjectionResult* res) noexcept {
   const int q = ws.num_active;
-  if (q == 0) {
-    res->ac = pb.au;  // no active row: exactly no force
-  } else {
-    if (iterations > 0) solve_working_set(ws, yu, b, &y);  // else y is already fresh
-    res->ac.noalias() = ws.L_inv.transpose() * y;  // ac = L^-T y
-    if (working_set_condition(ws) > kRefinementCondition) refine_kkt_point(pb, ws, &res->ac);
-    // At a degenerate vertex the working set's own multipliers may be negative
-    // though ac is optimal: nonnegative ones over the tight rows replace them.
-    const Vec6 y_final = ws.L.transpose() * res->ac;
-    if (has_negative_multiplier(ws, std::max(y_final.norm(), yu_norm), b))
-      recover_multipliers(ws, y_final, yu, b, m, feas_tol, dep_tol);
-  }
-  std::fill_n(res->lambda.begin(), m, 0.0);
+  std::fill_n(res->lambda.begin(), pb.num_rows, 0.0);
   for (int i = 0; i < q; ++i) {
     res->lambda[ws.active[i]] = ws.lambda_active[i];
     res->active[i] = ws.active[i];
@@ -944,7 +1006,6 @@ ProjectionStatus project(const ProjectionProblem& pb, const ProjectionSettings& 
   res->status = status;
   res->problem = nullptr;
   res->iterations = iterations;
-  // "optimal" only with the scale-free certificate (kkt_relative) met.
   res->kkt_relative = relative_kkt(pb, ws, *res);
   if (status == ProjectionStatus::kOptimal && !(res->kkt_relative <= settings.certificate_tol))
     res->status = status = ProjectionStatus::kUncertified;
@@ -955,6 +1016,50 @@ ProjectionStatus project(const ProjectionProblem& pb, const ProjectionSettings& 
     res->dual_infeasibility = res->complementarity = 0;
   }
   return status;
+}
+
+}  // namespace
+
+ProjectionStatus project(const ProjectionProblem& pb, const ProjectionSettings& settings,
+                         ProjectionWorkspace* workspace, ProjectionResult* res) noexcept {
+  if (res == nullptr) return ProjectionStatus::kBadInput;
+  if (const char* problem = call_problem(pb, settings, workspace, *res)) return bad_input(pb, problem, res);
+  ProjectionWorkspace& ws = *workspace;
+  if (const char* problem = update_cache(pb, ws)) {
+    ws.num_active = 0;
+    return bad_input(pb, problem, res);
+  }
+  const int m = pb.num_rows;
+
+  // Target in Cholesky coordinates: y_u = L^T au.
+  const Vec6 yu = ws.L.transpose() * pb.au;
+  // The problem's lengths (y-space) within range (see kMaxLength): |y_u| and each
+  // offset's distance |b_k| / |A_k| (an offset on a zero row is a bare sign test).
+  if (const char* problem = length_problem(yu, pb.b, ws, m)) return bad_input(pb, problem, res);
+  const LoopProblem lp{yu, yu.norm(), pb.b, m, settings.dependence_tol, settings.feasibility_tol,
+                       settings.max_iterations};
+
+  start_working_set(ws, settings.warm_start, m, lp.dep_tol);
+  LoopIterate it;
+  // Make the start dual feasible (a warm start's multipliers may be negative).
+  it.iterations += drop_until_dual_feasible(ws, yu, lp.yu_norm, lp.b, &it.y);
+  // Add the most violated row until none is (or a status ends the loop).
+  ProjectionStatus status = ProjectionStatus::kOptimal;
+  while (status == ProjectionStatus::kOptimal) {
+    const double y_scale = std::max(it.y.norm(), lp.yu_norm);
+    const int p = most_violated_row(ws, lp, it.y, y_scale);
+    if (p < 0) break;
+    status = step_to_row(ws, lp, p, y_scale, &it);
+  }
+
+  if (status == ProjectionStatus::kInfeasibleOffsets) {
+    ws.num_active = 0;
+    ws.factor_matches_cache = false;
+    return zero_force_result(pb, status, it.iterations, res);
+  }
+  if (ws.num_active == 0) res->ac = pb.au;  // no active row: exactly no force
+  else final_point(pb, ws, lp, &it, res);
+  return write_result(pb, settings, ws, status, it.iterations, res);
 }
 
 }  // namespace gauss6

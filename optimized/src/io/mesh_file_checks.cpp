@@ -227,30 +227,38 @@ bool read_binary_count(const unsigned char* p, const PlyProperty& prop, bool big
   return true;
 }
 
-}  // namespace
-
-void check_ply_structure(const std::string& path, const std::string& bytes) {
-  // Header: lines up to "end_header".
-  const std::string_view all(bytes);
-  if (all.substr(0, 3) != "ply") fail(path, "cannot parse as PLY: the file does not start with 'ply'");
+// Where a PLY header ends: the offset of its end_header line, and of the body
+// after that line.
+struct PlyHeaderEnd {
+  size_t end_tag;
+  size_t body;
+};
+PlyHeaderEnd find_ply_header_end(const std::string& path, std::string_view all) {
   // The header ends at the first line whose first word is end_header, as CGAL reads
   // it (a mere substring, e.g. inside a comment, does not end it).
-  size_t end_tag = std::string_view::npos, body = all.size();
   for (size_t line = 0; line < all.size();) {
     size_t eol = all.find('\n', line);
     if (eol == std::string_view::npos) eol = all.size();
     const std::vector<std::string_view> words = tokens_of(all.substr(line, eol - line));
-    if (!words.empty() && words[0] == "end_header") {
-      end_tag = line;
-      body = std::min(eol + 1, all.size());
-      break;
-    }
+    if (!words.empty() && words[0] == "end_header") return {line, std::min(eol + 1, all.size())};
     line = eol + 1;
   }
-  if (end_tag == std::string_view::npos) fail(path, "cannot parse as PLY: no 'end_header' line");
+  fail(path, "cannot parse as PLY: no 'end_header' line");
+}
+
+// A PLY header: its format ("ascii", "binary_little_endian" or
+// "binary_big_endian") and its elements in order.
+struct PlyHeader {
   std::string format;
   std::vector<PlyElement> elements;
-  LineCursor lines(all.substr(0, end_tag));
+};
+
+// Reads the header's lines (before end_header): format, elements and their
+// properties, each line checked; a format given, and properties for every
+// element that has items.
+PlyHeader read_ply_header(const std::string& path, std::string_view header) {
+  PlyHeader h;
+  LineCursor lines(header);
   std::vector<std::string_view> t;
   lines.next(&t);  // "ply"
   while (lines.next(&t)) {
@@ -259,14 +267,14 @@ void check_ply_structure(const std::string& path, const std::string& bytes) {
     if (t[0] == "format") {
       if (t.size() != 3 || (t[1] != "ascii" && t[1] != "binary_little_endian" && t[1] != "binary_big_endian"))
         fail(path, at + "expected 'format ascii|binary_little_endian|binary_big_endian 1.0'");
-      format = std::string(t[1]);
+      h.format = std::string(t[1]);
     } else if (t[0] == "element") {
       PlyElement e;
       if (t.size() != 3 || !parse_count(t[2], &e.count)) fail(path, at + "expected 'element NAME COUNT'");
       e.name = std::string(t[1]);
-      elements.push_back(std::move(e));
+      h.elements.push_back(std::move(e));
     } else if (t[0] == "property") {
-      if (elements.empty()) fail(path, at + "a 'property' line before any 'element' line");
+      if (h.elements.empty()) fail(path, at + "a 'property' line before any 'element' line");
       PlyProperty p;
       if (t.size() == 5 && t[1] == "list") {
         p.is_list = true;
@@ -284,18 +292,22 @@ void check_ply_structure(const std::string& path, const std::string& bytes) {
       } else {
         fail(path, at + "expected 'property TYPE NAME' or 'property list COUNT_TYPE TYPE NAME'");
       }
-      elements.back().properties.push_back(p);
+      h.elements.back().properties.push_back(p);
     } else {
       fail(path, at + "unknown header keyword '" + std::string(t[0]) + "'");
     }
   }
-  if (format.empty()) fail(path, "cannot parse as PLY: no 'format' line");
-  for (const PlyElement& e : elements)
+  if (h.format.empty()) fail(path, "cannot parse as PLY: no 'format' line");
+  for (const PlyElement& e : h.elements)
     if (e.count > 0 && e.properties.empty())
       fail(path, "cannot parse as PLY: element '" + e.name + "' has " + std::to_string(e.count) + " items but no properties");
-  // The types CGAL 5.5's reader assumes without checking (it dereferences a failed
-  // cast otherwise): vertex coordinates float or double, all three of one type (the
-  // reader takes y's and z's from x's), face indices 32-bit integers.
+  return h;
+}
+
+// The types CGAL 5.5's reader assumes without checking (it dereferences a failed
+// cast otherwise): vertex coordinates float or double, all three of one type (the
+// reader takes y's and z's from x's), face indices 32-bit integers.
+void check_ply_types(const std::string& path, const std::vector<PlyElement>& elements) {
   for (const PlyElement& e : elements) {
     std::string_view coordinate_type;
     for (const PlyProperty& p : e.properties) {
@@ -313,89 +325,111 @@ void check_ply_structure(const std::string& path, const std::string& bytes) {
                        "' must be a list of 32-bit integers (int or uint)");
     }
   }
+}
 
-  // Body: walk every item of every element, bounding each count by the bytes left.
+// An ASCII body from offset body on: every item of every element, each value
+// of its type, each count bounded by the bytes left, nothing after the last.
+void check_ply_ascii_body(const std::string& path, std::string_view all, size_t body,
+                          const std::vector<PlyElement>& elements) {
   const size_t size = all.size();
-  if (format == "ascii") {
-    // Tokens, whitespace-separated; each takes at least 2 bytes but the last.
-    size_t pos = body;
-    auto next_token = [&](std::string_view* tok) {
-      while (pos < size && is_space(all[pos])) ++pos;
-      const size_t start = pos;
-      while (pos < size && !is_space(all[pos])) ++pos;
-      *tok = all.substr(start, pos - start);
-      return pos > start;
-    };
-    for (const PlyElement& e : elements) {
-      if (e.count == 0) continue;
-      if (e.count > (size - body) / (2 * e.properties.size()) + 1)
-        fail(path, "cannot parse as PLY: element '" + e.name + "' states " + std::to_string(e.count) +
-                       " items, more than the file can hold");
-      for (uint64_t i = 0; i < e.count; ++i)
-        for (const PlyProperty& p : e.properties) {
-          std::string_view tok;
-          if (!next_token(&tok))
-            fail(path, "cannot parse as PLY: element '" + e.name + "' ends after " + std::to_string(i) + " of " +
-                           std::to_string(e.count) + " items");
-          const auto check_value = [&](std::string_view type) {
-            if (!ply_ascii_value(tok, type))
-              fail(path, "cannot parse as PLY: element '" + e.name + "' item " + std::to_string(i) + ": '" +
-                             std::string(tok) + "' is not a value of type " + std::string(type));
-          };
-          if (!p.is_list) {
-            check_value(p.type);
-            continue;
-          }
-          uint64_t n = 0;
-          if (!parse_count(tok, &n) || n > (size - pos) / 2 + 1)
-            fail(path, "cannot parse as PLY: element '" + e.name + "' item " + std::to_string(i) + ": bad list length '" +
-                           std::string(tok) + "' (not a count, or more values than the file holds)");
-          for (uint64_t k = 0; k < n; ++k) {
-            if (!next_token(&tok)) fail(path, "cannot parse as PLY: element '" + e.name + "': the file ends inside a list");
-            check_value(p.type);
-          }
-        }
-    }
-    // A file holding more than its header states (the reader stops at the counts).
-    if (std::string_view extra; next_token(&extra))
-      fail(path, "cannot parse as PLY: line " + std::to_string(1 + std::count(all.begin(), all.begin() + pos, '\n')) +
-                     ": more values than the header's elements state ('" + std::string(extra.substr(0, 32)) + "')");
-  } else {
-    const bool big = format == "binary_big_endian";
-    const auto* data = reinterpret_cast<const unsigned char*>(all.data());
-    size_t pos = body;
-    for (const PlyElement& e : elements) {
-      if (e.count == 0) continue;
-      uint64_t min_item = 0;
-      for (const PlyProperty& p : e.properties) min_item += p.is_list ? p.count_size : p.value_size;
-      if (e.count > (size - pos) / min_item)
-        fail(path, "cannot parse as PLY: element '" + e.name + "' states " + std::to_string(e.count) +
-                       " items, more than the file can hold");
-      for (uint64_t i = 0; i < e.count; ++i)
-        for (const PlyProperty& p : e.properties) {
-          const uint64_t head = p.is_list ? p.count_size : p.value_size;
-          if (size - pos < head) fail(path, "cannot parse as PLY: element '" + e.name + "': the file ends inside an item");
-          if (!p.is_list) {
-            pos += head;
-            continue;
-          }
-          uint64_t n = 0;
-          if (!read_binary_count(data + pos, p, big, &n))
-            fail(path, "cannot parse as PLY: element '" + e.name + "' item " + std::to_string(i) + ": negative or non-integer list length");
-          pos += head;
-          if (n > (size - pos) / static_cast<uint64_t>(p.value_size))
-            fail(path, "cannot parse as PLY: element '" + e.name + "' item " + std::to_string(i) + ": a list of " +
-                           std::to_string(n) + " values, more than the file holds");
-          pos += n * static_cast<uint64_t>(p.value_size);
-        }
-    }
-    // A file holding more than its header states; trailing white space (a
-    // writer's final newline) is no record.
+  // Tokens, whitespace-separated; each takes at least 2 bytes but the last.
+  size_t pos = body;
+  auto next_token = [&](std::string_view* tok) {
     while (pos < size && is_space(all[pos])) ++pos;
-    if (pos < size)
-      fail(path, "cannot parse as PLY: " + std::to_string(size - pos) +
-                     " bytes after the header's elements (the file holds more than it states)");
+    const size_t start = pos;
+    while (pos < size && !is_space(all[pos])) ++pos;
+    *tok = all.substr(start, pos - start);
+    return pos > start;
+  };
+  for (const PlyElement& e : elements) {
+    if (e.count == 0) continue;
+    if (e.count > (size - body) / (2 * e.properties.size()) + 1)
+      fail(path, "cannot parse as PLY: element '" + e.name + "' states " + std::to_string(e.count) +
+                     " items, more than the file can hold");
+    for (uint64_t i = 0; i < e.count; ++i)
+      for (const PlyProperty& p : e.properties) {
+        std::string_view tok;
+        if (!next_token(&tok))
+          fail(path, "cannot parse as PLY: element '" + e.name + "' ends after " + std::to_string(i) + " of " +
+                         std::to_string(e.count) + " items");
+        const auto check_value = [&](std::string_view type) {
+          if (!ply_ascii_value(tok, type))
+            fail(path, "cannot parse as PLY: element '" + e.name + "' item " + std::to_string(i) + ": '" +
+                           std::string(tok) + "' is not a value of type " + std::string(type));
+        };
+        if (!p.is_list) {
+          check_value(p.type);
+          continue;
+        }
+        uint64_t n = 0;
+        if (!parse_count(tok, &n) || n > (size - pos) / 2 + 1)
+          fail(path, "cannot parse as PLY: element '" + e.name + "' item " + std::to_string(i) + ": bad list length '" +
+                         std::string(tok) + "' (not a count, or more values than the file holds)");
+        for (uint64_t k = 0; k < n; ++k) {
+          if (!next_token(&tok)) fail(path, "cannot parse as PLY: element '" + e.name + "': the file ends inside a list");
+          check_value(p.type);
+        }
+      }
   }
+  // A file holding more than its header states (the reader stops at the counts).
+  if (std::string_view extra; next_token(&extra))
+    fail(path, "cannot parse as PLY: line " + std::to_string(1 + std::count(all.begin(), all.begin() + pos, '\n')) +
+                   ": more values than the header's elements state ('" + std::string(extra.substr(0, 32)) + "')");
+}
+
+// A binary body from offset body on, in the file's byte order: every item of
+// every element within the bytes left, list lengths non-negative integers,
+// nothing after the last item but white space.
+void check_ply_binary_body(const std::string& path, std::string_view all, size_t body,
+                           const std::vector<PlyElement>& elements, bool big_endian) {
+  const size_t size = all.size();
+  const auto* data = reinterpret_cast<const unsigned char*>(all.data());
+  size_t pos = body;
+  for (const PlyElement& e : elements) {
+    if (e.count == 0) continue;
+    uint64_t min_item = 0;
+    for (const PlyProperty& p : e.properties) min_item += p.is_list ? p.count_size : p.value_size;
+    if (e.count > (size - pos) / min_item)
+      fail(path, "cannot parse as PLY: element '" + e.name + "' states " + std::to_string(e.count) +
+                     " items, more than the file can hold");
+    for (uint64_t i = 0; i < e.count; ++i)
+      for (const PlyProperty& p : e.properties) {
+        const uint64_t head = p.is_list ? p.count_size : p.value_size;
+        if (size - pos < head) fail(path, "cannot parse as PLY: element '" + e.name + "': the file ends inside an item");
+        if (!p.is_list) {
+          pos += head;
+          continue;
+        }
+        uint64_t n = 0;
+        if (!read_binary_count(data + pos, p, big_endian, &n))
+          fail(path, "cannot parse as PLY: element '" + e.name + "' item " + std::to_string(i) + ": negative or non-integer list length");
+        pos += head;
+        if (n > (size - pos) / static_cast<uint64_t>(p.value_size))
+          fail(path, "cannot parse as PLY: element '" + e.name + "' item " + std::to_string(i) + ": a list of " +
+                         std::to_string(n) + " values, more than the file holds");
+        pos += n * static_cast<uint64_t>(p.value_size);
+      }
+  }
+  // A file holding more than its header states; trailing white space (a
+  // writer's final newline) is no record.
+  while (pos < size && is_space(all[pos])) ++pos;
+  if (pos < size)
+    fail(path, "cannot parse as PLY: " + std::to_string(size - pos) +
+                   " bytes after the header's elements (the file holds more than it states)");
+}
+
+}  // namespace
+
+// The header, then the body: every item of every element, each count bounded by
+// the bytes left.
+void check_ply_structure(const std::string& path, const std::string& bytes) {
+  const std::string_view all(bytes);
+  if (all.substr(0, 3) != "ply") fail(path, "cannot parse as PLY: the file does not start with 'ply'");
+  const PlyHeaderEnd end = find_ply_header_end(path, all);
+  const PlyHeader header = read_ply_header(path, all.substr(0, end.end_tag));
+  check_ply_types(path, header.elements);
+  if (header.format == "ascii") check_ply_ascii_body(path, all, end.body, header.elements);
+  else check_ply_binary_body(path, all, end.body, header.elements, header.format == "binary_big_endian");
 }
 
 // Binary STL: an 80-byte header, a 32-bit facet count, 50 bytes a facet. ASCII STL

@@ -260,24 +260,23 @@ void check_json_representable(const TableReader& r, const toml::node& node, cons
   }
 }
 
-}  // namespace
-
-Scene load_scene(const std::string& path) {
-  Scene scene;
-  scene.path = path;
-  toml::table root;
+// The scene file parsed as TOML: a file that is not regular (a FIFO or a device
+// is never read) or not TOML is an error, at its line when the parser gives one.
+toml::table parse_scene_file(const std::string& path) {
   if (const std::string problem = regular_file_problem(path, uint64_t(1) << 26); !problem.empty())
-    throw SceneError(path, problem);  // a FIFO or a device is never read
+    throw SceneError(path, problem);
   try {
-    root = toml::parse_file(path);
+    return toml::parse_file(path);
   } catch (const toml::parse_error& e) {
     throw SceneError(path, static_cast<int>(e.source().begin.line), /*key=*/"", std::string(e.description()),
                      static_cast<int>(e.source().begin.column));
   } catch (const std::exception& e) {
     throw SceneError(path, e.what());
   }
-  const toml::table empty;
-  TableReader top(path, root, "");
+}
+
+// The top-level keys: the tables allowed, format, version and name.
+void read_header(const TableReader& top, Scene* scene) {
   top.allow_only({"format", "version", "name", "gains", "contact", "obstacle", "god_object", "surface", "device"});
   require(top.string("format") == "gauss6-scene", top, "format", "must be \"gauss6-scene\"");
   // Compared as the file's 64-bit integer: 4294967297 is not version 1.
@@ -285,227 +284,276 @@ Scene load_scene(const std::string& path) {
   require(version >= kOldestSceneFormatVersion && version <= kSceneFormatVersion, top, "version",
           "unsupported version " + std::to_string(version) + " (this build reads versions " +
               std::to_string(kOldestSceneFormatVersion) + " to " + std::to_string(kSceneFormatVersion) + ")");
-  scene.version = static_cast<int>(version);
-  scene.name = top.string("name");
+  scene->version = static_cast<int>(version);
+  scene->name = top.string("name");
+}
 
-  // [gains]
-  TableReader gains(path, sub_table(top, "gains", true, empty), "gains.");
-  gains.allow_only({"ks", "kh"});
-  scene.gains.ks = gains.number("ks");
-  scene.gains.kh = gains.number("kh");
-  require(check_gains(scene.gains), gains);
+// [gains]
+void read_gains(const TableReader& r, Gains* gains) {
+  r.allow_only({"ks", "kh"});
+  gains->ks = r.number("ks");
+  gains->kh = r.number("kh");
+  require(check_gains(*gains), r);
+}
 
-  // [contact]
-  TableReader contact(path, sub_table(top, "contact", true, empty), "contact.");
-  contact.allow_only({"delta", "offset_eps", "offset_time"});
-  scene.contact.delta = contact.number("delta");
+// [contact]; contact.delta against the bodies' size is checked once they are read.
+void read_contact(const TableReader& r, ContactParameters* contact) {
+  r.allow_only({"delta", "offset_eps", "offset_time"});
+  contact->delta = r.number("delta");
   const ContactParameters defaults;
-  const double default_eps = kDefaultOffsetEpsPerDelta * scene.contact.delta;
-  scene.contact.offset_eps = contact.number("offset_eps", &default_eps);
-  scene.contact.offset_time = contact.number("offset_time", &defaults.offset_time);
-  require(check_contact_parameters(scene.contact), contact);
+  const double default_eps = kDefaultOffsetEpsPerDelta * contact->delta;
+  contact->offset_eps = r.number("offset_eps", &default_eps);
+  contact->offset_time = r.number("offset_time", &defaults.offset_time);
+  require(check_contact_parameters(*contact), r);
+}
 
-  std::set<std::string> names;
-  auto claim_name = [&](const TableReader& r, const std::string& name) {
-    require(!name.empty(), r, "name", "must not be empty");
-    require(names.insert(name).second, r, "name", "\"" + name + "\" is already the name of another body");
-  };
+// Claims a body's name: not empty and not another body's (names holds those claimed).
+void claim_body_name(const TableReader& r, const std::string& name, std::set<std::string>* names) {
+  require(!name.empty(), r, "name", "must not be empty");
+  require(names->insert(name).second, r, "name", "\"" + name + "\" is already the name of another body");
+}
 
-  // [[obstacle]]
-  if (const toml::node* n = root.get("obstacle")) {
-    const toml::array* arr = n->as_array();
-    if (!arr || !arr->is_array_of_tables()) top.fail(n->source(), "obstacle", "must be an array of tables [[obstacle]]");
-    for (size_t i = 0; i < arr->size(); ++i) {
-      TableReader r(path, *arr->get(i)->as_table(), "obstacle[" + std::to_string(i) + "].");
-      r.allow_only({"name", "mesh", "position", "orientation", "crease_angle"});
-      Body b;
-      b.role = BodyRole::kObstacle;
-      b.name = r.string("name");
-      claim_name(r, b.name);
-      b.pose = read_pose(r);
-      read_body_mesh(r, &b, &scene.warnings);
-      const double crease_default = b.crease_angle;
-      b.crease_angle = r.number("crease_angle", &crease_default);
-      require(check_crease_angle(b.crease_angle), r);
-      scene.obstacles.push_back(std::move(b));
-    }
-  }
-
-  // [god_object]
-  {
-    TableReader r(path, sub_table(top, "god_object", true, empty), "god_object.");
-    r.allow_only({"name", "mesh", "position", "orientation", "density", "mass", "center_of_mass", "inertia",
-                  "reference_point"});
-    Body& b = scene.god_object;
-    b.role = BodyRole::kGodObject;
+// [[obstacle]], each with its name, pose, mesh and crease angle.
+void read_obstacles(const TableReader& top, std::set<std::string>* names, Scene* scene) {
+  const toml::node* n = top.node("obstacle");
+  if (!n) return;
+  const toml::array* arr = n->as_array();
+  if (!arr || !arr->is_array_of_tables()) top.fail(n->source(), "obstacle", "must be an array of tables [[obstacle]]");
+  for (size_t i = 0; i < arr->size(); ++i) {
+    TableReader r(top.file(), *arr->get(i)->as_table(), "obstacle[" + std::to_string(i) + "].");
+    r.allow_only({"name", "mesh", "position", "orientation", "crease_angle"});
+    Body b;
+    b.role = BodyRole::kObstacle;
     b.name = r.string("name");
-    claim_name(r, b.name);
-    const Pose X_WM = read_pose(r);  // pose of the mesh's own frame
-    read_body_mesh(r, &b, &scene.warnings);
-    GodObjectMass& gm = scene.god_mass;
-    const bool has_density = r.has("density");
-    const bool has_given = r.has("mass") || r.has("center_of_mass") || r.has("inertia");
-    if (has_density == has_given)
-      r.fail(r.table().source(), "density",
-             "give either density, or all of mass, center_of_mass and inertia (not both, not neither)");
-    MassProperties mp;
-    if (has_density) {
-      gm.from_density = true;
-      gm.density = r.number("density");
-      require(gm.density > 0, r, "density", "must be > 0");
-      if (!b.report.closed())
-        r.fail(r.node("mesh")->source(), "mesh",
-               b.mesh_path + ": a mass from a density needs a closed mesh:\n" + b.report.describe());
-      std::string error;
-      if (!compute_mass_properties(b.mesh, gm.density, &mp, &error))
-        r.fail(r.node("mesh")->source(), "mesh", b.mesh_path + ": " + error);
-    } else {
-      gm.from_density = false;
-      mp.mass = r.number("mass");
-      require(mp.mass > 0, r, "mass", "must be > 0");
-      const Vec3 c = r.vector<3>("center_of_mass", nullptr);
-      mp.center_of_mass = c;
-      mp.inertia = r.matrix3("inertia");
-      require((mp.inertia - mp.inertia.transpose()).norm() <= 1e-12 * mp.inertia.norm(), r, "inertia",
-              "must be symmetric");
-      Eigen::SelfAdjointEigenSolver<Mat3> eig(mp.inertia);
-      require(eig.eigenvalues().minCoeff() > 0, r, "inertia", "must be positive definite");
-    }
-    // Body frame B: origin at G (the centre of mass unless reference_point is given).
-    const Vec3 G = r.vector<3>("reference_point", &mp.center_of_mass);
-    // G far from the mesh makes the body-frame vertices lose their digits (a vertex
-    // 1 m from a G 1e17 away is rounded to 16 m): G within 100 bounding-box diagonals.
-    {
-      const Vec3 lo = b.mesh.V.colwise().minCoeff(), hi = b.mesh.V.colwise().maxCoeff();
-      const double diagonal = (hi - lo).norm();
-      require((G - 0.5 * (lo + hi)).norm() <= 100 * diagonal, r, "reference_point",
-              "must lie within 100 bounding-box diagonals of the mesh (" + std::to_string(diagonal) + ")");
-      const Vec3 c = mp.center_of_mass - G;
-      const Mat3 I_G = mp.inertia + mp.mass * (c.squaredNorm() * Mat3::Identity() - c * c.transpose());
-      check_god_mass(r, has_density ? "density" : "mass", mp, I_G);
-    }
-    gm.mesh_to_body = G;
-    for (int v = 0; v < b.mesh.V.rows(); ++v) b.mesh.V.row(v) -= G.transpose();
-    mp.center_of_mass -= G;
-    gm.mass = mp;
-    b.pose = {transform_point(X_WM, G), X_WM.q};
+    claim_body_name(r, b.name, names);
+    b.pose = read_pose(r);
+    read_body_mesh(r, &b, &scene->warnings);
+    const double crease_default = b.crease_angle;
+    b.crease_angle = r.number("crease_angle", &crease_default);
+    require(check_crease_angle(b.crease_angle), r);
+    scene->obstacles.push_back(std::move(b));
   }
+}
+
+// The god-object's mass properties in its mesh's frame: from a density over
+// its closed mesh, or given whole (mass, center_of_mass, inertia), one or the
+// other; gm records which.
+MassProperties read_mass_properties(const TableReader& r, const Body& b, GodObjectMass* gm) {
+  const bool has_density = r.has("density");
+  const bool has_given = r.has("mass") || r.has("center_of_mass") || r.has("inertia");
+  if (has_density == has_given)
+    r.fail(r.table().source(), "density",
+           "give either density, or all of mass, center_of_mass and inertia (not both, not neither)");
+  MassProperties mp;
+  if (has_density) {
+    gm->from_density = true;
+    gm->density = r.number("density");
+    require(gm->density > 0, r, "density", "must be > 0");
+    if (!b.report.closed())
+      r.fail(r.node("mesh")->source(), "mesh",
+             b.mesh_path + ": a mass from a density needs a closed mesh:\n" + b.report.describe());
+    std::string error;
+    if (!compute_mass_properties(b.mesh, gm->density, &mp, &error))
+      r.fail(r.node("mesh")->source(), "mesh", b.mesh_path + ": " + error);
+  } else {
+    gm->from_density = false;
+    mp.mass = r.number("mass");
+    require(mp.mass > 0, r, "mass", "must be > 0");
+    const Vec3 c = r.vector<3>("center_of_mass", nullptr);
+    mp.center_of_mass = c;
+    mp.inertia = r.matrix3("inertia");
+    require((mp.inertia - mp.inertia.transpose()).norm() <= 1e-12 * mp.inertia.norm(), r, "inertia",
+            "must be symmetric");
+    Eigen::SelfAdjointEigenSolver<Mat3> eig(mp.inertia);
+    require(eig.eigenvalues().minCoeff() > 0, r, "inertia", "must be positive definite");
+  }
+  return mp;
+}
+
+// [god_object]: its name, pose and mesh, its mass, and its body frame B (origin
+// at G, the centre of mass unless reference_point is given), into which its
+// mesh and mass properties are moved.
+void read_god_object(const TableReader& r, std::set<std::string>* names, Scene* scene) {
+  r.allow_only({"name", "mesh", "position", "orientation", "density", "mass", "center_of_mass", "inertia",
+                "reference_point"});
+  Body& b = scene->god_object;
+  b.role = BodyRole::kGodObject;
+  b.name = r.string("name");
+  claim_body_name(r, b.name, names);
+  const Pose X_WM = read_pose(r);  // pose of the mesh's own frame
+  read_body_mesh(r, &b, &scene->warnings);
+  GodObjectMass& gm = scene->god_mass;
+  MassProperties mp = read_mass_properties(r, b, &gm);
+  const Vec3 G = r.vector<3>("reference_point", &mp.center_of_mass);
+  // G far from the mesh makes the body-frame vertices lose their digits (a vertex
+  // 1 m from a G 1e17 away is rounded to 16 m): G within 100 bounding-box diagonals.
+  {
+    const Vec3 lo = b.mesh.V.colwise().minCoeff(), hi = b.mesh.V.colwise().maxCoeff();
+    const double diagonal = (hi - lo).norm();
+    require((G - 0.5 * (lo + hi)).norm() <= 100 * diagonal, r, "reference_point",
+            "must lie within 100 bounding-box diagonals of the mesh (" + std::to_string(diagonal) + ")");
+    const Vec3 c = mp.center_of_mass - G;
+    const Mat3 I_G = mp.inertia + mp.mass * (c.squaredNorm() * Mat3::Identity() - c * c.transpose());
+    check_god_mass(r, gm.from_density ? "density" : "mass", mp, I_G);
+  }
+  gm.mesh_to_body = G;
+  for (int v = 0; v < b.mesh.V.rows(); ++v) b.mesh.V.row(v) -= G.transpose();
+  mp.center_of_mass -= G;
+  gm.mass = mp;
+  b.pose = {transform_point(X_WM, G), X_WM.q};
+}
+
+// One axis key of [surface], "x", "y" or "z", as 0, 1 or 2.
+int read_axis(const TableReader& r, const char* key, const std::string& fallback) {
+  const std::string a = r.string(key, &fallback);
+  if (a != "x" && a != "y" && a != "z") r.fail(r.node(key)->source(), key, "must be x, y or z");
+  return a[0] - 'x';
+}
+
+// The keys of [surface] when kind = "texture": the texture, its size and
+// axes, its image for a height map; version 1's slope converted to a height.
+void read_texture(const TableReader& r, int version, SurfaceSettings* s) {
+  s->shading = r.boolean("shading", false);
+  const std::string sine = "sine";
+  const std::string texture = r.string("texture", &sine);
+  if (texture == "sine") s->texture = TextureKind::kSine;
+  else if (texture == "bumps") s->texture = TextureKind::kBumps;
+  else if (texture == "height_map") s->texture = TextureKind::kHeightMap;
+  else r.fail(r.node("texture")->source(), "texture", "must be \"sine\", \"bumps\" or \"height_map\"");
+  s->amplitude = r.number("amplitude");
+  s->wavelength = r.number("wavelength");
+  s->axis = read_axis(r, "axis", "x");
+  const Vec3 zero = Vec3::Zero();
+  s->origin = r.vector<3>("origin", &zero);
+  if (s->texture != TextureKind::kSine) s->axis_v = read_axis(r, "axis_v", s->axis == 1 ? "x" : "y");
+  else if (r.has("axis_v")) r.fail(r.node("axis_v")->source(), "axis_v", "only for texture = bumps or height_map");
+  if (s->texture == TextureKind::kHeightMap) {
+    const fs::path image = fs::path(r.file()).parent_path() / r.string("image");
+    s->height_map.path = image.lexically_normal().string();
+    std::string error;
+    if (!read_height_map(s->height_map.path, &s->height_map, &error))
+      r.fail(r.node("image")->source(), "image", error);
+  } else if (r.has("image")) {
+    r.fail(r.node("image")->source(), "image", "only for texture = \"height_map\"");
+  }
+  if (version == 1) {
+    // Version 1's amplitude was the height field's steepest slope, in (0, 1]: the
+    // same field in scene units (surface.h) is A = slope L / (2 pi) for the sine,
+    // slope L / pi for the bumps, slope L / width (a pixel's pitch) for a height map.
+    if (!(s->amplitude > 0 && s->amplitude <= 1))
+      r.fail(r.node("amplitude")->source(), "amplitude", "must be in (0, 1] (version 1: a slope)");
+    const double per = texture_slope_per_amplitude(s->texture, s->wavelength, s->height_map.width);
+    if (per > 0) s->amplitude /= per;  // else the wavelength's rule below names the problem
+  }
+  require(check_surface_settings(*s), r);
+}
+
+// [surface] (optional): its kind, and a texture's keys only for a texture.
+void read_surface(const TableReader& r, int version, SurfaceSettings* s) {
+  r.allow_only({"kind", "shading", "texture", "amplitude", "wavelength", "axis", "axis_v", "origin", "image"});
+  const std::string none = "none";
+  const std::string kind = r.string("kind", &none);
+  if (kind == "none") s->kind = SurfaceKind::kNone;
+  else if (kind == "force_shading") s->kind = SurfaceKind::kForceShading;
+  else if (kind == "texture") s->kind = SurfaceKind::kTexture;
+  else r.fail(r.node("kind")->source(), "kind", "must be \"none\", \"force_shading\" or \"texture\"");
+  if (s->kind == SurfaceKind::kTexture) {
+    read_texture(r, version, s);
+  } else {
+    for (const char* k : {"shading", "texture", "amplitude", "wavelength", "axis", "axis_v", "origin", "image"})
+      if (r.has(k)) r.fail(r.node(k)->source(), k, "only for kind = \"texture\"");
+  }
+}
+
+// A simulated device's hand script: a script's name, a .json file, or a
+// [device.script] table kept as JSON.
+void read_device_script(const TableReader& r, DeviceSettings* d) {
+  const toml::node* script = r.node("script");
+  if (script && script->is_table()) {
+    // The hand script in the scene: checked here for what JSON cannot hold (its key names, types
+    // and times are the device's hand_script_from_json's to check, at run time, naming the key).
+    check_json_representable(r, *script, "script");
+    std::ostringstream json;
+    json << toml::json_formatter{*script->as_table()};
+    d->script_json = json.str();
+  } else if (script && !script->is_string()) {
+    r.fail(script->source(), "script", "must be a script's name, a .json file or a table (the script itself)");
+  } else if (!script) {
+    r.fail_missing("script", "a script's name, a .json file or a [device.script] table: docs/scene-format.md");
+  } else {
+    d->script = r.string("script");
+  }
+}
+
+// A HID device's USB ids (16-bit; -1 means any), serial and path.
+void read_hid_keys(const TableReader& r, DeviceSettings* d) {
+  const int64_t any = -1;
+  for (const char* k : {"vendor_id", "product_id"})
+    if (const int64_t id = r.integer(k, &any); id < -1 || id > 0xFFFF)
+      require(false, r, k, "must be a 16-bit USB id in [0, 65535] (or -1 for any)");
+  d->vendor_id = static_cast<int>(r.integer("vendor_id", &any));
+  d->product_id = static_cast<int>(r.integer("product_id", &any));
+  const std::string blank;
+  d->serial = r.string("serial", &blank);
+  d->path = r.string("path", &blank);
+}
+
+// [device]: its kind and that kind's keys (another kind's keys are errors),
+// its rate and force limits.
+void read_device(const TableReader& r, DeviceSettings* d) {
+  r.allow_only({"kind", "rate_hz", "max_force", "max_torque", "script", "trace", "vendor_id", "product_id",
+                "serial", "path"});
+  const std::string kind = r.string("kind");
+  std::vector<std::string> own;
+  if (kind == "simulated") {
+    d->kind = DeviceKind::kSimulated;
+    read_device_script(r, d);
+    own = {"script"};
+  } else if (kind == "replay") {
+    d->kind = DeviceKind::kReplay;
+    d->trace = (fs::path(r.file()).parent_path() / r.string("trace")).lexically_normal().string();
+    own = {"trace"};
+  } else if (kind == "hid") {
+    d->kind = DeviceKind::kHid;
+    read_hid_keys(r, d);
+    own = {"vendor_id", "product_id", "serial", "path"};
+  } else {
+    r.fail(r.node("kind")->source(), "kind", "must be \"simulated\", \"replay\" or \"hid\"");
+  }
+  // Keys of another device kind are errors, not silently ignored.
+  for (const char* k : {"script", "trace", "vendor_id", "product_id", "serial", "path"}) {
+    bool mine = false;
+    for (const std::string& o : own) mine |= o == k;
+    if (!mine && r.has(k)) r.fail(r.node(k)->source(), k, "not a key of a \"" + kind + "\" device");
+  }
+  const DeviceSettings defaults;
+  d->rate_hz = r.number("rate_hz", &defaults.rate_hz);
+  d->max_force = r.number("max_force", &defaults.max_force);
+  d->max_torque = r.number("max_torque", &defaults.max_torque);
+  require(check_device_settings(*d), r);
+}
+
+}  // namespace
+
+// A reader per table of the scene format (docs/scene-format.md), called in this
+// order: the error reported is the first one met in it.
+Scene load_scene(const std::string& path) {
+  Scene scene;
+  scene.path = path;
+  const toml::table root = parse_scene_file(path);
+  const toml::table empty;  // an optional table left out
+  const TableReader top(path, root, "");
+  read_header(top, &scene);
+  read_gains(TableReader(path, sub_table(top, "gains", true, empty), "gains."), &scene.gains);
+  const TableReader contact(path, sub_table(top, "contact", true, empty), "contact.");
+  read_contact(contact, &scene.contact);
+  std::set<std::string> names;  // the bodies' names, each once
+  read_obstacles(top, &names, &scene);
+  read_god_object(TableReader(path, sub_table(top, "god_object", true, empty), "god_object."), &names, &scene);
   require(check_delta_scale(scene), contact);  // delta against the bodies' coordinates
-
-  // [surface] (optional)
-  {
-    TableReader r(path, sub_table(top, "surface", false, empty), "surface.");
-    r.allow_only({"kind", "shading", "texture", "amplitude", "wavelength", "axis", "axis_v", "origin", "image"});
-    SurfaceSettings& s = scene.surface;
-    const std::string none = "none";
-    const std::string kind = r.string("kind", &none);
-    if (kind == "none") s.kind = SurfaceKind::kNone;
-    else if (kind == "force_shading") s.kind = SurfaceKind::kForceShading;
-    else if (kind == "texture") s.kind = SurfaceKind::kTexture;
-    else r.fail(r.node("kind")->source(), "kind", "must be \"none\", \"force_shading\" or \"texture\"");
-    auto read_axis = [&](const char* key, const std::string& fallback) {
-      const std::string a = r.string(key, &fallback);
-      if (a != "x" && a != "y" && a != "z") r.fail(r.node(key)->source(), key, "must be x, y or z");
-      return a[0] - 'x';
-    };
-    if (s.kind == SurfaceKind::kTexture) {
-      s.shading = r.boolean("shading", false);
-      const std::string sine = "sine";
-      const std::string texture = r.string("texture", &sine);
-      if (texture == "sine") s.texture = TextureKind::kSine;
-      else if (texture == "bumps") s.texture = TextureKind::kBumps;
-      else if (texture == "height_map") s.texture = TextureKind::kHeightMap;
-      else r.fail(r.node("texture")->source(), "texture", "must be \"sine\", \"bumps\" or \"height_map\"");
-      s.amplitude = r.number("amplitude");
-      s.wavelength = r.number("wavelength");
-      s.axis = read_axis("axis", "x");
-      const Vec3 zero = Vec3::Zero();
-      s.origin = r.vector<3>("origin", &zero);
-      if (s.texture != TextureKind::kSine) s.axis_v = read_axis("axis_v", s.axis == 1 ? "x" : "y");
-      else if (r.has("axis_v")) r.fail(r.node("axis_v")->source(), "axis_v", "only for texture = bumps or height_map");
-      if (s.texture == TextureKind::kHeightMap) {
-        const fs::path image = fs::path(path).parent_path() / r.string("image");
-        s.height_map.path = image.lexically_normal().string();
-        std::string error;
-        if (!read_height_map(s.height_map.path, &s.height_map, &error))
-          r.fail(r.node("image")->source(), "image", error);
-      } else if (r.has("image")) {
-        r.fail(r.node("image")->source(), "image", "only for texture = \"height_map\"");
-      }
-      if (version == 1) {
-        // Version 1's amplitude was the height field's steepest slope, in (0, 1]: the
-        // same field in scene units (surface.h) is A = slope L / (2 pi) for the sine,
-        // slope L / pi for the bumps, slope L / width (a pixel's pitch) for a height map.
-        if (!(s.amplitude > 0 && s.amplitude <= 1))
-          r.fail(r.node("amplitude")->source(), "amplitude", "must be in (0, 1] (version 1: a slope)");
-        const double per = texture_slope_per_amplitude(s.texture, s.wavelength, s.height_map.width);
-        if (per > 0) s.amplitude /= per;  // else the wavelength's rule below names the problem
-      }
-      require(check_surface_settings(s), r);
-    } else {
-      for (const char* k : {"shading", "texture", "amplitude", "wavelength", "axis", "axis_v", "origin", "image"})
-        if (r.has(k)) r.fail(r.node(k)->source(), k, "only for kind = \"texture\"");
-    }
-  }
-
-  // [device]
-  {
-    TableReader r(path, sub_table(top, "device", true, empty), "device.");
-    r.allow_only({"kind", "rate_hz", "max_force", "max_torque", "script", "trace", "vendor_id", "product_id",
-                  "serial", "path"});
-    DeviceSettings& d = scene.device;
-    const std::string kind = r.string("kind");
-    std::vector<std::string> own;
-    if (kind == "simulated") {
-      d.kind = DeviceKind::kSimulated;
-      const toml::node* script = r.node("script");
-      if (script && script->is_table()) {
-        // The hand script in the scene: checked here for what JSON cannot hold (its key names, types
-        // and times are the device's hand_script_from_json's to check, at run time, naming the key).
-        check_json_representable(r, *script, "script");
-        std::ostringstream json;
-        json << toml::json_formatter{*script->as_table()};
-        d.script_json = json.str();
-      } else if (script && !script->is_string()) {
-        r.fail(script->source(), "script", "must be a script's name, a .json file or a table (the script itself)");
-      } else if (!script) {
-        r.fail_missing("script", "a script's name, a .json file or a [device.script] table: docs/scene-format.md");
-      } else {
-        d.script = r.string("script");
-      }
-      own = {"script"};
-    } else if (kind == "replay") {
-      d.kind = DeviceKind::kReplay;
-      d.trace = (fs::path(path).parent_path() / r.string("trace")).lexically_normal().string();
-      own = {"trace"};
-    } else if (kind == "hid") {
-      d.kind = DeviceKind::kHid;
-      const int64_t any = -1;
-      // USB ids are 16-bit; -1 means any.
-      for (const char* k : {"vendor_id", "product_id"})
-        if (const int64_t id = r.integer(k, &any); id < -1 || id > 0xFFFF)
-          require(false, r, k, "must be a 16-bit USB id in [0, 65535] (or -1 for any)");
-      d.vendor_id = static_cast<int>(r.integer("vendor_id", &any));
-      d.product_id = static_cast<int>(r.integer("product_id", &any));
-      const std::string blank;
-      d.serial = r.string("serial", &blank);
-      d.path = r.string("path", &blank);
-      own = {"vendor_id", "product_id", "serial", "path"};
-    } else {
-      r.fail(r.node("kind")->source(), "kind", "must be \"simulated\", \"replay\" or \"hid\"");
-    }
-    // Keys of another device kind are errors, not silently ignored.
-    for (const char* k : {"script", "trace", "vendor_id", "product_id", "serial", "path"}) {
-      bool mine = false;
-      for (const std::string& o : own) mine |= o == k;
-      if (!mine && r.has(k)) r.fail(r.node(k)->source(), k, "not a key of a \"" + kind + "\" device");
-    }
-    const DeviceSettings defaults;
-    d.rate_hz = r.number("rate_hz", &defaults.rate_hz);
-    d.max_force = r.number("max_force", &defaults.max_force);
-    d.max_torque = r.number("max_torque", &defaults.max_torque);
-    require(check_device_settings(d), r);
-  }
+  read_surface(TableReader(path, sub_table(top, "surface", false, empty), "surface."), scene.version,
+               &scene.surface);
+  read_device(TableReader(path, sub_table(top, "device", true, empty), "device."), &scene.device);
   return scene;
 }
 
