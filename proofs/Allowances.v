@@ -207,18 +207,24 @@ Proof.
 Qed.
 
 
-(* ---- kRelativeRounding at its norm sites ----
-   round_up(v.norm() * (1 + kRelativeRounding)): Eigen's norm of a double
-   3-vector, sqrt of the sum of the three rounded squares (summed in any
-   order: the statement is symmetric in x, y, z), times the double
-   1 + kRelativeRounding (the compiler folds it, rounding to nearest), rounded
-   up, is at least the exact norm, provided |v|^2 >= 2^-1000: below that the
-   squares underflow and the bound can fall below |v| (proofs/README.md).
-   Sites: StartFrame::set (omega_norm, omega a double vector) and the same
-   form at SweptObbFrame::pose (|half|); not the shift of Displacement, whose
-   components are rounded differences. *)
+(* ---- kRelativeRounding, kRelativeRoundingWide and kNormFloor at the norm sites ----
+   rounding.h's norm_up(n, k) = max(round_up(n (1 + k)), Upper{kNormFloor})
+   and norm_down(n, k) = (d > kNormFloor ? d : 0), d = round_down(n (1 - k)),
+   with n the computed norm of a double 3-vector v: Eigen's v.norm() (or
+   std::sqrt(v.squaredNorm())), the square root of the sum of the three rounded
+   squares. The statements are symmetric in x, y, z, so they hold for any order
+   of the sum. The constant 1 + k is the double fl(1 + fl(k)) (the compiler
+   folds it, rounding to nearest). No fused multiply-add (x86-64 without FMA
+   in the build's flags).
+   Below |v|^2 = 2^-1000 the squares underflow and the computed norm may be 0
+   for a vector of norm 2^-537: the floor kNormFloor speaks there (this was a
+   finding: the form without it, round_up(n (1 + k)), fell 2^63 times below
+   |v| at such a v, and round_down(n (1 - k)) was <= 0, a divisor of
+   Upper / Lower whose double must be > 0). *)
 (* allowance kRelativeRounding = 1e-15 *)
 Definition kRelativeRounding := fl (/ 1000000000000000).
+(* allowance kRelativeRoundingWide = 1e-12 *)
+Definition kRelativeRoundingWide := fl (/ 1000000000000).
 
 Lemma fl_lower z : 0 <= z -> (1 - u) * z - eta <= fl z.
 Proof.
@@ -231,66 +237,248 @@ Proof.
   unfold Rabs in H; destruct Rcase_abs; lra.
 Qed.
 
-Lemma one_plus_rel : 1 + 7 * u <= fl (1 + kRelativeRounding).
+(* The folded constants: fl(1 + 1e-15) >= 1 + 8 u, fl(1 + 1e-12) >= 1 + 8 u,
+   0 <= fl(1 - 1e-12) <= 1 - 8 u. *)
+Lemma one_plus_fl c : / 1000000000000000 <= c <= 1 -> 1 + 8 * u <= fl (1 + fl c).
+Proof.
+  intros Hc. pose proof eta_pos. pose proof eta_small.
+  assert (bpow radix2 (-1022) <= / 1000000000000000000) by (simpl; lra).
+  assert (Hk : (1 - u) * c - eta <= fl c) by (apply fl_lower; lra).
+  assert (0 <= fl c) by (apply fl_nonneg; lra).
+  pose proof (fl_lower (1 + fl c) ltac:(lra)).
+  unfold u in *. lra.
+Qed.
+Lemma one_plus_relative : 1 + 8 * u <= fl (1 + kRelativeRounding).
+Proof. apply one_plus_fl. lra. Qed.
+Lemma one_plus_wide : 1 + 8 * u <= fl (1 + kRelativeRoundingWide).
+Proof. apply one_plus_fl. lra. Qed.
+Lemma one_minus_wide : 0 <= fl (1 - kRelativeRoundingWide) <= 1 - 8 * u.
 Proof.
   pose proof eta_pos. pose proof eta_small.
   assert (bpow radix2 (-1022) <= / 1000000000000000000) by (simpl; lra).
-  assert (Hk : (1 - u) * / 1000000000000000 - eta <= kRelativeRounding) by (apply fl_lower; lra).
-  assert (0 <= kRelativeRounding) by (apply fl_nonneg; lra).
-  pose proof (fl_lower (1 + kRelativeRounding) ltac:(lra)).
+  assert (Hk : (1 - u) * / 1000000000000 - eta <= kRelativeRoundingWide) by (apply fl_lower; lra).
+  assert (Hk' : kRelativeRoundingWide <= (1 + u) * / 1000000000000 + eta) by (apply fl_upper; lra).
+  split; [apply fl_nonneg; unfold u in *; lra|].
+  pose proof (fl_upper (1 - kRelativeRoundingWide) ltac:(unfold u in *; lra)).
   unfold u in *. lra.
 Qed.
 
-(* covers optimized/src/motion_bounds.cpp "void StartFrame::set(const CcdMotion& m, double u, double rho_in)" sha256:d727ef1e2605b2dd *)
-Theorem norm_relative_rounding x y z :
-  bpow radix2 (-1000) <= x * x + y * y + z * z ->
-  let s := fl (fl (fl (x * x) + fl (y * y)) + fl (z * z)) in
-  sqrt (x * x + y * y + z * z) <= next_up (fl (fl (sqrt s) * fl (1 + kRelativeRounding))).
+Lemma bpow_m53 : u = bpow radix2 (-53).
+Proof. unfold u; simpl; lra. Qed.
+
+(* S >= 2^-1002: the absolute errors of underflow, eta, are below 2^-20 u S. *)
+Lemma eta_rel S : bpow radix2 (-1002) <= S -> 1000000 * eta <= u * S.
 Proof.
-  intros HS s. pose proof eta_pos. pose proof eta_small. assert (Hu : 0 < u) by (unfold u; lra).
-  set (S := x * x + y * y + z * z) in *.
-  assert (E1 : 1000000 * eta <= u * bpow radix2 (-1000)).
-  { unfold eta, u. replace (/ 9007199254740992) with (bpow radix2 (-53)) by (simpl; lra).
-    rewrite <- bpow_plus. apply Rle_trans with (bpow radix2 22 * bpow radix2 (-1075)).
-    - apply Rmult_le_compat_r; [apply bpow_ge_0 | simpl; lra].
-    - rewrite <- bpow_plus. apply bpow_le. lia. }
-  assert (HeS : 1000000 * eta <= u * S)
-    by (apply Rle_trans with (u * bpow radix2 (-1000)); [exact E1 | apply Rmult_le_compat_l; lra]).
-  assert (X := fl_lower (x * x) ltac:(nra)); assert (Y := fl_lower (y * y) ltac:(nra));
-  assert (Z := fl_lower (z * z) ltac:(nra)).
-  assert (0 <= fl (x * x)) by (apply fl_nonneg; nra); assert (0 <= fl (y * y)) by (apply fl_nonneg; nra);
-  assert (0 <= fl (z * z)) by (apply fl_nonneg; nra).
-  assert (T := fl_lower (fl (x * x) + fl (y * y)) ltac:(lra)).
-  assert (0 <= fl (fl (x * x) + fl (y * y))) by (apply fl_nonneg; lra).
-  assert (Hs := fl_lower (fl (fl (x * x) + fl (y * y)) + fl (z * z)) ltac:(lra)). fold s in Hs.
-  assert (Hs' : (1 - 4 * u) * S <= s).
-  { unfold S in *. assert (0 <= x * x) by nra. assert (0 <= y * y) by nra. assert (0 <= z * z) by nra.
-    unfold u in *. nra. }
-  assert (HS0 : 0 < S) by (pose proof (bpow_gt_0 radix2 (-1000)); lra).
-  assert (Hr : (1 - 4 * u) * sqrt S <= sqrt s).
-  { apply Rle_trans with (sqrt ((1 - 4 * u) * S)); [|apply sqrt_le_1_alt; exact Hs'].
-    rewrite sqrt_mult by (unfold u; lra). apply Rmult_le_compat_r; [apply sqrt_pos|].
-    assert (0 <= 1 - 4 * u <= 1) by (unfold u; lra).
-    rewrite <- (sqrt_Rsqr (1 - 4 * u)) at 1 by lra. apply sqrt_le_1_alt. unfold Rsqr. nra. }
-  assert (Hn := fl_lower (sqrt s) (sqrt_pos s)).
-  assert (HsS : eta <= u * sqrt S).
-  { (* sqrt S >= S when S <= 1, and sqrt S >= 1 >= S... : use sqrt S >= S / sqrt S... simply: *)
-    destruct (Rle_or_lt S 1).
-    - assert (S <= sqrt S).
-      { rewrite <- (sqrt_Rsqr S) at 1 by lra. apply sqrt_le_1_alt. unfold Rsqr. nra. }
-      nra.
-    - assert (1 <= sqrt S) by (rewrite <- sqrt_1; apply sqrt_le_1_alt; lra).
-      unfold eta in *. apply Rle_trans with (bpow radix2 (-1075)); [lra|].
-      apply Rle_trans with u; [|nra]. unfold u. replace (/ 9007199254740992) with (bpow radix2 (-53)) by (simpl; lra).
-      apply bpow_le; lia. }
-  pose proof one_plus_rel.
-  assert (0 <= sqrt S) by apply sqrt_pos.
-  assert (Hn' : (1 - 6 * u) * sqrt S <= fl (sqrt s)) by (unfold u in *; nra).
-  apply up_ge. unfold u in *. nra.
+  intros HS. pose proof eta_pos. assert (0 < u) by (unfold u; lra).
+  apply Rle_trans with (u * bpow radix2 (-1002)); [|apply Rmult_le_compat_l; lra].
+  rewrite bpow_m53, <- bpow_plus. unfold eta.
+  apply Rle_trans with (bpow radix2 20 * bpow radix2 (-1075)).
+  - apply Rmult_le_compat_r; [apply bpow_ge_0 | simpl; lra].
+  - rewrite <- bpow_plus. apply bpow_le. lia.
 Qed.
+
+(* The sum of the three rounded squares, from below and from above. *)
+Lemma mul_le_l k a b : 0 <= k -> a <= b -> k * a <= k * b.
+Proof. intros; apply Rmult_le_compat_l; assumption. Qed.
+Lemma sumsq_lower x y z : let S := x * x + y * y + z * z in
+  bpow radix2 (-1002) <= S -> (1 - 4 * u) * S <= fl (fl (fl (x * x) + fl (y * y)) + fl (z * z)).
+Proof.
+  intros S HS. pose proof (eta_rel S HS). pose proof eta_pos. assert (0 < u < / 1000000) by (unfold u; lra).
+  assert (0 <= x * x) by nra. assert (0 <= y * y) by nra. assert (0 <= z * z) by nra.
+  pose proof (fl_lower (x * x) ltac:(lra)). pose proof (fl_lower (y * y) ltac:(lra)).
+  pose proof (fl_lower (z * z) ltac:(lra)).
+  set (a := fl (x * x)) in *; set (b := fl (y * y)) in *; set (c := fl (z * z)) in *.
+  assert (0 <= a) by (apply fl_nonneg; lra). assert (0 <= b) by (apply fl_nonneg; lra).
+  assert (0 <= c) by (apply fl_nonneg; lra).
+  pose proof (fl_lower (a + b) ltac:(lra)). set (t := fl (a + b)) in *.
+  assert (0 <= t) by (apply fl_nonneg; lra).
+  pose proof (fl_lower (t + c) ltac:(lra)).
+  assert (K1 : (1 - u) * S - 3 * eta <= a + b + c) by (unfold S; lra).
+  assert (K2 : (1 - u) * (a + b) - eta + c <= t + c) by lra.
+  assert (K3 : (1 - u) * ((1 - u) * (a + b) - eta + c) - eta <= fl (t + c))
+    by (apply Rle_trans with ((1 - u) * (t + c) - eta); [assert ((1 - u) * ((1 - u) * (a + b) - eta + c) <= (1 - u) * (t + c)) by (apply mul_le_l; lra); lra | lra]).
+  assert (0 <= (1 - u) * u * c) by (apply Rmult_le_pos; [nra | lra]).
+  assert (K4 : (1 - u) * (1 - u) * (a + b + c) - 2 * eta <= (1 - u) * ((1 - u) * (a + b) - eta + c) - eta) by nra.
+  assert (K5 : (1 - u) * (1 - u) * ((1 - u) * S - 3 * eta) <= (1 - u) * (1 - u) * (a + b + c))
+    by (apply mul_le_l; [nra | lra]).
+  assert (0 <= S) by (pose proof (bpow_ge_0 radix2 (-1002)); lra).
+  assert (Q1 : (1 - 3 * u) * S <= (1 - u) * (1 - u) * (1 - u) * S)
+    by (apply Rmult_le_compat_r; [lra | nra]).
+  assert (Q2 : (1 - u) * (1 - u) * eta <= 1 * eta) by (apply Rmult_le_compat_r; nra).
+  assert (u * eta <= / 1000 * eta) by (apply Rmult_le_compat_r; lra).
+  lra.
+Qed.
+Lemma sumsq_upper x y z : let S := x * x + y * y + z * z in
+  fl (fl (fl (x * x) + fl (y * y)) + fl (z * z)) <= (1 + 4 * u) * S + 6 * eta.
+Proof.
+  intros S. pose proof eta_pos. assert (0 < u < / 1000000) by (unfold u; lra).
+  assert (0 <= x * x) by nra. assert (0 <= y * y) by nra. assert (0 <= z * z) by nra.
+  pose proof (fl_upper (x * x) ltac:(lra)). pose proof (fl_upper (y * y) ltac:(lra)).
+  pose proof (fl_upper (z * z) ltac:(lra)).
+  set (a := fl (x * x)) in *; set (b := fl (y * y)) in *; set (c := fl (z * z)) in *.
+  assert (0 <= a) by (apply fl_nonneg; lra). assert (0 <= b) by (apply fl_nonneg; lra).
+  assert (0 <= c) by (apply fl_nonneg; lra).
+  pose proof (fl_upper (a + b) ltac:(lra)). set (t := fl (a + b)) in *.
+  assert (0 <= t) by (apply fl_nonneg; lra).
+  pose proof (fl_upper (t + c) ltac:(lra)).
+  assert (K1 : a + b + c <= (1 + u) * S + 3 * eta) by (unfold S; lra).
+  assert (K3 : fl (t + c) <= (1 + u) * ((1 + u) * (a + b) + eta + c) + eta)
+    by (apply Rle_trans with ((1 + u) * (t + c) + eta); [lra | assert ((1 + u) * (t + c) <= (1 + u) * ((1 + u) * (a + b) + eta + c)) by (apply mul_le_l; lra); lra]).
+  assert (K4 : (1 + u) * ((1 + u) * (a + b) + eta + c) + eta <= (1 + u) * (1 + u) * (a + b + c) + (2 + u) * eta) by nra.
+  assert (K5 : (1 + u) * (1 + u) * (a + b + c) <= (1 + u) * (1 + u) * ((1 + u) * S + 3 * eta))
+    by (apply mul_le_l; [nra | lra]).
+  assert (0 <= S) by (unfold S; lra).
+  assert (Q1 : (1 + u) * (1 + u) * (1 + u) * S <= (1 + 4 * u) * S) by (apply Rmult_le_compat_r; nra).
+  assert (Q2 : (1 + u) * (1 + u) * eta <= (1 + / 1000) * eta) by (apply Rmult_le_compat_r; nra).
+  assert (u * eta <= / 1000 * eta) by (apply Rmult_le_compat_r; lra).
+  lra.
+Qed.
+
+(* sqrt (2^-2e) = 2^-e. *)
+Lemma sqrt_bpow2 e : sqrt (bpow radix2 (2 * e)) = bpow radix2 e.
+Proof.
+  replace (2 * e)%Z with (e + e)%Z by lia. rewrite bpow_plus.
+  apply sqrt_square. apply bpow_ge_0.
+Qed.
+Lemma sqrt_scale k S : 0 <= k -> 0 <= S -> sqrt (k * k * S) = k * sqrt S.
+Proof. intros. rewrite sqrt_mult by nra. rewrite sqrt_square by lra. reflexivity. Qed.
+
+Definition norm_c x y z := fl (sqrt (fl (fl (fl (x * x) + fl (y * y)) + fl (z * z)))).
+
+(* allowance kNormFloor = 0x1p-500 *)
+Definition kNormFloor := bpow radix2 (-500).
+
+Theorem norm_upper_bound x y z k : 1 + 8 * u <= k ->
+  sqrt (x * x + y * y + z * z) <= Rmax (next_up (fl (norm_c x y z * k))) kNormFloor.
+Proof.
+  intros Hk. set (S := x * x + y * y + z * z).
+  assert (HS0 : 0 <= S) by (unfold S; nra).
+  destruct (Rlt_or_le S (bpow radix2 (-1000))) as [Hs|Hs].
+  - (* below the floor *)
+    apply Rle_trans with kNormFloor; [|apply Rmax_r].
+    unfold kNormFloor. rewrite <- (sqrt_bpow2 (-500)). apply sqrt_le_1_alt. simpl (2 * -500)%Z. lra.
+  - apply Rle_trans with (next_up (fl (norm_c x y z * k))); [|apply Rmax_l].
+    assert (HS2 : bpow radix2 (-1002) <= S)
+      by (eapply Rle_trans; [apply bpow_le with (e2 := (-1000)%Z); lia | exact Hs]).
+    pose proof (sumsq_lower x y z HS2) as Hs'. fold S in Hs'.
+    set (s := fl (fl (fl (x * x) + fl (y * y)) + fl (z * z))) in *.
+    pose proof eta_pos. assert (Hu : 0 < u < / 1000000) by (unfold u; lra).
+    set (N := sqrt S).
+    assert (HN : bpow radix2 (-500) <= N)
+      by (unfold N; rewrite <- (sqrt_bpow2 (-500)); apply sqrt_le_1_alt; exact Hs).
+    assert (HeN : 1000000 * eta <= u * N).
+    { apply Rle_trans with (u * bpow radix2 (-500)); [|apply Rmult_le_compat_l; lra].
+      rewrite bpow_m53, <- bpow_plus. unfold eta.
+      apply Rle_trans with (bpow radix2 20 * bpow radix2 (-1075)).
+      - apply Rmult_le_compat_r; [apply bpow_ge_0 | simpl; lra].
+      - rewrite <- bpow_plus. apply bpow_le. lia. }
+    assert (HN0 : 0 <= N) by apply sqrt_pos.
+    assert (Hr : (1 - 3 * u) * N <= sqrt s).
+    { unfold N. rewrite <- sqrt_scale by lra. apply sqrt_le_1_alt.
+      apply Rle_trans with ((1 - 4 * u) * S); [apply Rmult_le_compat_r; nra | exact Hs']. }
+    pose proof (fl_lower (sqrt s) (sqrt_pos s)) as Hf.
+    assert (Hf' : (1 - 5 * u) * N <= fl (sqrt s)).
+    { assert ((1 - u) * ((1 - 3 * u) * N) <= (1 - u) * sqrt s) by (apply mul_le_l; lra).
+      assert ((1 - 4 * u) * N <= ((1 - u) * (1 - 3 * u)) * N) by (apply Rmult_le_compat_r; nra).
+      lra. }
+    fold (norm_c x y z) in Hf'. unfold norm_c in *. fold s in Hf'.
+    assert (Hp : (1 + 2 * u) * N <= fl (sqrt s) * k).
+    { apply Rle_trans with (((1 - 5 * u) * N) * (1 + 8 * u)).
+      - assert (0 <= (1 + 2 * u) * N) by nra. apply Rle_trans with ((1 - 5 * u) * (1 + 8 * u) * N).
+        + apply Rmult_le_compat_r; nra.
+        + lra.
+      - apply Rmult_le_compat; nra. }
+    pose proof (fl_lower (fl (sqrt s) * k) ltac:(nra)) as Hq.
+    assert ((1 - u) * ((1 + 2 * u) * N) <= (1 - u) * (fl (sqrt s) * k)) by (apply mul_le_l; lra).
+    assert ((1 + / 2 * u) * N <= ((1 - u) * (1 + 2 * u)) * N) by (apply Rmult_le_compat_r; nra).
+    apply Rle_trans with (fl (fl (sqrt s) * k)); [|apply next_up_ge_F, F_fl]. lra.
+Qed.
+
+Theorem norm_lower_bound x y z k : 0 <= k <= 1 - 8 * u ->
+  let d := next_down (fl (norm_c x y z * k)) in
+  (if Rlt_dec kNormFloor d then d else 0) <= sqrt (x * x + y * y + z * z).
+Proof.
+  intros Hk d. set (S := x * x + y * y + z * z).
+  assert (HS0 : 0 <= S) by (unfold S; nra). pose proof eta_pos. assert (Hu : 0 < u < / 1000000) by (unfold u; lra).
+  unfold norm_c in d. set (s := fl (fl (fl (x * x) + fl (y * y)) + fl (z * z))) in *.
+  pose proof (sumsq_upper x y z) as Hs'. fold S s in Hs'.
+  assert (Hd : d <= fl (fl (sqrt s) * k)) by (apply next_down_le_F, F_fl).
+  destruct (Rlt_or_le S (bpow radix2 (-1002))) as [Hs|Hs].
+  - (* d is at most the floor: the result is 0 *)
+    assert (He : 6 * eta <= bpow radix2 (-1002)).
+    { unfold eta. apply Rle_trans with (bpow radix2 3 * bpow radix2 (-1075)).
+      - apply Rmult_le_compat_r; [apply bpow_ge_0 | simpl; lra].
+      - rewrite <- bpow_plus. apply bpow_le. lia. }
+    assert (Hb : bpow radix2 (-1000) = 4 * bpow radix2 (-1002))
+      by (replace (-1000)%Z with (2 + -1002)%Z by lia; rewrite bpow_plus; simpl; lra).
+    assert (Hss : s <= bpow radix2 (2 * -500)).
+    { simpl (2 * -500)%Z. rewrite Hb. assert (4 * u * S <= bpow radix2 (-1002)) by nra. nra. }
+    assert (Hq : sqrt s <= kNormFloor) by (unfold kNormFloor; rewrite <- sqrt_bpow2; apply sqrt_le_1_alt; exact Hss).
+    assert (HF : F kNormFloor) by (apply generic_format_bpow; unfold FLT_exp; lia).
+    assert (Hq' : fl (sqrt s) <= kNormFloor) by (apply fl_le_F; assumption).
+    assert (0 <= fl (sqrt s)) by (apply fl_nonneg, sqrt_pos).
+    assert (0 < kNormFloor) by apply bpow_gt_0.
+    assert (fl (fl (sqrt s) * k) <= kNormFloor) by (apply fl_le_F; [exact HF | nra]).
+    destruct (Rlt_dec kNormFloor d); [lra | apply sqrt_pos].
+  - assert (d <= sqrt S).
+    { pose proof (eta_rel S Hs) as HeS. set (N := sqrt S).
+      assert (HN0 : 0 <= N) by apply sqrt_pos.
+      assert (HN : bpow radix2 (-501) <= N).
+      { unfold N. rewrite <- (sqrt_bpow2 (-501)). apply sqrt_le_1_alt. simpl (2 * -501)%Z. exact Hs. }
+      assert (HeN : 1000000 * eta <= u * N).
+      { apply Rle_trans with (u * bpow radix2 (-501)); [|apply Rmult_le_compat_l; lra].
+        rewrite bpow_m53, <- bpow_plus. unfold eta.
+        apply Rle_trans with (bpow radix2 20 * bpow radix2 (-1075)).
+        - apply Rmult_le_compat_r; [apply bpow_ge_0 | simpl; lra].
+        - rewrite <- bpow_plus. apply bpow_le. lia. }
+      assert (Hr : sqrt s <= (1 + 3 * u) * N).
+      { unfold N. rewrite <- sqrt_scale by lra. apply sqrt_le_1_alt.
+        apply Rle_trans with ((1 + 5 * u) * S); [nra | apply Rmult_le_compat_r; nra]. }
+      pose proof (fl_upper (sqrt s) (sqrt_pos s)) as Hf.
+      assert (Hf' : fl (sqrt s) <= (1 + 5 * u) * N).
+      { assert ((1 + u) * sqrt s <= (1 + u) * ((1 + 3 * u) * N)) by (apply mul_le_l; lra).
+        assert (((1 + u) * (1 + 3 * u)) * N <= (1 + 9 / 2 * u) * N) by (apply Rmult_le_compat_r; nra).
+        lra. }
+      assert (0 <= fl (sqrt s)) by (apply fl_nonneg, sqrt_pos).
+      assert (Hp : fl (sqrt s) * k <= (1 - 2 * u) * N).
+      { apply Rle_trans with (((1 + 5 * u) * N) * (1 - 8 * u)).
+        - apply Rmult_le_compat; lra.
+        - apply Rle_trans with ((1 + 5 * u) * (1 - 8 * u) * N); [lra | apply Rmult_le_compat_r; nra]. }
+      pose proof (fl_upper (fl (sqrt s) * k) ltac:(nra)) as Hq.
+      assert ((1 + u) * (fl (sqrt s) * k) <= (1 + u) * ((1 - 2 * u) * N)) by (apply mul_le_l; lra).
+      assert (((1 + u) * (1 - 2 * u)) * N <= (1 - / 2 * u) * N) by (apply Rmult_le_compat_r; nra).
+      lra. }
+    destruct (Rlt_dec kNormFloor d); [assumption | apply sqrt_pos].
+Qed.
+
+(* The code's forms, at its sites. *)
+(* covers optimized/include/gauss6/rounding.h "GAUSS6_ALWAYS_INLINE Upper norm_up(double norm, double relative)" sha256:b4b3280a1e614758 *)
+(* covers optimized/src/motion_bounds.cpp "void StartFrame::set(const CcdMotion& m, double u, double rho_in)" sha256:cfac9ee869768b2c *)
+(* covers optimized/include/gauss6/motion_bounds.h "PosedObb pose(const Obb& b) const" sha256:d9a738b735b2fff9 *)
+(* covers optimized/include/gauss6/motion_bounds.h "double radius(double r2) const" sha256:6689317b141e2024 *)
+Theorem norm_up_relative x y z :
+  sqrt (x * x + y * y + z * z) <= Rmax (next_up (fl (norm_c x y z * fl (1 + kRelativeRounding)))) kNormFloor.
+Proof. apply norm_upper_bound, one_plus_relative. Qed.
+
+(* covers optimized/include/gauss6/rounding.h "GAUSS6_ALWAYS_INLINE Upper norm_up(double norm, double relative)" sha256:b4b3280a1e614758 *)
+(* covers optimized/include/gauss6/distance.h "GAUSS6_ALWAYS_INLINE void for_each_separating_axis(const SatSide& A" sha256:823fc811c899d033 *)
+Theorem norm_up_wide x y z :
+  sqrt (x * x + y * y + z * z) <= Rmax (next_up (fl (norm_c x y z * fl (1 + kRelativeRoundingWide)))) kNormFloor.
+Proof. apply norm_upper_bound, one_plus_wide. Qed.
+
+(* covers optimized/include/gauss6/rounding.h "GAUSS6_ALWAYS_INLINE Lower norm_down(double norm, double relative)" sha256:981268e19c3ba706 *)
+(* covers optimized/include/gauss6/motion_bounds.h "inline double triangle_time_lower_bound(const SatSide& A, const Vec3 r[3]" sha256:e6fe43232891e550 *)
+Theorem norm_down_wide x y z :
+  let d := next_down (fl (norm_c x y z * fl (1 - kRelativeRoundingWide))) in
+  (if Rlt_dec kNormFloor d then d else 0) <= sqrt (x * x + y * y + z * z).
+Proof. apply norm_lower_bound, one_minus_wide. Qed.
 
 (* The theorems, each answered by tools/check_proofs.sh. *)
 Print Assumptions linear_corner_rounding.
 Print Assumptions linear_corner_selection.
 Print Assumptions linear_corner_error_bound.
-Print Assumptions norm_relative_rounding.
+Print Assumptions norm_upper_bound.
+Print Assumptions norm_lower_bound.
+Print Assumptions norm_up_relative.
+Print Assumptions norm_up_wide.
+Print Assumptions norm_down_wide.

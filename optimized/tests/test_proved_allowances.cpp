@@ -16,6 +16,7 @@
 #include <random>
 
 #include "gauss6/error_allowances.h"
+#include "gauss6/motion_bounds.h"
 #include "gauss6/rounding.h"
 
 using namespace gauss6;
@@ -99,25 +100,87 @@ TEST_CASE("the least and largest corner values as enclose_linear selects them (A
   }
 }
 
-// norm_relative_rounding: round_up(|v| (1 + kRelativeRounding)), |v| by
-// Eigen's norm(), bounds the exact Euclidean norm of the double vector v from
-// above whenever |v|^2 >= 2^-1000 (the theorem's hypothesis), checked
-// exactly (squares of rationals) from |v|^2 = 2^-1000 up to 2^1020 in
-// magnitude, with zero and signed-zero components.
-TEST_CASE("norms rounded up with kRelativeRounding bound the exact norm (Allowances.v "
-          "norm_relative_rounding)",
+// norm_upper_bound, norm_lower_bound: norm_up / norm_down of the computed
+// norm bound the exact Euclidean norm of the double vector v, checked exactly
+// (squares of rationals) at every scale from subnormal components (where the
+// squares underflow, the theorems' floor kNormFloor speaking) to 2^509, with
+// zero and signed-zero components.
+TEST_CASE("norm_up and norm_down bound the exact norm at every scale (Allowances.v norm_up_relative, "
+          "norm_up_wide, norm_down_wide)",
           "[proved]") {
   std::mt19937_64 rng(454545);
   std::uniform_real_distribution<double> mant(-1, 1);
-  std::uniform_int_distribution<int> ex(-499, 509), pick(0, 4);
-  for (int n = 0; n < 20000; ++n) {
+  std::uniform_int_distribution<int> ex(-1074, 509), pick(0, 4);
+  for (int n = 0; n < 40000; ++n) {
     const int e = ex(rng);
     Eigen::Vector3d v(std::ldexp(mant(rng), e), std::ldexp(mant(rng), e), std::ldexp(mant(rng), e));
     const int k = pick(rng);
     if (k < 3) v[k] = k == 0 ? 0.0 : -0.0;
     const mpq_class S = Q(v.x()) * Q(v.x()) + Q(v.y()) * Q(v.y()) + Q(v.z()) * Q(v.z());
-    if (S < Q(0x1p-1000)) continue;
-    const double up = round_up(v.norm() * (1 + kRelativeRounding)).v;
-    REQUIRE(Q(up) * Q(up) >= S);
+    for (const double relative : {kRelativeRounding, kRelativeRoundingWide}) {
+      const double up = norm_up(v.norm(), relative).v;
+      REQUIRE(up > 0);
+      REQUIRE(Q(up) * Q(up) >= S);
+    }
+    const double down = norm_down(v.norm(), kRelativeRoundingWide).v;
+    REQUIRE(down >= 0);
+    REQUIRE(Q(down) * Q(down) <= S);
+    REQUIRE(norm_down(std::sqrt(v.squaredNorm()), kRelativeRoundingWide).v == down);
   }
+}
+
+// The finding the floor fixes: at |v| ~ 2^-537 the squares round to 0, so
+// the unfloored forms fell below |v| (up) or to a divisor <= 0 (down).
+TEST_CASE("the norm's bounds hold where the squares underflow (Allowances.v norm_upper_bound)", "[proved]") {
+  const Eigen::Vector3d v = Eigen::Vector3d::Constant(0x1p-538);
+  const mpq_class S = 3 * Q(0x1p-538) * Q(0x1p-538);
+  REQUIRE(v.norm() == 0);
+  const double unfloored = round_up(v.norm() * (1 + kRelativeRounding)).v;
+  CHECK(Q(unfloored) * Q(unfloored) < S);  // the old form: too small
+  const double up = norm_up(v.norm(), kRelativeRounding).v;
+  CHECK(Q(up) * Q(up) >= S);
+  CHECK(round_down(v.norm() * (1 - kRelativeRoundingWide)).v <= 0);  // the old divisor
+  CHECK(norm_down(v.norm(), kRelativeRoundingWide).v == 0);
+}
+
+// The sites. Displacement's shift between two positions 2^-538 apart per
+// coordinate bounds their distance (it was 2^-600 before the floor).
+TEST_CASE("Displacement's shift bounds the distance of positions whose squares underflow", "[proved]") {
+  Pose a, b;
+  // identity orientations (Quat's default)
+  b.p = Eigen::Vector3d::Constant(0x1p-538);
+  const detail::Displacement d(a, b);
+  REQUIRE(Q(d.shift) * Q(d.shift) >= 3 * Q(0x1p-538) * Q(0x1p-538));
+}
+
+// triangle_time_lower_bound along an axis whose computed norm underflows to 0
+// (the normal of a triangle with edges of 2^-305): a vertex at distance 1
+// closing at speed 1 meets the triangle's plane at time 1, so no bound above 1
+// may be returned (the divisor round_down(0) < 0 gave +inf before the guard).
+TEST_CASE("triangle_time_lower_bound drops an axis too short to divide by", "[proved]") {
+  const double h = 0x1p-305;
+  const Vec3 B[3] = {Vec3(0, 0, 0), Vec3(h, 0, 0), Vec3(0, h, 0)};
+  const Vec3 X[3] = {Vec3(0, 0, 1), Vec3(0, 0, 1), Vec3(0, 0, 1)};
+  REQUIRE(sat_side(B).n.norm() == 0);
+  REQUIRE(sat_side(B).n.z() > 0);
+  TriangleMotion m;
+  m.v = Vec3(0, 0, -1);
+  m.centre = X[0];
+  Vec3 r[3];
+  const double r_inf = corner_offsets<Shape::kVertex>(X, m.centre, r);
+  const double t = triangle_time_lower_bound<Shape::kVertex, Shape::kTriangle>(
+      sat_side<Shape::kVertex>(X), r, r_inf, sat_side(B), m, 0.0, std::numeric_limits<double>::infinity());
+  REQUIRE(t <= 1.0);
+}
+
+// for_each_separating_axis divides by norm_up(|a|): along the same short
+// normal, a big triangle at height 1 above the tiny one is at distance 1, and
+// the gap bound may not exceed it (it was about 2^60 before the floor).
+TEST_CASE("triangle_gap_lower_bound along an axis whose squares underflow", "[proved]") {
+  const double h = 0x1p-270;
+  const Vec3 A[3] = {Vec3(0, 0, 0), Vec3(h, 0, 0), Vec3(0, h, 0)};
+  const Vec3 B[3] = {Vec3(-1, -1, 1), Vec3(2, -1, 1), Vec3(-1, 2, 1)};
+  REQUIRE(sat_side(A).n.norm() == 0);
+  const double g = triangle_gap_lower_bound(sat_side(A), sat_side(B), std::numeric_limits<double>::infinity());
+  REQUIRE(g <= 1.0);
 }
