@@ -8,7 +8,7 @@
 From Coq Require Import Reals Psatz.
 From Coq Require Import List.
 Import ListNotations.
-From Flocq Require Import Core Relative.
+From Flocq Require Import Core Relative Plus_error.
 From Gauss6 Require Import Rounding.
 Open Scope R_scope.
 
@@ -473,6 +473,137 @@ Theorem norm_down_wide x y z :
   (if Rlt_dec kNormFloor d then d else 0) <= sqrt (x * x + y * y + z * z).
 Proof. apply norm_lower_bound, one_minus_wide. Qed.
 
+(* next_up moves a nonnegative r up by at least 2^-602 (its widening is at
+   least kTiny = 2^-600 and at least about 2 u r). *)
+Lemma next_up_plus r : 0 <= r -> r + bpow radix2 (-602) <= next_up r.
+Proof.
+  intros Hr. unfold next_up, widening. rewrite Rabs_pos_eq by exact Hr.
+  pose proof eta_pos. assert (Hu : 0 < u < / 1000000) by (unfold u; lra).
+  assert (HU : kUlp = 2 * u) by (unfold kUlp, u; simpl; lra).
+  rewrite HU.
+  assert (HT : bpow radix2 (-600) = 4 * bpow radix2 (-602))
+    by (replace (-600)%Z with (2 + -602)%Z by lia; rewrite bpow_plus; simpl; lra).
+  assert (He : 1000 * eta <= bpow radix2 (-602)).
+  { unfold eta. apply Rle_trans with (bpow radix2 10 * bpow radix2 (-1075)).
+    - apply Rmult_le_compat_r; [apply bpow_ge_0 | simpl; lra].
+    - rewrite <- bpow_plus. apply bpow_le. lia. }
+  assert (0 <= r * (2 * u)) by nra.
+  pose proof (fl_lower (r * (2 * u)) ltac:(lra)) as G1.
+  assert (0 <= fl (r * (2 * u))) by (apply fl_nonneg; lra).
+  assert (HFt : F kTiny) by (apply generic_format_bpow; unfold FLT_exp; lia).
+  assert (Hk : 0 < kTiny) by apply bpow_gt_0.
+  set (t := fl (fl (r * (2 * u)) + kTiny)).
+  assert (T1 : kTiny <= t) by (apply fl_ge_F; [exact HFt | lra]).
+  assert (T2 : fl (r * (2 * u)) <= t) by (apply fl_ge_F; [apply F_fl | lra]).
+  pose proof (fl_lower (r + t) ltac:(lra)) as G2.
+  unfold kTiny in T1. rewrite HT in T1.
+  set (B := bpow radix2 (-602)) in *.
+  assert (Q1 : 3 / 5 * (1 - u) * ((1 - u) * (2 * u) * r - eta) <= 3 / 5 * (1 - u) * t)
+    by (apply mul_le_l; lra).
+  assert (Q2 : 2 / 5 * (1 - u) * (4 * B) <= 2 / 5 * (1 - u) * t) by (apply mul_le_l; lra).
+  assert (Q3 : u * r <= (3 / 5 * (1 - u) * (1 - u) * (2 * u)) * r) by (apply Rmult_le_compat_r; nra).
+  assert (Q4 : u * B <= / 1000000 * B) by (apply Rmult_le_compat_r; lra).
+  assert (Q5 : 0 <= u * eta) by nra.
+  lra.
+Qed.
+
+(* A sum or difference of two doubles rounds within u of itself, relatively
+   (no underflow term: below the normal range it is exact). *)
+Lemma sub_rel x y : F x -> F y -> Rabs (fl (x - y) - (x - y)) <= u * Rabs (x - y).
+Proof.
+  intros Fx Fy.
+  destruct (FLT_plus_error_N_ex radix2 (-1074) 53 (fun t => negb (Z.even t)) x (- y) Fx (F_opp y Fy))
+    as (eps & He & E).
+  unfold fl. change (round radix2 (FLT_exp (-1074) 53) ZnearestE (x - y))
+    with (round radix2 (FLT_exp (-1074) 53) (Znearest (fun t => negb (Z.even t))) (x + - y)).
+  rewrite E. replace ((x + - y) * (1 + eps) - (x - y)) with ((x - y) * eps) by ring.
+  rewrite Rabs_mult, Rmult_comm. apply Rmult_le_compat_r; [apply Rabs_pos|].
+  assert (Hu : u_ro radix2 53 = u) by (unfold u_ro, u; simpl; lra).
+  rewrite Hu in He. assert (0 < u) by (unfold u; lra).
+  eapply Rle_trans; [exact He|]. apply Rmult_le_reg_r with (1 + u); [lra|].
+  unfold Rdiv. rewrite Rmult_assoc, Rinv_l by lra. nra.
+Qed.
+
+Lemma kRelativeRounding_ge : 9 * u <= kRelativeRounding.
+Proof.
+  pose proof eta_pos. pose proof eta_small.
+  assert (bpow radix2 (-1022) <= / 1000000000000000000) by (simpl; lra).
+  assert ((1 - u) * / 1000000000000000 - eta <= kRelativeRounding) by (apply fl_lower; lra).
+  unfold u in *. lra.
+Qed.
+
+(* ---- kRelativeRounding at the sub-interval's step ----
+   StartFrame::obb_frame: step = (u1 - u0) * dp_mid, each coordinate the
+   double fl(fl(u1 - u0) d) (u0, u1, d doubles), and its rounding covered by
+   step_error = round_up(kRelativeRounding * m * 2), m = |step|_inf (the
+   computed coordinates' largest magnitude, exact): within it of the exact
+   (u1 - u0) d, for every double input (the underflow of the product, eta,
+   is covered by next_up's absolute 2^-600). *)
+(* covers optimized/src/motion_bounds.cpp "SweptObbFrame StartFrame::obb_frame(double u1, double d) const" sha256:935ff5487d4e9f12 *)
+Theorem step_rounding u0 u1 d m :
+  F u0 -> F u1 -> F d -> Rabs (fl (fl (u1 - u0) * d)) <= m ->
+  Rabs (fl (fl (u1 - u0) * d) - (u1 - u0) * d) <= next_up (fl (fl (kRelativeRounding * m) * 2)).
+Proof.
+  intros F0 F1 Fd Hm. pose proof eta_pos. assert (Hu : 0 < u < / 1000000) by (unfold u; lra).
+  assert (He : 1000 * eta <= bpow radix2 (-602)).
+  { unfold eta. apply Rle_trans with (bpow radix2 10 * bpow radix2 (-1075)).
+    - apply Rmult_le_compat_r; [apply bpow_ge_0 | simpl; lra].
+    - rewrite <- bpow_plus. apply bpow_le. lia. }
+  pose proof (sub_rel u1 u0 F1 F0) as Ha. set (a := u1 - u0) in *. set (fa := fl a) in *.
+  pose proof (fl_err (fa * d)) as Hs. set (s := fl (fa * d)) in *.
+  set (X := Rabs (fa * d)) in *. set (Y := Rabs (a * d)).
+  assert (HX0 : 0 <= X) by apply Rabs_pos. assert (HY0 : 0 <= Y) by apply Rabs_pos.
+  assert (Hm0 : 0 <= m) by (pose proof (Rabs_pos s); lra).
+  (* |fa d - a d| <= u Y; (1 - u) Y <= X; (1 - u) X - eta <= |s| <= m *)
+  assert (E1 : Rabs (fa * d - a * d) <= u * Y).
+  { unfold Y. replace (fa * d - a * d) with ((fa - a) * d) by ring. rewrite !Rabs_mult.
+    rewrite <- Rmult_assoc. apply Rmult_le_compat_r; [apply Rabs_pos | exact Ha]. }
+  assert (E2 : (1 - u) * Y <= X).
+  { assert (Rabs a - Rabs fa <= u * Rabs a)
+      by (pose proof (Rabs_triang_inv a fa); rewrite Rabs_minus_sym in Ha; lra).
+    unfold X, Y. rewrite !Rabs_mult.
+    assert (0 <= Rabs d) by apply Rabs_pos.
+    assert ((1 - u) * Rabs a <= Rabs fa) by lra.
+    apply Rle_trans with (((1 - u) * Rabs a) * Rabs d); [lra | apply Rmult_le_compat_r; assumption]. }
+  assert (E3 : (1 - u) * X - eta <= m).
+  { pose proof (Rabs_triang_inv (fa * d) (s - fa * d)).
+    replace (fa * d - (s - fa * d)) with (2 * (fa * d) - s) in * by ring.
+    assert (X - Rabs s <= u * X + eta).
+    { pose proof (Rabs_triang_inv (fa * d) s). rewrite Rabs_minus_sym in Hs.
+      unfold X in *. lra. }
+    lra. }
+  assert (Q1 : u * X <= / 1000000 * X) by (apply Rmult_le_compat_r; lra).
+  assert (Q2 : u * Y <= / 1000000 * Y) by (apply Rmult_le_compat_r; lra).
+  assert (B1 : X <= 100001 / 100000 * (m + eta)) by lra.
+  assert (B2 : Y <= 10001 / 10000 * (m + eta)) by lra.
+  assert (C1 : u * X <= u * (100001 / 100000 * (m + eta))) by (apply mul_le_l; lra).
+  assert (C2 : u * Y <= u * (10001 / 10000 * (m + eta))) by (apply mul_le_l; lra).
+  assert (Err : Rabs (s - a * d) <= 21 / 10 * u * m + 2 * eta).
+  { replace (s - a * d) with ((s - fa * d) + (fa * d - a * d)) by ring.
+    eapply Rle_trans; [apply Rabs_triang|].
+    assert (u * eta <= / 1000000 * eta) by (apply Rmult_le_compat_r; lra). assert (0 <= u * m) by nra. unfold X in *. lra. }
+  (* the bound: at least 17.9 u m - 3 eta + 2^-602 *)
+  pose proof kRelativeRounding_ge as Hk.
+  assert (K1 : 9 * u * m <= kRelativeRounding * m) by (apply Rmult_le_compat_r; lra).
+  assert (0 <= kRelativeRounding * m) by nra.
+  pose proof (fl_lower (kRelativeRounding * m) ltac:(lra)) as K2.
+  assert (0 <= fl (kRelativeRounding * m)) by (apply fl_nonneg; lra).
+  pose proof (fl_lower (fl (kRelativeRounding * m) * 2) ltac:(lra)) as K3.
+  assert (0 <= fl (fl (kRelativeRounding * m) * 2)) by (apply fl_nonneg; lra).
+  pose proof (next_up_plus _ ltac:(eassumption)) as K4.
+  assert (K5 : (1 - u) * ((1 - u) * (9 * u * m)) <= (1 - u) * fl (kRelativeRounding * m) + (1 - u) * eta).
+  { assert ((1 - u) * (9 * u * m) <= (1 - u) * (kRelativeRounding * m)) by (apply mul_le_l; lra).
+    assert ((1 - u) * ((1 - u) * (kRelativeRounding * m) - eta) <= (1 - u) * fl (kRelativeRounding * m))
+      by (apply mul_le_l; lra).
+    assert ((1 - u) * ((1 - u) * (9 * u * m)) <= (1 - u) * ((1 - u) * (kRelativeRounding * m)))
+      by (apply mul_le_l; lra).
+    lra. }
+  assert (K6 : 89 / 10 * (u * m) <= ((1 - u) * (1 - u) * 9) * (u * m)) by (apply Rmult_le_compat_r; nra).
+  assert (u * eta <= / 1000000 * eta) by (apply Rmult_le_compat_r; lra).
+  assert (0 <= u * eta) by nra. assert (0 <= u * m) by nra.
+  lra.
+Qed.
+
 (* The theorems, each answered by tools/check_proofs.sh. *)
 Print Assumptions linear_corner_rounding.
 Print Assumptions linear_corner_selection.
@@ -482,3 +613,4 @@ Print Assumptions norm_lower_bound.
 Print Assumptions norm_up_relative.
 Print Assumptions norm_up_wide.
 Print Assumptions norm_down_wide.
+Print Assumptions step_rounding.

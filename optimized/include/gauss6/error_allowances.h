@@ -27,8 +27,9 @@ namespace gauss6 {
 // corner's |r_B| (StartFrame::radius).
 // Machine-checked at the norm sites (a double vector's norm, rounded up with
 // this allowance and the floor kNormFloor: norm_up in rounding.h):
-// proofs/Allowances.v, norm_upper_bound; the step's and the shift's rounded
-// components are not machine-checked yet.
+// proofs/Allowances.v, norm_upper_bound; the step's rounding
+// (StartFrame::obb_frame): step_rounding; the shift's rounded components are
+// not machine-checked yet.
 constexpr double kRelativeRounding = 1e-15;
 
 // The same roundings of a norm (or of a sum of two norms, its own rounding
