@@ -604,6 +604,199 @@ Proof.
   lra.
 Qed.
 
+Lemma add_rel x y : F x -> F y -> Rabs (fl (x + y) - (x + y)) <= u * Rabs (x + y).
+Proof.
+  intros Fx Fy. replace (x + y) with (x - - y) by ring. apply sub_rel; [exact Fx | apply F_opp, Fy].
+Qed.
+Lemma fl_lower_normal z : bpow radix2 (-1022) <= z -> (1 - u) * z <= fl z.
+Proof.
+  intros Hz. assert (0 < z) by (pose proof (bpow_gt_0 radix2 (-1022)); lra).
+  pose proof (relative_error_N_FLT radix2 (-1074) 53 ltac:(lia) (fun t => negb (Z.even t)) z) as G.
+  rewrite (Rabs_pos_eq z) in G by lra.
+  assert (Hb : bpow radix2 (-1074 + 53 - 1) = bpow radix2 (-1022)) by (f_equal; lia).
+  rewrite Hb in G. specialize (G Hz).
+  assert (Hu : / 2 * bpow radix2 (- (53) + 1) = u) by (unfold u; simpl; lra). rewrite Hu in G.
+  unfold fl. change ZnearestE with (Znearest (fun t => negb (Z.even t))).
+  unfold Rabs in G; destruct Rcase_abs; lra.
+Qed.
+
+(* The dot product of two double 3-vectors, (a0 v0 + a1 v1) + a2 v2 rounded
+   at each step, within 3.02 u T + 5.02 eta of the exact one, T the sum of the
+   terms' magnitudes (any order of the three terms: the statement is symmetric). *)
+Definition dot3 a0 a1 a2 v0 v1 v2 := fl (fl (fl (a0 * v0) + fl (a1 * v1)) + fl (a2 * v2)).
+Lemma dot3_err a0 a1 a2 v0 v1 v2 :
+  let T := Rabs (a0 * v0) + Rabs (a1 * v1) + Rabs (a2 * v2) in
+  Rabs (dot3 a0 a1 a2 v0 v1 v2 - (a0 * v0 + a1 * v1 + a2 * v2)) <= 302 / 100 * u * T + 502 / 100 * eta.
+Proof.
+  intros T. pose proof eta_pos. assert (Hu : 0 < u < / 1000000) by (unfold u; lra).
+  pose proof (fl_err (a0 * v0)). pose proof (fl_err (a1 * v1)). pose proof (fl_err (a2 * v2)).
+  pose proof (Rabs_pos (a0 * v0)). pose proof (Rabs_pos (a1 * v1)). pose proof (Rabs_pos (a2 * v2)).
+  assert (S1 : Rabs (fl (fl (a0 * v0) + fl (a1 * v1)) - (a0 * v0 + a1 * v1))
+               <= (u * (Rabs (a0 * v0) + Rabs (a1 * v1)) + 2 * eta)
+                  + u * ((Rabs (a0 * v0) + Rabs (a1 * v1)) + (u * (Rabs (a0 * v0) + Rabs (a1 * v1)) + 2 * eta)) + eta).
+  { apply step; [apply abs_sum_le; lra|].
+    replace (fl (a0 * v0) + fl (a1 * v1) - (a0 * v0 + a1 * v1))
+      with ((fl (a0 * v0) - a0 * v0) + (fl (a1 * v1) - a1 * v1)) by ring.
+    eapply Rle_trans; [apply Rabs_triang | lra]. }
+  set (T1 := Rabs (a0 * v0) + Rabs (a1 * v1)) in *.
+  assert (0 <= u * T1) by (unfold T1; nra). assert (u * (u * T1) <= / 1000000 * (u * T1)) by (apply Rmult_le_compat_r; lra).
+  assert (u * eta <= / 1000000 * eta) by (apply Rmult_le_compat_r; lra).
+  assert (S1' : Rabs (fl (fl (a0 * v0) + fl (a1 * v1)) - (a0 * v0 + a1 * v1)) <= 201 / 100 * u * T1 + 301 / 100 * eta) by lra.
+  assert (S2 : Rabs (dot3 a0 a1 a2 v0 v1 v2 - (a0 * v0 + a1 * v1 + a2 * v2))
+     <= ((201 / 100 * u * T1 + 301 / 100 * eta) + (u * Rabs (a2 * v2) + eta))
+        + u * (T + ((201 / 100 * u * T1 + 301 / 100 * eta) + (u * Rabs (a2 * v2) + eta))) + eta).
+  { unfold dot3. apply step.
+    - unfold T, T1. apply abs_sum_le; [apply abs_sum_le|]; lra.
+    - replace (fl (fl (a0 * v0) + fl (a1 * v1)) + fl (a2 * v2) - (a0 * v0 + a1 * v1 + a2 * v2))
+        with ((fl (fl (a0 * v0) + fl (a1 * v1)) - (a0 * v0 + a1 * v1)) + (fl (a2 * v2) - a2 * v2)) by ring.
+      eapply Rle_trans; [apply Rabs_triang | lra]. }
+  assert (0 <= u * T) by (unfold T; try unfold T1; nra). assert (u * (u * T) <= / 1000000 * (u * T)) by (apply Rmult_le_compat_r; lra).
+  assert (u * Rabs (a2 * v2) <= u * T) by (apply mul_le_l; unfold T; try unfold T1; lra).
+  assert (0 <= u * Rabs (a2 * v2)) by nra.
+  assert (u * (u * Rabs (a2 * v2)) <= / 1000000 * (u * Rabs (a2 * v2))) by (apply Rmult_le_compat_r; lra).
+  assert (u * T1 <= u * T) by (apply mul_le_l; unfold T, T1; lra).
+  assert (u * T1 + u * Rabs (a2 * v2) = u * T) by (unfold T, T1; ring).
+  lra.
+Qed.
+
+Lemma rel_lower z w : Rabs (z - w) <= u * w -> (1 - u) * w <= z.
+Proof. intros H. pose proof (Rle_abs (w - z)). rewrite Rabs_minus_sym in H. lra. Qed.
+
+(* ---- kAxisVelocityRounding ----
+   triangle_time_lower_bound (motion_bounds.h), the velocity term of an axis a
+   (doubles): along_v = side * a.dot(v) (side = +-1, exact), its slack
+   kAxisVelocityRounding * a_1 * v_inf (a_1 = |a|_1 summed in doubles, v_inf =
+   |v|_inf, exact), and toward = max(0, round_up(along_v)) + slack, rounded up:
+   toward is at least the exact side (a . v). Hypothesis |a|_1 >= 2^-900: the
+   axis is used only when norm_down(|a|) > 0 (the guard after it), which
+   proves |a| > kNormFloor = 2^-500 (norm_down_wide). *)
+(* allowance kAxisVelocityRounding = 1e-14 *)
+Definition kAxisVelocityRounding := fl (/ 100000000000000).
+
+Lemma kAxisVelocityRounding_ge : 90 * u <= kAxisVelocityRounding.
+Proof.
+  pose proof eta_pos. pose proof eta_small.
+  assert (bpow radix2 (-1022) <= / 1000000000000000000) by (simpl; lra).
+  assert ((1 - u) * / 100000000000000 - eta <= kAxisVelocityRounding) by (apply fl_lower; lra).
+  unfold u in *. lra.
+Qed.
+
+Lemma fl_side side x : (side = 1 \/ side = -1) -> F x -> fl (side * x) = side * x.
+Proof.
+  intros [-> | ->] Fx.
+  - rewrite Rmult_1_l. apply fl_F, Fx.
+  - replace (-1 * x) with (- x) by ring. apply fl_F, F_opp, Fx.
+Qed.
+
+(* covers optimized/include/gauss6/motion_bounds.h "inline double triangle_time_lower_bound(const SatSide& A, const Vec3 r[3]" sha256:e6fe43232891e550 *)
+Theorem axis_velocity_rounding side a0 a1 a2 v0 v1 v2 vinf :
+  (side = 1 \/ side = -1) -> F a0 -> F a1 -> F a2 ->
+  Rabs v0 <= vinf -> Rabs v1 <= vinf -> Rabs v2 <= vinf ->
+  bpow radix2 (-900) <= Rabs a0 + Rabs a1 + Rabs a2 ->
+  let along_v := fl (side * dot3 a0 a1 a2 v0 v1 v2) in
+  let a_1 := fl (fl (Rabs a0 + Rabs a1) + Rabs a2) in
+  let slack := fl (fl (kAxisVelocityRounding * a_1) * vinf) in
+  side * (a0 * v0 + a1 * v1 + a2 * v2) <= next_up (fl (Rmax 0 (next_up along_v) + slack)).
+Proof.
+  intros Hside F0 F1 F2 V0 V1 V2 HA along_v a_1 slack.
+  pose proof eta_pos. assert (Hu : 0 < u < / 1000000) by (unfold u; lra).
+  assert (HB : 1000 * eta <= bpow radix2 (-602)).
+  { unfold eta. apply Rle_trans with (bpow radix2 10 * bpow radix2 (-1075)).
+    - apply Rmult_le_compat_r; [apply bpow_ge_0 | simpl; lra].
+    - rewrite <- bpow_plus. apply bpow_le. lia. }
+  set (B := bpow radix2 (-602)) in *.
+  assert (Hv : 0 <= vinf) by (pose proof (Rabs_pos v0); lra).
+  set (A := Rabs a0 + Rabs a1 + Rabs a2) in *.
+  set (T := Rabs (a0 * v0) + Rabs (a1 * v1) + Rabs (a2 * v2)).
+  assert (HT : T <= A * vinf).
+  { unfold T, A. rewrite !Rabs_mult.
+    pose proof (Rabs_pos a0). pose proof (Rabs_pos a1). pose proof (Rabs_pos a2).
+    assert (Rabs a0 * Rabs v0 <= Rabs a0 * vinf) by (apply mul_le_l; lra).
+    assert (Rabs a1 * Rabs v1 <= Rabs a1 * vinf) by (apply mul_le_l; lra).
+    assert (Rabs a2 * Rabs v2 <= Rabs a2 * vinf) by (apply mul_le_l; lra). lra. }
+  assert (HT0 : 0 <= T) by (unfold T; pose proof (Rabs_pos (a0 * v0)); pose proof (Rabs_pos (a1 * v1));
+                            pose proof (Rabs_pos (a2 * v2)); lra).
+  (* the computed dot product *)
+  pose proof (dot3_err a0 a1 a2 v0 v1 v2) as Hd. fold T in Hd.
+  set (dt := dot3 a0 a1 a2 v0 v1 v2) in *.
+  assert (Fd : F dt) by apply F_fl.
+  assert (Hc : along_v = side * dt) by (apply fl_side; assumption).
+  set (E := side * (a0 * v0 + a1 * v1 + a2 * v2)).
+  assert (HE : E <= along_v + (302 / 100 * u * T + 502 / 100 * eta)).
+  { rewrite Hc. unfold E. pose proof (Rle_abs (dt - (a0 * v0 + a1 * v1 + a2 * v2))).
+    pose proof (Rle_abs ((a0 * v0 + a1 * v1 + a2 * v2) - dt)). rewrite Rabs_minus_sym in H1.
+    destruct Hside as [-> | ->]; lra. }
+  (* a_1 >= (1 - u)^2 A *)
+  assert (Fa0 : F (Rabs a0)) by (apply generic_format_abs, F0).
+  assert (Fa1 : F (Rabs a1)) by (apply generic_format_abs, F1).
+  assert (Fa2 : F (Rabs a2)) by (apply generic_format_abs, F2).
+  pose proof (add_rel _ _ Fa0 Fa1) as G1. set (t := fl (Rabs a0 + Rabs a1)) in *.
+  pose proof (add_rel _ _ (F_fl (Rabs a0 + Rabs a1)) Fa2) as G2. fold t in G2. fold a_1 in G2.
+  pose proof (Rabs_pos a0). pose proof (Rabs_pos a1). pose proof (Rabs_pos a2).
+  rewrite (Rabs_pos_eq (Rabs a0 + Rabs a1)) in G1 by lra.
+  assert (Ht : (1 - u) * (Rabs a0 + Rabs a1) <= t) by (apply rel_lower; exact G1).
+  assert (0 <= t) by nra.
+  rewrite (Rabs_pos_eq (t + Rabs a2)) in G2 by lra.
+  assert (Ha1 : (1 - u) * (t + Rabs a2) <= a_1) by (apply rel_lower; exact G2).
+  assert (Ha1' : (1 - u) * (1 - u) * A <= a_1).
+  { assert ((1 - u) * ((1 - u) * (Rabs a0 + Rabs a1) + Rabs a2) <= (1 - u) * (t + Rabs a2)) by (apply mul_le_l; lra).
+    assert ((1 - u) * (1 - u) * Rabs a2 <= (1 - u) * Rabs a2) by (apply Rmult_le_compat_r; nra).
+    unfold A. lra. }
+  (* the slack, at least 89 u T - eta *)
+  pose proof kAxisVelocityRounding_ge as Hk.
+  assert (HA0 : 0 <= A) by (pose proof (bpow_ge_0 radix2 (-900)); lra).
+  assert (Z1 : 90 * u * ((1 - u) * (1 - u) * A) <= kAxisVelocityRounding * a_1)
+    by (apply Rmult_le_compat; nra).
+  assert (Z2 : bpow radix2 (-1022) <= kAxisVelocityRounding * a_1).
+  { apply Rle_trans with (90 * u * ((1 - u) * (1 - u) * A)); [|exact Z1].
+    apply Rle_trans with (u * bpow radix2 (-900)).
+    - rewrite bpow_m53, <- bpow_plus. apply bpow_le. lia.
+    - assert (1 <= 90 * ((1 - u) * (1 - u))) by nra.
+      assert (0 <= u * bpow radix2 (-900)) by (pose proof (bpow_ge_0 radix2 (-900)); nra).
+      assert (u * bpow radix2 (-900) <= u * A) by (apply mul_le_l; lra).
+      assert (u * A <= (90 * ((1 - u) * (1 - u))) * (u * A)) by (apply Rle_trans with (1 * (u * A)); [lra | apply Rmult_le_compat_r; nra]).
+      lra. }
+  pose proof (fl_lower_normal _ Z2) as Z3.
+  assert (0 <= fl (kAxisVelocityRounding * a_1)) by (apply fl_nonneg; pose proof (bpow_ge_0 radix2 (-1022)); lra).
+  pose proof (fl_lower (fl (kAxisVelocityRounding * a_1) * vinf) ltac:(nra)) as Z4. fold slack in Z4.
+  assert (Z5 : (1 - u) * ((1 - u) * (kAxisVelocityRounding * a_1)) * vinf <= (1 - u) * (fl (kAxisVelocityRounding * a_1) * vinf)).
+  { assert ((1 - u) * (kAxisVelocityRounding * a_1) * vinf <= fl (kAxisVelocityRounding * a_1) * vinf)
+      by (apply Rmult_le_compat_r; lra).
+    assert ((1 - u) * ((1 - u) * (kAxisVelocityRounding * a_1) * vinf) <= (1 - u) * (fl (kAxisVelocityRounding * a_1) * vinf))
+      by (apply mul_le_l; lra).
+    lra. }
+  assert (Z6 : (1 - u) * ((1 - u) * (90 * u * ((1 - u) * (1 - u) * A))) * vinf
+               <= (1 - u) * ((1 - u) * (kAxisVelocityRounding * a_1)) * vinf).
+  { apply Rmult_le_compat_r; [lra|]. apply mul_le_l; [lra|]. apply mul_le_l; lra. }
+  assert (Z7 : 89 * u * (A * vinf) <= (1 - u) * ((1 - u) * (90 * u * ((1 - u) * (1 - u) * A))) * vinf).
+  { assert (0 <= u * (A * vinf)) by (apply Rmult_le_pos; [lra | apply Rmult_le_pos; lra]).
+    assert (89 * (u * (A * vinf)) <= ((1 - u) * (1 - u) * (1 - u) * (1 - u) * 90) * (u * (A * vinf)))
+      by (apply Rmult_le_compat_r; nra).
+    lra. }
+  assert (Hs : 89 * u * T - eta <= slack).
+  { assert (u * T <= u * (A * vinf)) by (apply mul_le_l; lra). lra. }
+  assert (Hs0 : 0 <= slack) by (apply fl_nonneg; nra).
+  assert (0 <= u * T) by nra. assert (u * eta <= / 1000000 * eta) by (apply Rmult_le_compat_r; lra).
+  assert (Fa : F along_v) by apply F_fl.
+  destruct (Rle_or_lt 0 along_v) as [Hp|Hn].
+  - pose proof (next_up_plus along_v Hp) as N1. fold B in N1.
+    assert (N2 : next_up along_v <= Rmax 0 (next_up along_v)) by apply Rmax_r.
+    pose proof (next_up_ge (Rmax 0 (next_up along_v) + slack)). lra.
+  - assert (FM : F (Rmax 0 (next_up along_v))).
+    { unfold Rmax. destruct Rle_dec; [apply F_fl | apply generic_format_0]. }
+    assert (M0 : 0 <= Rmax 0 (next_up along_v)) by apply Rmax_l.
+    pose proof (add_rel _ _ FM (F_fl (fl (kAxisVelocityRounding * a_1) * vinf))) as G3. fold slack in G3.
+    set (M := Rmax 0 (next_up along_v)) in *.
+    rewrite (Rabs_pos_eq (M + slack)) in G3 by lra.
+    assert (G4 : (1 - u) * (M + slack) <= fl (M + slack)) by (apply rel_lower; exact G3).
+    assert (HMs : 0 <= fl (M + slack)) by (apply fl_nonneg; lra).
+    pose proof (next_up_plus (fl (M + slack)) HMs) as N1. fold B in N1.
+    assert ((1 - u) * (89 * u * T - eta) <= (1 - u) * slack) by (apply mul_le_l; lra).
+    assert (u * M <= / 1000000 * M) by (apply Rmult_le_compat_r; lra).
+    assert (u * (u * T) <= / 1000000 * (u * T)) by (apply Rmult_le_compat_r; lra).
+    assert (0 <= u * eta) by nra. lra.
+Qed.
+
 (* The theorems, each answered by tools/check_proofs.sh. *)
 Print Assumptions linear_corner_rounding.
 Print Assumptions linear_corner_selection.
@@ -614,3 +807,4 @@ Print Assumptions norm_up_relative.
 Print Assumptions norm_up_wide.
 Print Assumptions norm_down_wide.
 Print Assumptions step_rounding.
+Print Assumptions axis_velocity_rounding.

@@ -204,3 +204,28 @@ TEST_CASE("the step's rounding within kRelativeRounding |step|_inf 2 (Allowances
     }
   }
 }
+
+// axis_velocity_rounding: triangle_time_lower_bound's velocity term along an
+// axis a, toward = max(0, round_up(side a.v)) + kAxisVelocityRounding |a|_1
+// |v|_inf (the code's operations, in its order), is at least the exact
+// side (a . v), checked in rationals for axes with |a|_1 >= 2^-900 (the
+// theorem's hypothesis: the guard norm_down(|a|) > 0 keeps only |a| > 2^-500)
+// and velocities of every scale down to subnormal, signed zeros included.
+TEST_CASE("the velocity term within kAxisVelocityRounding (Allowances.v axis_velocity_rounding)", "[proved]") {
+  std::mt19937_64 rng(45454);
+  std::uniform_real_distribution<double> mant(-1, 1);
+  std::uniform_int_distribution<int> ea(-899, 300), pick(0, 1);
+  for (int n = 0; n < 40000; ++n) {
+    const int e = ea(rng);
+    Eigen::Vector3d a(std::ldexp(mant(rng), e), std::ldexp(mant(rng), e), std::ldexp(mant(rng), e));
+    const Eigen::Vector3d v(coordinate(rng), coordinate(rng), coordinate(rng));
+    if (Q(std::abs(a.x())) + Q(std::abs(a.y())) + Q(std::abs(a.z())) < Q(0x1p-900)) continue;
+    const double side = pick(rng) ? 1.0 : -1.0;
+    const double along_v = side * a.dot(v);
+    const double a_1 = a.cwiseAbs().sum(), v_inf = v.cwiseAbs().maxCoeff();
+    const double slack = kAxisVelocityRounding * a_1 * v_inf;
+    const double toward = (max(Upper{0.0}, round_up(along_v)) + Upper{slack}).v;
+    const mpq_class exact = Q(side) * (Q(a.x()) * Q(v.x()) + Q(a.y()) * Q(v.y()) + Q(a.z()) * Q(v.z()));
+    REQUIRE(exact <= Q(toward));
+  }
+}

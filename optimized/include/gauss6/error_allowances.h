@@ -67,7 +67,9 @@ constexpr double kAxisProductRounding = 1e-13;
 
 // The velocity term a.v of triangle_time_lower_bound and its share of the
 // sums that follow: within 3.01 u + 2 u of |a|_1 |v|_inf (5.6e-16); 1e-14
-// covers it 18 times. Site: triangle_time_lower_bound.
+// covers it 18 times. Site: triangle_time_lower_bound. Machine-checked:
+// proofs/Allowances.v, axis_velocity_rounding (for |a|_1 >= 2^-900, which the
+// site's guard norm_down(|a|) > 0 ensures).
 constexpr double kAxisVelocityRounding = 1e-14;
 
 // Posing a body point in doubles, X = R r_B + p (R = rotation_matrix(q): each
