@@ -524,13 +524,18 @@ Proof.
   unfold Rdiv. rewrite Rmult_assoc, Rinv_l by lra. nra.
 Qed.
 
-Lemma kRelativeRounding_ge : 9 * u <= kRelativeRounding.
+(* A decimal allowance c >= 1e-15, rounded to its double, is at least k u
+   whenever (1 - u) c - 2^-1000 is. *)
+Lemma fl_decimal_ge c k : / 1000000000000000 <= c -> k * u <= (1 - u) * c - bpow radix2 (-1000) -> k * u <= fl c.
 Proof.
-  pose proof eta_pos. pose proof eta_small.
-  assert (bpow radix2 (-1022) <= / 1000000000000000000) by (simpl; lra).
-  assert ((1 - u) * / 1000000000000000 - eta <= kRelativeRounding) by (apply fl_lower; lra).
-  unfold u in *. lra.
+  intros Hc Hk. pose proof eta_pos.
+  assert (eta <= bpow radix2 (-1000)) by (unfold eta; apply bpow_le; lia).
+  assert ((1 - u) * c - eta <= fl c) by (apply fl_lower; lra). lra.
 Qed.
+Lemma bpow_m1000 : bpow radix2 (-1000) <= / 1000000000000000000000000.
+Proof. simpl; lra. Qed.
+Lemma kRelativeRounding_ge : 9 * u <= kRelativeRounding.
+Proof. apply fl_decimal_ge; pose proof bpow_m1000; unfold u; lra. Qed.
 
 (* ---- kRelativeRounding at the sub-interval's step ----
    StartFrame::obb_frame: step = (u1 - u0) * dp_mid, each coordinate the
@@ -674,12 +679,7 @@ Proof. intros H. pose proof (Rle_abs (w - z)). rewrite Rabs_minus_sym in H. lra.
 Definition kAxisVelocityRounding := fl (/ 100000000000000).
 
 Lemma kAxisVelocityRounding_ge : 90 * u <= kAxisVelocityRounding.
-Proof.
-  pose proof eta_pos. pose proof eta_small.
-  assert (bpow radix2 (-1022) <= / 1000000000000000000) by (simpl; lra).
-  assert ((1 - u) * / 100000000000000 - eta <= kAxisVelocityRounding) by (apply fl_lower; lra).
-  unfold u in *. lra.
-Qed.
+Proof. apply fl_decimal_ge; pose proof bpow_m1000; unfold u; lra. Qed.
 
 Lemma fl_side side x : (side = 1 \/ side = -1) -> F x -> fl (side * x) = side * x.
 Proof.
