@@ -62,7 +62,7 @@ void StartFrame::set(const CcdMotion& m, double u, double rho_in) {
   omega_error = (2 * sqrt(g_err2)).v;
   omega2 = (4 * g_norm2).v;
   g2 = g_norm2.v;
-  omega_norm = round_up(omega.norm() * (1 + kRelativeRounding)).v;
+  omega_norm = norm_up(omega.norm(), kRelativeRounding).v;
   dp_max = norm_upper(m.dp).v;
   speed = (Upper{dp_max} + Upper{turn_rate} * Upper{rho}).v;
   const Upper p_inf{p.cwiseAbs().maxCoeff()};
@@ -104,7 +104,7 @@ Displacement::Displacement(const Pose& a, const Pose& b) {
   const Quat qa = normalized(a.q), qb = normalized(b.q);
   const Vec3 v = qa.w * qb.vec() - qb.w * qa.vec() - qa.vec().cross(qb.vec());  // vec(conj(qa) qb)
   turn = (round_up(2 * v.norm()) + Upper{kQuaternionTurnRounding}).v;
-  shift = round_up((b.p - a.p).norm() * (1 + kRelativeRounding)).v;
+  shift = norm_up((b.p - a.p).norm(), kRelativeRounding).v;
   if (!(turn < std::numeric_limits<double>::infinity() && shift < std::numeric_limits<double>::infinity()))
     turn = shift = std::numeric_limits<double>::infinity();
 }

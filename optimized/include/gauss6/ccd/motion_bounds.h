@@ -103,7 +103,11 @@ inline double triangle_time_lower_bound(const SatSide& A, const Vec3 r[3], doubl
       slack += kAxisProductRounding * a_1 * omega_inf * r_inf;
     }
     const Upper toward = max(Upper{0.0}, round_up(approach)) + Upper{slack};
-    const Upper speed = toward / round_down(a.norm() * (1 - kRelativeRoundingWide)) + Upper{m.w};
+    // |a| from below, > 0 (Upper / Lower needs a positive divisor's double): an
+    // axis too short to bound it proves nothing.
+    const Lower a_norm = norm_down(a.norm(), kRelativeRoundingWide);
+    if (!(a_norm.v > 0)) return false;
+    const Upper speed = toward / a_norm + Upper{m.w};
     const double t = speed.v > 0 ? (clear / speed).v : std::numeric_limits<double>::infinity();
     if (!(t <= std::numeric_limits<double>::infinity())) return false;  // NaN
     best = std::max(best, t);
@@ -195,7 +199,7 @@ struct SweptObbFrame {
       out.half_step = 0.5 * node_step;
       // The spread; the roundings of c (as R r_B's), the cross product and the sum.
       const double rounding = kSpinRounding * (spin.cwiseAbs().maxCoeff() * radius.v + step.cwiseAbs().maxCoeff());
-      const Upper half = round_up(b.half.norm() * (1 + kRelativeRounding));
+      const Upper half = norm_up(b.half.norm(), kRelativeRounding);
       out.grow = (Upper{out.grow} + (Upper{spread} * half + Upper{rounding})).v;
     } else {
       out.half_step = 0.5 * step;
@@ -443,7 +447,7 @@ struct StartFrame {
   // A body point's double position at u0.
   Vec3 pose(const Vec3& r_B) const { return R * r_B + p; }
   // A bound >= sqrt(r2) and <= rho (every body point's |r_B| is).
-  double radius(double r2) const { return std::min(rho, round_up(std::sqrt(r2) * (1 + kRelativeRounding)).v); }
+  double radius(double r2) const { return std::min(rho, norm_up(std::sqrt(r2), kRelativeRounding).v); }
   // The god face gf at u0 (pose, radius), from `cache` when posed there in
   // this sub-interval.
   const SweptBoxCache::PosedFace& posed_face(const TriangleMesh& gm, int gf, SweptBoxCache* cache) const {

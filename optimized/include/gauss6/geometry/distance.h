@@ -38,9 +38,10 @@ void closest_segment_parameters(const Vec3& p0, const Vec3& p1, const Vec3& q0, 
 // max_A a.x) / |a| (or the mirror). Whatever the rounded axis a is, the
 // computed difference of two projections is within kAxisProductRounding |a|_1
 // s of the exact one, s the largest coordinate of the six corners; so raw less
-// that is below the exact gap along a. Dividing by |a| (1 +
-// kRelativeRoundingWide), the quotient rounded down, covers the roundings of
-// the norm and the quotient (error_allowances.h).
+// that is below the exact gap along a. Dividing by norm_up(|a|,
+// kRelativeRoundingWide) (rounding.h; >= the exact |a|, also where the squares
+// underflow: proofs/Allowances.v, norm_upper_bound), the quotient rounded
+// down, covers the roundings of the norm and the quotient.
 // A zero or non-finite axis proves nothing (NaN or inf is dropped).
 // extra: one more axis to try first (any vector; nullptr: none), e.g. the
 // direction between the closest points of two features.
@@ -97,7 +98,7 @@ GAUSS6_ALWAYS_INLINE void for_each_separating_axis(const SatSide& A, const SatSi
     const double side = b_lo - a_hi >= a_lo - b_hi ? 1.0 : -1.0;
     const double proven = std::max(b_lo - a_hi, a_lo - b_hi) - kAxisProductRounding * a.cwiseAbs().sum() * s;
     if (!(proven > 0)) return false;  // also on NaN
-    const double g = (Lower{proven} / round_up(a.norm() * (1 + kRelativeRoundingWide))).v;
+    const double g = (Lower{proven} / norm_up(a.norm(), kRelativeRoundingWide)).v;
     if (!(g < std::numeric_limits<double>::infinity())) return false;
     return on_axis(a, g, side);
   };

@@ -25,11 +25,11 @@ namespace gauss6 {
 // Sites: |omega| and the step's rounding (StartFrame::set, ::obb_frame), the
 // shift |p_b - p_a| (Displacement), |half| (SweptObbFrame::pose), and a
 // corner's |r_B| (StartFrame::radius).
-// Machine-checked for the norm of a double vector (|omega| in StartFrame::set,
-// |half|): proofs/Allowances.v, norm_relative_rounding, which needs |v|^2 >=
-// 2^-1000 or v = 0: below that the squares underflow and round_up(|v| (1 +
-// kRelativeRounding)) may fall below |v| (proofs/README.md); the other sites'
-// arguments are not machine-checked yet.
+// Machine-checked at the norm sites (a double vector's norm, rounded up with
+// this allowance and the floor kNormFloor: norm_up in rounding.h):
+// proofs/Allowances.v, norm_upper_bound; the step's rounding
+// (StartFrame::obb_frame): step_rounding; the shift's rounded components are
+// not machine-checked yet.
 constexpr double kRelativeRounding = 1e-15;
 
 // The same roundings of a norm (or of a sum of two norms, its own rounding
@@ -39,7 +39,19 @@ constexpr double kRelativeRounding = 1e-15;
 // lockstep runs; both are sound. Sites: |a| of a separating axis, rounded up
 // (for_each_separating_axis) and down (triangle_time_lower_bound), and
 // |center| + |half| of a god node's box (SweptObbFrame::pose).
+// Machine-checked at the norm sites (norm_up, norm_down in rounding.h):
+// proofs/Allowances.v, norm_upper_bound, norm_lower_bound; the sum of two norms
+// is not machine-checked yet.
 constexpr double kRelativeRoundingWide = 1e-12;
+
+// The absolute floor of a norm's bounds (norm_up, norm_down in rounding.h):
+// where the squares of a double vector underflow (|v| below about 2^-500), the
+// computed norm errs by far more than any relative allowance (all three
+// squares round to 0 at |v| ~ 2^-538), so the upper bound is at least 2^-500
+// and a lower bound not above 2^-500 is replaced by 0. Above it the squares'
+// underflow errs by less than 2^-73 of |v|^2: proofs/Allowances.v,
+// norm_upper_bound, norm_lower_bound.
+constexpr double kNormFloor = 0x1p-500;
 
 // A short sum of products along a rounded separating axis a, relative to
 // |a|_1 times the largest coordinates of the other factors. The difference of
@@ -55,7 +67,9 @@ constexpr double kAxisProductRounding = 1e-13;
 
 // The velocity term a.v of triangle_time_lower_bound and its share of the
 // sums that follow: within 3.01 u + 2 u of |a|_1 |v|_inf (5.6e-16); 1e-14
-// covers it 18 times. Site: triangle_time_lower_bound.
+// covers it 18 times. Site: triangle_time_lower_bound. Machine-checked:
+// proofs/Allowances.v, axis_velocity_rounding (for |a|_1 >= 2^-900, which the
+// site's guard norm_down(|a|) > 0 ensures).
 constexpr double kAxisVelocityRounding = 1e-14;
 
 // Posing a body point in doubles, X = R r_B + p (R = rotation_matrix(q): each

@@ -12,6 +12,8 @@
 #include <cmath>
 #include <limits>
 
+#include "gauss6/numeric/error_allowances.h"
+
 namespace gauss6 {
 
 // ---------------------------------------------------------------------------
@@ -187,6 +189,21 @@ GAUSS6_ALWAYS_INLINE Upper norm_upper(const IVec3& v) {
   Upper s2{0};
   for (const Interval& c : v) s2 = s2 + sqr(magnitude(c));
   return sqrt(s2);
+}
+
+// Bounds of the exact Euclidean norm of a double 3-vector v from its computed
+// norm (v.norm() or std::sqrt(v.squaredNorm()): the square root of the sum of
+// the three rounded squares, in any order), with a relative allowance
+// (kRelativeRounding or kRelativeRoundingWide) and the absolute floor
+// kNormFloor where the squares underflow; norm_down is 0 where the computed
+// norm is that small, so that a divisor it gives is > 0 or tested.
+// proofs/Allowances.v: norm_upper_bound, norm_lower_bound.
+GAUSS6_ALWAYS_INLINE Upper norm_up(double norm, double relative) {
+  return max(round_up(norm * (1 + relative)), Upper{kNormFloor});
+}
+GAUSS6_ALWAYS_INLINE Lower norm_down(double norm, double relative) {
+  const Lower d = round_down(norm * (1 - relative));
+  return d.v > kNormFloor ? d : Lower{0};
 }
 
 }  // namespace gauss6
