@@ -10,6 +10,7 @@ import subprocess
 import sys
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 from gauss6 import adapters, conformance, paths
@@ -132,3 +133,21 @@ def test_an_engine_failure_is_a_row_and_exit_2(tmp_path):
 def test_suite_usage_errors(tmp_path, args, message):
     p = gauss6_cli("validate", *args, "--out", tmp_path / "o")
     assert p.returncode == EXIT_USAGE and message in p.stderr
+
+
+def test_an_adapter_reports_the_deepest_contacts_within_the_contracts_capacity():
+    # Rapier found 46,883 manifold points on the dense plate: the adapters report the deepest
+    # CONTACT_CAPACITY of them, in the framework's order, and fewer unchanged.
+    from gauss6.adapters.common import reported_contacts
+    from gauss6.engine import CONTACT_CAPACITY
+
+    rng = np.random.default_rng(43)
+    rows = rng.normal(size=(3 * CONTACT_CAPACITY, 7))
+    out = reported_contacts(rows)
+    assert out.shape == (CONTACT_CAPACITY, 7)
+    deepest = np.sort(rows[:, 6])[:CONTACT_CAPACITY]
+    assert np.array_equal(np.sort(out[:, 6]), deepest)
+    kept = [i for i in range(len(rows)) if rows[i, 6] <= deepest[-1]]
+    assert np.array_equal(out, rows[kept])
+    assert np.array_equal(reported_contacts(rows[:5]), rows[:5])
+    assert reported_contacts([]).shape == (0, 7)
