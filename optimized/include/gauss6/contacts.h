@@ -17,13 +17,15 @@
 // shared by two coplanar faces gives one contact, not two.
 //
 // A set that would exceed its capacity is reduced to the support of each patch
-// (reduce_to_patch_supports): contacts whose normals agree within merge_angle
+// (reduce_to_patch_supports): contacts whose normals agree within patch_angle
 // form a patch, and a contact of a patch that lies inside the convex hull of
 // the patch's other points (seen along the normal) is left out, except the
 // patch's smallest separation. Its row [n, (I - G) x n] is affine in I, so it is
 // a convex combination of the hull vertices' rows: the cone {J a >= 0} and the
-// cone of contact wrenches {J^T lambda} are the same with or without it (to the
-// merge_angle of the normals). A dense coplanar patch (a flat tool on a finely
+// cone of contact wrenches {J^T lambda} are the same with or without it, to the
+// angle between the normals (at most patch_angle: a tool tilted by 1e-5 rad on
+// a plate turns its edge/edge normals by as much, each a patch of its own at
+// merge_angle). A dense coplanar patch (a flat tool on a finely
 // tessellated plate: thousands of pairs) is then its corners, wherever the
 // search met them first. A set that fits is never reduced: every pair within
 // the distance is in it.
@@ -49,6 +51,7 @@ struct ContactSettings {
   double distance = 0;            // pairs within this distance: delta (1 + a small factor) (scene units, > 0)
   double merge_distance = 0;      // merge contacts closer than this (scene units; 0: 1e-3 distance)
   double merge_angle = 1e-6;      // ... whose normals differ by less than this (radians)
+  double patch_angle = 1e-3;      // a full set's patches: normals within this (radians; reduce_to_patch_supports)
   double parallel_sine = 1e-9;    // edges with |e1 x e2| <= this |e1| |e2| count as parallel
 };
 
@@ -89,9 +92,9 @@ struct ContactSet {
 // keeps, in their order, the contacts of patches of one or two contacts, and of
 // larger ones the vertices of the convex hull of their points projected on the
 // plane normal to the patch's first normal, and the smallest separation.
-// Contacts of one patch: normals within merge_angle (radians) of its first
+// Contacts of one patch: normals within patch_angle (radians) of its first
 // contact's. Rows J are not touched. Returns the number of contacts left out.
-int reduce_to_patch_supports(double merge_angle, ContactSet* set) noexcept;
+int reduce_to_patch_supports(double patch_angle, ContactSet* set) noexcept;
 
 // World positions of the god-object's vertices, posed on first use in each call
 // (a vertex is current when its stamp equals `stamp`), the god nodes' world
