@@ -33,22 +33,6 @@ Vec3 unit_normal(const Vec3& a, const Vec3& b, const Vec3& c) {
   return len > 0 && std::isfinite(len) ? Vec3(n / len) : Vec3::Zero();
 }
 
-// The normal of a vertex/face pair: the face's normal n (signed out of the
-// obstacle) when the closest point is inside the face, where the gap (from the
-// obstacle's point to the god-object's) lies along it; otherwise the gap's own
-// direction. A closest point on the face's boundary makes the pair a vertex
-// near an edge or a corner of the face, whose distance grows along the gap,
-// not along the face's normal, which may be square to it: a plate's vertex
-// just beside a puck's bottom edge, against the puck's side face, made a row
-// that forbade sliding the puck over it (the battery's dense_plate froze).
-// kInsideCosine: the gap along n to rounding. A gap under `floor` (the merge
-// distance) has no direction to trust: n.
-constexpr double kInsideCosine = 1 - 1e-9;
-Vec3 vertex_face_normal(const Vec3& n, const Vec3& gap, double sep, double floor) {
-  if (!(sep > floor) || gap.dot(n) >= kInsideCosine * sep) return n;
-  return gap / sep;
-}
-
 // Whether a -> b -> c turns left by more than rounding: twice the signed area
 // of the triangle above kCollinearSine |b - a| |c - a|. Points along a hull
 // edge (the contacts of a tool's edge crossing a plate's edges) are collinear
@@ -207,21 +191,18 @@ ContactStatus generate_contacts(const CcdBody* obstacles, int num_obstacles, con
       // god-object's corner (vertex k, or edge k -> k + 1), j: the obstacle's.
       for_each_feature_pair(go, oo, [&](PairKind kind, int k, int j) {
         switch (kind) {
-          case PairKind::kGodVertexObstacleFace: {  // the obstacle face's normal (inside it)
+          case PairKind::kGodVertexObstacleFace: {  // the obstacle face's normal
             const Vec3& x = gv(gf, k);
-            const Vec3 gap = x - closest_point_on_triangle(x, oa, obb, oc);
-            const double sep = gap.norm();
-            const Vec3 n = vertex_face_normal(unit_normal(oa, obb, oc), gap, sep, col.merge_distance);
+            const double sep = (x - closest_point_on_triangle(x, oa, obb, oc)).norm();
+            const Vec3 n = unit_normal(oa, obb, oc);
             if (sep <= d && n != Vec3::Zero()) col.add({x, n, sep, {kind, o, gf, k, of, -1}});
             break;
           }
-          case PairKind::kObstacleVertexGodFace: {  // minus the god face's normal (inside it)
+          case PairKind::kObstacleVertexGodFace: {  // minus the god face's normal
             const Vec3 y = ov(of, j);
             const Vec3 c = closest_point_on_triangle(y, gv(gf, 0), gv(gf, 1), gv(gf, 2));
-            const Vec3 gap = c - y;
-            const double sep = gap.norm();
-            const Vec3 n = vertex_face_normal(-unit_normal(gv(gf, 0), gv(gf, 1), gv(gf, 2)), gap, sep,
-                                              col.merge_distance);
+            const double sep = (y - c).norm();
+            const Vec3 n = -unit_normal(gv(gf, 0), gv(gf, 1), gv(gf, 2));
             if (sep <= d && n != Vec3::Zero()) col.add({c, n, sep, {kind, o, gf, -1, of, j}});
             break;
           }

@@ -234,29 +234,3 @@ TEST_CASE("contacts: a dense coplanar patch is reduced to its support, the same 
     }
   }
 }
-
-TEST_CASE("contacts: a vertex beside a face's edge takes the gap's direction, not the face's normal", "[contacts]") {
-  // The slab's top corner (2, 2, 0) lies 0.3 delta beside the god box's bottom
-  // corner on x and y and 1.2 delta below it: its closest point on the box's
-  // bottom face and on its two side faces is that corner, on each face's
-  // boundary. The side faces' normals (-x, -y out of the obstacle) are square
-  // to the gap and made rows that forbade sliding the box over the slab's
-  // corner; the pair's normal is the gap's direction, one contact for the three
-  // faces. The box's corner over the slab's top face is inside that face: +z.
-  BoxOverSlab f;
-  const Pose X{Vec3(2 - 0.5 - 0.3 * kDelta, 2 - 0.5 - 0.3 * kDelta, 0.5 + 1.2 * kDelta), Quat{}};
-  f.cs.distance = 1.5 * kDelta;
-  REQUIRE(f.contacts_at(X) == ContactStatus::kOk);
-  const Vec3 gap = Vec3(-0.3, -0.3, 1.2).normalized();
-  int along_gap = 0, up = 0;
-  for (int k = 0; k < f.set.num_contacts; ++k) {
-    const Contact& c = f.set.contacts[k];
-    INFO("contact " << k << " normal " << c.normal.transpose());
-    CHECK(c.normal.z() > 0.5);  // no side face's normal
-    // 1e-9: the gap of 1.3e-5 from coordinates of about 2 rounds at 1e-16 / 1e-5.
-    along_gap += (c.normal - gap).norm() < 1e-9;
-    up += c.normal == Vec3(0, 0, 1);
-  }
-  CHECK(along_gap == 1);
-  CHECK(up >= 1);
-}
