@@ -194,4 +194,9 @@ def plan(count: int, seed: int, families: list[str] | None = None) -> list[dict]
                     next_index[f] += 1
                     pending[f] -= k
                     total += k
+    for family in sorted({c["family"] for c in chunks} & set(SCRIPTS)):
+        script = paths.DATASETS_DIR / "scripts" / SCRIPTS[family]
+        if not script.is_file():  # an installed package without a checkout's datasets
+            raise ValueError(f"{script}: missing: the {family} steps follow this hand script of the datasets "
+                             "folder (GAUSS6_DATASETS_DIR); leave the family out with --family")
     return chunks

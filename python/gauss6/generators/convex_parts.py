@@ -22,7 +22,7 @@ from pathlib import Path
 
 import numpy as np
 
-from . import source
+from . import source as source_of
 
 GENERATOR_VERSION = "1"
 
@@ -110,7 +110,7 @@ def generate(V, F, out_dir: Path, params: ConvexPartsParams = ConvexPartsParams(
     key = mesh_key(V, F, params)
     parts = decompose(V, F, params)
     header = [f"convex parts of {source or 'a mesh'} ({len(V)} vertices, {len(F)} faces): {len(parts)} parts",
-              f"generator: {source(__spec__.name)[0]} version {GENERATOR_VERSION}",
+              f"generator: {source_of(__spec__.name)[0]} version {GENERATOR_VERSION}",
               f"coacd {version('coacd')}, parameters {json.dumps(params.to_json(), sort_keys=True)}"]
     path = out_dir / f"{key}.obj"
     write_obj(path, parts, header)
