@@ -797,6 +797,66 @@ Proof.
     assert (0 <= u * eta) by nra. lra.
 Qed.
 
+(* ---- kCornerOffsetRounding ----
+   corner_offsets (motion_bounds.h): r_k = A_k - centre, each coordinate one
+   rounded difference of two doubles (the god corner X at u0 and G = p).
+   StartFrame's motion() adds turn_rate (static_error + kCornerOffsetRounding r)
+   to the speed bound: static_error covers the double corner's distance from the
+   exact one, kCornerOffsetRounding r the subtraction's rounding, which the
+   theorem bounds in the Euclidean norm (what the turn acts on). A difference
+   of doubles errs by at most u of itself, underflow included (it is exact
+   there: sub_rel), so no absolute term. Hypotheses: |X - p| <= r + s (r >=
+   the exact corner's |r_B|, s = static_error >= the double corner's distance
+   from the exact one) and s <= 9000 r. The latter is not checked by the code:
+   static_error (kPoseRounding (|p|_inf + rho) plus the stop pose's deviation)
+   passes 9000 r only for a body more than ~10^16 of its size from the origin
+   (or a stop deviation 9000 times the triangle's radius); there the
+   subtraction's u s is covered by round_up's widening of the sum, which this
+   theorem does not model. *)
+(* allowance kCornerOffsetRounding = 1e-12 *)
+Definition kCornerOffsetRounding := fl (/ 1000000000000).
+
+Lemma abs_sq t : Rabs t * Rabs t = t * t.
+Proof. rewrite <- Rabs_mult. apply Rabs_pos_eq. nra. Qed.
+
+(* covers optimized/include/gauss6/ccd/motion_bounds.h "GAUSS6_ALWAYS_INLINE double corner_offsets(" sha256:a6814e84c72b62d0 *)
+(* covers optimized/include/gauss6/ccd/motion_bounds.h "bool motion(double r, double u_limit" sha256:e360e4764b160611 *)
+Theorem corner_offset_rounding x y z px py pz r s :
+  F x -> F y -> F z -> F px -> F py -> F pz ->
+  sqrt ((x - px) * (x - px) + (y - py) * (y - py) + (z - pz) * (z - pz)) <= r + s ->
+  0 <= s <= 9000 * r ->
+  let dx := fl (x - px) - (x - px) in let dy := fl (y - py) - (y - py) in
+  let dz := fl (z - pz) - (z - pz) in
+  sqrt (dx * dx + dy * dy + dz * dz) <= kCornerOffsetRounding * r.
+Proof.
+  intros Fx Fy Fz Fpx Fpy Fpz Hn Hs dx dy dz.
+  assert (Hu : 0 < u < / 1000000) by (unfold u; lra).
+  set (S := (x - px) * (x - px) + (y - py) * (y - py) + (z - pz) * (z - pz)) in *.
+  assert (Sq : forall a b, F a -> F b -> (fl (a - b) - (a - b)) * (fl (a - b) - (a - b)) <= u * u * ((a - b) * (a - b))).
+  { intros a b Fa Fb. pose proof (sub_rel a b Fa Fb) as H.
+    set (e := fl (a - b) - (a - b)) in *.
+    rewrite <- (abs_sq e), <- (abs_sq (a - b)).
+    replace (u * u * (Rabs (a - b) * Rabs (a - b))) with ((u * Rabs (a - b)) * (u * Rabs (a - b))) by ring.
+    apply Rmult_le_compat; try apply Rabs_pos; lra. }
+  assert (H1 : dx * dx + dy * dy + dz * dz <= (u * sqrt S) * (u * sqrt S)).
+  { pose proof (Sq x px Fx Fpx); pose proof (Sq y py Fy Fpy); pose proof (Sq z pz Fz Fpz).
+    assert (0 <= S) by (unfold S; pose proof (Rle_0_sqr (x - px)); pose proof (Rle_0_sqr (y - py));
+      pose proof (Rle_0_sqr (z - pz)); unfold Rsqr in *; lra).
+    replace ((u * sqrt S) * (u * sqrt S)) with (u * u * (sqrt S * sqrt S)) by ring.
+    rewrite sqrt_sqrt by lra. unfold dx, dy, dz, S. lra. }
+  assert (H2 : sqrt (dx * dx + dy * dy + dz * dz) <= u * sqrt S).
+  { rewrite <- (sqrt_square (u * sqrt S)) by (pose proof (sqrt_pos S); nra). apply sqrt_le_1_alt. exact H1. }
+  assert (Hk : (1 - u) * / 1000000000000 - eta <= kCornerOffsetRounding) by (apply fl_lower; lra).
+  pose proof eta_pos. pose proof eta_small.
+  assert (bpow radix2 (-1022) <= / 1000000000000000000) by (simpl; lra).
+  assert (0 <= r) by lra.
+  assert (u * sqrt S <= u * (r + s)) by (apply mul_le_l; lra).
+  assert (Hk2 : 9001 * u <= kCornerOffsetRounding) by (unfold u in *; lra).
+  assert (9001 * u * r <= kCornerOffsetRounding * r) by (apply Rmult_le_compat_r; lra).
+  assert (u * s <= u * (9000 * r)) by (apply mul_le_l; lra).
+  lra.
+Qed.
+
 (* The theorems, each answered by tools/check_proofs.sh. *)
 Print Assumptions linear_corner_rounding.
 Print Assumptions linear_corner_selection.
@@ -808,3 +868,4 @@ Print Assumptions norm_up_wide.
 Print Assumptions norm_down_wide.
 Print Assumptions step_rounding.
 Print Assumptions axis_velocity_rounding.
+Print Assumptions corner_offset_rounding.
