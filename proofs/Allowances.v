@@ -857,6 +857,198 @@ Proof.
   lra.
 Qed.
 
+(* ---- kBoxProductRounding, kUnderflowFloor at swept_box ----
+   swept_box (motion_bounds.cpp), one world coordinate i, the row (m_j) of
+   R_mid, (a_j) = |m_j| of R_abs and (q_j) >= 0 of R_rad, the body box's centre
+   c and half-widths h (doubles): reach_j = fl(|c_j| + h_j), centre =
+   sum3(fl(m_j c_j)), half = fl(sum3(fl(a_j h_j)) + sum3(fl(q_j reach_j))),
+   scale = sum3(fl(fl(a_j + q_j) reach_j)), sum3 the sum of three doubles in
+   any order. Every R within q of R_mid entrywise maps every r within h of c
+   to within half + kBoxProductRounding scale + kUnderflowFloor of centre
+   (grow rounds that sum up: Rounding.v's upper_add, upper_mul). No
+   hypothesis on magnitudes: the sums of doubles err relatively only (exact
+   where they underflow) and the nine products' underflow, at most 12 2^-1075
+   in all with the factor kBoxProductRounding, is under kUnderflowFloor. *)
+(* allowance kBoxProductRounding = 2e-15 *)
+Definition kBoxProductRounding := fl (2 / 1000000000000000).
+(* allowance kUnderflowFloor = 1e-300 *)
+Definition kUnderflowFloor := fl (/ IZR (Z.pow 10 300)).
+
+Definition sum3 x y z := fl (fl (x + y) + z).
+
+Lemma sum_lower x y : F x -> F y -> 0 <= x -> 0 <= y -> (1 - u) * (x + y) <= fl (x + y).
+Proof.
+  intros Fx Fy Hx Hy. apply rel_lower. pose proof (add_rel x y Fx Fy) as H.
+  rewrite (Rabs_pos_eq (x + y)) in H by lra. exact H.
+Qed.
+Lemma sum3_lower x y z : F x -> F y -> F z -> 0 <= x -> 0 <= y -> 0 <= z ->
+  (1 - u) * (1 - u) * (x + y + z) <= sum3 x y z.
+Proof.
+  intros. unfold sum3. assert (0 < u < / 1000000) by (unfold u; lra).
+  pose proof (sum_lower x y H H0 H2 H3).
+  assert (0 <= fl (x + y)) by (apply fl_nonneg; lra).
+  pose proof (sum_lower (fl (x + y)) z (F_fl _) H1 H7 H4).
+  assert ((1 - u) * ((1 - u) * (x + y)) <= (1 - u) * fl (x + y)) by (apply mul_le_l; lra).
+  assert (0 <= (1 - u) * u * z) by (apply Rmult_le_pos; nra).
+  nra.
+Qed.
+Lemma sum3_err x y z : F x -> F y -> F z ->
+  Rabs (sum3 x y z - (x + y + z)) <= 2 * u * (Rabs x + Rabs y) + u * (1 + u) * (Rabs x + Rabs y) + u * Rabs z.
+Proof.
+  intros Fx Fy Fz. unfold sum3. assert (0 < u < / 1000000) by (unfold u; lra).
+  pose proof (add_rel x y Fx Fy) as E1. pose proof (add_rel (fl (x + y)) z (F_fl _) Fz) as E2.
+  pose proof (Rabs_triang x y).
+  assert (Rabs (fl (x + y)) <= (1 + u) * (Rabs x + Rabs y)).
+  { replace (fl (x + y)) with ((fl (x + y) - (x + y)) + (x + y)) by ring.
+    eapply Rle_trans; [apply Rabs_triang|]. assert (u * Rabs (x + y) <= u * (Rabs x + Rabs y)) by (apply mul_le_l; lra). lra. }
+  assert (Rabs (fl (x + y) + z) <= (1 + u) * (Rabs x + Rabs y) + Rabs z)
+    by (eapply Rle_trans; [apply Rabs_triang | lra]).
+  assert (u * Rabs (fl (x + y) + z) <= u * ((1 + u) * (Rabs x + Rabs y) + Rabs z)) by (apply mul_le_l; lra).
+  assert (u * Rabs (x + y) <= u * (Rabs x + Rabs y)) by (apply mul_le_l; lra).
+  replace (fl (fl (x + y) + z) - (x + y + z)) with ((fl (fl (x + y) + z) - (fl (x + y) + z)) + (fl (x + y) - (x + y))) by ring.
+  eapply Rle_trans; [apply Rabs_triang|]. pose proof (Rabs_pos x); pose proof (Rabs_pos y). unfold u in *; lra.
+Qed.
+Lemma prod_lower a b : 0 <= a -> 0 <= b -> (1 - u) * (a * b) - eta <= fl (a * b).
+Proof. intros. apply fl_lower. nra. Qed.
+Lemma term_exact m q c h R r :
+  0 <= h -> Rabs (R - m) <= q -> Rabs (r - c) <= h ->
+  Rabs (R * r - m * c) <= Rabs m * h + q * (Rabs c + h).
+Proof.
+  intros Hh HR Hr. replace (R * r - m * c) with (m * (r - c) + (R - m) * r) by ring.
+  eapply Rle_trans; [apply Rabs_triang|]. rewrite !Rabs_mult.
+  assert (Rabs r <= Rabs c + h) by (replace r with (c + (r - c)) by ring; eapply Rle_trans; [apply Rabs_triang | lra]).
+  pose proof (Rabs_pos m). pose proof (Rabs_pos (R - m)). pose proof (Rabs_pos r). pose proof (Rabs_pos (r - c)).
+  assert (Rabs m * Rabs (r - c) <= Rabs m * h) by (apply mul_le_l; lra).
+  assert (Rabs (R - m) * Rabs r <= q * (Rabs c + h)) by (apply Rmult_le_compat; lra).
+  lra.
+Qed.
+(* A term's lower bounds: fl(q reach) and fl(fl(a + q) reach), reach = fl(|c| + h). *)
+Lemma reach_lower c h : F c -> F h -> 0 <= h -> (1 - u) * (Rabs c + h) <= fl (Rabs c + h).
+Proof. intros. apply sum_lower; [apply generic_format_abs; assumption | assumption | apply Rabs_pos | assumption]. Qed.
+Lemma qreach_lower q c h : F c -> F h -> 0 <= h -> 0 <= q ->
+  (1 - u) * (1 - u) * (q * (Rabs c + h)) - eta <= fl (q * fl (Rabs c + h)).
+Proof.
+  intros. assert (0 < u < / 1000000) by (unfold u; lra). pose proof (reach_lower c h H H0 H1).
+  pose proof (Rabs_pos c).
+  assert (q * ((1 - u) * (Rabs c + h)) <= q * fl (Rabs c + h)) by (apply mul_le_l; lra).
+  pose proof (prod_lower q (fl (Rabs c + h)) H2 ltac:(nra)). nra.
+Qed.
+Lemma sreach_lower a q c h : F a -> F q -> F c -> F h -> 0 <= h -> 0 <= q -> 0 <= a ->
+  (1 - u) * (1 - u) * (1 - u) * ((a + q) * (Rabs c + h)) - eta <= fl (fl (a + q) * fl (Rabs c + h)).
+Proof.
+  intros. assert (0 < u < / 1000000) by (unfold u; lra). pose proof (reach_lower c h H1 H2 H3).
+  pose proof (sum_lower a q H H0 H5 H4). pose proof (Rabs_pos c).
+  assert (0 <= fl (a + q)) by (apply fl_nonneg; lra).
+  assert (0 <= fl (Rabs c + h)) by (apply fl_nonneg; lra).
+  assert ((1 - u) * (a + q) * ((1 - u) * (Rabs c + h)) <= fl (a + q) * fl (Rabs c + h))
+    by (apply Rmult_le_compat; nra).
+  pose proof (prod_lower (fl (a + q)) (fl (Rabs c + h)) H10 H11). nra.
+Qed.
+
+(* covers optimized/src/ccd/motion_bounds.cpp "Aabb swept_box(const MotionEnclosure& e, const Aabb& body)" sha256:17e777d36e576019 *)
+Theorem swept_box_rounding m0 m1 m2 q0 q1 q2 c0 c1 c2 h0 h1 h2 R0 R1 R2 r0 r1 r2 :
+  (forall x, In x [m0; m1; m2; q0; q1; q2; c0; c1; c2; h0; h1; h2] -> F x) ->
+  0 <= q0 -> 0 <= q1 -> 0 <= q2 -> 0 <= h0 -> 0 <= h1 -> 0 <= h2 ->
+  Rabs (R0 - m0) <= q0 -> Rabs (R1 - m1) <= q1 -> Rabs (R2 - m2) <= q2 ->
+  Rabs (r0 - c0) <= h0 -> Rabs (r1 - c1) <= h1 -> Rabs (r2 - c2) <= h2 ->
+  let centre := sum3 (fl (m0 * c0)) (fl (m1 * c1)) (fl (m2 * c2)) in
+  let half := fl (sum3 (fl (Rabs m0 * h0)) (fl (Rabs m1 * h1)) (fl (Rabs m2 * h2))
+                  + sum3 (fl (q0 * fl (Rabs c0 + h0))) (fl (q1 * fl (Rabs c1 + h1))) (fl (q2 * fl (Rabs c2 + h2)))) in
+  let scale := sum3 (fl (fl (Rabs m0 + q0) * fl (Rabs c0 + h0))) (fl (fl (Rabs m1 + q1) * fl (Rabs c1 + h1)))
+                    (fl (fl (Rabs m2 + q2) * fl (Rabs c2 + h2))) in
+  Rabs ((R0 * r0 + R1 * r1 + R2 * r2) - centre) <= half + kBoxProductRounding * scale + kUnderflowFloor.
+Proof.
+  intros HF Hq0 Hq1 Hq2 Hh0 Hh1 Hh2 HR0 HR1 HR2 Hr0 Hr1 Hr2 centre half scale.
+  assert (Hu : 0 < u < / 1000000) by (unfold u; lra). pose proof eta_pos. pose proof eta_small.
+  assert (Hsmall : 5 * bpow radix2 (-1000) <= / IZR (Z.pow 10 300) * / 2) by (simpl; lra).
+  assert (bpow radix2 (-1022) <= bpow radix2 (-1000)) by (apply bpow_le; lia).
+  assert (Fm0 : F m0) by (apply HF; simpl; tauto). assert (Fm1 : F m1) by (apply HF; simpl; tauto).
+  assert (Fm2 : F m2) by (apply HF; simpl; tauto). assert (Fq0 : F q0) by (apply HF; simpl; tauto).
+  assert (Fq1 : F q1) by (apply HF; simpl; tauto). assert (Fq2 : F q2) by (apply HF; simpl; tauto).
+  assert (Fc0 : F c0) by (apply HF; simpl; tauto). assert (Fc1 : F c1) by (apply HF; simpl; tauto).
+  assert (Fc2 : F c2) by (apply HF; simpl; tauto). assert (Fh0 : F h0) by (apply HF; simpl; tauto).
+  assert (Fh1 : F h1) by (apply HF; simpl; tauto). assert (Fh2 : F h2) by (apply HF; simpl; tauto).
+  pose proof (Rabs_pos m0). pose proof (Rabs_pos m1). pose proof (Rabs_pos m2).
+  pose proof (Rabs_pos c0). pose proof (Rabs_pos c1). pose proof (Rabs_pos c2).
+  (* exact: within H of the exact R_mid c *)
+  set (HB := (Rabs m0 * h0 + q0 * (Rabs c0 + h0)) + (Rabs m1 * h1 + q1 * (Rabs c1 + h1))
+            + (Rabs m2 * h2 + q2 * (Rabs c2 + h2))).
+  set (A := Rabs m0 * Rabs c0 + Rabs m1 * Rabs c1 + Rabs m2 * Rabs c2).
+  set (T := (Rabs m0 + q0) * (Rabs c0 + h0) + (Rabs m1 + q1) * (Rabs c1 + h1) + (Rabs m2 + q2) * (Rabs c2 + h2)).
+  assert (HT : T = HB + A) by (unfold T, HB, A; ring).
+  assert (HA : 0 <= A) by (unfold A; nra).
+  assert (HH : 0 <= HB) by (unfold HB; nra).
+  assert (E1 : Rabs ((R0 * r0 + R1 * r1 + R2 * r2) - (m0 * c0 + m1 * c1 + m2 * c2)) <= HB).
+  { pose proof (term_exact m0 q0 c0 h0 R0 r0 Hh0 HR0 Hr0). pose proof (term_exact m1 q1 c1 h1 R1 r1 Hh1 HR1 Hr1).
+    pose proof (term_exact m2 q2 c2 h2 R2 r2 Hh2 HR2 Hr2).
+    replace ((R0 * r0 + R1 * r1 + R2 * r2) - (m0 * c0 + m1 * c1 + m2 * c2))
+      with ((R0 * r0 - m0 * c0) + (R1 * r1 - m1 * c1) + (R2 * r2 - m2 * c2)) by ring.
+    unfold HB. eapply Rle_trans; [apply Rabs_triang|]. pose proof (Rabs_triang (R0 * r0 - m0 * c0) (R1 * r1 - m1 * c1)). lra. }
+  (* the centre's rounding: within 6 u A + 4 eta *)
+  assert (P : forall m c, Rabs (fl (m * c) - m * c) <= u * (Rabs m * Rabs c) + eta /\
+                         Rabs (fl (m * c)) <= (1 + u) * (Rabs m * Rabs c) + eta).
+  { intros m c. pose proof (fl_err (m * c)) as G. rewrite Rabs_mult in G. split; [exact G|].
+    replace (fl (m * c)) with ((fl (m * c) - m * c) + m * c) by ring.
+    eapply Rle_trans; [apply Rabs_triang|]. rewrite Rabs_mult. lra. }
+  destruct (P m0 c0) as [P0 B0]; destruct (P m1 c1) as [P1 B1]; destruct (P m2 c2) as [P2 B2].
+  pose proof (sum3_err (fl (m0 * c0)) (fl (m1 * c1)) (fl (m2 * c2)) (F_fl _) (F_fl _) (F_fl _)) as S3.
+  fold centre in S3.
+  assert (E2 : Rabs (centre - (m0 * c0 + m1 * c1 + m2 * c2)) <= 6 * u * A + 4 * eta).
+  { replace (centre - (m0 * c0 + m1 * c1 + m2 * c2))
+      with ((centre - (fl (m0 * c0) + fl (m1 * c1) + fl (m2 * c2)))
+            + ((fl (m0 * c0) - m0 * c0) + (fl (m1 * c1) - m1 * c1) + (fl (m2 * c2) - m2 * c2))) by ring.
+    eapply Rle_trans; [apply Rabs_triang|]. unfold A.
+    pose proof (Rabs_triang (fl (m0 * c0) - m0 * c0 + (fl (m1 * c1) - m1 * c1)) (fl (m2 * c2) - m2 * c2)).
+    pose proof (Rabs_triang (fl (m0 * c0) - m0 * c0) (fl (m1 * c1) - m1 * c1)).
+    set (a0 := Rabs m0 * Rabs c0) in *. set (a1 := Rabs m1 * Rabs c1) in *. set (a2 := Rabs m2 * Rabs c2) in *.
+    set (y0 := Rabs (fl (m0 * c0))) in *. set (y1 := Rabs (fl (m1 * c1))) in *. set (y2 := Rabs (fl (m2 * c2))) in *.
+    assert (0 <= a0) by (unfold a0; nra). assert (0 <= a1) by (unfold a1; nra). assert (0 <= a2) by (unfold a2; nra).
+    unfold u in *. lra. }
+  (* half from below: (1 - u)^5 H - 6 eta *)
+  assert (HQ : forall m q c h, F m -> F q -> F c -> F h -> 0 <= q -> 0 <= h ->
+     0 <= fl (Rabs m * h) /\ 0 <= fl (q * fl (Rabs c + h)) /\ 0 <= fl (fl (Rabs m + q) * fl (Rabs c + h))).
+  { intros m q c h Fm Fq Fc Fh Hq Hh. pose proof (Rabs_pos m). pose proof (Rabs_pos c).
+    assert (0 <= fl (Rabs c + h)) by (apply fl_nonneg; lra).
+    assert (0 <= fl (Rabs m + q)) by (apply fl_nonneg; lra).
+    split; [|split]; apply fl_nonneg; nra. }
+  destruct (HQ m0 q0 c0 h0) as (N0 & M0 & K0); try assumption.
+  destruct (HQ m1 q1 c1 h1) as (N1 & M1 & K1); try assumption.
+  destruct (HQ m2 q2 c2 h2) as (N2 & M2 & K2); try assumption.
+  pose proof (sum3_lower _ _ _ (F_fl (Rabs m0 * h0)) (F_fl (Rabs m1 * h1)) (F_fl (Rabs m2 * h2)) N0 N1 N2) as L1.
+  pose proof (sum3_lower _ _ _ (F_fl (q0 * fl (Rabs c0 + h0))) (F_fl (q1 * fl (Rabs c1 + h1))) (F_fl (q2 * fl (Rabs c2 + h2))) M0 M1 M2) as L2.
+  pose proof (sum3_lower _ _ _ (F_fl (fl (Rabs m0 + q0) * fl (Rabs c0 + h0))) (F_fl (fl (Rabs m1 + q1) * fl (Rabs c1 + h1)))
+     (F_fl (fl (Rabs m2 + q2) * fl (Rabs c2 + h2))) K0 K1 K2) as L3. fold scale in L3.
+  pose proof (prod_lower (Rabs m0) h0 ltac:(lra) Hh0). pose proof (prod_lower (Rabs m1) h1 ltac:(lra) Hh1).
+  pose proof (prod_lower (Rabs m2) h2 ltac:(lra) Hh2).
+  pose proof (qreach_lower q0 c0 h0) as Q0. pose proof (qreach_lower q1 c1 h1) as Q1. pose proof (qreach_lower q2 c2 h2) as Q2.
+  pose proof (sreach_lower (Rabs m0) q0 c0 h0 (generic_format_abs _ _ _ Fm0)) as T0.
+  pose proof (sreach_lower (Rabs m1) q1 c1 h1 (generic_format_abs _ _ _ Fm1)) as T1.
+  pose proof (sreach_lower (Rabs m2) q2 c2 h2 (generic_format_abs _ _ _ Fm2)) as T2.
+  specialize (Q0 Fc0 Fh0 Hh0 Hq0). specialize (Q1 Fc1 Fh1 Hh1 Hq1). specialize (Q2 Fc2 Fh2 Hh2 Hq2).
+  specialize (T0 Fq0 Fc0 Fh0 Hh0 Hq0 ltac:(lra)). specialize (T1 Fq1 Fc1 Fh1 Hh1 Hq1 ltac:(lra)).
+  specialize (T2 Fq2 Fc2 Fh2 Hh2 Hq2 ltac:(lra)).
+  set (S1 := sum3 (fl (Rabs m0 * h0)) (fl (Rabs m1 * h1)) (fl (Rabs m2 * h2))) in *.
+  set (S2 := sum3 (fl (q0 * fl (Rabs c0 + h0))) (fl (q1 * fl (Rabs c1 + h1))) (fl (q2 * fl (Rabs c2 + h2)))) in *.
+  assert (0 <= S1) by (unfold u in *; lra). assert (0 <= S2) by (unfold u in *; lra).
+  assert (Hhalf : (1 - u) * (S1 + S2) <= half) by (apply sum_lower; [apply F_fl | apply F_fl | lra | lra]).
+  assert (Ehalf : (1 - 6 * u) * HB - 7 * eta <= half).
+  { unfold HB. unfold u in *. lra. }
+  assert (Escale : (1 - 6 * u) * T - 4 * eta <= scale).
+  { assert (0 <= T) by lra. unfold T. unfold u in *. lra. }
+  assert (0 <= scale) by (unfold scale, sum3; apply fl_nonneg; apply Rplus_le_le_0_compat; [apply fl_nonneg|]; lra).
+  (* the allowances' doubles *)
+  assert (Hk : (1 - u) * (2 / 1000000000000000) - eta <= kBoxProductRounding) by (apply fl_lower; lra).
+  assert (Hf : (1 - u) * / IZR (Z.pow 10 300) - eta <= kUnderflowFloor) by (apply fl_lower; apply Rlt_le, Rinv_0_lt_compat; apply IZR_lt; reflexivity).
+  assert (Hk17 : 17 * u <= kBoxProductRounding) by (unfold u in *; lra).
+  assert (17 * u * scale <= kBoxProductRounding * scale) by (apply Rmult_le_compat_r; lra).
+  assert (17 * u * ((1 - 6 * u) * T - 4 * eta) <= 17 * u * scale) by (apply mul_le_l; lra).
+  assert (/ IZR (Z.pow 10 300) * / 2 <= kUnderflowFloor) by (unfold u in *; lra).
+  replace ((R0 * r0 + R1 * r1 + R2 * r2) - centre)
+    with (((R0 * r0 + R1 * r1 + R2 * r2) - (m0 * c0 + m1 * c1 + m2 * c2)) - (centre - (m0 * c0 + m1 * c1 + m2 * c2))) by ring.
+  eapply Rle_trans; [apply abs_diff_le; [exact E1 | exact E2]|].
+  assert (0 <= T) by lra. unfold u in *. lra.
+Qed.
+
 (* The theorems, each answered by tools/check_proofs.sh. *)
 Print Assumptions linear_corner_rounding.
 Print Assumptions linear_corner_selection.
@@ -869,3 +1061,4 @@ Print Assumptions norm_down_wide.
 Print Assumptions step_rounding.
 Print Assumptions axis_velocity_rounding.
 Print Assumptions corner_offset_rounding.
+Print Assumptions swept_box_rounding.

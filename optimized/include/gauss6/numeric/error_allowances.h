@@ -144,6 +144,7 @@ constexpr double kBoxPoseRounding = 1e-12;
 // nonnegative terms, within 7.01 u of itself <= 7.01 u T; T itself is
 // computed within 7.01 u. Under 10.1 u (1.12e-15) of the computed T in all;
 // 2e-15 covers it 1.8 times (kUnderflowFloor below it). Site: swept_box.
+// Machine-checked: proofs/Allowances.v, swept_box_rounding (with kUnderflowFloor).
 constexpr double kBoxProductRounding = 2e-15;
 
 // An absolute floor under the relative allowances of box extents, where the
@@ -151,7 +152,8 @@ constexpr double kBoxProductRounding = 2e-15;
 // underflowing product or sum errs by at most 2^-1075 (2.5e-324; 2^-1022,
 // 2.2e-308, on a thread that flushes subnormals to zero), and a box's few
 // dozen of them stay below 1e-306; 1e-300 covers them and is below any extent
-// that matters. Sites: fit_obb, generate_contacts, swept_box.
+// that matters. Sites: fit_obb, generate_contacts, swept_box. Machine-checked
+// at swept_box: proofs/Allowances.v, swept_box_rounding.
 constexpr double kUnderflowFloor = 1e-300;
 
 // A corner value of F = (w + a ea) - b eb for linearly moving points (the
