@@ -112,6 +112,7 @@ bool fill_some(StepState* s, long budget) {
     const TraversalStatus ts = traverse(*s, frame, enc, pf.swept, 0.0, fill_dist, pf.obstacle, &pf.stack, &pf.pending,
                                         budget, &used, [&](int gf, int of, int o) {
       double radius = 0;
+      charge(s, kWorkWeightTrianglePair);  // (the chunks' ends check: fill_within_budget)
       const double gap = frame.gap(frame.posed_face(*god.mesh, gf, &pf.swept), *s->obstacles[o].mesh, of, fill_dist,
                                    &radius);
       if (gap > fill_dist) return true;
@@ -193,7 +194,7 @@ void take_background_fill(StepState* s, const CacheRanges& r, Displacement* sinc
   const bool needed = !r.usable(s->u_cached) && r.usable(r.range(moved_ahead, pf.margin));
   if (!r.usable(s->u_cached) && !needed) {
     pf.active = false;  // the god-object went elsewhere
-  } else if ((better && pf.complete) || (needed && fill_some(s, std::numeric_limits<long>::max()))) {
+  } else if ((better && pf.complete) || (needed && fill_within_budget(s, std::numeric_limits<long>::max()))) {
     put_fill(s);
     s->result->cache_refilled = true;
     *since = ahead;
@@ -219,7 +220,9 @@ void refill_if_worth(StepState* s, const CacheRanges& r, Displacement* since) {
   const double fresh_margin =
       list_margin(*s, pc.has_last ? Displacement(pc.last_x0, s->X0).bound(rho) : 0.0, margin, step_margin_max(*s));
   bool fill = !fresh && r.usable(r.range(Displacement(s->X0, s->X0).bound(rho), fresh_margin));
-  if (fill && s->start.speed <= policy(*s).slow_fraction * margin) {
+  if (fill && pc.budget_cut) {
+    fill = false;
+  } else if (fill && s->start.speed <= policy(*s).slow_fraction * margin) {
     pc.rest = 0;
   } else if (fill && pc.rest > 0) {
     fill = --pc.rest == 0;
@@ -229,7 +232,11 @@ void refill_if_worth(StepState* s, const CacheRanges& r, Displacement* since) {
   }
   if (!fill) return;
   start_fill(s, /*ahead=*/nullptr, fresh_margin);
-  const bool filled = fill_some(s, std::numeric_limits<long>::max());
+  const bool filled = fill_within_budget(s, std::numeric_limits<long>::max());
+  // A fill the update's budget cut short is dropped, and no step fills at
+  // once until one completes its search within its budget (plain descents,
+  // each within the budget): no later update spends its budget on it again.
+  if (!filled && out_of_budget(*s)) pc.budget_cut = true;
   pc.clear();
   s->u_cached = 0;
   s->cache_keyed = false;
@@ -265,6 +272,10 @@ void search_cached_pairs(StepState* s, const ProximityCache& pc, const Displacem
   for (int k = 0; k < pc.num_pairs; ++k) {
     const ProximityCache::Pair& c = pc.pairs[static_cast<size_t>(k)];
     ++result->num_triangle_pairs;
+    if (charge(s, kWorkWeightTrianglePair)) {  // nothing of [u0, u_cached] proven, the candidates' buffer in part
+      result->num_near_pairs = -1;
+      return stop_on_budget(s, u0);
+    }
     if (Lower{c.gap} - Upper{moving.bound(c.radius)} > Upper{s->reach}) {
       ++result->num_axis_culls;
       continue;
@@ -278,10 +289,25 @@ void search_cached_pairs(StepState* s, const ProximityCache& pc, const Displacem
     cand[num_cand++] = {{c.god_face, c.obstacle_face, c.obstacle}, t};  // fits: the cache has cand's capacity
   }
   set_near_pairs(s, num_cand, 0.0);
-  test_candidates(s, num_cand);
+  test_candidates(s, num_cand);  // (the budget's end: stop_on_budget)
 }
 
 }  // namespace
+
+// Node pairs a fill descends between two charges to the update's budget.
+constexpr long kFillChunk = 64;
+bool fill_within_budget(StepState* s, long max_node_pairs) {
+  if (s->ws->budget == nullptr) return fill_some(s, max_node_pairs);
+  const ProximityCache::Fill& pf = s->ws->cache.fill;
+  for (long left = max_node_pairs; left > 0 && !out_of_budget(*s);) {
+    const long cost = pf.cost;
+    const bool complete = fill_some(s, std::min(left, kFillChunk));
+    left -= pf.cost - cost;
+    charge(s, kWorkWeightNodePair * (pf.cost - cost));
+    if (complete || !pf.active) return complete;  // done, or dropped (does not fit)
+  }
+  return false;
+}
 
 // Coherence (proximity_cache.h): [0, u_cached] is the range
 // over which no point moves farther than the margin from the cache's pose;
@@ -376,9 +402,10 @@ void fill_cache_in_background(StepState* s) {
         start_fill(s, &ahead, m);
       }
     }
-    if (pf.active && !pf.complete) fill_some(s, settings.cache.fill_budget);
+    if (pf.active && !pf.complete) fill_within_budget(s, settings.cache.fill_budget);
   }
   // The next step's background fill and list margin follow this step's motion.
+  pc.budget_cut = pc.budget_cut && out_of_budget(*s);  // this step's search completed within its budget
   pc.last_x0 = X0;
   pc.has_last = true;
 }

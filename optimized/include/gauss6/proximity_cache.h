@@ -80,6 +80,8 @@ struct ProximityCache {
   double margin_min = 0, margin_max = 0;  // the settings it was filled under (keys)
   int uses = 0;  // later steps served since the fill
   int rest = 0;  // chances to refill still to pass over (ProximityCacheSettings::skip_after_poor_fill)
+  bool budget_cut = false;  // a fill at once was cut short by an update's budget: none until a step's search
+                            // completes within its budget (the next steps descend instead)
   CcdBody god;
   std::vector<CcdBody> obstacles;  // the keys; capacity obstacle_capacity, reserved here (never grows)
   // A fill in progress (ProximityCacheSettings::fill_budget): the same kind

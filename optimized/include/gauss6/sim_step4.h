@@ -22,6 +22,7 @@
 #include "gauss6/pose.h"
 #include "gauss6/runtime_events.h"
 #include "gauss6/runtime_model.h"
+#include "gauss6/update_budget.h"
 
 namespace gauss6 {
 
@@ -73,6 +74,7 @@ struct GodObjectStep {
   LegEnd proven;                      // the first leg from x_start, whole and free, served by halvings
   std::vector<TrianglePair> proven_near;  // its near pairs, copied before later legs reuse legs_ws
   StepPaths paths;
+  UpdateBudget budget;                // the update's (RuntimeSettings::budget; docs/sim-step.md, "Budgeted updates")
 };
 
 // Step 4 of a sim step alone, from its recorded inputs (SimStepInfo::x_start,
@@ -88,7 +90,9 @@ struct GodObjectStep {
 // the legs of the last try), u_hit, num_halves, status and num_contacts, and
 // s->step4.paths. Real time: no allocation; at most 5 CCDs a try (two a leg,
 // split at a half turn, and one check) over 1 + kMaxSettleShortenings tries,
-// and 3 more out of a graze.
+// and 3 more out of a graze. Under a budget (RuntimeSettings::budget) the
+// update ends when it runs out, at the end of what its CCDs proved free, with
+// the contact set there (info's budget_exhausted, work_units, budget_deferred).
 void advance_god_object(const RuntimeModel& model, const Pose& x_start, const Pose& x_target, const Vec6& residual,
                         SimState* s, SimStepInfo* info) noexcept;
 
