@@ -189,7 +189,7 @@ TraversalStatus descend(StepState* s, double u_end, const Visit& visit) {
         const int before = s->result->num_node_pairs;
         ts = traverse(*s, s->start, s->e, s->ws->swept, u_end, s->reach, o, &stack, &pending, chunk,
                       &s->result->num_node_pairs, visit, record);
-        if (charge(s, kWorkWeightNodePair * (s->result->num_node_pairs - before)) && ts == TraversalStatus::kPaused)
+        if (charge(s, Work::kNodePair, s->result->num_node_pairs - before) && ts == TraversalStatus::kPaused)
           return ts;
       } while (ts == TraversalStatus::kPaused);
       if (ts == TraversalStatus::kStopped && keep) {
@@ -244,7 +244,7 @@ bool search_sub_intervals(StepState* s) {
     const TraversalStatus ts = descend(s, std::min(u1, result->u_hit), [&](int gf, int of, int o) {
       const CcdBody& ob = s->obstacles[o];
       ++result->num_triangle_pairs;
-      if (charge(s, kWorkWeightTrianglePair)) return false;
+      if (charge(s, Work::kTrianglePair, 1)) return false;
       const double t = s->start.earliest(s->start.posed_face(*god.mesh, gf, &s->ws->swept), *ob.mesh, of, s->reach,
                                          tester.end());
       if (t > tester.end()) {

@@ -92,12 +92,15 @@ bool answered(const StepState& s);
 bool test_candidates(StepState* s, int num_cand);
 
 // The update's budget (CcdStepWorkspace::budget, update_budget.h): charges
-// `units` of work, true when it has run out (now or before); false without one.
-inline bool charge(StepState* s, long units) { return s->ws->budget != nullptr && s->ws->budget->spend(units); }
+// `count` pieces of work, true when it has run out (now or before); false without one.
+inline bool charge(StepState* s, Work kind, long count) {
+  return s->ws->budget != nullptr && s->ws->budget->spend(kind, count);
+}
 inline bool out_of_budget(const StepState& s) { return s.ws->budget != nullptr && s.ws->budget->exhausted(); }
 // A narrow-phase test just run, begun with `boxes_before` boxes counted: its set-up and boxes.
 inline bool charge_test(StepState* s, long boxes_before) {
-  return charge(s, kWorkWeightPairTest + kWorkWeightBox * (s->result->num_box_iterations - boxes_before));
+  charge(s, Work::kPairTest, 1);
+  return charge(s, Work::kBox, s->result->num_box_iterations - boxes_before);
 }
 // The budget ran out with the motion proven free of every pair not yet
 // tested up to u (at the step's reach), every pair tested searched to the

@@ -20,6 +20,7 @@ const char* update_budget_settings_problem(const UpdateBudgetSettings& s) {
 void UpdateBudget::start(const UpdateBudgetSettings& settings) noexcept {
   settings_ = settings;
   used_ = 0;
+  for (long& p : pieces_) p = 0;
   exhausted_ = false;
   cpu_start_ = settings.cpu_seconds > 0 ? detail::thread_cpu_seconds() : 0.0;
   // No budget: never checked. A count alone: checked when it is reached.

@@ -69,19 +69,22 @@ TEST_CASE("budget: the settings are checked by name", "[runtime][budget]") {
 
 TEST_CASE("budget: the count runs out at its units, the clock at its checks", "[runtime][budget]") {
   UpdateBudget b;
-  b.start({0, 100, 10});
-  CHECK_FALSE(b.spend(99));
-  CHECK(b.spend(1));  // 100 units: spent
+  const long w = kWorkWeight[static_cast<int>(Work::kNodePair)];
+  b.start({0, 100 * w, 10});
+  CHECK_FALSE(b.spend(Work::kNodePair, 99));
+  CHECK(b.spend(Work::kNodePair, 1));  // 100 node pairs: spent
   CHECK(b.exhausted());
-  CHECK(b.used() == 100);
+  CHECK(b.used() == 100 * w);
+  CHECK(b.pieces(Work::kNodePair) == 100);
   b.start({0, 0, 10});  // none: never runs out
-  CHECK_FALSE(b.spend(LONG_MAX / 2));
+  CHECK(b.pieces(Work::kNodePair) == 0);
+  CHECK_FALSE(b.spend(Work::kBox, LONG_MAX / 8));
   // A CPU budget already spent is found at the first check, check_interval units on, not before.
   b.start({1e-12, 0, 10});
   volatile double x = 0;
   for (int i = 0; i < 100000; ++i) x = x + 1;  // some CPU time
-  CHECK_FALSE(b.spend(9));
-  CHECK(b.spend(1));
+  CHECK_FALSE(b.spend(Work::kNodePair, 9));
+  CHECK(b.spend(Work::kNodePair, 1));
 }
 
 TEST_CASE("budget: a budget that never runs out changes nothing, bit for bit", "[runtime][budget]") {

@@ -21,13 +21,18 @@
 
 namespace gauss6 {
 
-// The weights of the work units (instructions per piece of work, divided by
-// kInstructionsPerUnit and rounded; docs/benchmarks.md gives the fit).
-inline constexpr long kWorkWeightNodePair = 1;       // a node pair of a tree descent (boxes tested)
-inline constexpr long kWorkWeightTrianglePair = 2;   // a candidate triangle pair's time or gap bound
-inline constexpr long kWorkWeightPairTest = 4;       // a narrow-phase pair test's set-up
-inline constexpr long kWorkWeightBox = 2;            // a narrow-phase box (one bisection of a feature pair)
-inline constexpr long kInstructionsPerUnit = 100;    // about, per unit (the calibration's ratio)
+// The pieces of work the CCD charges, and their weights in work units
+// (instructions per piece, divided by kInstructionsPerUnit and rounded;
+// docs/benchmarks.md gives the fit).
+enum class Work { kNodePair = 0, kTrianglePair, kPairTest, kBox };
+inline constexpr int kNumWorkKinds = 4;
+inline constexpr long kWorkWeight[kNumWorkKinds] = {
+    1,   // kNodePair: a node pair of a tree descent or fill (boxes tested)
+    2,   // kTrianglePair: a candidate triangle pair's time or gap bound
+    4,   // kPairTest: a narrow-phase test's set-up (a triangle pair)
+    2,   // kBox: a narrow-phase box (one bisection of a feature pair)
+};
+inline constexpr long kInstructionsPerUnit = 650;    // about, per unit (the calibration's ratio)
 
 // CPU time that a 1 kHz sim loop can give a god-object update on every update:
 // the period (1 ms) less the rest of the sim step (the projection, publishing:
@@ -41,8 +46,8 @@ inline constexpr double kRecommendedUpdateCpuSeconds = 0.4e-3;
 // replays (docs/benchmarks.md), which count the steps beyond it.
 inline constexpr double kUpdateOverrunBound = 0.2e-3;
 // Work units between two reads of the CPU clock (a read costs about a
-// microsecond on a VM; 2048 units, about 200,000 instructions, about 50 us).
-inline constexpr long kDefaultBudgetCheckInterval = 512;
+// microsecond on a VM; 64 units, about 40,000 instructions, 10-20 us here).
+inline constexpr long kDefaultBudgetCheckInterval = 64;
 
 struct UpdateBudgetSettings {
   double cpu_seconds = 0;   // CPU time per update (s, > 0; 0: no time budget; kRecommendedUpdateCpuSeconds)
@@ -60,12 +65,14 @@ class UpdateBudget {
  public:
   // A new update under `settings` (reads the CPU clock once when it has a time budget).
   void start(const UpdateBudgetSettings& settings) noexcept;
-  // Charges `units`; true when the budget has run out (by now or before).
-  bool spend(long units) noexcept {
-    used_ += units;
+  // Charges `count` pieces of work of one kind; true when the budget has run out (by now or before).
+  bool spend(Work kind, long count) noexcept {
+    pieces_[static_cast<int>(kind)] += count;
+    used_ += kWorkWeight[static_cast<int>(kind)] * count;
     if (used_ >= next_check_) check();
     return exhausted_;
   }
+  long pieces(Work kind) const { return pieces_[static_cast<int>(kind)]; }  // charged in this update
   bool exhausted() const { return exhausted_; }
   long used() const { return used_; }       // units charged in this update
   double cpu_start() const { return cpu_start_; }  // s, thread CPU clock at start() (time budget only)
@@ -74,6 +81,7 @@ class UpdateBudget {
   void check() noexcept;
   UpdateBudgetSettings settings_;
   long used_ = 0;
+  long pieces_[kNumWorkKinds] = {};
   long next_check_ = 0;      // the count at which the budget is checked next
   double cpu_start_ = 0;
   bool exhausted_ = false;
