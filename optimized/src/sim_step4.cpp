@@ -62,7 +62,10 @@ bool ccd_leg(const RuntimeModel& model, const Pose& x0, const Pose& x1, bool fil
   CcdStepResult& r = leg.ccd;
   CcdStepRequest request{x0, x1, g->hints.data(), g->num_hints};
   request.fill_cache = fill;
-  request.lead_sweep = settling ? kSettleLeadSweep : 0.0;
+  // A settling leg, or any leg after an update that ran out of its budget (its
+  // command grew while the god-object lagged: proven piece by piece from the
+  // start, each cheap, the update goes as far as its budget proves).
+  request.lead_sweep = settling || g->budget_ran_out ? kSettleLeadSweep : 0.0;
   leg.from = x0;
   leg.one_piece = true;
   run_ccd(model, request, &g->legs_ws, &r);
@@ -311,8 +314,11 @@ bool settle(const RuntimeModel& model, const Pose& x_start, const Vec6& residual
 // update's work, and what of the command it left for the next ones (the
 // distance of xs from x_target: travel plus turn times the god-object's radius).
 void end_on_budget(const RuntimeModel& model, const Pose& x_target, SimState* s, SimStepInfo* info) {
-  const GodObjectStep& g = s->step4;
+  GodObjectStep& g = s->step4;
   info->work_units = g.budget.used();
+  info->budget_exhausted = false;
+  info->budget_deferred = 0;
+  g.budget_ran_out = g.budget.exhausted();
   if (!g.budget.exhausted()) return;
   info->budget_exhausted = true;
   if (g.leg.ccd.budget_exhausted)

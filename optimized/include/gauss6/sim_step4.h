@@ -75,6 +75,7 @@ struct GodObjectStep {
   std::vector<TrianglePair> proven_near;  // its near pairs, copied before later legs reuse legs_ws
   StepPaths paths;
   UpdateBudget budget;                // the update's (RuntimeSettings::budget; docs/sim-step.md, "Budgeted updates")
+  bool budget_ran_out = false;        // the last update's did: this one's first leg searches in lead pieces
 };
 
 // Step 4 of a sim step alone, from its recorded inputs (SimStepInfo::x_start,
