@@ -14,9 +14,9 @@
 #include <vector>
 
 #include "bench_data.h"
-#include "gauss6/bvh.h"
-#include "gauss6/ccd_step.h"
-#include "gauss6/mesh_io.h"
+#include "gauss6/geometry/bvh.h"
+#include "gauss6/step/ccd_step.h"
+#include "gauss6/io/mesh_io.h"
 #include "latency.h"
 
 namespace gauss6::bench {

@@ -28,8 +28,8 @@
 
 #include "bench_data.h"
 #include "ccd_query_data.h"
-#include "gauss6/ccd.h"
-#include "gauss6/ccd_queries.h"
+#include "gauss6/ccd/ccd.h"
+#include "gauss6/io/ccd_queries.h"
 #include "gauss6/reference/ccd.h"
 #include "latency.h"
 

@@ -11,9 +11,9 @@
 #include <vector>
 
 #include "bench_data.h"
-#include "gauss6/ccd_step.h"
-#include "gauss6/contacts.h"
-#include "gauss6/runtime.h"
+#include "gauss6/step/ccd_step.h"
+#include "gauss6/contact/contacts.h"
+#include "gauss6/runtime/runtime.h"
 #include "latency.h"
 
 namespace gauss6::bench {

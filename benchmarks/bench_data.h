@@ -24,15 +24,15 @@
 
 #include <nlohmann/json.hpp>
 
-#include "gauss6/bvh.h"
-#include "gauss6/ccd_step.h"
-#include "gauss6/mesh_io.h"
-#include "gauss6/pose.h"
-#include "gauss6/qp_instances.h"
-#include "gauss6/quasistatics.h"
-#include "gauss6/runtime.h"
+#include "gauss6/geometry/bvh.h"
+#include "gauss6/step/ccd_step.h"
+#include "gauss6/io/mesh_io.h"
+#include "gauss6/geometry/pose.h"
+#include "gauss6/io/qp_instances.h"
+#include "gauss6/contact/quasistatics.h"
+#include "gauss6/runtime/runtime.h"
 #include "gauss6/scenario.h"
-#include "gauss6/scene.h"
+#include "gauss6/io/scene.h"
 #include "gauss6/simulated_device.h"
 
 namespace gauss6::bench {

@@ -11,8 +11,8 @@
 #include <vector>
 
 #include "bench_data.h"
-#include "gauss6/qp_instances.h"
-#include "gauss6/quasistatics.h"
+#include "gauss6/io/qp_instances.h"
+#include "gauss6/contact/quasistatics.h"
 #include "latency.h"
 
 namespace gauss6::bench {

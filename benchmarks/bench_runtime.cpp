@@ -28,9 +28,9 @@
 #include <string>
 
 #include "bench_data.h"
-#include "gauss6/runtime.h"
+#include "gauss6/runtime/runtime.h"
 #include "gauss6/scenario.h"
-#include "gauss6/scene.h"
+#include "gauss6/io/scene.h"
 #include "gauss6/simulated_device.h"
 #include "latency.h"
 

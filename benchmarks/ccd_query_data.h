@@ -11,8 +11,8 @@
 #include <vector>
 
 #include "bench_data.h"
-#include "gauss6/ccd.h"
-#include "gauss6/ccd_queries.h"
+#include "gauss6/ccd/ccd.h"
+#include "gauss6/io/ccd_queries.h"
 
 namespace gauss6::bench {
 

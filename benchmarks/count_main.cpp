@@ -39,8 +39,8 @@
 
 #include "bench_data.h"
 #include "ccd_query_data.h"
-#include "gauss6/qp_instances.h"
-#include "gauss6/quasistatics.h"
+#include "gauss6/io/qp_instances.h"
+#include "gauss6/contact/quasistatics.h"
 
 namespace gauss6::bench {
 namespace {

@@ -7,12 +7,12 @@
 #include <fstream>
 #include <stdexcept>
 
-#include "gauss6/ccd_queries.h"
-#include "gauss6/load_error.h"
-#include "gauss6/mesh_io.h"
-#include "gauss6/qp_instances.h"
+#include "gauss6/io/ccd_queries.h"
+#include "gauss6/io/load_error.h"
+#include "gauss6/io/mesh_io.h"
+#include "gauss6/io/qp_instances.h"
 #include "gauss6/replay_device.h"
-#include "gauss6/scene.h"
+#include "gauss6/io/scene.h"
 #include "gauss6/simulated_device.h"
 #include "gauss6/trace.h"
 

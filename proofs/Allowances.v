@@ -1,4 +1,4 @@
-(* The named error allowances of optimized/include/gauss6/error_allowances.h,
+(* The named error allowances of optimized/include/gauss6/numeric/error_allowances.h,
    proved in Flocq: for each, the rounding error of the expression at its
    sites, evaluated as the code evaluates it (the same operations in the same
    order, each rounded to nearest binary64: Rounding.v's `fl`), is within the
@@ -8,7 +8,7 @@
 From Coq Require Import Reals Psatz.
 From Coq Require Import List.
 Import ListNotations.
-From Flocq Require Import Core Relative.
+From Flocq Require Import Core Relative Plus_error.
 From Gauss6 Require Import Rounding.
 Open Scope R_scope.
 
@@ -112,8 +112,8 @@ Proof.
   - unfold u in *; lra.
 Qed.
 
-(* covers optimized/src/ccd.cpp "LinearPoints make_linear_points(" sha256:badaaa4fc2f7da52 *)
-(* covers optimized/src/ccd.cpp "void enclose_linear(" sha256:b914611386face38 *)
+(* covers optimized/src/ccd/ccd.cpp "LinearPoints make_linear_points(" sha256:badaaa4fc2f7da52 *)
+(* covers optimized/src/ccd/ccd.cpp "void enclose_linear(" sha256:b914611386face38 *)
 Theorem linear_corner_rounding M t a b
     xw0 yw0 xw1 yw1 xa0 ya0 xa1 ya1 xb0 yb0 xb1 yb1 :
   0 <= t <= 1 -> 0 <= a <= 1 -> 0 <= b <= 1 ->
@@ -169,7 +169,7 @@ Qed.
    as the least corner value (and the mirror for the largest) instead of all
    four: that value is one of the four computed corner values, and no larger
    than any of them, rounding being monotone. *)
-(* covers optimized/src/ccd.cpp "void enclose_linear(" sha256:b914611386face38 *)
+(* covers optimized/src/ccd/ccd.cpp "void enclose_linear(" sha256:b914611386face38 *)
 Theorem linear_corner_selection w pa0 pa1 pb0 pb1 :
   let corner pa pb := fl (fl (w + pa) - pb) in
   let least := fl (fl (w + Rmin pa0 pa1) - Rmax pb0 pb1) in
@@ -196,7 +196,7 @@ Qed.
 (* make_linear_points' p.error = kLinearCornerRounding * Upper{M} +
    Upper{kLinearCornerUnderflow}, rounded up (Rounding.v): at least the bound
    of linear_corner_rounding. *)
-(* covers optimized/src/ccd.cpp "LinearPoints make_linear_points(" sha256:badaaa4fc2f7da52 *)
+(* covers optimized/src/ccd/ccd.cpp "LinearPoints make_linear_points(" sha256:badaaa4fc2f7da52 *)
 Theorem linear_corner_error_bound M :
   0 <= M ->
   kLinearCornerRounding * M + kLinearCornerUnderflow
@@ -207,18 +207,24 @@ Proof.
 Qed.
 
 
-(* ---- kRelativeRounding at its norm sites ----
-   round_up(v.norm() * (1 + kRelativeRounding)): Eigen's norm of a double
-   3-vector, sqrt of the sum of the three rounded squares (summed in any
-   order: the statement is symmetric in x, y, z), times the double
-   1 + kRelativeRounding (the compiler folds it, rounding to nearest), rounded
-   up, is at least the exact norm, provided |v|^2 >= 2^-1000: below that the
-   squares underflow and the bound can fall below |v| (proofs/README.md).
-   Sites: StartFrame::set (omega_norm, omega a double vector) and the same
-   form at SweptObbFrame::pose (|half|); not the shift of Displacement, whose
-   components are rounded differences. *)
+(* ---- kRelativeRounding, kRelativeRoundingWide and kNormFloor at the norm sites ----
+   rounding.h's norm_up(n, k) = max(round_up(n (1 + k)), Upper{kNormFloor})
+   and norm_down(n, k) = (d > kNormFloor ? d : 0), d = round_down(n (1 - k)),
+   with n the computed norm of a double 3-vector v: Eigen's v.norm() (or
+   std::sqrt(v.squaredNorm())), the square root of the sum of the three rounded
+   squares. The statements are symmetric in x, y, z, so they hold for any order
+   of the sum. The constant 1 + k is the double fl(1 + fl(k)) (the compiler
+   folds it, rounding to nearest). No fused multiply-add (x86-64 without FMA
+   in the build's flags).
+   Below |v|^2 = 2^-1000 the squares underflow and the computed norm may be 0
+   for a vector of norm 2^-537: the floor kNormFloor speaks there (this was a
+   finding: the form without it, round_up(n (1 + k)), fell 2^63 times below
+   |v| at such a v, and round_down(n (1 - k)) was <= 0, a divisor of
+   Upper / Lower whose double must be > 0). *)
 (* allowance kRelativeRounding = 1e-15 *)
 Definition kRelativeRounding := fl (/ 1000000000000000).
+(* allowance kRelativeRoundingWide = 1e-12 *)
+Definition kRelativeRoundingWide := fl (/ 1000000000000).
 
 Lemma fl_lower z : 0 <= z -> (1 - u) * z - eta <= fl z.
 Proof.
@@ -231,66 +237,574 @@ Proof.
   unfold Rabs in H; destruct Rcase_abs; lra.
 Qed.
 
-Lemma one_plus_rel : 1 + 7 * u <= fl (1 + kRelativeRounding).
+(* The folded constants: fl(1 + 1e-15) >= 1 + 8 u, fl(1 + 1e-12) >= 1 + 8 u,
+   0 <= fl(1 - 1e-12) <= 1 - 8 u. *)
+Lemma one_plus_fl c : / 1000000000000000 <= c <= 1 -> 1 + 8 * u <= fl (1 + fl c).
+Proof.
+  intros Hc. pose proof eta_pos. pose proof eta_small.
+  assert (bpow radix2 (-1022) <= / 1000000000000000000) by (simpl; lra).
+  assert (Hk : (1 - u) * c - eta <= fl c) by (apply fl_lower; lra).
+  assert (0 <= fl c) by (apply fl_nonneg; lra).
+  pose proof (fl_lower (1 + fl c) ltac:(lra)).
+  unfold u in *. lra.
+Qed.
+Lemma one_plus_relative : 1 + 8 * u <= fl (1 + kRelativeRounding).
+Proof. apply one_plus_fl. lra. Qed.
+Lemma one_plus_wide : 1 + 8 * u <= fl (1 + kRelativeRoundingWide).
+Proof. apply one_plus_fl. lra. Qed.
+Lemma one_minus_wide : 0 <= fl (1 - kRelativeRoundingWide) <= 1 - 8 * u.
 Proof.
   pose proof eta_pos. pose proof eta_small.
   assert (bpow radix2 (-1022) <= / 1000000000000000000) by (simpl; lra).
-  assert (Hk : (1 - u) * / 1000000000000000 - eta <= kRelativeRounding) by (apply fl_lower; lra).
-  assert (0 <= kRelativeRounding) by (apply fl_nonneg; lra).
-  pose proof (fl_lower (1 + kRelativeRounding) ltac:(lra)).
+  assert (Hk : (1 - u) * / 1000000000000 - eta <= kRelativeRoundingWide) by (apply fl_lower; lra).
+  assert (Hk' : kRelativeRoundingWide <= (1 + u) * / 1000000000000 + eta) by (apply fl_upper; lra).
+  split; [apply fl_nonneg; unfold u in *; lra|].
+  pose proof (fl_upper (1 - kRelativeRoundingWide) ltac:(unfold u in *; lra)).
   unfold u in *. lra.
 Qed.
 
-(* covers optimized/src/motion_bounds.cpp "void StartFrame::set(const CcdMotion& m, double u, double rho_in)" sha256:d727ef1e2605b2dd *)
-Theorem norm_relative_rounding x y z :
-  bpow radix2 (-1000) <= x * x + y * y + z * z ->
-  let s := fl (fl (fl (x * x) + fl (y * y)) + fl (z * z)) in
-  sqrt (x * x + y * y + z * z) <= next_up (fl (fl (sqrt s) * fl (1 + kRelativeRounding))).
+Lemma bpow_m53 : u = bpow radix2 (-53).
+Proof. unfold u; simpl; lra. Qed.
+
+(* S >= 2^-1002: the absolute errors of underflow, eta, are below 2^-20 u S. *)
+Lemma eta_rel S : bpow radix2 (-1002) <= S -> 1000000 * eta <= u * S.
 Proof.
-  intros HS s. pose proof eta_pos. pose proof eta_small. assert (Hu : 0 < u) by (unfold u; lra).
-  set (S := x * x + y * y + z * z) in *.
-  assert (E1 : 1000000 * eta <= u * bpow radix2 (-1000)).
-  { unfold eta, u. replace (/ 9007199254740992) with (bpow radix2 (-53)) by (simpl; lra).
-    rewrite <- bpow_plus. apply Rle_trans with (bpow radix2 22 * bpow radix2 (-1075)).
+  intros HS. pose proof eta_pos. assert (0 < u) by (unfold u; lra).
+  apply Rle_trans with (u * bpow radix2 (-1002)); [|apply Rmult_le_compat_l; lra].
+  rewrite bpow_m53, <- bpow_plus. unfold eta.
+  apply Rle_trans with (bpow radix2 20 * bpow radix2 (-1075)).
+  - apply Rmult_le_compat_r; [apply bpow_ge_0 | simpl; lra].
+  - rewrite <- bpow_plus. apply bpow_le. lia.
+Qed.
+
+(* The sum of the three rounded squares, from below and from above. *)
+Lemma mul_le_l k a b : 0 <= k -> a <= b -> k * a <= k * b.
+Proof. intros; apply Rmult_le_compat_l; assumption. Qed.
+Lemma sumsq_lower x y z : let S := x * x + y * y + z * z in
+  bpow radix2 (-1002) <= S -> (1 - 4 * u) * S <= fl (fl (fl (x * x) + fl (y * y)) + fl (z * z)).
+Proof.
+  intros S HS. pose proof (eta_rel S HS). pose proof eta_pos. assert (0 < u < / 1000000) by (unfold u; lra).
+  assert (0 <= x * x) by nra. assert (0 <= y * y) by nra. assert (0 <= z * z) by nra.
+  pose proof (fl_lower (x * x) ltac:(lra)). pose proof (fl_lower (y * y) ltac:(lra)).
+  pose proof (fl_lower (z * z) ltac:(lra)).
+  set (a := fl (x * x)) in *; set (b := fl (y * y)) in *; set (c := fl (z * z)) in *.
+  assert (0 <= a) by (apply fl_nonneg; lra). assert (0 <= b) by (apply fl_nonneg; lra).
+  assert (0 <= c) by (apply fl_nonneg; lra).
+  pose proof (fl_lower (a + b) ltac:(lra)). set (t := fl (a + b)) in *.
+  assert (0 <= t) by (apply fl_nonneg; lra).
+  pose proof (fl_lower (t + c) ltac:(lra)).
+  assert (K1 : (1 - u) * S - 3 * eta <= a + b + c) by (unfold S; lra).
+  assert (K2 : (1 - u) * (a + b) - eta + c <= t + c) by lra.
+  assert (K3 : (1 - u) * ((1 - u) * (a + b) - eta + c) - eta <= fl (t + c))
+    by (apply Rle_trans with ((1 - u) * (t + c) - eta); [assert ((1 - u) * ((1 - u) * (a + b) - eta + c) <= (1 - u) * (t + c)) by (apply mul_le_l; lra); lra | lra]).
+  assert (0 <= (1 - u) * u * c) by (apply Rmult_le_pos; [nra | lra]).
+  assert (K4 : (1 - u) * (1 - u) * (a + b + c) - 2 * eta <= (1 - u) * ((1 - u) * (a + b) - eta + c) - eta) by nra.
+  assert (K5 : (1 - u) * (1 - u) * ((1 - u) * S - 3 * eta) <= (1 - u) * (1 - u) * (a + b + c))
+    by (apply mul_le_l; [nra | lra]).
+  assert (0 <= S) by (pose proof (bpow_ge_0 radix2 (-1002)); lra).
+  assert (Q1 : (1 - 3 * u) * S <= (1 - u) * (1 - u) * (1 - u) * S)
+    by (apply Rmult_le_compat_r; [lra | nra]).
+  assert (Q2 : (1 - u) * (1 - u) * eta <= 1 * eta) by (apply Rmult_le_compat_r; nra).
+  assert (u * eta <= / 1000 * eta) by (apply Rmult_le_compat_r; lra).
+  lra.
+Qed.
+Lemma sumsq_upper x y z : let S := x * x + y * y + z * z in
+  fl (fl (fl (x * x) + fl (y * y)) + fl (z * z)) <= (1 + 4 * u) * S + 6 * eta.
+Proof.
+  intros S. pose proof eta_pos. assert (0 < u < / 1000000) by (unfold u; lra).
+  assert (0 <= x * x) by nra. assert (0 <= y * y) by nra. assert (0 <= z * z) by nra.
+  pose proof (fl_upper (x * x) ltac:(lra)). pose proof (fl_upper (y * y) ltac:(lra)).
+  pose proof (fl_upper (z * z) ltac:(lra)).
+  set (a := fl (x * x)) in *; set (b := fl (y * y)) in *; set (c := fl (z * z)) in *.
+  assert (0 <= a) by (apply fl_nonneg; lra). assert (0 <= b) by (apply fl_nonneg; lra).
+  assert (0 <= c) by (apply fl_nonneg; lra).
+  pose proof (fl_upper (a + b) ltac:(lra)). set (t := fl (a + b)) in *.
+  assert (0 <= t) by (apply fl_nonneg; lra).
+  pose proof (fl_upper (t + c) ltac:(lra)).
+  assert (K1 : a + b + c <= (1 + u) * S + 3 * eta) by (unfold S; lra).
+  assert (K3 : fl (t + c) <= (1 + u) * ((1 + u) * (a + b) + eta + c) + eta)
+    by (apply Rle_trans with ((1 + u) * (t + c) + eta); [lra | assert ((1 + u) * (t + c) <= (1 + u) * ((1 + u) * (a + b) + eta + c)) by (apply mul_le_l; lra); lra]).
+  assert (K4 : (1 + u) * ((1 + u) * (a + b) + eta + c) + eta <= (1 + u) * (1 + u) * (a + b + c) + (2 + u) * eta) by nra.
+  assert (K5 : (1 + u) * (1 + u) * (a + b + c) <= (1 + u) * (1 + u) * ((1 + u) * S + 3 * eta))
+    by (apply mul_le_l; [nra | lra]).
+  assert (0 <= S) by (unfold S; lra).
+  assert (Q1 : (1 + u) * (1 + u) * (1 + u) * S <= (1 + 4 * u) * S) by (apply Rmult_le_compat_r; nra).
+  assert (Q2 : (1 + u) * (1 + u) * eta <= (1 + / 1000) * eta) by (apply Rmult_le_compat_r; nra).
+  assert (u * eta <= / 1000 * eta) by (apply Rmult_le_compat_r; lra).
+  lra.
+Qed.
+
+(* sqrt (2^-2e) = 2^-e. *)
+Lemma sqrt_bpow2 e : sqrt (bpow radix2 (2 * e)) = bpow radix2 e.
+Proof.
+  replace (2 * e)%Z with (e + e)%Z by lia. rewrite bpow_plus.
+  apply sqrt_square. apply bpow_ge_0.
+Qed.
+Lemma sqrt_scale k S : 0 <= k -> 0 <= S -> sqrt (k * k * S) = k * sqrt S.
+Proof. intros. rewrite sqrt_mult by nra. rewrite sqrt_square by lra. reflexivity. Qed.
+
+Definition norm_c x y z := fl (sqrt (fl (fl (fl (x * x) + fl (y * y)) + fl (z * z)))).
+
+(* allowance kNormFloor = 0x1p-500 *)
+Definition kNormFloor := bpow radix2 (-500).
+
+Theorem norm_upper_bound x y z k : 1 + 8 * u <= k ->
+  sqrt (x * x + y * y + z * z) <= Rmax (next_up (fl (norm_c x y z * k))) kNormFloor.
+Proof.
+  intros Hk. set (S := x * x + y * y + z * z).
+  assert (HS0 : 0 <= S) by (unfold S; nra).
+  destruct (Rlt_or_le S (bpow radix2 (-1000))) as [Hs|Hs].
+  - (* below the floor *)
+    apply Rle_trans with kNormFloor; [|apply Rmax_r].
+    unfold kNormFloor. rewrite <- (sqrt_bpow2 (-500)). apply sqrt_le_1_alt. simpl (2 * -500)%Z. lra.
+  - apply Rle_trans with (next_up (fl (norm_c x y z * k))); [|apply Rmax_l].
+    assert (HS2 : bpow radix2 (-1002) <= S)
+      by (eapply Rle_trans; [apply bpow_le with (e2 := (-1000)%Z); lia | exact Hs]).
+    pose proof (sumsq_lower x y z HS2) as Hs'. fold S in Hs'.
+    set (s := fl (fl (fl (x * x) + fl (y * y)) + fl (z * z))) in *.
+    pose proof eta_pos. assert (Hu : 0 < u < / 1000000) by (unfold u; lra).
+    set (N := sqrt S).
+    assert (HN : bpow radix2 (-500) <= N)
+      by (unfold N; rewrite <- (sqrt_bpow2 (-500)); apply sqrt_le_1_alt; exact Hs).
+    assert (HeN : 1000000 * eta <= u * N).
+    { apply Rle_trans with (u * bpow radix2 (-500)); [|apply Rmult_le_compat_l; lra].
+      rewrite bpow_m53, <- bpow_plus. unfold eta.
+      apply Rle_trans with (bpow radix2 20 * bpow radix2 (-1075)).
+      - apply Rmult_le_compat_r; [apply bpow_ge_0 | simpl; lra].
+      - rewrite <- bpow_plus. apply bpow_le. lia. }
+    assert (HN0 : 0 <= N) by apply sqrt_pos.
+    assert (Hr : (1 - 3 * u) * N <= sqrt s).
+    { unfold N. rewrite <- sqrt_scale by lra. apply sqrt_le_1_alt.
+      apply Rle_trans with ((1 - 4 * u) * S); [apply Rmult_le_compat_r; nra | exact Hs']. }
+    pose proof (fl_lower (sqrt s) (sqrt_pos s)) as Hf.
+    assert (Hf' : (1 - 5 * u) * N <= fl (sqrt s)).
+    { assert ((1 - u) * ((1 - 3 * u) * N) <= (1 - u) * sqrt s) by (apply mul_le_l; lra).
+      assert ((1 - 4 * u) * N <= ((1 - u) * (1 - 3 * u)) * N) by (apply Rmult_le_compat_r; nra).
+      lra. }
+    fold (norm_c x y z) in Hf'. unfold norm_c in *. fold s in Hf'.
+    assert (Hp : (1 + 2 * u) * N <= fl (sqrt s) * k).
+    { apply Rle_trans with (((1 - 5 * u) * N) * (1 + 8 * u)).
+      - assert (0 <= (1 + 2 * u) * N) by nra. apply Rle_trans with ((1 - 5 * u) * (1 + 8 * u) * N).
+        + apply Rmult_le_compat_r; nra.
+        + lra.
+      - apply Rmult_le_compat; nra. }
+    pose proof (fl_lower (fl (sqrt s) * k) ltac:(nra)) as Hq.
+    assert ((1 - u) * ((1 + 2 * u) * N) <= (1 - u) * (fl (sqrt s) * k)) by (apply mul_le_l; lra).
+    assert ((1 + / 2 * u) * N <= ((1 - u) * (1 + 2 * u)) * N) by (apply Rmult_le_compat_r; nra).
+    apply Rle_trans with (fl (fl (sqrt s) * k)); [|apply next_up_ge_F, F_fl]. lra.
+Qed.
+
+Theorem norm_lower_bound x y z k : 0 <= k <= 1 - 8 * u ->
+  let d := next_down (fl (norm_c x y z * k)) in
+  (if Rlt_dec kNormFloor d then d else 0) <= sqrt (x * x + y * y + z * z).
+Proof.
+  intros Hk d. set (S := x * x + y * y + z * z).
+  assert (HS0 : 0 <= S) by (unfold S; nra). pose proof eta_pos. assert (Hu : 0 < u < / 1000000) by (unfold u; lra).
+  unfold norm_c in d. set (s := fl (fl (fl (x * x) + fl (y * y)) + fl (z * z))) in *.
+  pose proof (sumsq_upper x y z) as Hs'. fold S s in Hs'.
+  assert (Hd : d <= fl (fl (sqrt s) * k)) by (apply next_down_le_F, F_fl).
+  destruct (Rlt_or_le S (bpow radix2 (-1002))) as [Hs|Hs].
+  - (* d is at most the floor: the result is 0 *)
+    assert (He : 6 * eta <= bpow radix2 (-1002)).
+    { unfold eta. apply Rle_trans with (bpow radix2 3 * bpow radix2 (-1075)).
+      - apply Rmult_le_compat_r; [apply bpow_ge_0 | simpl; lra].
+      - rewrite <- bpow_plus. apply bpow_le. lia. }
+    assert (Hb : bpow radix2 (-1000) = 4 * bpow radix2 (-1002))
+      by (replace (-1000)%Z with (2 + -1002)%Z by lia; rewrite bpow_plus; simpl; lra).
+    assert (Hss : s <= bpow radix2 (2 * -500)).
+    { simpl (2 * -500)%Z. rewrite Hb. assert (4 * u * S <= bpow radix2 (-1002)) by nra. nra. }
+    assert (Hq : sqrt s <= kNormFloor) by (unfold kNormFloor; rewrite <- sqrt_bpow2; apply sqrt_le_1_alt; exact Hss).
+    assert (HF : F kNormFloor) by (apply generic_format_bpow; unfold FLT_exp; lia).
+    assert (Hq' : fl (sqrt s) <= kNormFloor) by (apply fl_le_F; assumption).
+    assert (0 <= fl (sqrt s)) by (apply fl_nonneg, sqrt_pos).
+    assert (0 < kNormFloor) by apply bpow_gt_0.
+    assert (fl (fl (sqrt s) * k) <= kNormFloor) by (apply fl_le_F; [exact HF | nra]).
+    destruct (Rlt_dec kNormFloor d); [lra | apply sqrt_pos].
+  - assert (d <= sqrt S).
+    { pose proof (eta_rel S Hs) as HeS. set (N := sqrt S).
+      assert (HN0 : 0 <= N) by apply sqrt_pos.
+      assert (HN : bpow radix2 (-501) <= N).
+      { unfold N. rewrite <- (sqrt_bpow2 (-501)). apply sqrt_le_1_alt. simpl (2 * -501)%Z. exact Hs. }
+      assert (HeN : 1000000 * eta <= u * N).
+      { apply Rle_trans with (u * bpow radix2 (-501)); [|apply Rmult_le_compat_l; lra].
+        rewrite bpow_m53, <- bpow_plus. unfold eta.
+        apply Rle_trans with (bpow radix2 20 * bpow radix2 (-1075)).
+        - apply Rmult_le_compat_r; [apply bpow_ge_0 | simpl; lra].
+        - rewrite <- bpow_plus. apply bpow_le. lia. }
+      assert (Hr : sqrt s <= (1 + 3 * u) * N).
+      { unfold N. rewrite <- sqrt_scale by lra. apply sqrt_le_1_alt.
+        apply Rle_trans with ((1 + 5 * u) * S); [nra | apply Rmult_le_compat_r; nra]. }
+      pose proof (fl_upper (sqrt s) (sqrt_pos s)) as Hf.
+      assert (Hf' : fl (sqrt s) <= (1 + 5 * u) * N).
+      { assert ((1 + u) * sqrt s <= (1 + u) * ((1 + 3 * u) * N)) by (apply mul_le_l; lra).
+        assert (((1 + u) * (1 + 3 * u)) * N <= (1 + 9 / 2 * u) * N) by (apply Rmult_le_compat_r; nra).
+        lra. }
+      assert (0 <= fl (sqrt s)) by (apply fl_nonneg, sqrt_pos).
+      assert (Hp : fl (sqrt s) * k <= (1 - 2 * u) * N).
+      { apply Rle_trans with (((1 + 5 * u) * N) * (1 - 8 * u)).
+        - apply Rmult_le_compat; lra.
+        - apply Rle_trans with ((1 + 5 * u) * (1 - 8 * u) * N); [lra | apply Rmult_le_compat_r; nra]. }
+      pose proof (fl_upper (fl (sqrt s) * k) ltac:(nra)) as Hq.
+      assert ((1 + u) * (fl (sqrt s) * k) <= (1 + u) * ((1 - 2 * u) * N)) by (apply mul_le_l; lra).
+      assert (((1 + u) * (1 - 2 * u)) * N <= (1 - / 2 * u) * N) by (apply Rmult_le_compat_r; nra).
+      lra. }
+    destruct (Rlt_dec kNormFloor d); [assumption | apply sqrt_pos].
+Qed.
+
+(* The code's forms, at its sites. *)
+(* covers optimized/include/gauss6/numeric/rounding.h "GAUSS6_ALWAYS_INLINE Upper norm_up(double norm, double relative)" sha256:b4b3280a1e614758 *)
+(* covers optimized/src/ccd/motion_bounds.cpp "void StartFrame::set(const CcdMotion& m, double u, double rho_in)" sha256:cfac9ee869768b2c *)
+(* covers optimized/include/gauss6/ccd/motion_bounds.h "PosedObb pose(const Obb& b) const" sha256:d9a738b735b2fff9 *)
+(* covers optimized/include/gauss6/ccd/motion_bounds.h "double radius(double r2) const" sha256:6689317b141e2024 *)
+Theorem norm_up_relative x y z :
+  sqrt (x * x + y * y + z * z) <= Rmax (next_up (fl (norm_c x y z * fl (1 + kRelativeRounding)))) kNormFloor.
+Proof. apply norm_upper_bound, one_plus_relative. Qed.
+
+(* covers optimized/include/gauss6/numeric/rounding.h "GAUSS6_ALWAYS_INLINE Upper norm_up(double norm, double relative)" sha256:b4b3280a1e614758 *)
+(* covers optimized/include/gauss6/geometry/distance.h "GAUSS6_ALWAYS_INLINE void for_each_separating_axis(const SatSide& A" sha256:823fc811c899d033 *)
+Theorem norm_up_wide x y z :
+  sqrt (x * x + y * y + z * z) <= Rmax (next_up (fl (norm_c x y z * fl (1 + kRelativeRoundingWide)))) kNormFloor.
+Proof. apply norm_upper_bound, one_plus_wide. Qed.
+
+(* covers optimized/include/gauss6/numeric/rounding.h "GAUSS6_ALWAYS_INLINE Lower norm_down(double norm, double relative)" sha256:981268e19c3ba706 *)
+(* covers optimized/include/gauss6/ccd/motion_bounds.h "inline double triangle_time_lower_bound(const SatSide& A, const Vec3 r[3]" sha256:e6fe43232891e550 *)
+Theorem norm_down_wide x y z :
+  let d := next_down (fl (norm_c x y z * fl (1 - kRelativeRoundingWide))) in
+  (if Rlt_dec kNormFloor d then d else 0) <= sqrt (x * x + y * y + z * z).
+Proof. apply norm_lower_bound, one_minus_wide. Qed.
+
+(* next_up moves a nonnegative r up by at least 2^-602 (its widening is at
+   least kTiny = 2^-600 and at least about 2 u r). *)
+Lemma next_up_plus r : 0 <= r -> r + bpow radix2 (-602) <= next_up r.
+Proof.
+  intros Hr. unfold next_up, widening. rewrite Rabs_pos_eq by exact Hr.
+  pose proof eta_pos. assert (Hu : 0 < u < / 1000000) by (unfold u; lra).
+  assert (HU : kUlp = 2 * u) by (unfold kUlp, u; simpl; lra).
+  rewrite HU.
+  assert (HT : bpow radix2 (-600) = 4 * bpow radix2 (-602))
+    by (replace (-600)%Z with (2 + -602)%Z by lia; rewrite bpow_plus; simpl; lra).
+  assert (He : 1000 * eta <= bpow radix2 (-602)).
+  { unfold eta. apply Rle_trans with (bpow radix2 10 * bpow radix2 (-1075)).
     - apply Rmult_le_compat_r; [apply bpow_ge_0 | simpl; lra].
     - rewrite <- bpow_plus. apply bpow_le. lia. }
-  assert (HeS : 1000000 * eta <= u * S)
-    by (apply Rle_trans with (u * bpow radix2 (-1000)); [exact E1 | apply Rmult_le_compat_l; lra]).
-  assert (X := fl_lower (x * x) ltac:(nra)); assert (Y := fl_lower (y * y) ltac:(nra));
-  assert (Z := fl_lower (z * z) ltac:(nra)).
-  assert (0 <= fl (x * x)) by (apply fl_nonneg; nra); assert (0 <= fl (y * y)) by (apply fl_nonneg; nra);
-  assert (0 <= fl (z * z)) by (apply fl_nonneg; nra).
-  assert (T := fl_lower (fl (x * x) + fl (y * y)) ltac:(lra)).
-  assert (0 <= fl (fl (x * x) + fl (y * y))) by (apply fl_nonneg; lra).
-  assert (Hs := fl_lower (fl (fl (x * x) + fl (y * y)) + fl (z * z)) ltac:(lra)). fold s in Hs.
-  assert (Hs' : (1 - 4 * u) * S <= s).
-  { unfold S in *. assert (0 <= x * x) by nra. assert (0 <= y * y) by nra. assert (0 <= z * z) by nra.
-    unfold u in *. nra. }
-  assert (HS0 : 0 < S) by (pose proof (bpow_gt_0 radix2 (-1000)); lra).
-  assert (Hr : (1 - 4 * u) * sqrt S <= sqrt s).
-  { apply Rle_trans with (sqrt ((1 - 4 * u) * S)); [|apply sqrt_le_1_alt; exact Hs'].
-    rewrite sqrt_mult by (unfold u; lra). apply Rmult_le_compat_r; [apply sqrt_pos|].
-    assert (0 <= 1 - 4 * u <= 1) by (unfold u; lra).
-    rewrite <- (sqrt_Rsqr (1 - 4 * u)) at 1 by lra. apply sqrt_le_1_alt. unfold Rsqr. nra. }
-  assert (Hn := fl_lower (sqrt s) (sqrt_pos s)).
-  assert (HsS : eta <= u * sqrt S).
-  { (* sqrt S >= S when S <= 1, and sqrt S >= 1 >= S... : use sqrt S >= S / sqrt S... simply: *)
-    destruct (Rle_or_lt S 1).
-    - assert (S <= sqrt S).
-      { rewrite <- (sqrt_Rsqr S) at 1 by lra. apply sqrt_le_1_alt. unfold Rsqr. nra. }
-      nra.
-    - assert (1 <= sqrt S) by (rewrite <- sqrt_1; apply sqrt_le_1_alt; lra).
-      unfold eta in *. apply Rle_trans with (bpow radix2 (-1075)); [lra|].
-      apply Rle_trans with u; [|nra]. unfold u. replace (/ 9007199254740992) with (bpow radix2 (-53)) by (simpl; lra).
-      apply bpow_le; lia. }
-  pose proof one_plus_rel.
-  assert (0 <= sqrt S) by apply sqrt_pos.
-  assert (Hn' : (1 - 6 * u) * sqrt S <= fl (sqrt s)) by (unfold u in *; nra).
-  apply up_ge. unfold u in *. nra.
+  assert (0 <= r * (2 * u)) by nra.
+  pose proof (fl_lower (r * (2 * u)) ltac:(lra)) as G1.
+  assert (0 <= fl (r * (2 * u))) by (apply fl_nonneg; lra).
+  assert (HFt : F kTiny) by (apply generic_format_bpow; unfold FLT_exp; lia).
+  assert (Hk : 0 < kTiny) by apply bpow_gt_0.
+  set (t := fl (fl (r * (2 * u)) + kTiny)).
+  assert (T1 : kTiny <= t) by (apply fl_ge_F; [exact HFt | lra]).
+  assert (T2 : fl (r * (2 * u)) <= t) by (apply fl_ge_F; [apply F_fl | lra]).
+  pose proof (fl_lower (r + t) ltac:(lra)) as G2.
+  unfold kTiny in T1. rewrite HT in T1.
+  set (B := bpow radix2 (-602)) in *.
+  assert (Q1 : 3 / 5 * (1 - u) * ((1 - u) * (2 * u) * r - eta) <= 3 / 5 * (1 - u) * t)
+    by (apply mul_le_l; lra).
+  assert (Q2 : 2 / 5 * (1 - u) * (4 * B) <= 2 / 5 * (1 - u) * t) by (apply mul_le_l; lra).
+  assert (Q3 : u * r <= (3 / 5 * (1 - u) * (1 - u) * (2 * u)) * r) by (apply Rmult_le_compat_r; nra).
+  assert (Q4 : u * B <= / 1000000 * B) by (apply Rmult_le_compat_r; lra).
+  assert (Q5 : 0 <= u * eta) by nra.
+  lra.
+Qed.
+
+(* A sum or difference of two doubles rounds within u of itself, relatively
+   (no underflow term: below the normal range it is exact). *)
+Lemma sub_rel x y : F x -> F y -> Rabs (fl (x - y) - (x - y)) <= u * Rabs (x - y).
+Proof.
+  intros Fx Fy.
+  destruct (FLT_plus_error_N_ex radix2 (-1074) 53 (fun t => negb (Z.even t)) x (- y) Fx (F_opp y Fy))
+    as (eps & He & E).
+  unfold fl. change (round radix2 (FLT_exp (-1074) 53) ZnearestE (x - y))
+    with (round radix2 (FLT_exp (-1074) 53) (Znearest (fun t => negb (Z.even t))) (x + - y)).
+  rewrite E. replace ((x + - y) * (1 + eps) - (x - y)) with ((x - y) * eps) by ring.
+  rewrite Rabs_mult, Rmult_comm. apply Rmult_le_compat_r; [apply Rabs_pos|].
+  assert (Hu : u_ro radix2 53 = u) by (unfold u_ro, u; simpl; lra).
+  rewrite Hu in He. assert (0 < u) by (unfold u; lra).
+  eapply Rle_trans; [exact He|]. apply Rmult_le_reg_r with (1 + u); [lra|].
+  unfold Rdiv. rewrite Rmult_assoc, Rinv_l by lra. nra.
+Qed.
+
+(* A decimal allowance c >= 1e-15, rounded to its double, is at least k u
+   whenever (1 - u) c - 2^-1000 is. *)
+Lemma fl_decimal_ge c k : / 1000000000000000 <= c -> k * u <= (1 - u) * c - bpow radix2 (-1000) -> k * u <= fl c.
+Proof.
+  intros Hc Hk. pose proof eta_pos.
+  assert (eta <= bpow radix2 (-1000)) by (unfold eta; apply bpow_le; lia).
+  assert ((1 - u) * c - eta <= fl c) by (apply fl_lower; lra). lra.
+Qed.
+Lemma bpow_m1000 : bpow radix2 (-1000) <= / 1000000000000000000000000.
+Proof. simpl; lra. Qed.
+Lemma kRelativeRounding_ge : 9 * u <= kRelativeRounding.
+Proof. apply fl_decimal_ge; pose proof bpow_m1000; unfold u; lra. Qed.
+
+(* ---- kRelativeRounding at the sub-interval's step ----
+   StartFrame::obb_frame: step = (u1 - u0) * dp_mid, each coordinate the
+   double fl(fl(u1 - u0) d) (u0, u1, d doubles), and its rounding covered by
+   step_error = round_up(kRelativeRounding * m * 2), m = |step|_inf (the
+   computed coordinates' largest magnitude, exact): within it of the exact
+   (u1 - u0) d, for every double input (the underflow of the product, eta,
+   is covered by next_up's absolute 2^-600). *)
+(* covers optimized/src/ccd/motion_bounds.cpp "SweptObbFrame StartFrame::obb_frame(double u1, double d) const" sha256:935ff5487d4e9f12 *)
+Theorem step_rounding u0 u1 d m :
+  F u0 -> F u1 -> F d -> Rabs (fl (fl (u1 - u0) * d)) <= m ->
+  Rabs (fl (fl (u1 - u0) * d) - (u1 - u0) * d) <= next_up (fl (fl (kRelativeRounding * m) * 2)).
+Proof.
+  intros F0 F1 Fd Hm. pose proof eta_pos. assert (Hu : 0 < u < / 1000000) by (unfold u; lra).
+  assert (He : 1000 * eta <= bpow radix2 (-602)).
+  { unfold eta. apply Rle_trans with (bpow radix2 10 * bpow radix2 (-1075)).
+    - apply Rmult_le_compat_r; [apply bpow_ge_0 | simpl; lra].
+    - rewrite <- bpow_plus. apply bpow_le. lia. }
+  pose proof (sub_rel u1 u0 F1 F0) as Ha. set (a := u1 - u0) in *. set (fa := fl a) in *.
+  pose proof (fl_err (fa * d)) as Hs. set (s := fl (fa * d)) in *.
+  set (X := Rabs (fa * d)) in *. set (Y := Rabs (a * d)).
+  assert (HX0 : 0 <= X) by apply Rabs_pos. assert (HY0 : 0 <= Y) by apply Rabs_pos.
+  assert (Hm0 : 0 <= m) by (pose proof (Rabs_pos s); lra).
+  (* |fa d - a d| <= u Y; (1 - u) Y <= X; (1 - u) X - eta <= |s| <= m *)
+  assert (E1 : Rabs (fa * d - a * d) <= u * Y).
+  { unfold Y. replace (fa * d - a * d) with ((fa - a) * d) by ring. rewrite !Rabs_mult.
+    rewrite <- Rmult_assoc. apply Rmult_le_compat_r; [apply Rabs_pos | exact Ha]. }
+  assert (E2 : (1 - u) * Y <= X).
+  { assert (Rabs a - Rabs fa <= u * Rabs a)
+      by (pose proof (Rabs_triang_inv a fa); rewrite Rabs_minus_sym in Ha; lra).
+    unfold X, Y. rewrite !Rabs_mult.
+    assert (0 <= Rabs d) by apply Rabs_pos.
+    assert ((1 - u) * Rabs a <= Rabs fa) by lra.
+    apply Rle_trans with (((1 - u) * Rabs a) * Rabs d); [lra | apply Rmult_le_compat_r; assumption]. }
+  assert (E3 : (1 - u) * X - eta <= m).
+  { pose proof (Rabs_triang_inv (fa * d) (s - fa * d)).
+    replace (fa * d - (s - fa * d)) with (2 * (fa * d) - s) in * by ring.
+    assert (X - Rabs s <= u * X + eta).
+    { pose proof (Rabs_triang_inv (fa * d) s). rewrite Rabs_minus_sym in Hs.
+      unfold X in *. lra. }
+    lra. }
+  assert (Q1 : u * X <= / 1000000 * X) by (apply Rmult_le_compat_r; lra).
+  assert (Q2 : u * Y <= / 1000000 * Y) by (apply Rmult_le_compat_r; lra).
+  assert (B1 : X <= 100001 / 100000 * (m + eta)) by lra.
+  assert (B2 : Y <= 10001 / 10000 * (m + eta)) by lra.
+  assert (C1 : u * X <= u * (100001 / 100000 * (m + eta))) by (apply mul_le_l; lra).
+  assert (C2 : u * Y <= u * (10001 / 10000 * (m + eta))) by (apply mul_le_l; lra).
+  assert (Err : Rabs (s - a * d) <= 21 / 10 * u * m + 2 * eta).
+  { replace (s - a * d) with ((s - fa * d) + (fa * d - a * d)) by ring.
+    eapply Rle_trans; [apply Rabs_triang|].
+    assert (u * eta <= / 1000000 * eta) by (apply Rmult_le_compat_r; lra). assert (0 <= u * m) by nra. unfold X in *. lra. }
+  (* the bound: at least 17.9 u m - 3 eta + 2^-602 *)
+  pose proof kRelativeRounding_ge as Hk.
+  assert (K1 : 9 * u * m <= kRelativeRounding * m) by (apply Rmult_le_compat_r; lra).
+  assert (0 <= kRelativeRounding * m) by nra.
+  pose proof (fl_lower (kRelativeRounding * m) ltac:(lra)) as K2.
+  assert (0 <= fl (kRelativeRounding * m)) by (apply fl_nonneg; lra).
+  pose proof (fl_lower (fl (kRelativeRounding * m) * 2) ltac:(lra)) as K3.
+  assert (0 <= fl (fl (kRelativeRounding * m) * 2)) by (apply fl_nonneg; lra).
+  pose proof (next_up_plus _ ltac:(eassumption)) as K4.
+  assert (K5 : (1 - u) * ((1 - u) * (9 * u * m)) <= (1 - u) * fl (kRelativeRounding * m) + (1 - u) * eta).
+  { assert ((1 - u) * (9 * u * m) <= (1 - u) * (kRelativeRounding * m)) by (apply mul_le_l; lra).
+    assert ((1 - u) * ((1 - u) * (kRelativeRounding * m) - eta) <= (1 - u) * fl (kRelativeRounding * m))
+      by (apply mul_le_l; lra).
+    assert ((1 - u) * ((1 - u) * (9 * u * m)) <= (1 - u) * ((1 - u) * (kRelativeRounding * m)))
+      by (apply mul_le_l; lra).
+    lra. }
+  assert (K6 : 89 / 10 * (u * m) <= ((1 - u) * (1 - u) * 9) * (u * m)) by (apply Rmult_le_compat_r; nra).
+  assert (u * eta <= / 1000000 * eta) by (apply Rmult_le_compat_r; lra).
+  assert (0 <= u * eta) by nra. assert (0 <= u * m) by nra.
+  lra.
+Qed.
+
+Lemma add_rel x y : F x -> F y -> Rabs (fl (x + y) - (x + y)) <= u * Rabs (x + y).
+Proof.
+  intros Fx Fy. replace (x + y) with (x - - y) by ring. apply sub_rel; [exact Fx | apply F_opp, Fy].
+Qed.
+Lemma fl_lower_normal z : bpow radix2 (-1022) <= z -> (1 - u) * z <= fl z.
+Proof.
+  intros Hz. assert (0 < z) by (pose proof (bpow_gt_0 radix2 (-1022)); lra).
+  pose proof (relative_error_N_FLT radix2 (-1074) 53 ltac:(lia) (fun t => negb (Z.even t)) z) as G.
+  rewrite (Rabs_pos_eq z) in G by lra.
+  assert (Hb : bpow radix2 (-1074 + 53 - 1) = bpow radix2 (-1022)) by (f_equal; lia).
+  rewrite Hb in G. specialize (G Hz).
+  assert (Hu : / 2 * bpow radix2 (- (53) + 1) = u) by (unfold u; simpl; lra). rewrite Hu in G.
+  unfold fl. change ZnearestE with (Znearest (fun t => negb (Z.even t))).
+  unfold Rabs in G; destruct Rcase_abs; lra.
+Qed.
+
+(* The dot product of two double 3-vectors, (a0 v0 + a1 v1) + a2 v2 rounded
+   at each step, within 3.02 u T + 5.02 eta of the exact one, T the sum of the
+   terms' magnitudes (any order of the three terms: the statement is symmetric). *)
+Definition dot3 a0 a1 a2 v0 v1 v2 := fl (fl (fl (a0 * v0) + fl (a1 * v1)) + fl (a2 * v2)).
+Lemma dot3_err a0 a1 a2 v0 v1 v2 :
+  let T := Rabs (a0 * v0) + Rabs (a1 * v1) + Rabs (a2 * v2) in
+  Rabs (dot3 a0 a1 a2 v0 v1 v2 - (a0 * v0 + a1 * v1 + a2 * v2)) <= 302 / 100 * u * T + 502 / 100 * eta.
+Proof.
+  intros T. pose proof eta_pos. assert (Hu : 0 < u < / 1000000) by (unfold u; lra).
+  pose proof (fl_err (a0 * v0)). pose proof (fl_err (a1 * v1)). pose proof (fl_err (a2 * v2)).
+  pose proof (Rabs_pos (a0 * v0)). pose proof (Rabs_pos (a1 * v1)). pose proof (Rabs_pos (a2 * v2)).
+  assert (S1 : Rabs (fl (fl (a0 * v0) + fl (a1 * v1)) - (a0 * v0 + a1 * v1))
+               <= (u * (Rabs (a0 * v0) + Rabs (a1 * v1)) + 2 * eta)
+                  + u * ((Rabs (a0 * v0) + Rabs (a1 * v1)) + (u * (Rabs (a0 * v0) + Rabs (a1 * v1)) + 2 * eta)) + eta).
+  { apply step; [apply abs_sum_le; lra|].
+    replace (fl (a0 * v0) + fl (a1 * v1) - (a0 * v0 + a1 * v1))
+      with ((fl (a0 * v0) - a0 * v0) + (fl (a1 * v1) - a1 * v1)) by ring.
+    eapply Rle_trans; [apply Rabs_triang | lra]. }
+  set (T1 := Rabs (a0 * v0) + Rabs (a1 * v1)) in *.
+  assert (0 <= u * T1) by (unfold T1; nra). assert (u * (u * T1) <= / 1000000 * (u * T1)) by (apply Rmult_le_compat_r; lra).
+  assert (u * eta <= / 1000000 * eta) by (apply Rmult_le_compat_r; lra).
+  assert (S1' : Rabs (fl (fl (a0 * v0) + fl (a1 * v1)) - (a0 * v0 + a1 * v1)) <= 201 / 100 * u * T1 + 301 / 100 * eta) by lra.
+  assert (S2 : Rabs (dot3 a0 a1 a2 v0 v1 v2 - (a0 * v0 + a1 * v1 + a2 * v2))
+     <= ((201 / 100 * u * T1 + 301 / 100 * eta) + (u * Rabs (a2 * v2) + eta))
+        + u * (T + ((201 / 100 * u * T1 + 301 / 100 * eta) + (u * Rabs (a2 * v2) + eta))) + eta).
+  { unfold dot3. apply step.
+    - unfold T, T1. apply abs_sum_le; [apply abs_sum_le|]; lra.
+    - replace (fl (fl (a0 * v0) + fl (a1 * v1)) + fl (a2 * v2) - (a0 * v0 + a1 * v1 + a2 * v2))
+        with ((fl (fl (a0 * v0) + fl (a1 * v1)) - (a0 * v0 + a1 * v1)) + (fl (a2 * v2) - a2 * v2)) by ring.
+      eapply Rle_trans; [apply Rabs_triang | lra]. }
+  assert (0 <= u * T) by (unfold T; try unfold T1; nra). assert (u * (u * T) <= / 1000000 * (u * T)) by (apply Rmult_le_compat_r; lra).
+  assert (u * Rabs (a2 * v2) <= u * T) by (apply mul_le_l; unfold T; try unfold T1; lra).
+  assert (0 <= u * Rabs (a2 * v2)) by nra.
+  assert (u * (u * Rabs (a2 * v2)) <= / 1000000 * (u * Rabs (a2 * v2))) by (apply Rmult_le_compat_r; lra).
+  assert (u * T1 <= u * T) by (apply mul_le_l; unfold T, T1; lra).
+  assert (u * T1 + u * Rabs (a2 * v2) = u * T) by (unfold T, T1; ring).
+  lra.
+Qed.
+
+Lemma rel_lower z w : Rabs (z - w) <= u * w -> (1 - u) * w <= z.
+Proof. intros H. pose proof (Rle_abs (w - z)). rewrite Rabs_minus_sym in H. lra. Qed.
+
+(* ---- kAxisVelocityRounding ----
+   triangle_time_lower_bound (motion_bounds.h), the velocity term of an axis a
+   (doubles): along_v = side * a.dot(v) (side = +-1, exact), its slack
+   kAxisVelocityRounding * a_1 * v_inf (a_1 = |a|_1 summed in doubles, v_inf =
+   |v|_inf, exact), and toward = max(0, round_up(along_v)) + slack, rounded up:
+   toward is at least the exact side (a . v). Hypothesis |a|_1 >= 2^-900: the
+   axis is used only when norm_down(|a|) > 0 (the guard after it), which
+   proves |a| > kNormFloor = 2^-500 (norm_down_wide). *)
+(* allowance kAxisVelocityRounding = 1e-14 *)
+Definition kAxisVelocityRounding := fl (/ 100000000000000).
+
+Lemma kAxisVelocityRounding_ge : 90 * u <= kAxisVelocityRounding.
+Proof. apply fl_decimal_ge; pose proof bpow_m1000; unfold u; lra. Qed.
+
+Lemma fl_side side x : (side = 1 \/ side = -1) -> F x -> fl (side * x) = side * x.
+Proof.
+  intros [-> | ->] Fx.
+  - rewrite Rmult_1_l. apply fl_F, Fx.
+  - replace (-1 * x) with (- x) by ring. apply fl_F, F_opp, Fx.
+Qed.
+
+(* covers optimized/include/gauss6/ccd/motion_bounds.h "inline double triangle_time_lower_bound(const SatSide& A, const Vec3 r[3]" sha256:e6fe43232891e550 *)
+Theorem axis_velocity_rounding side a0 a1 a2 v0 v1 v2 vinf :
+  (side = 1 \/ side = -1) -> F a0 -> F a1 -> F a2 ->
+  Rabs v0 <= vinf -> Rabs v1 <= vinf -> Rabs v2 <= vinf ->
+  bpow radix2 (-900) <= Rabs a0 + Rabs a1 + Rabs a2 ->
+  let along_v := fl (side * dot3 a0 a1 a2 v0 v1 v2) in
+  let a_1 := fl (fl (Rabs a0 + Rabs a1) + Rabs a2) in
+  let slack := fl (fl (kAxisVelocityRounding * a_1) * vinf) in
+  side * (a0 * v0 + a1 * v1 + a2 * v2) <= next_up (fl (Rmax 0 (next_up along_v) + slack)).
+Proof.
+  intros Hside F0 F1 F2 V0 V1 V2 HA along_v a_1 slack.
+  pose proof eta_pos. assert (Hu : 0 < u < / 1000000) by (unfold u; lra).
+  assert (HB : 1000 * eta <= bpow radix2 (-602)).
+  { unfold eta. apply Rle_trans with (bpow radix2 10 * bpow radix2 (-1075)).
+    - apply Rmult_le_compat_r; [apply bpow_ge_0 | simpl; lra].
+    - rewrite <- bpow_plus. apply bpow_le. lia. }
+  set (B := bpow radix2 (-602)) in *.
+  assert (Hv : 0 <= vinf) by (pose proof (Rabs_pos v0); lra).
+  set (A := Rabs a0 + Rabs a1 + Rabs a2) in *.
+  set (T := Rabs (a0 * v0) + Rabs (a1 * v1) + Rabs (a2 * v2)).
+  assert (HT : T <= A * vinf).
+  { unfold T, A. rewrite !Rabs_mult.
+    pose proof (Rabs_pos a0). pose proof (Rabs_pos a1). pose proof (Rabs_pos a2).
+    assert (Rabs a0 * Rabs v0 <= Rabs a0 * vinf) by (apply mul_le_l; lra).
+    assert (Rabs a1 * Rabs v1 <= Rabs a1 * vinf) by (apply mul_le_l; lra).
+    assert (Rabs a2 * Rabs v2 <= Rabs a2 * vinf) by (apply mul_le_l; lra). lra. }
+  assert (HT0 : 0 <= T) by (unfold T; pose proof (Rabs_pos (a0 * v0)); pose proof (Rabs_pos (a1 * v1));
+                            pose proof (Rabs_pos (a2 * v2)); lra).
+  (* the computed dot product *)
+  pose proof (dot3_err a0 a1 a2 v0 v1 v2) as Hd. fold T in Hd.
+  set (dt := dot3 a0 a1 a2 v0 v1 v2) in *.
+  assert (Fd : F dt) by apply F_fl.
+  assert (Hc : along_v = side * dt) by (apply fl_side; assumption).
+  set (E := side * (a0 * v0 + a1 * v1 + a2 * v2)).
+  assert (HE : E <= along_v + (302 / 100 * u * T + 502 / 100 * eta)).
+  { rewrite Hc. unfold E. pose proof (Rle_abs (dt - (a0 * v0 + a1 * v1 + a2 * v2))).
+    pose proof (Rle_abs ((a0 * v0 + a1 * v1 + a2 * v2) - dt)). rewrite Rabs_minus_sym in H1.
+    destruct Hside as [-> | ->]; lra. }
+  (* a_1 >= (1 - u)^2 A *)
+  assert (Fa0 : F (Rabs a0)) by (apply generic_format_abs, F0).
+  assert (Fa1 : F (Rabs a1)) by (apply generic_format_abs, F1).
+  assert (Fa2 : F (Rabs a2)) by (apply generic_format_abs, F2).
+  pose proof (add_rel _ _ Fa0 Fa1) as G1. set (t := fl (Rabs a0 + Rabs a1)) in *.
+  pose proof (add_rel _ _ (F_fl (Rabs a0 + Rabs a1)) Fa2) as G2. fold t in G2. fold a_1 in G2.
+  pose proof (Rabs_pos a0). pose proof (Rabs_pos a1). pose proof (Rabs_pos a2).
+  rewrite (Rabs_pos_eq (Rabs a0 + Rabs a1)) in G1 by lra.
+  assert (Ht : (1 - u) * (Rabs a0 + Rabs a1) <= t) by (apply rel_lower; exact G1).
+  assert (0 <= t) by nra.
+  rewrite (Rabs_pos_eq (t + Rabs a2)) in G2 by lra.
+  assert (Ha1 : (1 - u) * (t + Rabs a2) <= a_1) by (apply rel_lower; exact G2).
+  assert (Ha1' : (1 - u) * (1 - u) * A <= a_1).
+  { assert ((1 - u) * ((1 - u) * (Rabs a0 + Rabs a1) + Rabs a2) <= (1 - u) * (t + Rabs a2)) by (apply mul_le_l; lra).
+    assert ((1 - u) * (1 - u) * Rabs a2 <= (1 - u) * Rabs a2) by (apply Rmult_le_compat_r; nra).
+    unfold A. lra. }
+  (* the slack, at least 89 u T - eta *)
+  pose proof kAxisVelocityRounding_ge as Hk.
+  assert (HA0 : 0 <= A) by (pose proof (bpow_ge_0 radix2 (-900)); lra).
+  assert (Z1 : 90 * u * ((1 - u) * (1 - u) * A) <= kAxisVelocityRounding * a_1)
+    by (apply Rmult_le_compat; nra).
+  assert (Z2 : bpow radix2 (-1022) <= kAxisVelocityRounding * a_1).
+  { apply Rle_trans with (90 * u * ((1 - u) * (1 - u) * A)); [|exact Z1].
+    apply Rle_trans with (u * bpow radix2 (-900)).
+    - rewrite bpow_m53, <- bpow_plus. apply bpow_le. lia.
+    - assert (1 <= 90 * ((1 - u) * (1 - u))) by nra.
+      assert (0 <= u * bpow radix2 (-900)) by (pose proof (bpow_ge_0 radix2 (-900)); nra).
+      assert (u * bpow radix2 (-900) <= u * A) by (apply mul_le_l; lra).
+      assert (u * A <= (90 * ((1 - u) * (1 - u))) * (u * A)) by (apply Rle_trans with (1 * (u * A)); [lra | apply Rmult_le_compat_r; nra]).
+      lra. }
+  pose proof (fl_lower_normal _ Z2) as Z3.
+  assert (0 <= fl (kAxisVelocityRounding * a_1)) by (apply fl_nonneg; pose proof (bpow_ge_0 radix2 (-1022)); lra).
+  pose proof (fl_lower (fl (kAxisVelocityRounding * a_1) * vinf) ltac:(nra)) as Z4. fold slack in Z4.
+  assert (Z5 : (1 - u) * ((1 - u) * (kAxisVelocityRounding * a_1)) * vinf <= (1 - u) * (fl (kAxisVelocityRounding * a_1) * vinf)).
+  { assert ((1 - u) * (kAxisVelocityRounding * a_1) * vinf <= fl (kAxisVelocityRounding * a_1) * vinf)
+      by (apply Rmult_le_compat_r; lra).
+    assert ((1 - u) * ((1 - u) * (kAxisVelocityRounding * a_1) * vinf) <= (1 - u) * (fl (kAxisVelocityRounding * a_1) * vinf))
+      by (apply mul_le_l; lra).
+    lra. }
+  assert (Z6 : (1 - u) * ((1 - u) * (90 * u * ((1 - u) * (1 - u) * A))) * vinf
+               <= (1 - u) * ((1 - u) * (kAxisVelocityRounding * a_1)) * vinf).
+  { apply Rmult_le_compat_r; [lra|]. apply mul_le_l; [lra|]. apply mul_le_l; lra. }
+  assert (Z7 : 89 * u * (A * vinf) <= (1 - u) * ((1 - u) * (90 * u * ((1 - u) * (1 - u) * A))) * vinf).
+  { assert (0 <= u * (A * vinf)) by (apply Rmult_le_pos; [lra | apply Rmult_le_pos; lra]).
+    assert (89 * (u * (A * vinf)) <= ((1 - u) * (1 - u) * (1 - u) * (1 - u) * 90) * (u * (A * vinf)))
+      by (apply Rmult_le_compat_r; nra).
+    lra. }
+  assert (Hs : 89 * u * T - eta <= slack).
+  { assert (u * T <= u * (A * vinf)) by (apply mul_le_l; lra). lra. }
+  assert (Hs0 : 0 <= slack) by (apply fl_nonneg; nra).
+  assert (0 <= u * T) by nra. assert (u * eta <= / 1000000 * eta) by (apply Rmult_le_compat_r; lra).
+  assert (Fa : F along_v) by apply F_fl.
+  destruct (Rle_or_lt 0 along_v) as [Hp|Hn].
+  - pose proof (next_up_plus along_v Hp) as N1. fold B in N1.
+    assert (N2 : next_up along_v <= Rmax 0 (next_up along_v)) by apply Rmax_r.
+    pose proof (next_up_ge (Rmax 0 (next_up along_v) + slack)). lra.
+  - assert (FM : F (Rmax 0 (next_up along_v))).
+    { unfold Rmax. destruct Rle_dec; [apply F_fl | apply generic_format_0]. }
+    assert (M0 : 0 <= Rmax 0 (next_up along_v)) by apply Rmax_l.
+    pose proof (add_rel _ _ FM (F_fl (fl (kAxisVelocityRounding * a_1) * vinf))) as G3. fold slack in G3.
+    set (M := Rmax 0 (next_up along_v)) in *.
+    rewrite (Rabs_pos_eq (M + slack)) in G3 by lra.
+    assert (G4 : (1 - u) * (M + slack) <= fl (M + slack)) by (apply rel_lower; exact G3).
+    assert (HMs : 0 <= fl (M + slack)) by (apply fl_nonneg; lra).
+    pose proof (next_up_plus (fl (M + slack)) HMs) as N1. fold B in N1.
+    assert ((1 - u) * (89 * u * T - eta) <= (1 - u) * slack) by (apply mul_le_l; lra).
+    assert (u * M <= / 1000000 * M) by (apply Rmult_le_compat_r; lra).
+    assert (u * (u * T) <= / 1000000 * (u * T)) by (apply Rmult_le_compat_r; lra).
+    assert (0 <= u * eta) by nra. lra.
 Qed.
 
 (* The theorems, each answered by tools/check_proofs.sh. *)
 Print Assumptions linear_corner_rounding.
 Print Assumptions linear_corner_selection.
 Print Assumptions linear_corner_error_bound.
-Print Assumptions norm_relative_rounding.
+Print Assumptions norm_upper_bound.
+Print Assumptions norm_lower_bound.
+Print Assumptions norm_up_relative.
+Print Assumptions norm_up_wide.
+Print Assumptions norm_down_wide.
+Print Assumptions step_rounding.
+Print Assumptions axis_velocity_rounding.

@@ -26,8 +26,8 @@
 
 #include "gauss6/engine.h"
 #include "gauss6/engine_config.h"
-#include "gauss6/runtime.h"
-#include "gauss6/scene.h"
+#include "gauss6/runtime/runtime.h"
+#include "gauss6/io/scene.h"
 
 namespace {
 

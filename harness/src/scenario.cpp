@@ -4,7 +4,7 @@
 // property_observers.h).
 #include "gauss6/scenario.h"
 
-#include "gauss6/regular_file.h"
+#include "gauss6/io/regular_file.h"
 
 #include <atomic>
 #include <chrono>
@@ -22,9 +22,8 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
-constexpr uint32_t bit(RuntimeEventKind k) { return 1u << static_cast<int>(k); }
-constexpr uint32_t kWatchdogEvents = bit(RuntimeEventKind::kDeviceTimeout) | bit(RuntimeEventKind::kSimStalled) |
-                                     bit(RuntimeEventKind::kCouplingStalled);
+constexpr uint32_t kWatchdogEvents = event_bit(RuntimeEventKind::kDeviceTimeout) | event_bit(RuntimeEventKind::kSimStalled) |
+                                     event_bit(RuntimeEventKind::kCouplingStalled);
 
 // What a tick row needs from the last coupling step (another thread's, with
 // ForceSource::kCouplingLoop): passed through a seqlock.
@@ -125,7 +124,7 @@ void on_haptic_tick(void* user, const HapticTickRecord& rec) {
   row.buttons = rec.buttons;
   row.flags = (rec.gripped ? kTickGripped : 0u) |
               (has_coupling && c.god_sequence != r->last_sequence ? kTickNewContactSet : 0u) |
-              (rec.active_events & bit(RuntimeEventKind::kForceClamped) ? kTickForceClamped : 0u) |
+              (rec.active_events & event_bit(RuntimeEventKind::kForceClamped) ? kTickForceClamped : 0u) |
               (rec.active_events & kWatchdogEvents ? kTickWatchdog : 0u);
   if (has_coupling) r->last_sequence = c.god_sequence;
   r->writer->append(row);

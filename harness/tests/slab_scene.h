@@ -7,8 +7,8 @@
 #include <string>
 
 #include "../../optimized/tests/mesh_shapes.h"
-#include "gauss6/mass_properties.h"
-#include "gauss6/scene.h"
+#include "gauss6/geometry/mass_properties.h"
+#include "gauss6/io/scene.h"
 
 namespace gauss6::test {
 

@@ -21,7 +21,7 @@
 #include <thread>
 
 #include "../../optimized/tests/mesh_shapes.h"
-#include "gauss6/mass_properties.h"
+#include "gauss6/geometry/mass_properties.h"
 #include "gauss6/scenario.h"
 #include "slab_scene.h"
 

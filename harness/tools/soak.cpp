@@ -26,9 +26,9 @@
 #include <thread>
 #include <vector>
 
-#include "gauss6/runtime.h"
+#include "gauss6/runtime/runtime.h"
 #include "gauss6/scenario.h"
-#include "gauss6/scene.h"
+#include "gauss6/io/scene.h"
 #include "gauss6/simulated_device.h"
 
 using namespace gauss6;

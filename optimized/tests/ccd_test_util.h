@@ -6,7 +6,7 @@
 
 #include <gmpxx.h>
 
-#include "gauss6/pose.h"
+#include "gauss6/geometry/pose.h"
 
 namespace gauss6::test {
 

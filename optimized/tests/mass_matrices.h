@@ -1,7 +1,7 @@
 // Generalised mass matrices shared by the coupling and offsetting tests.
 #pragma once
 
-#include "gauss6/pose.h"
+#include "gauss6/geometry/pose.h"
 
 namespace gauss6::test {
 

@@ -9,7 +9,7 @@
 #include <utility>
 #include <vector>
 
-#include "gauss6/mesh.h"
+#include "gauss6/geometry/mesh.h"
 
 namespace gauss6::test {
 

@@ -17,8 +17,8 @@
 #include <thread>
 #include <vector>
 
-#include "gauss6/mass_properties.h"
-#include "gauss6/runtime.h"
+#include "gauss6/geometry/mass_properties.h"
+#include "gauss6/runtime/runtime.h"
 #include "mesh_shapes.h"
 
 namespace gauss6::test {

@@ -10,7 +10,7 @@
 #include <limits>
 #include <random>
 
-#include "gauss6/bernstein.h"
+#include "gauss6/numeric/bernstein.h"
 
 using namespace gauss6;
 

@@ -9,7 +9,7 @@
 #include <utility>
 #include <vector>
 
-#include "gauss6/bvh.h"
+#include "gauss6/geometry/bvh.h"
 #include "mesh_shapes.h"
 
 using namespace gauss6;

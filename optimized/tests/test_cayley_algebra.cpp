@@ -16,8 +16,8 @@
 #include <cmath>
 #include <random>
 
-#include "gauss6/motion.h"
-#include "gauss6/pose.h"
+#include "gauss6/ccd/motion.h"
+#include "gauss6/geometry/pose.h"
 
 using namespace gauss6;
 

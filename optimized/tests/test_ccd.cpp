@@ -17,8 +17,8 @@
 #include <xmmintrin.h>
 #endif
 
-#include "gauss6/ccd.h"
-#include "gauss6/ccd_queries.h"
+#include "gauss6/ccd/ccd.h"
+#include "gauss6/io/ccd_queries.h"
 #include "ccd_test_util.h"
 
 using namespace gauss6;

@@ -14,7 +14,7 @@
 #include <cstdio>
 #include <random>
 
-#include "gauss6/ccd.h"
+#include "gauss6/ccd/ccd.h"
 #include "ccd_test_util.h"
 
 using namespace gauss6;

@@ -17,13 +17,13 @@
 #include <utility>
 #include <vector>
 
-#include "gauss6/bvh.h"
-#include "gauss6/ccd_step.h"
-#include "gauss6/ccd.h"
-#include "gauss6/contacts.h"
-#include "gauss6/distance.h"
-#include "gauss6/runtime.h"
-#include "gauss6/scene.h"
+#include "gauss6/geometry/bvh.h"
+#include "gauss6/step/ccd_step.h"
+#include "gauss6/ccd/ccd.h"
+#include "gauss6/contact/contacts.h"
+#include "gauss6/geometry/distance.h"
+#include "gauss6/runtime/runtime.h"
+#include "gauss6/io/scene.h"
 
 using namespace gauss6;
 

@@ -13,9 +13,9 @@
 #include <random>
 #include <set>
 
-#include "gauss6/bvh.h"
-#include "gauss6/ccd.h"
-#include "gauss6/ccd_step.h"
+#include "gauss6/geometry/bvh.h"
+#include "gauss6/ccd/ccd.h"
+#include "gauss6/step/ccd_step.h"
 #include "mesh_shapes.h"
 
 using namespace gauss6;

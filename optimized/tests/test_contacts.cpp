@@ -6,8 +6,8 @@
 #include <cmath>
 #include <random>
 
-#include "gauss6/ccd_step.h"
-#include "gauss6/contacts.h"
+#include "gauss6/step/ccd_step.h"
+#include "gauss6/contact/contacts.h"
 #include "mesh_shapes.h"
 
 using namespace gauss6;

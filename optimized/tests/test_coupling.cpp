@@ -5,9 +5,9 @@
 #include <cmath>
 #include <limits>
 
-#include "gauss6/coupling.h"
-#include "gauss6/haptic_loop.h"
-#include "gauss6/runtime_events.h"
+#include "gauss6/contact/coupling.h"
+#include "gauss6/runtime/haptic_loop.h"
+#include "gauss6/runtime/runtime_events.h"
 #include "mass_matrices.h"
 
 namespace {

@@ -8,7 +8,7 @@
 #include <limits>
 #include <random>
 
-#include "gauss6/distance.h"
+#include "gauss6/geometry/distance.h"
 #include "triangle_pairs.h"
 
 using namespace gauss6;

@@ -8,11 +8,11 @@
 
 #include <unistd.h>
 
-#include "gauss6/ccd_queries.h"
-#include "gauss6/load_error.h"
-#include "gauss6/mesh_io.h"
-#include "gauss6/qp_instances.h"
-#include "gauss6/scene.h"
+#include "gauss6/io/ccd_queries.h"
+#include "gauss6/io/load_error.h"
+#include "gauss6/io/mesh_io.h"
+#include "gauss6/io/qp_instances.h"
+#include "gauss6/io/scene.h"
 
 using namespace gauss6;
 namespace fs = std::filesystem;

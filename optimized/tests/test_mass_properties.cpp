@@ -9,7 +9,7 @@
 #include <Eigen/Cholesky>
 #include <Eigen/Geometry>
 
-#include "gauss6/mass_properties.h"
+#include "gauss6/geometry/mass_properties.h"
 #include "mesh_shapes.h"
 
 using namespace gauss6;

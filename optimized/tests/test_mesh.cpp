@@ -7,7 +7,7 @@
 
 #include <Eigen/Geometry>
 
-#include "gauss6/mesh.h"
+#include "gauss6/geometry/mesh.h"
 #include "mesh_shapes.h"
 
 using namespace gauss6;

@@ -8,8 +8,8 @@
 #include <random>
 #include <string>
 
-#include "gauss6/mass_properties.h"
-#include "gauss6/mesh_io.h"
+#include "gauss6/geometry/mass_properties.h"
+#include "gauss6/io/mesh_io.h"
 #include "mesh_shapes.h"
 
 using namespace gauss6;

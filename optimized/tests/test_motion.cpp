@@ -6,7 +6,7 @@
 #include <random>
 #include <string>
 
-#include "gauss6/motion.h"
+#include "gauss6/ccd/motion.h"
 
 using namespace gauss6;
 

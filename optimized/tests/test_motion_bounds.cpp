@@ -7,9 +7,9 @@
 #include <limits>
 #include <random>
 
-#include "gauss6/bvh.h"
-#include "gauss6/ccd.h"
-#include "gauss6/motion_bounds.h"
+#include "gauss6/geometry/bvh.h"
+#include "gauss6/ccd/ccd.h"
+#include "gauss6/ccd/motion_bounds.h"
 #include "triangle_pairs.h"
 
 using namespace gauss6;

@@ -15,8 +15,8 @@
 #include <limits>
 #include <utility>
 
-#include "gauss6/coupling.h"
-#include "gauss6/offsetting.h"
+#include "gauss6/contact/coupling.h"
+#include "gauss6/contact/offsetting.h"
 #include "mass_matrices.h"
 
 namespace {

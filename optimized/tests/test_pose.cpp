@@ -4,7 +4,7 @@
 #include <cmath>
 #include <random>
 
-#include "gauss6/pose.h"
+#include "gauss6/geometry/pose.h"
 
 using namespace gauss6;
 

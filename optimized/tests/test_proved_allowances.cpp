@@ -15,8 +15,9 @@
 #include <limits>
 #include <random>
 
-#include "gauss6/error_allowances.h"
-#include "gauss6/rounding.h"
+#include "gauss6/numeric/error_allowances.h"
+#include "gauss6/ccd/motion_bounds.h"
+#include "gauss6/numeric/rounding.h"
 
 using namespace gauss6;
 
@@ -99,25 +100,132 @@ TEST_CASE("the least and largest corner values as enclose_linear selects them (A
   }
 }
 
-// norm_relative_rounding: round_up(|v| (1 + kRelativeRounding)), |v| by
-// Eigen's norm(), bounds the exact Euclidean norm of the double vector v from
-// above whenever |v|^2 >= 2^-1000 (the theorem's hypothesis), checked
-// exactly (squares of rationals) from |v|^2 = 2^-1000 up to 2^1020 in
-// magnitude, with zero and signed-zero components.
-TEST_CASE("norms rounded up with kRelativeRounding bound the exact norm (Allowances.v "
-          "norm_relative_rounding)",
+// norm_upper_bound, norm_lower_bound: norm_up / norm_down of the computed
+// norm bound the exact Euclidean norm of the double vector v, checked exactly
+// (squares of rationals) at every scale from subnormal components (where the
+// squares underflow, the theorems' floor kNormFloor speaking) to 2^509, with
+// zero and signed-zero components.
+TEST_CASE("norm_up and norm_down bound the exact norm at every scale (Allowances.v norm_up_relative, "
+          "norm_up_wide, norm_down_wide)",
           "[proved]") {
   std::mt19937_64 rng(454545);
   std::uniform_real_distribution<double> mant(-1, 1);
-  std::uniform_int_distribution<int> ex(-499, 509), pick(0, 4);
-  for (int n = 0; n < 20000; ++n) {
+  std::uniform_int_distribution<int> ex(-1074, 509), pick(0, 4);
+  for (int n = 0; n < 40000; ++n) {
     const int e = ex(rng);
     Eigen::Vector3d v(std::ldexp(mant(rng), e), std::ldexp(mant(rng), e), std::ldexp(mant(rng), e));
     const int k = pick(rng);
     if (k < 3) v[k] = k == 0 ? 0.0 : -0.0;
     const mpq_class S = Q(v.x()) * Q(v.x()) + Q(v.y()) * Q(v.y()) + Q(v.z()) * Q(v.z());
-    if (S < Q(0x1p-1000)) continue;
-    const double up = round_up(v.norm() * (1 + kRelativeRounding)).v;
-    REQUIRE(Q(up) * Q(up) >= S);
+    for (const double relative : {kRelativeRounding, kRelativeRoundingWide}) {
+      const double up = norm_up(v.norm(), relative).v;
+      REQUIRE(up > 0);
+      REQUIRE(Q(up) * Q(up) >= S);
+    }
+    const double down = norm_down(v.norm(), kRelativeRoundingWide).v;
+    REQUIRE(down >= 0);
+    REQUIRE(Q(down) * Q(down) <= S);
+    REQUIRE(norm_down(std::sqrt(v.squaredNorm()), kRelativeRoundingWide).v == down);
+  }
+}
+
+// The finding the floor fixes: at |v| ~ 2^-537 the squares round to 0, so
+// the unfloored forms fell below |v| (up) or to a divisor <= 0 (down).
+TEST_CASE("the norm's bounds hold where the squares underflow (Allowances.v norm_upper_bound)", "[proved]") {
+  const Eigen::Vector3d v = Eigen::Vector3d::Constant(0x1p-538);
+  const mpq_class S = 3 * Q(0x1p-538) * Q(0x1p-538);
+  REQUIRE(v.norm() == 0);
+  const double unfloored = round_up(v.norm() * (1 + kRelativeRounding)).v;
+  CHECK(Q(unfloored) * Q(unfloored) < S);  // the old form: too small
+  const double up = norm_up(v.norm(), kRelativeRounding).v;
+  CHECK(Q(up) * Q(up) >= S);
+  CHECK(round_down(v.norm() * (1 - kRelativeRoundingWide)).v <= 0);  // the old divisor
+  CHECK(norm_down(v.norm(), kRelativeRoundingWide).v == 0);
+}
+
+// The sites. Displacement's shift between two positions 2^-538 apart per
+// coordinate bounds their distance (it was 2^-600 before the floor).
+TEST_CASE("Displacement's shift bounds the distance of positions whose squares underflow", "[proved]") {
+  Pose a, b;
+  // identity orientations (Quat's default)
+  b.p = Eigen::Vector3d::Constant(0x1p-538);
+  const detail::Displacement d(a, b);
+  REQUIRE(Q(d.shift) * Q(d.shift) >= 3 * Q(0x1p-538) * Q(0x1p-538));
+}
+
+// triangle_time_lower_bound along an axis whose computed norm underflows to 0
+// (the normal of a triangle with edges of 2^-305): a vertex at distance 1
+// closing at speed 1 meets the triangle's plane at time 1, so no bound above 1
+// may be returned (the divisor round_down(0) < 0 gave +inf before the guard).
+TEST_CASE("triangle_time_lower_bound drops an axis too short to divide by", "[proved]") {
+  const double h = 0x1p-305;
+  const Vec3 B[3] = {Vec3(0, 0, 0), Vec3(h, 0, 0), Vec3(0, h, 0)};
+  const Vec3 X[3] = {Vec3(0, 0, 1), Vec3(0, 0, 1), Vec3(0, 0, 1)};
+  REQUIRE(sat_side(B).n.norm() == 0);
+  REQUIRE(sat_side(B).n.z() > 0);
+  TriangleMotion m;
+  m.v = Vec3(0, 0, -1);
+  m.centre = X[0];
+  Vec3 r[3];
+  const double r_inf = corner_offsets<Shape::kVertex>(X, m.centre, r);
+  const double t = triangle_time_lower_bound<Shape::kVertex, Shape::kTriangle>(
+      sat_side<Shape::kVertex>(X), r, r_inf, sat_side(B), m, 0.0, std::numeric_limits<double>::infinity());
+  REQUIRE(t <= 1.0);
+}
+
+// for_each_separating_axis divides by norm_up(|a|): along the same short
+// normal, a big triangle at height 1 above the tiny one is at distance 1, and
+// the gap bound may not exceed it (it was about 2^60 before the floor).
+TEST_CASE("triangle_gap_lower_bound along an axis whose squares underflow", "[proved]") {
+  const double h = 0x1p-270;
+  const Vec3 A[3] = {Vec3(0, 0, 0), Vec3(h, 0, 0), Vec3(0, h, 0)};
+  const Vec3 B[3] = {Vec3(-1, -1, 1), Vec3(2, -1, 1), Vec3(-1, 2, 1)};
+  REQUIRE(sat_side(A).n.norm() == 0);
+  const double g = triangle_gap_lower_bound(sat_side(A), sat_side(B), std::numeric_limits<double>::infinity());
+  REQUIRE(g <= 1.0);
+}
+
+// step_rounding: the sub-interval's step (u1 - u0) dp_mid as StartFrame::obb_frame
+// computes it, each coordinate within step_error = round_up(kRelativeRounding
+// |step|_inf 2) of the exact product, for u0 <= u1 in [0, 1] (of every scale,
+// equal, 0 and 1) and coordinates of every scale from subnormal to 1e30
+// (signed zeros, the least normal), checked in rationals.
+TEST_CASE("the step's rounding within kRelativeRounding |step|_inf 2 (Allowances.v step_rounding)", "[proved]") {
+  std::mt19937_64 rng(4545);
+  for (int n = 0; n < 20000; ++n) {
+    double u0 = parameter(rng), u1 = parameter(rng);
+    if (u0 > u1) std::swap(u0, u1);
+    const Eigen::Vector3d dp(coordinate(rng), coordinate(rng), coordinate(rng));
+    const Eigen::Vector3d step = (u1 - u0) * dp;
+    const double step_error = round_up(kRelativeRounding * step.cwiseAbs().maxCoeff() * 2).v;
+    for (int i = 0; i < 3; ++i) {
+      const mpq_class err = Q(step[i]) - (Q(u1) - Q(u0)) * Q(dp[i]);
+      REQUIRE(abs(err) <= Q(step_error));
+    }
+  }
+}
+
+// axis_velocity_rounding: triangle_time_lower_bound's velocity term along an
+// axis a, toward = max(0, round_up(side a.v)) + kAxisVelocityRounding |a|_1
+// |v|_inf (the code's operations, in its order), is at least the exact
+// side (a . v), checked in rationals for axes with |a|_1 >= 2^-900 (the
+// theorem's hypothesis: the guard norm_down(|a|) > 0 keeps only |a| > 2^-500)
+// and velocities of every scale down to subnormal, signed zeros included.
+TEST_CASE("the velocity term within kAxisVelocityRounding (Allowances.v axis_velocity_rounding)", "[proved]") {
+  std::mt19937_64 rng(45454);
+  std::uniform_real_distribution<double> mant(-1, 1);
+  std::uniform_int_distribution<int> ea(-899, 300), pick(0, 1);
+  for (int n = 0; n < 40000; ++n) {
+    const int e = ea(rng);
+    Eigen::Vector3d a(std::ldexp(mant(rng), e), std::ldexp(mant(rng), e), std::ldexp(mant(rng), e));
+    const Eigen::Vector3d v(coordinate(rng), coordinate(rng), coordinate(rng));
+    if (Q(std::abs(a.x())) + Q(std::abs(a.y())) + Q(std::abs(a.z())) < Q(0x1p-900)) continue;
+    const double side = pick(rng) ? 1.0 : -1.0;
+    const double along_v = side * a.dot(v);
+    const double a_1 = a.cwiseAbs().sum(), v_inf = v.cwiseAbs().maxCoeff();
+    const double slack = kAxisVelocityRounding * a_1 * v_inf;
+    const double toward = (max(Upper{0.0}, round_up(along_v)) + Upper{slack}).v;
+    const mpq_class exact = Q(side) * (Q(a.x()) * Q(v.x()) + Q(a.y()) * Q(v.y()) + Q(a.z()) * Q(v.z()));
+    REQUIRE(exact <= Q(toward));
   }
 }

@@ -13,7 +13,7 @@
 #include <cmath>
 #include <random>
 
-#include "gauss6/bernstein.h"
+#include "gauss6/numeric/bernstein.h"
 
 using namespace gauss6;
 

@@ -17,7 +17,7 @@
 #include <random>
 #include <vector>
 
-#include "gauss6/rounding.h"
+#include "gauss6/numeric/rounding.h"
 
 using namespace gauss6;
 

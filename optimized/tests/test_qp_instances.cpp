@@ -15,7 +15,7 @@
 
 #include <Eigen/Cholesky>
 
-#include "gauss6/qp_instances.h"
+#include "gauss6/io/qp_instances.h"
 
 using namespace gauss6;
 namespace fs = std::filesystem;

@@ -29,9 +29,9 @@
 #include <sstream>
 #include <vector>
 
-#include "gauss6/coupling.h"
-#include "gauss6/qp_instances.h"
-#include "gauss6/quasistatics.h"
+#include "gauss6/contact/coupling.h"
+#include "gauss6/io/qp_instances.h"
+#include "gauss6/contact/quasistatics.h"
 
 namespace {
 

@@ -12,9 +12,9 @@
 
 #include <Eigen/Eigenvalues>
 
-#include "gauss6/coupling.h"
-#include "gauss6/qp_instances.h"
-#include "gauss6/quasistatics.h"
+#include "gauss6/contact/coupling.h"
+#include "gauss6/io/qp_instances.h"
+#include "gauss6/contact/quasistatics.h"
 
 using namespace gauss6;
 

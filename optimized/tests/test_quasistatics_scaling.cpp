@@ -10,8 +10,8 @@
 #include <string>
 #include <vector>
 
-#include "gauss6/qp_instances.h"
-#include "gauss6/quasistatics.h"
+#include "gauss6/io/qp_instances.h"
+#include "gauss6/contact/quasistatics.h"
 
 using namespace gauss6;
 

@@ -21,8 +21,8 @@
 #include <thread>
 #include <vector>
 
-#include "gauss6/mass_properties.h"
-#include "gauss6/runtime.h"
+#include "gauss6/geometry/mass_properties.h"
+#include "gauss6/runtime/runtime.h"
 #include "mesh_shapes.h"
 #include "runtime_fixtures.h"
 
@@ -486,6 +486,14 @@ double lowest_over_crease_along(const RuntimeModel& model, const Pose& a, const 
   return h;
 }
 
+// Step 4 on a sim loop's state, as sim_step runs it (sim_loop.cpp's advance_by).
+static void step4_on(const RuntimeModel& model, const Pose& x_start, const Pose& x_target, const Vec6& residual, SimState* s,
+                     SimStepInfo* info) {
+  advance_god_object(model, x_start, x_target, residual, s->M, &s->contacts, &s->step4, info);
+  s->xs = info->xs;
+  s->M = mass_matrix_at(model, s->xs.q);
+}
+
 TEST_CASE("runtime: step 4's paths: settle, refused settle, shortening, keep_a_contact, graze lift", "[runtime]") {
   // Each path of step 4 (docs/sim-step.md), named by the section that takes it
   // and checked by what it is for (each fails with its path removed). The tip
@@ -498,7 +506,7 @@ TEST_CASE("runtime: step 4's paths: settle, refused settle, shortening, keep_a_c
   SimState s(model);
   SimStepInfo info;
   auto start_at = [&](const Pose& x0) {  // in contact with the flat face at x0
-    advance_god_object(model, x0, x0, Vec6::Zero(), &s, &info);
+    step4_on(model, x0, x0, Vec6::Zero(), &s, &info);
     REQUIRE(info.status == SimStepStatus::kFree);
     REQUIRE(info.num_contacts > 0);
   };
@@ -507,7 +515,7 @@ TEST_CASE("runtime: step 4's paths: settle, refused settle, shortening, keep_a_c
     const Pose x0{Vec3(-0.001, 0, kHalf + gap), Quat{}};
     const Pose x1{x0.p + Vec3(0.003, 0, 0), Quat{}};
     start_at(x0);
-    advance_god_object(model, x0, x1, Vec6::Zero(), &s, &info);
+    step4_on(model, x0, x1, Vec6::Zero(), &s, &info);
     CHECK(info.status == SimStepStatus::kFree);
     CHECK_FALSE(info.settled);
     CHECK(s.step4.paths.settles == 0);
@@ -523,7 +531,7 @@ TEST_CASE("runtime: step 4's paths: settle, refused settle, shortening, keep_a_c
     const Pose x0{Vec3(-kDelta, 0, kHalf + gap), Quat{}};
     const Pose x1{x0.p + Vec3(4 * kDelta, 0, 0), Quat{}};
     start_at(x0);
-    advance_god_object(model, x0, x1, pressing, &s, &info);
+    step4_on(model, x0, x1, pressing, &s, &info);
     CHECK(info.settled);
     CHECK(info.num_shortenings == 0);
     CHECK(s.step4.paths.settles == 1);
@@ -560,7 +568,7 @@ TEST_CASE("runtime: step 4's paths: settle, refused settle, shortening, keep_a_c
     const Pose x0{Vec3(-0.001, 0, kHalf + gap), Quat{}};
     const Pose x1{x0.p + Vec3(0.003, 0, 0), Quat{}};
     start_at(x0);
-    advance_god_object(model, x0, x1, pressing, &s, &info);
+    step4_on(model, x0, x1, pressing, &s, &info);
     CHECK(info.settled);
     CHECK(info.num_shortenings == 2);
     CHECK(s.step4.paths.refused == 2);
@@ -598,7 +606,7 @@ TEST_CASE("runtime: step 4's paths: settle, refused settle, shortening, keep_a_c
     const Pose x0{Vec3(-0.001, 0, kHalf + gap), Quat{}};
     const Pose x1{x0.p + Vec3(0.012, 0, 0), Quat{}};
     start_at(x0);
-    advance_god_object(model, x0, x1, pressing, &s, &info);
+    step4_on(model, x0, x1, pressing, &s, &info);
     CHECK(info.settled);
     CHECK(info.num_shortenings == kMaxSettleShortenings);
     CHECK(s.step4.paths.refused == kMaxSettleShortenings + 1);
@@ -619,7 +627,7 @@ TEST_CASE("runtime: step 4's paths: settle, refused settle, shortening, keep_a_c
     const Pose x0{Vec3(-0.004, 0, kHalf + 1.05 * kDelta), Quat{}};
     const Pose x1{x0.p + Vec3(0.001, 0, -0.15 * kDelta), Quat{}};
     start_at(x0);
-    advance_god_object(model, x0, x1, Vec6::Zero(), &s, &info);
+    step4_on(model, x0, x1, Vec6::Zero(), &s, &info);
     CHECK(s.step4.paths.grazed);
     CHECK(s.step4.paths.lifted);
     CHECK(s.xs.p.x() - x0.p.x() > 0.0004);  // without the lift: u_hit 0
@@ -708,7 +716,7 @@ TEST_CASE("runtime: a run's recorded CCD inputs replay its collision work exactl
     const bool had_contacts = k > 0 && r.rec.sims[k - 1].num_contacts > 0;
     CHECK(sim.residual == (had_contacts ? Vec6(sim.au - sim.ac) : Vec6::Zero()));
     // Replayed on a fresh state: the same pose (bit for bit) and contacts.
-    advance_god_object(model, sim.x_start, sim.x_target, sim.residual, &replay, &info);
+    step4_on(model, sim.x_start, sim.x_target, sim.residual, &replay, &info);
     CHECK(std::memcmp(replay.xs.p.data(), sim.xs.p.data(), sizeof(double) * 3) == 0);
     CHECK((replay.xs.q.w == sim.xs.q.w && replay.xs.q.x == sim.xs.q.x && replay.xs.q.y == sim.xs.q.y &&
            replay.xs.q.z == sim.xs.q.z));

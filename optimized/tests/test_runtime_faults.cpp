@@ -19,9 +19,9 @@
 #include <thread>
 #include <vector>
 
-#include "gauss6/runtime.h"
+#include "gauss6/runtime/runtime.h"
 #include "mesh_shapes.h"
-#include "gauss6/coupling.h"
+#include "gauss6/contact/coupling.h"
 #include "runtime_fixtures.h"
 
 using namespace gauss6;

@@ -13,9 +13,9 @@
 
 #include <unistd.h>
 
-#include "gauss6/mass_properties.h"
-#include "gauss6/runtime_model.h"
-#include "gauss6/scene.h"
+#include "gauss6/geometry/mass_properties.h"
+#include "gauss6/runtime/runtime_model.h"
+#include "gauss6/io/scene.h"
 
 using namespace gauss6;
 namespace fs = std::filesystem;

@@ -6,7 +6,7 @@
 
 #include <cmath>
 
-#include "gauss6/surface.h"
+#include "gauss6/contact/surface.h"
 #include "mesh_shapes.h"
 
 using namespace gauss6;

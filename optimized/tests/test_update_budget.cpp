@@ -8,8 +8,8 @@
 #include <climits>
 #include <cstring>
 
-#include "gauss6/contacts.h"
-#include "gauss6/update_budget.h"
+#include "gauss6/contact/contacts.h"
+#include "gauss6/step/update_budget.h"
 #include "runtime_fixtures.h"
 
 namespace gauss6::test {

@@ -9,7 +9,7 @@
 
 #include <Eigen/Core>
 
-#include "gauss6/pose.h"
+#include "gauss6/geometry/pose.h"
 
 namespace gauss6::test {
 

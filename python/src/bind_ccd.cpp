@@ -19,11 +19,11 @@
 #include <string>
 #include <vector>
 
-#include "gauss6/bvh.h"
-#include "gauss6/ccd_step.h"
-#include "gauss6/ccd.h"
-#include "gauss6/ccd_queries.h"
-#include "gauss6/feature_ids.h"
+#include "gauss6/geometry/bvh.h"
+#include "gauss6/step/ccd_step.h"
+#include "gauss6/ccd/ccd.h"
+#include "gauss6/io/ccd_queries.h"
+#include "gauss6/geometry/feature_ids.h"
 #include "gauss6/reference/ccd.h"
 #include "module.h"
 
@@ -433,11 +433,9 @@ class CcdMeshPair {
   std::unique_ptr<reference::ExactMeshPair> exact_;
 };
 
-}  // namespace
 
-void bind_ccd(py::module_& m) {
-  py::module_ ccd = m.def_submodule("ccd", "Continuous collision detection: optimized and exact, side by side.");
-
+// The CCD query files (ccd_queries.h format): listed, read as arrays, run through one implementation.
+void bind_query_files(py::module_& ccd) {
   ccd.def("list_query_files",
           [](const std::string& root) {
             py::list out;
@@ -451,8 +449,14 @@ void bind_ccd(py::module_& m) {
           py::arg("time_tolerance") = 1e-6,
           "Runs every query of a CCD query file (ccd_queries.h format) through impl ('optimized' or 'reference'): "
           "dict with hit, expected, line (per query), inexact, seconds (primitive calls only).");
+  ccd.def("read_query_file", &read_query_arrays, py::arg("path"), py::arg("kind"),
+          "A CCD query file (ccd_queries.h format) as arrays: dict with points (n, 8, 3) as doubles in file order "
+          "(rows 0-3 at u = 0, 4-7 at u = 1), expected, line, exact (each coordinate is the double given).");
+}
 
-  // Per-query CCD (documented for users in python/gauss6/ccd.py).
+// Per-query CCD of the optimized narrow phase, linear and rigid (documented for users in
+// python/gauss6/ccd.py).
+void bind_queries(py::module_& ccd) {
   py::class_<QueryResult>(ccd, "QueryResult",
                           "One CCD query's answer: hit, u_hit (<= the exact first contact u*), status, "
                           "time_tolerance_reached, distance_reached, iterations, filter_intervals.")
@@ -547,7 +551,10 @@ void bind_ccd(py::module_& m) {
           py::arg("max_iterations") = py::none(), py::arg("use_u_filter") = py::none(),
           py::arg("early_hit") = py::none(),
           "Rigid edge/edge CCD: the body's edge (body frame) moving, the other edge static (world frame).");
+}
 
+// The exact first contact of the same queries (reference).
+void bind_exact_queries(py::module_& ccd) {
   py::class_<reference::ExactToi>(ccd, "ExactToi", "Exact first contact u* of one query (reference).")
       .def_readonly("hit", &reference::ExactToi::hit)
       .def_readonly("lower", &reference::ExactToi::lower, "double bracket lower <= u* <= upper")
@@ -607,10 +614,10 @@ void bind_ccd(py::module_& m) {
           },
           py::arg("p0"), py::arg("q0"), py::arg("p1"), py::arg("q1"), py::arg("edge_B"), py::arg("edge_W"),
           py::kw_only(), py::arg("u_end") = 1.0, "Exact first contact over [0, u_end] of rigid_edge_edge's query.");
-  ccd.def("read_query_file", &read_query_arrays, py::arg("path"), py::arg("kind"),
-          "A CCD query file (ccd_queries.h format) as arrays: dict with points (n, 8, 3) as doubles in file order "
-          "(rows 0-3 at u = 0, 4-7 at u = 1), expected, line, exact (each coordinate is the double given).");
+}
 
+// A mesh pair for mesh-level CCD: the optimized step, the exact first contact and separations.
+void bind_mesh_pair(py::module_& ccd) {
   py::class_<ExactContact>(ccd, "ExactContact", "Exact first contact u* of a mesh step (reference).")
       .def_property_readonly("hit", [](const ExactContact& c) { return c.contact.toi.hit; })
       .def_property_readonly("lower", [](const ExactContact& c) { return c.contact.toi.lower; },
@@ -660,6 +667,16 @@ void bind_ccd(py::module_& m) {
       .def("separation_bracket", &CcdMeshPair::separation_bracket, py::arg("p"), py::arg("q"), py::arg("max_distance"),
            "Certified bracket (lower, upper) of the minimum distance at pose (p, q), intervals only (no exact "
            "arithmetic): lower = max_distance, upper = inf when every pair is farther than max_distance.");
+}
+
+}  // namespace
+
+void bind_ccd(py::module_& m) {
+  py::module_ ccd = m.def_submodule("ccd", "Continuous collision detection: optimized and exact, side by side.");
+  bind_query_files(ccd);
+  bind_queries(ccd);
+  bind_exact_queries(ccd);
+  bind_mesh_pair(ccd);
 }
 
 }  // namespace gauss6::python

@@ -3,14 +3,14 @@
 #include <pybind11/eigen.h>
 #include <pybind11/stl.h>
 
-#include "gauss6/ccd.h"
-#include "gauss6/load_error.h"
-#include "gauss6/mass_properties.h"
-#include "gauss6/mesh.h"
-#include "gauss6/mesh_io.h"
-#include "gauss6/pose.h"
-#include "gauss6/qp_instances.h"
-#include "gauss6/scene.h"
+#include "gauss6/ccd/ccd.h"
+#include "gauss6/io/load_error.h"
+#include "gauss6/geometry/mass_properties.h"
+#include "gauss6/geometry/mesh.h"
+#include "gauss6/io/mesh_io.h"
+#include "gauss6/geometry/pose.h"
+#include "gauss6/io/qp_instances.h"
+#include "gauss6/io/scene.h"
 #include "module.h"
 
 namespace py = pybind11;
@@ -44,16 +44,11 @@ Scene load_scene_warning(const std::string& path) {
   return scene;
 }
 
-void bind_core(py::module_& m) {
-  // Every load-time error (load_error.h: scenes, meshes, CCD query and projection-
-  // instance files) becomes gauss6.LoadError, a ValueError with the same message
-  // ("FILE:LINE: KEY: problem"). SceneError and MeshFileError are its old names.
-  const auto& load_error = py::register_exception<LoadError>(m, "LoadError", PyExc_ValueError);
-  m.attr("SceneError") = load_error;
-  m.attr("MeshFileError") = load_error;
+namespace {
 
-  // The defaults of the scene file's optional keys and of the CCD settings, read
-  // from default-constructed C++ structs: the one place they are stated.
+// The defaults of the scene file's optional keys and of the CCD settings, read
+// from default-constructed C++ structs: the one place they are stated.
+void bind_defaults(py::module_& m) {
   m.def("defaults",
         [] {
           const ContactParameters contact;
@@ -77,8 +72,10 @@ void bind_core(py::module_& m) {
         },
         "Defaults of the scene file's optional keys (contact: offset_eps as a multiple of delta) and of "
         "CcdSettings, from the C++ structs.");
+}
 
-  // Poses: p (3,), q (4,) as (w, x, y, z).
+// Poses: p (3,), q (4,) as (w, x, y, z).
+void bind_poses(py::module_& m) {
   m.def("rotation_matrix", [](const Eigen::Vector4d& q) { return rotation_matrix(quat_from(q)); }, py::arg("q"),
         "Rational rotation matrix R(q) = (...)/|q|^2 of METHOD.md section 1.");
   m.def("pose_difference",
@@ -92,8 +89,10 @@ void bind_core(py::module_& m) {
           return py::make_tuple(Eigen::Vector3d(x.p), quat_to(x.q));
         },
         py::arg("p"), py::arg("q"), py::arg("a"), "xs (+) a: returns (p, q).");
+}
 
-  // Meshes.
+// Meshes: read, validated, their mass properties.
+void bind_meshes(py::module_& m) {
   py::class_<MeshReport>(m, "MeshReport")
       .def_readonly("num_vertices", &MeshReport::num_vertices)
       .def_readonly("num_triangles", &MeshReport::num_triangles)
@@ -142,8 +141,10 @@ void bind_core(py::module_& m) {
         },
         py::arg("V"), py::arg("F"), py::arg("density"),
         "Volume, mass, centre of mass and inertia about it (mesh frame) of a closed mesh.");
+}
 
-  // Projection instances (datasets_generated/qp/), read by the C++ reader.
+// Projection instances (datasets_generated/qp/), read by the C++ reader.
+void bind_qp_instances(py::module_& m) {
   py::class_<QpInstance>(m, "QpInstance")
       .def_readonly("id", &QpInstance::id)
       .def_readonly("M", &QpInstance::M)
@@ -155,10 +156,12 @@ void bind_core(py::module_& m) {
       .def_readonly("step", &QpInstance::step);
   m.def("read_qp_instances", &read_qp_instances, py::arg("path"),
         "Reads a projection-instance family file (datasets_generated/qp/README.md).");
+}
 
-  // Scenes: loaded once (load_scene), then summarised here and resolved into
-  // the effective settings by runtime.effective_settings, without reading the
-  // files again.
+// Scenes: loaded once (load_scene), then summarised here and resolved into
+// the effective settings by runtime.effective_settings, without reading the
+// files again.
+void bind_scenes(py::module_& m) {
   py::class_<Scene>(m, "Scene", "A loaded and validated scene (opaque; gauss6.load_scene).")
       .def_readonly("path", &Scene::path)
       .def_readonly("name", &Scene::name);
@@ -182,6 +185,23 @@ void bind_core(py::module_& m) {
           return d;
         },
         py::arg("scene"), py::arg("self_intersections") = true, "Summarises a loaded scene's bodies.");
+}
+
+}  // namespace
+
+void bind_core(py::module_& m) {
+  // Every load-time error (load_error.h: scenes, meshes, CCD query and projection-
+  // instance files) becomes gauss6.LoadError, a ValueError with the same message
+  // ("FILE:LINE: KEY: problem"). SceneError and MeshFileError are its old names.
+  const auto& load_error = py::register_exception<LoadError>(m, "LoadError", PyExc_ValueError);
+  m.attr("SceneError") = load_error;
+  m.attr("MeshFileError") = load_error;
+
+  bind_defaults(m);
+  bind_poses(m);
+  bind_meshes(m);
+  bind_qp_instances(m);
+  bind_scenes(m);
 }
 
 }  // namespace gauss6::python

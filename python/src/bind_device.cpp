@@ -29,13 +29,9 @@ py::dict entry_dict(const HidDeviceEntry& e) {
   d["profile"] = p ? py::cast(std::string(p->name)) : py::none();
   return d;
 }
-}  // namespace
 
-void bind_device(py::module_& parent) {
-  py::module_ m = parent.def_submodule("device", "Devices (simulated, HID) and the trace writer");
-  // A trace file's errors are load-time errors: gauss6.device.TraceError is a gauss6.LoadError.
-  py::register_exception<TraceError>(m, "TraceError", parent.attr("LoadError"));
-
+// HID enumeration and the known device profiles.
+void bind_hid(py::module_& m) {
   m.def("list_hid_devices", [] {
     py::list out;
     for (const HidDeviceEntry& e : list_hid_devices(*make_hidapi_backend())) out.append(entry_dict(e));
@@ -57,8 +53,10 @@ void bind_device(py::module_& parent) {
     }
     return out;
   }, "The known HID device profiles (the SpaceMouse family).");
+}
 
-  // The simulated device, driven from Python in lockstep: read(t) then write(t, F).
+// The simulated device, driven from Python in lockstep: read(t) then write(t, F).
+void bind_simulated_device(py::module_& m) {
   py::class_<SimulatedDevice>(m, "SimulatedDevice")
       .def(py::init([](const std::string& script_json, double rate_hz, double max_force, double max_torque,
                        const std::string& origin) {
@@ -101,8 +99,10 @@ void bind_device(py::module_& parent) {
       .def("write", [](SimulatedDevice& d, double t, const Vec6& F) { return std::string(to_string(d.write(t, F))); },
            py::arg("t"), py::arg("F"), "Hold the wrench F = (force, torque) until the next write.")
       .def_property_readonly("rate_hz", [](const SimulatedDevice& d) { return d.info().rate_hz; });
+}
 
-  // The replay device, driven from Python: the handle poses of a trace's ticks, played back.
+// The replay device, driven from Python: the handle poses of a trace's ticks, played back.
+void bind_replay_device(py::module_& m) {
   py::class_<ReplayDevice>(m, "ReplayDevice")
       .def(py::init([](const std::string& trace_path) {
              return std::make_unique<ReplayDevice>(ReplayDevice::from_trace(read_trace(trace_path),
@@ -122,7 +122,10 @@ void bind_device(py::module_& parent) {
       .def_property_readonly("num_samples", &ReplayDevice::num_samples)
       .def_property_readonly("rate_hz", [](const ReplayDevice& d) { return d.info().rate_hz; })
       .def_property_readonly("name", [](const ReplayDevice& d) { return d.info().name; });
+}
 
+// The trace writer: ticks, steps, contacts and events appended, flushed by a thread or by hand.
+void bind_trace_writer(py::module_& m) {
   py::class_<TraceWriter>(m, "TraceWriter")
       .def(py::init([](const std::string& path, const std::string& scene, const std::string& device, double rate_hz,
                        const std::vector<std::pair<std::string, double>>& phases, const std::string& extra_json,
@@ -187,6 +190,18 @@ void bind_device(py::module_& parent) {
         d["num_chunks"] = s.num_chunks;
         return d;
       });
+}
+
+}  // namespace
+
+void bind_device(py::module_& parent) {
+  py::module_ m = parent.def_submodule("device", "Devices (simulated, HID) and the trace writer");
+  // A trace file's errors are load-time errors: gauss6.device.TraceError is a gauss6.LoadError.
+  py::register_exception<TraceError>(m, "TraceError", parent.attr("LoadError"));
+  bind_hid(m);
+  bind_simulated_device(m);
+  bind_replay_device(m);
+  bind_trace_writer(m);
 }
 
 }  // namespace gauss6::python

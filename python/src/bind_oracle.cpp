@@ -8,8 +8,8 @@
 #include <memory>
 #include <vector>
 
-#include "gauss6/contacts.h"
-#include "gauss6/scene.h"
+#include "gauss6/contact/contacts.h"
+#include "gauss6/io/scene.h"
 #include "module.h"
 
 namespace py = pybind11;

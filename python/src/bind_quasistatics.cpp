@@ -12,8 +12,8 @@
 #include <optional>
 #include <string>
 
-#include "gauss6/coupling.h"
-#include "gauss6/quasistatics.h"
+#include "gauss6/contact/coupling.h"
+#include "gauss6/contact/quasistatics.h"
 #include "module.h"
 
 namespace py = pybind11;

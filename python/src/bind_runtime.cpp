@@ -15,7 +15,7 @@
 
 #include "gauss6/reference/ccd.h"
 #include "gauss6/scenario.h"
-#include "gauss6/scene.h"
+#include "gauss6/io/scene.h"
 #include "module.h"
 
 namespace py = pybind11;

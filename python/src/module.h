@@ -10,9 +10,9 @@
 
 #include <Eigen/Core>
 
-#include "gauss6/mesh.h"
-#include "gauss6/pose.h"
-#include "gauss6/scene.h"
+#include "gauss6/geometry/mesh.h"
+#include "gauss6/geometry/pose.h"
+#include "gauss6/io/scene.h"
 
 namespace gauss6::python {
 void bind_core(pybind11::module_& m);          // poses, meshes, mass properties, scenes

@@ -234,7 +234,7 @@ def _scene_naming(tmp_path, source: str, target: str, path) -> object:
 
 def test_files_a_scene_names_are_refused_when_they_are_not_regular_files(tmp_path, fifo):
     """The C++ loaders (scene, height map, hand script) check what a path is before opening it
-    (gauss6/regular_file.h): in a child process with a timeout, as a FIFO would hang a reader."""
+    (gauss6/io/regular_file.h): in a child process with a timeout, as a FIFO would hang a reader."""
     fifo_json = tmp_path / "script.json"
     os.mkfifo(fifo_json)
     code = ("import sys; from gauss6._gauss6 import runtime\n"

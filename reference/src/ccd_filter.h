@@ -12,7 +12,7 @@
 
 #include <array>
 
-#include "gauss6/feature_pair.h"
+#include "gauss6/geometry/feature_pair.h"
 #include "gauss6/reference/ccd.h"
 
 namespace gauss6::reference::detail {

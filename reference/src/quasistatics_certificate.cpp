@@ -183,32 +183,15 @@ std::vector<std::string> to_strings(const std::vector<Rational>& values) {
   return out;
 }
 
-CertificateReport check_certificate(const ProjectionProblem& problem, const std::vector<int>& active_set) {
-  const Mat6& M = problem.M;
-  const Vec6& au = problem.au;
-  const Eigen::MatrixXd& J = problem.J;
-  const Eigen::VectorXd& b = problem.b;
-  CertificateReport rep;  // failure = bad_input until the inputs are checked
-  if (!internal::valid_inputs(M, au, J, b)) return rep;
-  const int m = static_cast<int>(J.rows());
-  auto rhs = [&](int k) { return b.size() == 0 ? 0.0 : b[k]; };
+namespace {
 
-  // W as a list of distinct rows, in the caller's order.
-  std::vector<char> in_w(m, 0);
-  std::vector<int> rows;
-  for (int k : active_set) {
-    if (k < 0 || k >= m) return rep;
-    if (!in_w[k]) {
-      in_w[k] = 1;
-      rows.push_back(k);
-    }
-  }
+using internal::Sym6;
 
-  const internal::Sym6 Ms = internal::symmetric_part(M);
-
-  // 1. A maximal independent subset B of W, greedily in W's order, by
-  //    fraction-free row reduction of the integer-scaled rows: each echelon row
-  //    is zero at the pivot columns of the earlier ones.
+// A maximal independent subset B of the rows W, greedily in W's order, by
+// fraction-free row reduction of the integer-scaled rows: each echelon row is
+// zero at the pivot columns of the earlier ones. *num_dependent counts the
+// rows left out.
+std::vector<int> independent_rows(const Eigen::MatrixXd& J, const std::vector<int>& rows, int* num_dependent) {
   std::vector<std::array<mpz_class, 6>> echelon;
   std::vector<int> pivot_col;
   std::vector<int> basis;
@@ -225,7 +208,7 @@ CertificateReport check_certificate(const ProjectionProblem& problem, const std:
     int p = 0;
     while (p < 6 && sgn(r[p]) == 0) ++p;
     if (p == 6) {
-      ++rep.num_dependent_rows;
+      ++*num_dependent;
       continue;
     }
     mpz_class content = 0;  // keep the entries small
@@ -235,14 +218,32 @@ CertificateReport check_certificate(const ProjectionProblem& problem, const std:
     pivot_col.push_back(p);
     basis.push_back(k);
   }
-  const int nb = static_cast<int>(basis.size());
-  rep.rank = nb;
+  return basis;
+}
 
-  // 2. The KKT point of B, written for d = a - au:
-  //      [ sym(M)  -J_B^T ] [ d        ]   [ 0                ]
-  //      [ J_B      0     ] [ lambda_B ] = [ b_B - J_B au     ],
-  //    each row scaled to integers and solved fraction-free; the first six
-  //    pivots are M's leading minors, which checks that M is positive definite.
+// c_k = J_k au - b_k of every row, exact (b empty: 0).
+std::vector<Rational> exact_offsets_at_au(const Eigen::MatrixXd& J, const Vec6& au, const Eigen::VectorXd& b) {
+  const int m = static_cast<int>(J.rows());
+  std::vector<Rational> c(m);
+  for (int k = 0; k < m; ++k) {
+    Rational v = -Rational(b.size() == 0 ? 0.0 : b[k]);
+    for (int t = 0; t < 6; ++t)
+      if (J(k, t) != 0 && au[t] != 0) v += Rational(J(k, t)) * Rational(au[t]);
+    c[k] = std::move(v);
+  }
+  return c;
+}
+
+// The KKT point of B, written for d = a - au:
+//   [ sym(M)  -J_B^T ] [ d        ]   [ 0                ]
+//   [ J_B      0     ] [ lambda_B ] = [ b_B - J_B au     ],
+// each row scaled to integers and solved fraction-free: *x = det (d, lambda_B)
+// (Cramer numerators) and *det the determinant. The first six pivots are M's
+// leading minors, which checks that M is positive definite: false when not
+// (J_B has full row rank, so only such an M makes the solve fail).
+bool solve_basis_kkt(const Sym6& Ms, const Eigen::MatrixXd& J, const std::vector<int>& basis,
+                     const std::vector<Rational>& c, std::vector<mpz_class>* x, mpz_class* det) {
+  const int nb = static_cast<int>(basis.size());
   const int n = 6 + nb, w = n + 1;
   std::vector<mpz_class> K(static_cast<size_t>(n) * w);
   std::vector<Rational> row(w);
@@ -252,57 +253,27 @@ CertificateReport check_certificate(const ProjectionProblem& problem, const std:
     row[n] = 0;
     internal::integerize(row.data(), w, &K[static_cast<size_t>(w) * i]);
   }
-  std::vector<Rational> c(m);  // c_k = J_k au - b_k, exact
-  for (int k = 0; k < m; ++k) {
-    Rational v = -Rational(rhs(k));
-    for (int t = 0; t < 6; ++t)
-      if (J(k, t) != 0 && au[t] != 0) v += Rational(J(k, t)) * Rational(au[t]);
-    c[k] = std::move(v);
-  }
   for (int q = 0; q < nb; ++q) {
     for (int j = 0; j < 6; ++j) row[j] = J(basis[q], j);
     for (int j = 6; j < n; ++j) row[j] = 0;
     row[n] = -c[basis[q]];
     internal::integerize(row.data(), w, &K[static_cast<size_t>(w) * (6 + q)]);
   }
-  std::vector<mpz_class> x;
-  mpz_class det;
-  if (!internal::bareiss_solve(K, n, /*spd_block=*/6, x, det)) {
-    // J_B has full row rank, so only a non-positive-definite M gets here.
-    return rep;
-  }
+  return internal::bareiss_solve(K, n, /*spd_block=*/6, *x, *det);
+}
+
+// Primal feasibility of every row at a = au + x(0:6) / det: s_k = J_k a - b_k =
+// c_k + J_k d, so det s_k = det c_k + J_k x is dyadic: no division per row.
+// Returns the most violated row (-1 when none is) and *amount, its b_k - J_k a;
+// *tight gets the rows tight at a (of W or not: KKT allows a multiplier on any
+// row tight at a).
+int most_violated_row(const Eigen::MatrixXd& J, const std::vector<Rational>& c, const std::vector<mpz_class>& x,
+                      const mpz_class& det, Rational* amount, std::vector<int>* tight) {
+  const int m = static_cast<int>(J.rows());
   const int det_sign = sgn(det);
   const Rational det_q(det);
-
-  Row6 a;
-  for (int t = 0; t < 6; ++t) {
-    a[t] = Rational(x[t]) / det_q;
-    a[t] += au[t];
-  }
-  std::vector<Rational> lambda_b(nb);
-  for (int q = 0; q < nb; ++q) lambda_b[q] = Rational(x[6 + q]) / det_q;
-
-  rep.ac_exact.assign(a.begin(), a.end());
-  rep.lambda_exact.assign(m, Rational(0));
-  for (int q = 0; q < nb; ++q) rep.lambda_exact[basis[q]] = lambda_b[q];
-
-  auto finish = [&](CertificateFailure failure, int bad_row, const Rational& amount) {
-    rep.failure = failure;
-    rep.pass = failure == CertificateFailure::none;
-    rep.row = bad_row;
-    rep.amount = to_double_nearest(amount);
-    for (int t = 0; t < 6; ++t) rep.ac_rounded[t] = to_double_nearest(rep.ac_exact[t]);
-    rep.lambda_rounded.resize(m);
-    for (int k = 0; k < m; ++k) rep.lambda_rounded[k] = to_double_nearest(rep.lambda_exact[k]);
-    return rep;
-  };
-
-  // 3. Primal feasibility of every row: s_k = J_k a - b_k = c_k + J_k d, so
-  //    det s_k = det c_k + J_k x is dyadic: no division per row. Remember which
-  //    rows are tight (of W or not: KKT allows a multiplier on any row tight at a).
   int worst_row = -1;
   Rational worst = 0;  // most negative det_sign * det * s_k
-  std::vector<int> tight;
   Rational ts;
   for (int k = 0; k < m; ++k) {
     ts = c[k] * det_q;
@@ -313,12 +284,100 @@ CertificateReport check_certificate(const ProjectionProblem& problem, const std:
       worst = ts;
       worst_row = k;
     }
-    if (sgn(ts) == 0) tight.push_back(k);
+    if (sgn(ts) == 0) tight->push_back(k);
   }
-  if (worst_row >= 0) {
-    const Rational amount = -worst / abs(det_q);
-    return finish(CertificateFailure::violated_constraint, worst_row, amount);
+  if (worst_row >= 0) *amount = -worst / abs(det_q);
+  return worst_row;
+}
+
+// Multipliers lambda_T >= 0 over the tight rows T with the same wrench
+// g = J_B^T lambda_B as B's, searched by the exact LP and verified here,
+// exactly, whatever found them; false when none is found.
+bool nonnegative_tight_multipliers(const Eigen::MatrixXd& J, const std::vector<int>& basis,
+                                   const std::vector<Rational>& lambda_b, const std::vector<int>& tight,
+                                   std::vector<Rational>* lambda_t) {
+  const int nb = static_cast<int>(basis.size());
+  Row6 g;
+  for (int t = 0; t < 6; ++t) {
+    Rational v = 0;
+    for (int i = 0; i < nb; ++i) v += Rational(J(basis[i], t)) * lambda_b[i];
+    g[t] = v;
   }
+  if (!internal::find_nonnegative_combination(J, tight, g, *lambda_t) || lambda_t->size() != tight.size())
+    return false;
+  bool ok = std::all_of(lambda_t->begin(), lambda_t->end(), [](const Rational& l) { return sgn(l) >= 0; });
+  for (int t = 0; t < 6 && ok; ++t) {
+    Rational v = 0;
+    for (size_t i = 0; i < tight.size(); ++i) v += Rational(J(tight[i], t)) * (*lambda_t)[i];
+    ok = v == g[t];
+  }
+  return ok;
+}
+
+// The report's verdict (failure, row, amount) and its exact values rounded to nearest.
+CertificateReport finished(CertificateReport rep, CertificateFailure failure, int bad_row, const Rational& amount) {
+  rep.failure = failure;
+  rep.pass = failure == CertificateFailure::none;
+  rep.row = bad_row;
+  rep.amount = to_double_nearest(amount);
+  for (int t = 0; t < 6; ++t) rep.ac_rounded[t] = to_double_nearest(rep.ac_exact[t]);
+  rep.lambda_rounded.resize(rep.lambda_exact.size());
+  for (size_t k = 0; k < rep.lambda_exact.size(); ++k) rep.lambda_rounded[k] = to_double_nearest(rep.lambda_exact[k]);
+  return rep;
+}
+
+}  // namespace
+
+// The certificate in four steps: a basis B of W, the KKT point of B, primal
+// feasibility of every row, then dual feasibility (lambda_B >= 0, or
+// nonnegative multipliers over the tight rows).
+CertificateReport check_certificate(const ProjectionProblem& problem, const std::vector<int>& active_set) {
+  const Mat6& M = problem.M;
+  const Vec6& au = problem.au;
+  const Eigen::MatrixXd& J = problem.J;
+  const Eigen::VectorXd& b = problem.b;
+  CertificateReport rep;  // failure = bad_input until the inputs are checked
+  if (!internal::valid_inputs(M, au, J, b)) return rep;
+  const int m = static_cast<int>(J.rows());
+
+  // W as a list of distinct rows, in the caller's order.
+  std::vector<char> in_w(m, 0);
+  std::vector<int> rows;
+  for (int k : active_set) {
+    if (k < 0 || k >= m) return rep;
+    if (!in_w[k]) {
+      in_w[k] = 1;
+      rows.push_back(k);
+    }
+  }
+
+  // 1. A maximal independent subset B of W.
+  const std::vector<int> basis = independent_rows(J, rows, &rep.num_dependent_rows);
+  const int nb = static_cast<int>(basis.size());
+  rep.rank = nb;
+
+  // 2. The KKT point of B: a = au + d and lambda_B.
+  const std::vector<Rational> c = exact_offsets_at_au(J, au, b);
+  std::vector<mpz_class> x;
+  mpz_class det;
+  if (!solve_basis_kkt(internal::symmetric_part(M), J, basis, c, &x, &det)) return rep;
+  const Rational det_q(det);
+  Row6 a;
+  for (int t = 0; t < 6; ++t) {
+    a[t] = Rational(x[t]) / det_q;
+    a[t] += au[t];
+  }
+  std::vector<Rational> lambda_b(nb);
+  for (int q = 0; q < nb; ++q) lambda_b[q] = Rational(x[6 + q]) / det_q;
+  rep.ac_exact.assign(a.begin(), a.end());
+  rep.lambda_exact.assign(m, Rational(0));
+  for (int q = 0; q < nb; ++q) rep.lambda_exact[basis[q]] = lambda_b[q];
+
+  // 3. Primal feasibility of every row.
+  std::vector<int> tight;
+  Rational amount;
+  if (const int worst_row = most_violated_row(J, c, x, det, &amount, &tight); worst_row >= 0)
+    return finished(std::move(rep), CertificateFailure::violated_constraint, worst_row, amount);
 
   // 4. Dual feasibility: lambda_B >= 0 settles it.
   int neg_row = -1;
@@ -328,37 +387,17 @@ CertificateReport check_certificate(const ProjectionProblem& problem, const std:
       neg_value = lambda_b[i];
       neg_row = basis[i];
     }
-  if (neg_row < 0) return finish(CertificateFailure::none, -1, Rational(0));
-
+  if (neg_row < 0) return finished(std::move(rep), CertificateFailure::none, -1, Rational(0));
   // Otherwise, with more tight rows than B, the multipliers are not unique:
-  // search lambda >= 0 over the tight rows with the same wrench g = J_B^T lambda_B,
-  // then verify it here, exactly, whatever found it.
-  if (static_cast<int>(tight.size()) > nb) {
-    Row6 g;
-    for (int t = 0; t < 6; ++t) {
-      Rational v = 0;
-      for (int i = 0; i < nb; ++i) v += Rational(J(basis[i], t)) * lambda_b[i];
-      g[t] = v;
-    }
-    std::vector<Rational> lambda_t;
-    if (internal::find_nonnegative_combination(J, tight, g, lambda_t) &&
-        lambda_t.size() == tight.size()) {
-      bool ok = std::all_of(lambda_t.begin(), lambda_t.end(),
-                            [](const Rational& l) { return sgn(l) >= 0; });
-      for (int t = 0; t < 6 && ok; ++t) {
-        Rational v = 0;
-        for (size_t i = 0; i < tight.size(); ++i) v += Rational(J(tight[i], t)) * lambda_t[i];
-        ok = v == g[t];
-      }
-      if (ok) {
-        rep.used_lp = true;
-        std::fill(rep.lambda_exact.begin(), rep.lambda_exact.end(), Rational(0));
-        for (size_t i = 0; i < tight.size(); ++i) rep.lambda_exact[tight[i]] = lambda_t[i];
-        return finish(CertificateFailure::none, -1, Rational(0));
-      }
-    }
+  // nonnegative ones over the tight rows may exist.
+  std::vector<Rational> lambda_t;
+  if (static_cast<int>(tight.size()) > nb && nonnegative_tight_multipliers(J, basis, lambda_b, tight, &lambda_t)) {
+    rep.used_lp = true;
+    std::fill(rep.lambda_exact.begin(), rep.lambda_exact.end(), Rational(0));
+    for (size_t i = 0; i < tight.size(); ++i) rep.lambda_exact[tight[i]] = lambda_t[i];
+    return finished(std::move(rep), CertificateFailure::none, -1, Rational(0));
   }
-  return finish(CertificateFailure::negative_multiplier, neg_row, -neg_value);
+  return finished(std::move(rep), CertificateFailure::negative_multiplier, neg_row, -neg_value);
 }
 
 }  // namespace gauss6::reference

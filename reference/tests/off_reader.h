@@ -7,7 +7,7 @@
 #include <stdexcept>
 #include <string>
 
-#include "gauss6/mesh.h"
+#include "gauss6/geometry/mesh.h"
 
 namespace gauss6::test {
 

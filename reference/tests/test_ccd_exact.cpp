@@ -1,5 +1,5 @@
 // Tests of the exact continuous collision detection (gauss6/reference/ccd.h)
-// and of the shared CCD query reader (gauss6/ccd_queries.h). Every expected
+// and of the shared CCD query reader (gauss6/io/ccd_queries.h). Every expected
 // time here is derived by hand; the comparisons are exact (rationals), so no
 // tolerance is involved unless a test says otherwise.
 #include <catch2/catch.hpp>
@@ -14,7 +14,7 @@
 #include <sstream>
 #include <string>
 
-#include "gauss6/ccd_queries.h"
+#include "gauss6/io/ccd_queries.h"
 #include "gauss6/reference/ccd.h"
 
 namespace {
@@ -466,7 +466,7 @@ TEST_CASE("mesh first contact: each touching pair, solved alone, touches at u* (
   CHECK_THROWS_AS(feature_pair_first_contact(mp, m, far), std::invalid_argument);
 }
 
-TEST_CASE("canonical feature ids of an optimized feature pair (gauss6/feature_ids.h)", "[refccd]") {
+TEST_CASE("canonical feature ids of an optimized feature pair (gauss6/geometry/feature_ids.h)", "[refccd]") {
   gauss6::MatrixX3i god_F(2, 3), obstacle_F(1, 3);
   god_F << 0, 1, 2, 2, 1, 3;
   obstacle_F << 7, 5, 6;

@@ -4,7 +4,7 @@
 #include "gauss6/hid_device.h"
 #include "gauss6/reference/ccd.h"
 #include "gauss6/scenario.h"
-#include "gauss6/scene.h"
+#include "gauss6/io/scene.h"
 #include "gauss6/trace.h"
 
 int main() { return 0; }

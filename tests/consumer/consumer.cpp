@@ -5,10 +5,10 @@
 #include <cstdio>
 #include <vector>
 
-#include "gauss6/bvh.h"
-#include "gauss6/ccd_step.h"
-#include "gauss6/mesh.h"
-#include "gauss6/pose.h"
+#include "gauss6/geometry/bvh.h"
+#include "gauss6/step/ccd_step.h"
+#include "gauss6/geometry/mesh.h"
+#include "gauss6/geometry/pose.h"
 
 using gauss6::Vec3;
 

@@ -10,7 +10,7 @@
 #include <string>
 #include <vector>
 
-#include "gauss6/device_port.h"
+#include "gauss6/runtime/device_port.h"
 #include "gauss6/trace.h"
 
 namespace gauss6 {

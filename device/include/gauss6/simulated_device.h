@@ -24,8 +24,8 @@
 #include <string>
 #include <vector>
 
-#include "gauss6/device_port.h"
-#include "gauss6/pose.h"
+#include "gauss6/runtime/device_port.h"
+#include "gauss6/geometry/pose.h"
 
 namespace gauss6 {
 

@@ -10,7 +10,7 @@
 // in N and N m, world frame; energies in J.
 #pragma once
 
-#include "gauss6/runtime.h"
+#include "gauss6/runtime/runtime.h"
 
 namespace gauss6 {
 

@@ -32,8 +32,8 @@
 
 #include "gauss6/property_observers.h"
 #include "gauss6/replay_device.h"
-#include "gauss6/runtime.h"
-#include "gauss6/scene.h"
+#include "gauss6/runtime/runtime.h"
+#include "gauss6/io/scene.h"
 #include "gauss6/simulated_device.h"
 #include "gauss6/trace.h"
 

@@ -20,9 +20,9 @@
 #include <string>
 #include <vector>
 
-#include "gauss6/device_port.h"
-#include "gauss6/load_error.h"
-#include "gauss6/pose.h"
+#include "gauss6/runtime/device_port.h"
+#include "gauss6/io/load_error.h"
+#include "gauss6/geometry/pose.h"
 
 namespace gauss6 {
 

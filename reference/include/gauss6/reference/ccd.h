@@ -27,11 +27,11 @@
 
 #include <gmpxx.h>
 
-#include "gauss6/aabb.h"
-#include "gauss6/ccd_queries.h"
-#include "gauss6/feature_ids.h"
-#include "gauss6/mesh.h"
-#include "gauss6/pose.h"
+#include "gauss6/geometry/aabb.h"
+#include "gauss6/io/ccd_queries.h"
+#include "gauss6/geometry/feature_ids.h"
+#include "gauss6/geometry/mesh.h"
+#include "gauss6/geometry/pose.h"
 
 namespace gauss6::reference {
 
@@ -66,7 +66,7 @@ int compare_toi(const ExactToi& a, const ExactToi& b);
 
 using ExactPoint = std::array<mpq_class, 3>;
 
-// The optimized linear queries (gauss6/ccd.h) with exact points and no window:
+// The optimized linear queries (gauss6/ccd/ccd.h) with exact points and no window:
 // index [0] is the position at t = 0, [1] at t = 1.
 // Vertex/face: contact when the vertex lies on the closed triangle face[.][0..2].
 struct LinearVertexFaceQuery {
@@ -79,7 +79,7 @@ struct LinearEdgeEdgeQuery {
 };
 ExactToi ccd_linear_vertex_face(const LinearVertexFaceQuery& q);
 ExactToi ccd_linear_edge_edge(const LinearEdgeEdgeQuery& q);
-// A query of the shared file format (gauss6/ccd_queries.h), by its kind.
+// A query of the shared file format (gauss6/io/ccd_queries.h), by its kind.
 ExactToi query_toi(const CcdQuery& query);
 ExactPoint to_exact(const RationalPoint& p);
 
@@ -105,7 +105,7 @@ ExactPoint motion_point_exact(const ExactCayleyMotion& m, const mpq_class& u, co
 // Exact world position under the static pose X (METHOD.md section 1).
 ExactPoint transform_point_exact(const Pose& X, const Vec3& r_B);
 
-// The optimized rigid queries (gauss6/ccd.h), exactly: the body (the god-object)
+// The optimized rigid queries (gauss6/ccd/ccd.h), exactly: the body (the god-object)
 // moves, the obstacle is static; body features in the body frame (B), obstacle
 // features in the world frame (W). Only contacts at u <= u_end are looked for
 // (u_end in (0, 1], a double taken exactly; std::invalid_argument otherwise): a
@@ -146,7 +146,7 @@ int coplanarity_degree(const RigidEdgeEdgeQuery& q);
 // Mesh level: a moving god-object mesh (body frame B) against a static obstacle
 // mesh (world frame W). The moving body of the primitives above is the
 // god-object: the god side of the shared PairKind and FeaturePair
-// (gauss6/feature_pair.h). Boxes are the shared gauss6::Aabb (gauss6/aabb.h).
+// (gauss6/geometry/feature_pair.h). Boxes are the shared gauss6::Aabb (gauss6/geometry/aabb.h).
 
 // Bounding-box tree over items (triangles, vertices or edges). Node i has box
 // box[i]; an inner node has children child[i] and child[i] + 1; a leaf has
@@ -178,7 +178,7 @@ std::vector<std::array<int32_t, 2>> mesh_edges(const TriangleMesh& m);
 struct MeshContact {
   ExactToi toi;                        // first contact over all feature pairs
   std::vector<FeaturePairIds> pairs;   // every pair touching exactly at u* (empty on a miss), in
-                                       // canonical ids (gauss6/feature_ids.h)
+                                       // canonical ids (gauss6/geometry/feature_ids.h)
   int64_t num_candidate_pairs = 0;     // pairs whose swept boxes overlap
   int64_t num_filtered_pairs = 0;      // of those, ruled out by the interval filter (no exact arithmetic)
   int64_t num_exact_pairs = 0;         // of those, solved exactly (root isolation)

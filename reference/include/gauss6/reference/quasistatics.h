@@ -23,7 +23,7 @@
 #include <string>
 #include <vector>
 
-#include "gauss6/pose.h"
+#include "gauss6/geometry/pose.h"
 
 namespace gauss6::reference {
 
@@ -39,7 +39,7 @@ using Rational = mpq_class;
 // sym(M) (ac - au) = J^T lambda exactly (sufficient for this strictly convex
 // problem); infeasible means a Farkas certificate y >= 0 with J^T y = 0 and
 // b^T y > 0 was checked exactly.
-// The names mirror the optimized projection's (gauss6/quasistatics.h) where the
+// The names mirror the optimized projection's (gauss6/contact/quasistatics.h) where the
 // meaning is the same; kSolverFailure has no optimized counterpart, and the
 // exact solver has no iteration cap.
 enum class ProjectionStatus {

@@ -1,0 +1,195 @@
+// The named error allowances of the conservative bounds: each literal that
+// covers rounding somewhere in the collision pipeline or the contact step,
+// with its argument stated once here (what rounding it covers, why the value
+// is enough, and by what margin) and the sites that use it. The arithmetic
+// that carries them, rounded the safe way, is in rounding.h.
+//
+// u = 2^-53 (1.1e-16), the unit roundoff of round-to-nearest doubles; a
+// product or sum of nonnegative terms rounds within u of itself, relatively,
+// and a dot product of two 3-vectors within 3.01 u of the sum of its terms'
+// magnitudes. The relative allowances assume no product underflows (values
+// above 1e-290 or so); below that only kUnderflowFloor speaks for them.
+#pragma once
+
+#include <limits>
+
+namespace gauss6 {
+
+// Relative error of a value computed from exact doubles by a few rounded
+// operations that do not cancel. A Euclidean norm of a 3-vector (three
+// squares and two sums of nonnegative terms within (1 + u)^3, the square root
+// halving that, then rounding once more) is within 2.6 u (2.9e-16) of itself;
+// the product of a rounded difference and a double, within 2.01 u per
+// coordinate. 1e-15 covers a norm 3.4 times, and, taken twice, the two
+// roundings of the sub-interval's step (u1 - u0) dp_mid 9 times.
+// Sites: |omega| and the step's rounding (StartFrame::set, ::obb_frame), the
+// shift |p_b - p_a| (Displacement), |half| (SweptObbFrame::pose), and a
+// corner's |r_B| (StartFrame::radius).
+// Machine-checked at the norm sites (a double vector's norm, rounded up with
+// this allowance and the floor kNormFloor: norm_up in rounding.h):
+// proofs/Allowances.v, norm_upper_bound; the step's rounding
+// (StartFrame::obb_frame): step_rounding; the shift's rounded components are
+// not machine-checked yet.
+constexpr double kRelativeRounding = 1e-15;
+
+// The same roundings of a norm (or of a sum of two norms, its own rounding
+// covered by next_up) with the wider allowance the separating-axis and
+// box-radius sites take: 1e-12 covers 2.6 u 3400 times. Kept apart from
+// kRelativeRounding because merging either into the other would move the
+// lockstep runs; both are sound. Sites: |a| of a separating axis, rounded up
+// (for_each_separating_axis) and down (triangle_time_lower_bound), and
+// |center| + |half| of a god node's box (SweptObbFrame::pose).
+// Machine-checked at the norm sites (norm_up, norm_down in rounding.h):
+// proofs/Allowances.v, norm_upper_bound, norm_lower_bound; the sum of two norms
+// is not machine-checked yet.
+constexpr double kRelativeRoundingWide = 1e-12;
+
+// The absolute floor of a norm's bounds (norm_up, norm_down in rounding.h):
+// where the squares of a double vector underflow (|v| below about 2^-500), the
+// computed norm errs by far more than any relative allowance (all three
+// squares round to 0 at |v| ~ 2^-538), so the upper bound is at least 2^-500
+// and a lower bound not above 2^-500 is replaced by 0. Above it the squares'
+// underflow errs by less than 2^-73 of |v|^2: proofs/Allowances.v,
+// norm_upper_bound, norm_lower_bound.
+constexpr double kNormFloor = 0x1p-500;
+
+// A short sum of products along a rounded separating axis a, relative to
+// |a|_1 times the largest coordinates of the other factors. The difference of
+// two projections a.y - a.x of corners with coordinates <= s: each projection
+// within 3.01 u |a|_1 s, the difference rounding within 2 u |a|_1 s, under
+// 8.1 u (9e-16) of |a|_1 s. The turn term r.(a x omega), with T = |a|_1
+// |omega|_inf |r|_inf: the cross product's rounding moves it by 4.02 u T, its
+// own by 6.02 u T (|a x omega|_1 <= 2 |a|_1 |omega|_inf), the sums that join
+// it to a.v by 8 u T: under 19 u (2.1e-15) of T. 1e-13 covers the gap 110
+// times and the turn 47 times. Sites: for_each_separating_axis (distance.h),
+// triangle_time_lower_bound (motion_bounds.h).
+constexpr double kAxisProductRounding = 1e-13;
+
+// The velocity term a.v of triangle_time_lower_bound and its share of the
+// sums that follow: within 3.01 u + 2 u of |a|_1 |v|_inf (5.6e-16); 1e-14
+// covers it 18 times. Site: triangle_time_lower_bound. Machine-checked:
+// proofs/Allowances.v, axis_velocity_rounding (for |a|_1 >= 2^-900, which the
+// site's guard norm_down(|a|) > 0 ensures).
+constexpr double kAxisVelocityRounding = 1e-14;
+
+// Posing a body point in doubles, X = R r_B + p (R = rotation_matrix(q): each
+// entry, a sum of four squares over |q|^2, within 9 u of the exact rotation
+// of q), and projecting it on a unit n: R r_B within (15.6 + 5.2) u rho per
+// coordinate (the entries' error on |r_B|_1 <= sqrt(3) rho, the products and
+// sums), + p within u (|p|_inf + rho), n.X within 3.01 u sqrt(3) of |X|_inf:
+// under 45 u (5e-15) of |p|_inf + rho, Euclidean. 1e-13 covers it 20 times.
+// Sites: StartFrame::set (static_error, with the stop pose's deviation) and
+// the contact step's test of the CCD's near pairs (sim_loop.cpp), which
+// argue the same posing.
+constexpr double kPoseRounding = 1e-13;
+
+// The turn between two double poses, 2 |vec(conj(qa) qb)| (Displacement),
+// absolute (every term is at most 1): the two normalisations put each
+// component within 4 u of the exact unit quaternion's; each component of the
+// product, four products whose magnitudes sum to at most 1 and three sums,
+// within 12 u; its norm within sqrt(3) 12 u + 2.6 u; twice that, under 48 u
+// (5.3e-15). 1e-14 covers it 1.9 times. Site: Displacement.
+constexpr double kQuaternionTurnRounding = 1e-14;
+
+// The directional sweep of a god node's oriented box (SweptObbFrame::pose):
+// the node's segment step + spin x c from the doubles c = R center (within
+// 3.01 u of |center|_1 <= sqrt(3) radius per coordinate), the cross product
+// (two products and a difference) and the sum: under 19 u (2.1e-15) of
+// |spin|_inf radius + |step|_inf. 1e-14 covers it 4.7 times.
+constexpr double kSpinRounding = 1e-14;
+
+// A god corner's offset from G in triangle_time_lower_bound, the subtraction
+// X - p, rounds each coordinate within u of the offset (<= r, the corners'
+// largest |r_B| up to static_error, which holds the posing's own rounding:
+// kPoseRounding). The turn acts on it at turn_rate: 1e-12 r covers it 9000
+// times. Site: StartFrame::earliest.
+constexpr double kCornerOffsetRounding = 1e-12;
+
+// The 15-axis test of two oriented boxes (obb_separated). Its axes are
+// orthonormal to within 1e-15 (the eigenvectors of fit_obb, turned by the
+// double R), so |C| (C = a's axes^T b's) is raised by 1e-15 entrywise: the
+// cross axes of near-parallel edges then cannot prove a gap out of rounding
+// noise. Every side of every comparison is a sum of at most a dozen products
+// of an entry of |C| (<= 1 + 1e-15) and a number <= s (the largest
+// coordinate, extent or step involved), each within a few units of u of
+// itself, and the axes' error moves each by at most 1e-15 s: under 3e-14 s in
+// all. 1e-11 s covers it 300 times.
+constexpr double kObbAxisRounding = 1e-15;
+constexpr double kObbSeparationRounding = 1e-11;
+
+// The half extents of a fitted oriented box (fit_obb), relative to the
+// largest coordinate of its points: each point's projection on the double
+// axes (three products and two sums) is within 3.01 u sqrt(3) of it (5.8e-16),
+// and the centre (the axes times the mid-projection) and (hi - lo) / 2 round
+// within a few units more: under 2e-15. 1e-13 covers it 50 times.
+constexpr double kObbFitRounding = 1e-13;
+
+// The world box of a god node's body box at a double pose, c +- h with c =
+// G + R m, h = |R| half (generate_contacts), grown to hold the posed double
+// vertices G + R v: c, h and each vertex round within a few units of u (under
+// 20 u) of |c| + h, per coordinate, wherever G and R m do not cancel; 1e-12
+// covers that 450 times. Where they cancel (|c| much below |G|), the
+// roundings are relative to |G| + |R m| instead, and the allowance does not
+// cover them when h is tiny too (a node flat along a world axis near the
+// coordinate plane): such a box may miss a vertex by a rounding (~1e-17 of
+// |G|). Site: generate_contacts.
+constexpr double kBoxPoseRounding = 1e-12;
+
+// A body box c +- h mapped by an interval rotation in midpoint-radius form
+// (swept_box: R within R_rad of R_mid entrywise): the world box R_mid c +-
+// (|R_mid| h + R_rad (|c| + h)), in doubles. With T = (|R_mid| + R_rad) (|c| +
+// h) per coordinate, R_mid c rounds within 3.01 u sum |R_mid| |c| <= 3.01 u T,
+// and the half-width, a sum of six rounded products of rounded sums of
+// nonnegative terms, within 7.01 u of itself <= 7.01 u T; T itself is
+// computed within 7.01 u. Under 10.1 u (1.12e-15) of the computed T in all;
+// 2e-15 covers it 1.8 times (kUnderflowFloor below it). Site: swept_box.
+constexpr double kBoxProductRounding = 2e-15;
+
+// An absolute floor under the relative allowances of box extents, where the
+// relative term vanishes or underflows (all coordinates 0 or subnormal): each
+// underflowing product or sum errs by at most 2^-1075 (2.5e-324; 2^-1022,
+// 2.2e-308, on a thread that flushes subnormals to zero), and a box's few
+// dozen of them stay below 1e-306; 1e-300 covers them and is below any extent
+// that matters. Sites: fit_obb, generate_contacts, swept_box.
+constexpr double kUnderflowFloor = 1e-300;
+
+// A corner value of F = (w + a ea) - b eb for linearly moving points (the
+// narrow phase's enclose_linear, ccd.cpp), every input coordinate bounded by M
+// and u, a, b in [0, 1], is computed within 128 u M + 64 2^-1022 of the exact
+// one (69 u M + 44 2^-1075 proved): proofs/Allowances.v, linear_corner_rounding
+// (and linear_corner_selection, linear_corner_error_bound for the min / max
+// taken and the bound rounded up). The proof models gradual underflow; the
+// underflow term counts 2^-1022 per operation so that it also covers a thread
+// that flushes subnormals to zero (rounding.h), which the proof does not model.
+constexpr double kLinearCornerRounding = 0x1p-46;  // 128 u
+constexpr double kLinearCornerUnderflow = 64 * std::numeric_limits<double>::min();  // 2^-1016
+
+// The Bernstein lower bounds of the u-filter's polynomials (bernstein.h:
+// BernsteinBasis, positive_on), degree N <= 6 on [u0, u1] within [0, 1]:
+// S_i = sum_j lo_j w_ij, each weight w_ij a sum of at most N + 1 nonnegative
+// terms C C' u0^a u1^b divided by C(N, j) (exact integers). Computed: a power
+// within (N - 1) u, times the other power u, times the integer u, the sum N u,
+// the quotient u: each weight within (2N + 1) u of itself; the N + 1 products
+// lo_j w_ij (u each) and their sum (N u) then put S~_i within (3N + 2) u T_i
+// of S_i, T_i = sum_j |lo_j| w_ij (to first order; 20 u at N = 6). 2^-48 = 32 u
+// covers that 1.6 times, and the roundings of the bound itself (T~_i is
+// within (3N + 2) u of T_i too, the product by 2^-48 is exact, and the last
+// sum and difference round by u each).
+// Underflow: each underflowing operation errs by at most 2^-1022 (FTZ
+// included: rounding.h), and the factors it meets later are <= 1 (powers of
+// u <= 1) or <= 20 (the integers): a weight errs by < 2^-1012 more, S~_i by
+// < 2^-1012 sum_j |lo_j| + 16 2^-1022; a subnormal lo_j read as zero (DAZ)
+// by < 2^-1022 w_ij. 2^-1000 (1 + sum_j |lo_j|) covers all of it 2^11 times
+// and stays normal. A fused multiply-add, if a compiler contracted one, rounds
+// once instead of twice: within the same bound.
+constexpr double kBernsteinRounding = 0x1p-48;    // 32 u
+constexpr double kBernsteinUnderflow = 0x1p-1000;  // times 1 + sum_j |lo_j|
+
+// Not a bound but a floor on the narrow phase's distance tolerance, relative
+// to the query's largest coordinate: F's enclosures are at least a few units
+// of u of the coordinates wide (128 u for linear motion, kLinearCornerRounding),
+// so a tolerance below that could never be met; 1e-12 stays 70 times above it.
+// Sites: bisect and filtered_bisect (ccd.cpp).
+constexpr double kDistanceToleranceFloor = 1e-12;
+
+}  // namespace gauss6

@@ -1,0 +1,465 @@
+// The proximity cache's stages of the CCD step (proximity_cache.h, coherence
+// between steps): serve the step's start from the list in use, put a
+// background fill in use or refill the list at X0 when that pays, search the
+// cached range from the list's pairs, and fill the next list in the background
+// at the pose the god-object is heading for. Where each policy constant of
+// ProximityCacheSettings acts is said at its use.
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "ccd_step_state.h"
+#include "gauss6/geometry/distance.h"
+#include "gauss6/numeric/rounding.h"
+
+namespace gauss6 {
+
+bool valid_proximity_cache_settings(const ProximityCacheSettings& s) {
+  const auto in_unit = [](double x) { return x > 0 && x <= 1; };  // false for NaN
+  return s.margin >= 0 && std::isfinite(s.margin) && s.margin_max >= 0 && std::isfinite(s.margin_max) &&
+         s.fill_budget >= 0 && s.steps_per_list > 0 && std::isfinite(s.steps_per_list) &&
+         in_unit(s.slow_fraction) && in_unit(s.max_probe_sub_intervals) && in_unit(s.fill_lead) &&
+         s.min_uses >= 1 && s.skip_after_poor_fill >= 0;
+}
+
+namespace detail {
+
+namespace {
+
+// The policy constants (ProximityCacheSettings).
+const ProximityCacheSettings& policy(const StepState& s) { return s.settings.cache; }
+
+// The margin of a list filled now: about steps_per_list steps like the last
+// one (v), within [margin, margin_max]: a wide one while the god-object slides
+// steadily (fewer fills), the narrow one at rest (a shorter list to scan).
+double list_margin(const StepState& s, double v, double margin, double margin_max) {
+  return std::clamp(policy(s).steps_per_list * v, margin, margin_max);
+}
+
+bool same_body(const CcdBody& a, const CcdBody& b) { return a.mesh == b.mesh && a.bvh == b.bvh; }
+
+// The list was filled for this step's god-object and obstacles (meshes and trees).
+bool same_bodies(const ProximityCache& pc, const StepState& s) {
+  bool k = same_body(pc.god, s.god) && static_cast<int>(pc.obstacles.size()) == s.num_obstacles;
+  for (int o = 0; k && o < s.num_obstacles; ++o) k = same_body(pc.obstacles[static_cast<size_t>(o)], s.obstacles[o]);
+  return k;
+}
+
+// The settings' margins, the larger one at least the smaller.
+double step_margin(const StepState& s) { return s.settings.cache.margin; }
+double step_margin_max(const StepState& s) { return std::max(s.settings.cache.margin_max, step_margin(s)); }
+
+// The list in use was filled for these meshes, trees, reach and margins.
+bool is_keyed(const StepState& s) {
+  const ProximityCache& pc = s.ws->cache;
+  return pc.num_pairs >= 0 && s.num_obstacles <= pc.obstacle_capacity && pc.reach == s.reach &&
+         pc.margin_min == step_margin(s) && pc.margin_max == step_margin_max(s) && same_bodies(pc, s);
+}
+
+// Fills: every pair not proven apart by reach + pf.margin with the god-object
+// at pf.ref (X0, or the pose a background fill is started at:
+// fill_cache_in_background), descended into pf.pairs obstacle by obstacle, a
+// budget of node pairs at a time (fill_some: true once complete; a fill that
+// does not fit, in pf.pairs or on pf.stack, is dropped), then swapped in
+// (put_fill).
+void start_obstacle(StepState* s) {
+  ProximityCache::Fill& pf = s->ws->cache.fill;
+  if (pf.obstacle < s->num_obstacles &&
+      !start_candidate_pairs(*s->god.bvh, *s->obstacles[pf.obstacle].bvh, &pf.stack, &pf.pending))
+    pf.active = false;
+}
+
+// A fill of margin m at X0 (ahead: nullptr), or at *ahead when a motion can
+// stand still there (else at X0).
+void start_fill(StepState* s, const Pose* ahead, double m) {
+  ProximityCache::Fill& pf = s->ws->cache.fill;
+  pf.margin = m;
+  pf.ref = s->X0;
+  pf.motion = s->motion;
+  if (ahead) {
+    CcdMotion still;
+    if (make_ccd_motion(*ahead, *ahead, &still) == MotionStatus::kOk) {
+      pf.ref = *ahead;
+      pf.motion = still;
+    }
+  }
+  pf.cost = 0;
+  pf.swept_dist = -1;  // another pose: the boxes of the last fill are stale
+  pf.num_pairs = 0;
+  pf.obstacle = 0;
+  pf.active = true;
+  pf.complete = false;
+  start_obstacle(s);
+}
+
+bool fill_some(StepState* s, long budget) {
+  ProximityCache& pc = s->ws->cache;
+  ProximityCache::Fill& pf = pc.fill;
+  if (!pf.active) return false;
+  const CcdBody& god = s->god;
+  StartFrame frame;
+  frame.set(pf.motion, 0.0, s->rho);
+  MotionEnclosure enc;
+  enclose_motion(pf.motion, {0, 0}, &enc);
+  const int capacity = static_cast<int>(pf.pairs.size());
+  const double fill_dist = (Upper{s->reach} + Upper{pf.margin}).v;
+  if (pf.swept_dist != fill_dist) {  // (start_fill sets -1)
+    pf.swept.next_interval();
+    pf.swept_dist = fill_dist;
+  }
+  while (pf.obstacle < s->num_obstacles) {
+    int used = 0;
+    const TraversalStatus ts = traverse(*s, frame, enc, pf.swept, 0.0, fill_dist, pf.obstacle, &pf.stack, &pf.pending,
+                                        budget, &used, [&](int gf, int of, int o) {
+      double radius = 0;
+      charge(s, Work::kTrianglePair, 1);  // (the chunks' ends check: fill_within_budget)
+      const double gap = frame.gap(frame.posed_face(*god.mesh, gf, &pf.swept), *s->obstacles[o].mesh, of, fill_dist,
+                                   &radius);
+      if (gap > fill_dist) return true;
+      if (pf.num_pairs == capacity) return false;  // does not fit: no cache
+      pf.pairs[static_cast<size_t>(pf.num_pairs++)] = {gap, radius, gf, of, o};
+      return true;
+    });
+    s->result->num_fill_node_pairs += used;
+    pf.cost += used;
+    budget -= used;
+    if (ts == TraversalStatus::kPaused) return false;
+    if (ts != TraversalStatus::kDone) {
+      pf.active = false;
+      return false;
+    }
+    ++pf.obstacle;
+    start_obstacle(s);
+    if (!pf.active) return false;
+  }
+  pf.complete = true;
+  pc.fill_cost = pf.cost;
+  return true;
+}
+
+// The list's index by gap (ProximityCache::by_gap): a counting sort of its
+// ids into kGapBuckets buckets, stable (each bucket in increasing id order).
+int gap_bucket(const ProximityCache& pc, double gap) {
+  const double b = gap / pc.gap_width;  // (NaN, negative: the first)
+  return b >= ProximityCache::kGapBuckets - 1 ? ProximityCache::kGapBuckets - 1 : (b > 0 ? static_cast<int>(b) : 0);
+}
+void index_by_gap(ProximityCache* pc) {
+  constexpr int K = ProximityCache::kGapBuckets;
+  pc->gap_width = (pc->reach + pc->margin) / K;
+  pc->max_radius = 0;
+  int count[K + 1] = {};
+  for (int k = 0; k < pc->num_pairs; ++k) {
+    const ProximityCache::Pair& c = pc->pairs[static_cast<size_t>(k)];
+    ++count[gap_bucket(*pc, c.gap) + 1];
+    pc->max_radius = std::max(pc->max_radius, c.radius);
+  }
+  for (int b = 0; b < K; ++b) count[b + 1] += count[b];
+  std::copy(count, count + K + 1, pc->bucket_begin);
+  for (int k = 0; k < pc->num_pairs; ++k) {
+    const int b = gap_bucket(*pc, pc->pairs[static_cast<size_t>(k)].gap);
+    pc->by_gap[static_cast<size_t>(count[b]++)] = k;
+  }
+}
+
+void put_fill(StepState* s) {
+  ProximityCache& pc = s->ws->cache;
+  ProximityCache::Fill& pf = pc.fill;
+  std::swap(pc.pairs, pf.pairs);
+  pc.num_pairs = pf.num_pairs;
+  pc.ref = pf.ref;
+  pc.reach = s->reach;
+  pc.margin = pf.margin;
+  pc.margin_min = step_margin(*s);
+  pc.margin_max = step_margin_max(*s);
+  pc.god = s->god;
+  pc.obstacles.assign(s->obstacles, s->obstacles + s->num_obstacles);
+  pc.uses = 0;
+  pc.budget_cut = false;
+  pf.active = false;
+  index_by_gap(&pc);
+}
+
+// The ids of the list's pairs that a step whose points move at most `moving`
+// from the list's pose may bring within the reach, in list order, into
+// ids (near_ids): the buckets whose gaps start below reach + the largest
+// move (and the next, for the rounding of the bucket's index); a pair of a
+// later bucket is farther apart than that (each pair is checked again).
+int near_pairs_of(const ProximityCache& pc, const Displacement& moving, double reach, std::vector<int32_t>* ids) {
+  const double reached = (Upper{reach} + Upper{moving.bound(pc.max_radius)}).v;
+  constexpr int K = ProximityCache::kGapBuckets;
+  const int last = reached <= std::numeric_limits<double>::max() ? std::min(gap_bucket(pc, reached) + 1, K - 1)
+                                                                   : K - 1;  // (infinite, NaN: every bucket)
+  const int n = pc.bucket_begin[last + 1];
+  std::copy(pc.by_gap.begin(), pc.by_gap.begin() + n, ids->begin());
+  std::sort(ids->begin(), ids->begin() + n);
+  return n;
+}
+
+// The ranges of the step's start that a list can serve.
+struct CacheRanges {
+  double speed;    // the god-object's at u = 0 (StartFrame::speed)
+  double u_rest;   // the rest of the step (up to a hint's hit)
+  bool probing;    // hints given and none hit: a short first search may pay
+  double u_probe;  // over [0, u_probe] no point moves a quarter of the margin
+  int n;           // sub-intervals
+  double max_probe;  // a first search is shorter than this many sub-intervals (max_probe_sub_intervals)
+  bool stops_early;  // a leg expected to stop early (CcdStepRequest::lead_sweep > 0): any range serves
+  // [0, u] keeps every point within m of a list's pose, the points `moved`
+  // from there by X0 (0: none).
+  double range(double moved, double m) const {
+    const double u = speed > 0 ? ((Lower{m} - Upper{moved}) / Upper{speed}).v : 1.0;
+    return u > 0 ? std::min(u, 1.0) : 0.0;  // also NaN
+  }
+  // The part of a cache range [0, u] to search from the cache (0: none): all
+  // of it when it covers the rest of the step or the leg stops early
+  // (stops_early); else, as a first search, at most
+  // the range over which no point moves slow_fraction of the margin, and only
+  // when that is under max_probe sub-intervals (a longer one saves no descent).
+  double window(double u) const {
+    if (!(u > 0)) return 0.0;  // also NaN
+    if (u >= u_rest || stops_early) return u;
+    const double w = std::min(u, u_probe);
+    return probing && w > 0 && w < max_probe / n ? w : 0.0;
+  }
+  bool usable(double u) const { return window(u) > 0; }
+};
+
+// The fill's pose is ahead of the god-object's path (fill_cache_in_background):
+// put it in use once it leaves more of its margin than the list in use does, or
+// (finished now if need be) when that list cannot serve this step.
+void take_background_fill(StepState* s, const CacheRanges& r, Displacement* since) {
+  ProximityCache& pc = s->ws->cache;
+  ProximityCache::Fill& pf = pc.fill;
+  const Displacement ahead(pf.ref, s->X0);
+  const double moved_ahead = ahead.bound(s->rho);
+  const bool better = pf.margin - moved_ahead > pc.margin - s->cache_moved;
+  const bool needed = !r.usable(s->u_cached) && r.usable(r.range(moved_ahead, pf.margin));
+  if (!r.usable(s->u_cached) && !needed) {
+    pf.active = false;  // the god-object went elsewhere
+  } else if ((better && pf.complete) || (needed && fill_within_budget(s, std::numeric_limits<long>::max()))) {
+    put_fill(s);
+    s->result->cache_refilled = true;
+    *since = ahead;
+    s->cache_moved = moved_ahead;
+    s->u_cached = r.range(s->cache_moved, pc.margin);
+  }
+}
+
+// A fill costs more than a descent over the step (its boxes are grown by
+// the margin) and pays only when later steps use it: after a fill that
+// served fewer than min_uses later steps (a peg sliding half the margin a
+// step, steps that each start far from the last), the next
+// skip_after_poor_fill chances to fill are passed over (plain descents), and
+// the one after that fills. A step that moves at most slow_fraction of the
+// margin fills regardless (the list then serves the next steps unless the
+// god-object speeds up).
+// The fill is at once, at X0 (u = 0).
+void refill_if_worth(StepState* s, const CacheRanges& r, Displacement* since) {
+  ProximityCache& pc = s->ws->cache;
+  const double margin = step_margin(*s), rho = s->rho;
+  const bool fresh = r.usable(s->u_cached);
+  if (fresh) ++pc.uses;
+  const double fresh_margin =
+      list_margin(*s, pc.has_last ? Displacement(pc.last_x0, s->X0).bound(rho) : 0.0, margin, step_margin_max(*s));
+  bool fill = !fresh && r.usable(r.range(Displacement(s->X0, s->X0).bound(rho), fresh_margin));
+  if (fill && pc.budget_cut && pc.fill.active) {
+    fill = false;  // the fill the budget cut short goes on (take_background_fill)
+  } else if (fill && s->start.speed <= policy(*s).slow_fraction * margin) {
+    pc.rest = 0;
+  } else if (fill && pc.rest > 0) {
+    fill = --pc.rest == 0;
+  } else if (fill && pc.num_pairs >= 0 && pc.uses < policy(*s).min_uses) {
+    pc.rest = policy(*s).skip_after_poor_fill;
+    fill = false;
+  }
+  if (!fill) return;
+  start_fill(s, /*ahead=*/nullptr, fresh_margin);
+  const bool filled = fill_within_budget(s, std::numeric_limits<long>::max());
+  // A fill the update's budget cut short goes on at the next updates as a
+  // background fill (while the list in use keeps the keys: take_background_fill
+  // finishes it, within their budgets, and puts it in use), and none starts
+  // at once meanwhile: no update spends its budget on the same fill again.
+  // Without a list in use (the first fill) it is dropped.
+  if (!filled && out_of_budget(*s) && pc.fill.active && pc.num_pairs >= 0) {
+    pc.budget_cut = true;
+    s->u_cached = 0;
+    return;
+  }
+  pc.clear();
+  s->u_cached = 0;
+  s->cache_keyed = false;
+  if (filled) {
+    put_fill(s);
+    s->cache_keyed = true;
+    s->result->cache_filled = true;
+    *since = Displacement(s->X0, s->X0);
+    s->cache_moved = since->bound(rho);
+    s->u_cached = r.range(s->cache_moved, pc.margin);
+  }
+}
+
+// [searched, u_cached] from the list's pairs (then [0, u_cached] is searched):
+// each pair's own certificate first (its gap at the cache's pose less how far
+// its points can move from there by u_cached: a few flops); the time bound
+// only for the pairs it does not keep beyond the reach; then the candidates'
+// tests.
+void search_cached_pairs(StepState* s, const ProximityCache& pc, const Displacement& since) {
+  CcdStepResult* result = s->result;
+  PairTester& tester = s->tester;
+  CcdStepWorkspace::Candidate* const cand = s->ws->candidates.data();
+  const double u0 = s->searched;
+  s->searched = std::max(u0, s->u_cached);
+  if (!(u0 < std::min(s->u_cached, result->u_hit))) return;
+  enclose_motion(s->motion, {u0, std::min(s->u_cached, result->u_hit)}, &s->e);
+  s->ws->swept.next_interval();
+  tester.u0 = u0;
+  tester.u1 = s->u_cached;
+  Displacement moving = since;
+  moving.add(s->start, s->u_cached);
+  int num_cand = 0;
+  std::vector<int32_t>& ids = s->ws->cache.near_ids;  // this workspace's (pc may be borrowed)
+  const int num_near = near_pairs_of(pc, moving, s->reach, &ids);
+  for (int i = 0; i < num_near; ++i) {
+    const ProximityCache::Pair& c = pc.pairs[static_cast<size_t>(ids[static_cast<size_t>(i)])];
+    ++result->num_triangle_pairs;
+    if (charge(s, Work::kTrianglePair, 1)) {  // nothing of [u0, u_cached] proven, the candidates' buffer in part
+      result->num_near_pairs = -1;
+      return stop_on_budget(s, u0);
+    }
+    if (Lower{c.gap} - Upper{moving.bound(c.radius)} > Upper{s->reach}) {
+      ++result->num_axis_culls;
+      continue;
+    }
+    const double t = s->start.earliest(s->start.posed_face(*s->god.mesh, c.god_face, &s->ws->swept),
+                                       *s->obstacles[c.obstacle].mesh, c.obstacle_face, s->reach, tester.end());
+    if (t > tester.end()) {
+      ++result->num_axis_culls;
+      continue;
+    }
+    cand[num_cand++] = {{c.god_face, c.obstacle_face, c.obstacle}, t};  // fits: the cache has cand's capacity
+  }
+  set_near_pairs(s, num_cand, 0.0);
+  test_candidates(s, num_cand);  // (the budget's end: stop_on_budget)
+}
+
+}  // namespace
+
+// Node pairs a fill descends between two charges to the update's budget.
+constexpr long kFillChunk = 64;
+bool fill_within_budget(StepState* s, long max_node_pairs) {
+  if (s->ws->budget == nullptr) return fill_some(s, max_node_pairs);
+  const ProximityCache::Fill& pf = s->ws->cache.fill;
+  for (long left = max_node_pairs; left > 0 && !out_of_budget(*s);) {
+    const long cost = pf.cost;
+    const bool complete = fill_some(s, std::min(left, kFillChunk));
+    left -= pf.cost - cost;
+    charge(s, Work::kNodePair, pf.cost - cost);
+    if (complete || !pf.active) return complete;  // done, or dropped (does not fit)
+  }
+  return false;
+}
+
+// Coherence (proximity_cache.h): [0, u_cached] is the range
+// over which no point moves farther than the margin from the cache's pose;
+// there the cached pairs are the candidates, with no descent. The range is
+// used when it covers the rest of the step (up to a hint's hit), or, when
+// the god-object starts in contact and no hint hit, as a short first search
+// (under half a sub-interval: a contact likely to be met soon, as a bunny's
+// ear turned back onto the back it rests on, ends the step there without
+// sweeping the boxes over the whole step). A range covering only part of a
+// step would search the pairs near X0 twice (the list, then the descents of
+// the rest): not used, but by a leg expected to stop early (a settling leg,
+// CcdStepRequest::lead_sweep > 0), which stops soon after its start and so
+// most often inside the list's range: the list then answers its lead pieces,
+// where each of them would descend the trees to the same standing proximity.
+// The cache is refilled
+// at X0 when its own range cannot be used for this step and a fresh one's
+// would (a step that moves less than the margin, or a short first search).
+void serve_proximity_cache(StepState* s) {
+  ProximityCache& pc = s->ws->cache;
+  s->cache_keyed = is_keyed(*s);
+  if (!s->cache_keyed) pc.fill.active = false;  // a fill for other meshes or settings
+  // More obstacles than the cache can be keyed by: no cache (its keys never grow).
+  if (s->tester.done() || s->num_obstacles > pc.obstacle_capacity) return;
+  const CcdStepResult& result = *s->result;
+  const double margin = step_margin(*s);
+  const double speed = s->start.speed;  // start: at u = 0 (ccd_step)
+  const CacheRanges r{speed,
+                      result.hit ? result.u_hit : 1.0,
+                      s->hints && s->num_hints > 0 && !result.hit,
+                      speed > 0 ? round_down(policy(*s).slow_fraction * margin / speed).v : 1.0,
+                      s->n,
+                      policy(*s).max_probe_sub_intervals,
+                      s->lead_sweep > 0};
+  const bool keyed = s->cache_keyed;
+  Displacement since(keyed ? pc.ref : s->X0, s->X0);
+  s->cache_moved = keyed ? since.bound(s->rho) : std::numeric_limits<double>::infinity();
+  s->u_cached = keyed ? r.range(s->cache_moved, pc.margin) : 0.0;
+  if (keyed && pc.fill.active) take_background_fill(s, r, &since);
+  refill_if_worth(s, r, &since);
+  s->u_cached = r.window(s->u_cached);
+  s->result->u_cached = s->u_cached;
+  if (s->u_cached > 0) search_cached_pairs(s, pc, since);
+}
+
+// The borrowed list (CcdStepWorkspace::borrowed) serves the step when it
+// holds what this step needs: the same god-object and obstacles, filled for a
+// reach at least this step's (it holds every pair not proven farther than
+// its reach plus its margin apart at its pose, so every pair that can come
+// within the smaller reach while no point has moved farther than the margin
+// from there), room for its pairs among the candidates, and a range over which no
+// point leaves its margin that covers the rest of the step (up to a hint's
+// hit). Nothing of the list changes: no use counted, no fill.
+void serve_borrowed_list(StepState* s) {
+  const ProximityCache* pc = s->ws->borrowed;
+  if (s->tester.done() || pc == nullptr || pc->num_pairs < 0) return;
+  if (!(pc->reach >= s->reach && pc->num_pairs <= static_cast<int>(s->ws->candidates.size()) && same_bodies(*pc, *s)))
+    return;
+  const Displacement since(pc->ref, s->X0);
+  const double speed = s->start.speed;  // start: at u = 0 (ccd_step)
+  const double u_rest = s->result->hit ? s->result->u_hit : 1.0;
+  const double u = speed > 0 ? ((Lower{pc->margin} - Upper{since.bound(s->rho)}) / Upper{speed}).v : 1.0;
+  if (!(u > 0 && u >= u_rest)) return;  // also NaN
+  s->u_cached = std::min(u, 1.0);
+  s->result->u_cached = s->u_cached;
+  search_cached_pairs(s, *pc, since);
+}
+
+// The background fill (ProximityCacheSettings::fill_budget node pairs per
+// step, while the list in use serves). Each step is taken to move the
+// god-object as much as the last one did (v), and a fill to take as many
+// steps as the last one did (j). A fill is started when the list in use has
+// about j steps left, at the pose the god-object will reach if it goes on
+// so for j steps and fill_lead of the margin further: put in use about j
+// steps from now, that list then serves from fill_lead of the margin behind
+// its pose to the margin ahead. Any pose is sound (the list is for the pose it was
+// filled at); a good guess only makes the list serve longer.
+void fill_cache_in_background(StepState* s) {
+  ProximityCache& pc = s->ws->cache;
+  ProximityCache::Fill& pf = pc.fill;
+  const CcdStepSettings& settings = s->settings;
+  const Pose& X0 = s->X0;
+  if (settings.cache.fill_budget > 0 && s->cache_keyed) {
+    if (!pf.active && s->result->u_cached > 0 && pc.has_last) {
+      const double v = Displacement(pc.last_x0, X0).bound(s->rho);
+      const double j = std::ceil(static_cast<double>(std::max(pc.fill_cost, 1L)) /
+                                 static_cast<double>(settings.cache.fill_budget));
+      const double m = list_margin(*s, v, step_margin(*s), step_margin_max(*s));
+      if (v > 0 && v < m && pc.margin - s->cache_moved <= (j + 1) * v) {
+        const double k = j + std::max(0.0, policy(*s).fill_lead * m / v - 1);
+        const Quat dq = normalized(X0.q * conjugate(pc.last_x0.q));
+        const Pose ahead{X0.p + k * (X0.p - pc.last_x0.p), normalized(quat_exp(k * quat_log(dq)) * X0.q)};
+        start_fill(s, &ahead, m);
+      }
+    }
+    if (pf.active && !pf.complete) fill_within_budget(s, settings.cache.fill_budget);
+  }
+  // The next step's background fill and list margin follow this step's motion.
+  pc.budget_cut = pc.budget_cut && out_of_budget(*s);  // this step's search completed within its budget
+  pc.last_x0 = X0;
+  pc.has_last = true;
+}
+
+}  // namespace detail
+
+}  // namespace gauss6
