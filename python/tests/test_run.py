@@ -258,7 +258,7 @@ BUDGET_UNITS = 100
 def test_the_recommended_budget_is_the_libraries(scene_dir, tmp_path):
     from gauss6 import paths
 
-    header = (paths.REPO_ROOT / "optimized/include/gauss6/update_budget.h").read_text()
+    header = (paths.REPO_ROOT / "optimized/include/gauss6/step/update_budget.h").read_text()
     line = next(l for l in header.splitlines() if "kRecommendedUpdateCpuSeconds =" in l)
     assert float(line.split("=")[1].strip().rstrip(";")) == run_mod.RECOMMENDED_BUDGET_S
     r = run_cli("run", str(scene_dir / "scene.toml"), "--out", str(tmp_path), "--budget-cpu", "2")
