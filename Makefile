@@ -108,7 +108,9 @@ reproduce: setup
 clean:
 	rm -rf build build-fuzz build-asan build-tsan out
 
-# The wheel built from the checkout, installed into a fresh venv (python/tests/test_packaging.py,
-# also run by `make test`: its build of the extension reuses the main build's objects through ccache).
+# The wheel built from the checkout (pyproject.toml), installed into a fresh venv outside the
+# checkout, where it runs the command, the viewer, validate, `datasets generate` (every file the
+# committed bytes) and seeded campaigns (python/tests/test_packaging.py, also run by `make test`:
+# its build of the extension reuses the main build's objects through ccache).
 wheel-test: setup
 	$(VENV)/python -m pytest -q python/tests/test_packaging.py

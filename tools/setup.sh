@@ -2,7 +2,8 @@
 # Brings a clone of gauss6 to a working state, idempotently: Debian packages,
 # the Python venv at .venv (pinned requirements.txt), the run viewer's npm packages
 # (viewer/package-lock.json) and its bundled script, the CMake build (Release
-# with debug info) with the Python extension, and the `gauss6` command in the venv.
+# with debug info) with the Python extension, and the `gauss6` package and command in the venv
+# (the checkout's python/ on its path).
 # A second run only rebuilds incrementally. Called by `make test` and `make reproduce`.
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
@@ -79,7 +80,16 @@ if [ ! -f build/build.ninja ]; then
 fi
 cmake --build build -j "${GAUSS6_JOBS:-$(nproc)}"
 
-# 5. The gauss6 package and command in the venv (editable: the extension lives in python/gauss6).
-if [ ! -x .venv/bin/gauss6 ]; then
-  .venv/bin/python -m pip install -q --disable-pip-version-check --no-deps --no-build-isolation -e python
+# 5. The gauss6 package and command in the venv, from the checkout: python/ on the venv's path
+#    (a .pth file; CMake writes the extension gauss6._gauss6 and _version.py into python/gauss6),
+#    and a `gauss6` script that runs `python -m gauss6`. pyproject.toml (scikit-build-core) is
+#    for wheels (`make wheel-check`): an editable install of it would build the extension a
+#    second time. An earlier set-up's pip install of python/ is removed first.
+site=$(.venv/bin/python -c 'import sysconfig; print(sysconfig.get_paths()["purelib"])')
+if .venv/bin/python -m pip show -q gauss6 >/dev/null 2>&1; then
+  .venv/bin/python -m pip uninstall -q -y --disable-pip-version-check gauss6
 fi
+echo "$root/python" > "$site/gauss6-checkout.pth"
+printf '#!/bin/sh\n# The gauss6 command of the checkout %s (tools/setup.sh).\nexec "%s/.venv/bin/python" -m gauss6 "$@"\n' \
+  "$root" "$root" > .venv/bin/gauss6
+chmod +x .venv/bin/gauss6

@@ -1,6 +1,7 @@
 // Tests of contacts.h: a box resting on a box (four corner contacts, normals +z,
-// the Jacobian rows), duplicates merged, the edge/edge normal's sign, and the
-// contact sets found from the CCD's near pairs against those of a full descent.
+// the Jacobian rows), duplicates merged, the edge/edge normal's sign, the
+// contact sets found from the CCD's near pairs against those of a full descent,
+// and a dense coplanar patch reduced to its support.
 #include <catch2/catch.hpp>
 
 #include <cmath>
@@ -173,4 +174,63 @@ TEST_CASE("contacts: the CCD's near pairs give the same set as the descent", "[c
   std::printf("near pairs: used at %d of 400 stop poses, %d of them with contacts\n", used, with_contacts);
   CHECK(used > 300);
   CHECK(with_contacts > 100);
+}
+
+TEST_CASE("contacts: a dense coplanar patch is reduced to its support, the same cone", "[contacts]") {
+  // A unit box laid flat on a 40 x 40 grid sheet (3,200 coplanar triangles, the
+  // interior vertices jittered in the plane), turned about z and moved by seeded
+  // amounts, a delta above it: over 200 contacts within the distance, against a
+  // set of 16. Without the reduction the set kept the first 16 found, one
+  // corner of the patch. Reduced, it must give the same constraints: the least
+  // J_k a over every contact found (a set of 4096, never reduced) and over the
+  // reduced set agree for any motion a, since each row is affine in its point
+  // and the least of an affine function over a patch is at a hull vertex.
+  // 1e-12: rounding of rows of norm ~1 (points within 2 of G) and of |a| = 1.
+  std::mt19937 rng(43);
+  std::uniform_real_distribution<double> U(-1, 1);
+  constexpr int kGrid = 40;
+  std::vector<Eigen::Vector3d> V;
+  std::vector<std::array<int, 3>> F;
+  for (int i = 0; i <= kGrid; ++i)
+    for (int j = 0; j <= kGrid; ++j) {
+      const bool edge = i == 0 || j == 0 || i == kGrid || j == kGrid;
+      const double h = 4.0 / kGrid, jx = edge ? 0 : 0.25 * h * U(rng), jy = edge ? 0 : 0.25 * h * U(rng);
+      V.emplace_back(-2 + i * h + jx, -2 + j * h + jy, 0.0);
+    }
+  for (int i = 0; i < kGrid; ++i)
+    for (int j = 0; j < kGrid; ++j) {
+      const int a = i * (kGrid + 1) + j, b = a + kGrid + 1;
+      F.push_back({a, b, b + 1});
+      F.push_back({a, b + 1, a + 1});
+    }
+  const TriangleMesh sheet = gauss6::test::make_mesh(V, F, "sheet"), god = make_box(1, 1, 1);
+  const Bvh sb = build_bvh(sheet), gb = build_bvh(god);
+  const CcdBody obstacle{&sheet, &sb};
+  ContactWorkspace ws(god);
+  ContactSet small(16), all(4096);
+  ContactSettings cs;
+  cs.distance = 1.5 * kDelta;
+  for (int trial = 0; trial < 20; ++trial) {
+    const Pose X{Vec3(0.3 * U(rng), 0.3 * U(rng), 0.5 + kDelta), quat_exp(Vec3(0, 0, 0.5 * U(rng)))};
+    REQUIRE(generate_contacts(&obstacle, 1, {&god, &gb}, X, cs, &ws, &all) == ContactStatus::kOk);
+    REQUIRE(all.num_reductions == 0);
+    REQUIRE(all.num_contacts > 200);
+    REQUIRE(generate_contacts(&obstacle, 1, {&god, &gb}, X, cs, &ws, &small) == ContactStatus::kOk);
+    CHECK(small.num_reductions > 0);
+    CHECK(small.num_contacts <= 16);
+    CHECK(small.num_pairs_within == all.num_pairs_within);
+    // The smallest separation is kept.
+    double least_all = 1e300, least_small = 1e300;
+    for (int k = 0; k < all.num_contacts; ++k) least_all = std::min(least_all, all.contacts[k].separation);
+    for (int k = 0; k < small.num_contacts; ++k) least_small = std::min(least_small, small.contacts[k].separation);
+    CHECK(least_small == least_all);
+    for (int d = 0; d < 50; ++d) {
+      Vec6 a;
+      for (int i = 0; i < 6; ++i) a[i] = U(rng);
+      a.normalize();
+      const double min_all = (all.J.topRows(all.num_contacts) * a).minCoeff();
+      const double min_small = (small.J.topRows(small.num_contacts) * a).minCoeff();
+      CHECK(std::abs(min_all - min_small) <= 1e-12);
+    }
+  }
 }

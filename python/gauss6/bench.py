@@ -1,6 +1,6 @@
 """`gauss6 bench`: run the Google Benchmark suites (benchmarks/) and write out/bench/.
 
-    python -m gauss6.bench [--build DIR] [--out DIR] [--filter REGEX] [--repetitions N] [--min-time S]
+    gauss6 bench [--build DIR] [--out DIR] [--filter REGEX] [--repetitions N] [--min-time S]
 
 Writes into --out (default out/bench/):
   benchmarks.json   Google Benchmark's own JSON (every repetition and its aggregates);
@@ -17,13 +17,11 @@ finding the benchmark binary, running it, and reading its JSON.
 """
 from __future__ import annotations
 
-import argparse
 import json
 import math
 import os
 import re
 import subprocess
-import sys
 from collections import defaultdict
 from pathlib import Path
 
@@ -175,39 +173,3 @@ def run(build_dir: Path | None, out_dir: Path, filter_regex: str = "", repetitio
     (out_dir / "table.md").write_text(format_table(rows, doc.get("context")) + "\n")
     plot(rows, out_dir / "latency")
     return rows
-
-
-def add_arguments(p: argparse.ArgumentParser) -> None:
-    p.add_argument("--build", type=Path, default=None, help="CMake build tree (default: GAUSS6_BUILD_DIR or build/)")
-    p.add_argument("--out", type=Path, default=paths.REPO_ROOT / "out" / "bench", help="output folder")
-    p.add_argument("--filter", default="", help="Google Benchmark filter (regex)")
-    p.add_argument("--repetitions", type=int, default=3)
-    p.add_argument("--min-time", type=float, default=None, help="seconds per benchmark (Google Benchmark default 0.5)")
-
-
-def run_cli(args: argparse.Namespace) -> int:
-    try:
-        rows = run(args.build, args.out, args.filter, args.repetitions, args.min_time)
-    except (FileNotFoundError, RuntimeError) as e:
-        print(f"gauss6: error: {e}", file=sys.stderr)
-        return 2
-    print(format_table(rows))
-    print(f"written to {args.out}")
-    return 0
-
-
-def register(subparsers) -> None:
-    """Adds `gauss6 bench` to the CLI's subparsers."""
-    p = subparsers.add_parser("bench", help="run the benchmark suites; JSON, table and plot in out/bench/")
-    add_arguments(p)
-    p.set_defaults(func=run_cli)
-
-
-def main(argv: list[str] | None = None) -> int:
-    parser = argparse.ArgumentParser(prog="gauss6 bench", description=__doc__.split("\n")[0])
-    add_arguments(parser)
-    return run_cli(parser.parse_args(argv))
-
-
-if __name__ == "__main__":
-    sys.exit(main())

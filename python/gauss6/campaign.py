@@ -338,18 +338,6 @@ def _run_distributed(campaign: Campaign, todo: list[int], results: list, store: 
     return n_workers
 
 
-def add_arguments(parser) -> None:
-    """The options every campaign command shares."""
-    from .cli import nonnegative_int, output_dir
-
-    parser.add_argument("--workers", type=nonnegative_int, default=None,
-                        help="worker processes of the embedded LocalCluster (default: all cores; 0: serial, "
-                             "in this process)")
-    parser.add_argument("--scheduler", metavar="ADDRESS",
-                        help="run on an existing Dask cluster (tcp://host:port) instead of a LocalCluster")
-    parser.add_argument("--out", type=output_dir, help="folder for the per-chunk results; a rerun into it resumes")
-
-
 def chunk_ranges(count: int, chunk_size: int) -> list[tuple[int, int]]:
     """[begin, end) index ranges of at most chunk_size covering range(count)."""
     return [(b, min(b + chunk_size, count)) for b in range(0, count, chunk_size)]

@@ -1,7 +1,7 @@
 """Rigid CCD steps generated from seeds on the fly (not stored), for campaigns.
 
 Step families (steps in the format of datasets_generated/ccd/README.md):
-- the generator's own sets, drawn by its builders (datasets_generated/ccd/generate.py):
+- the generator's own sets, drawn by its builders (gauss6.generators.ccd):
   random, grazing, parallel, rotation_about_g, zero_rotation, large_rotation, tunnelling;
 - sliding: contacts sliding at delta: the lowest vertex 0.9-1.1 delta above the
   obstacle's tangent plane, a tangential haptic-size translation and a small rotation
@@ -27,9 +27,7 @@ seconds, rare and last in each round).
 from __future__ import annotations
 
 import functools
-import importlib.util
 import json
-import sys
 
 import numpy as np
 from numpy.random import PCG64, Generator
@@ -56,12 +54,10 @@ SCENARIO_JITTER = (2e-3, 0.02)      # m, rad
 
 @functools.cache
 def generator():
-    """datasets_generated/ccd/generate.py as a module (loaded once per process)."""
-    spec = importlib.util.spec_from_file_location("gauss6_ccd_generate", paths.DATASETS_DIR / "ccd" / "generate.py")
-    gen = importlib.util.module_from_spec(spec)
-    sys.modules[spec.name] = gen  # dataclasses look their module up by name
-    spec.loader.exec_module(gen)
-    return gen
+    """The step sets' generator, gauss6.generators.ccd."""
+    from .generators import ccd
+
+    return ccd
 
 
 @functools.cache
@@ -198,4 +194,9 @@ def plan(count: int, seed: int, families: list[str] | None = None) -> list[dict]
                     next_index[f] += 1
                     pending[f] -= k
                     total += k
+    for family in sorted({c["family"] for c in chunks} & set(SCRIPTS)):
+        script = paths.DATASETS_DIR / "scripts" / SCRIPTS[family]
+        if not script.is_file():  # an installed package without a checkout's datasets
+            raise ValueError(f"{script}: missing: the {family} steps follow this hand script of the datasets "
+                             "folder (GAUSS6_DATASETS_DIR); leave the family out with --family")
     return chunks

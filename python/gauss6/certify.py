@@ -32,13 +32,11 @@ Exit status: 0 certified, 1 a violation, 2 a usage or load error.
 """
 from __future__ import annotations
 
-import argparse
 import functools
 import json
 import math
 import os
 import platform
-import sys
 import time
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
@@ -316,83 +314,3 @@ def write_report(res: CertifyResult, scene_path, trace_path, out: Path, name: st
     (out / f"{name}.json").write_text(json.dumps(doc, indent=2) + "\n")
     (out / f"{name}.md").write_text(to_markdown(doc))
     return doc
-
-
-def cmd_witness(args: argparse.Namespace) -> int:
-    """`gauss6 certify --witness FILE [--scene SCENE]`: re-check a validate witness exactly (witness.recheck);
-    exit 0 when the violation stands, 1 when it does not, 2 on a bad file."""
-    from .paths import read_input_text
-    from .witness import recheck
-
-    try:
-        doc = json.loads(read_input_text(args.witness))
-        stands, text = recheck(doc, args.scene)
-    except (OSError, ValueError, KeyError, TypeError, RuntimeError) as e:
-        print(f"gauss6 certify: {args.witness}: {e}", file=sys.stderr)
-        return 2
-    print(text)
-    return 0 if stands else 1
-
-
-def tick_range_arg(text: str) -> tuple[int, int]:
-    """--ticks A:B: two integers, 0 <= A < B (whether B is within the trace is checked once it is read)."""
-    try:
-        a, b = (int(x) for x in text.split(":"))
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"--ticks must be A:B (integers), not {text!r}") from None
-    if not 0 <= a < b:
-        raise argparse.ArgumentTypeError(f"{text}: the tick range is empty or negative (give A:B with 0 <= A < B)")
-    return a, b
-
-
-def cmd_certify(args: argparse.Namespace) -> int:
-    from .trace import coverage
-
-    if args.witness:
-        return cmd_witness(args)
-    if not args.trace or not args.scene:
-        print("gauss6 certify: give a TRACE and --scene SCENE (or --witness FILE)", file=sys.stderr)
-        return 2
-    trace, scene = Path(args.trace), Path(args.scene)
-    tick_range = args.ticks
-
-    def progress(done: int, total: int) -> None:
-        if not args.quiet:
-            print(f"\rcertify: {done}/{total} ticks", end="", file=sys.stderr, flush=True)
-
-    try:
-        res = certify(scene, trace, tick_range=tick_range, progress=progress)
-        cov = coverage(load_trace(trace))
-    except (ValueError, RuntimeError, OSError) as e:
-        print(f"\ngauss6 certify: {e}", file=sys.stderr)
-        return 2
-    if not args.quiet:
-        print(file=sys.stderr)
-    if not cov["complete"]:
-        print(f"gauss6 certify: warning: {trace}: the trace is incomplete ({'; '.join(cov['cut']) or 'not closed'}); "
-              "only the ticks it holds are certified (certify.json: coverage)", file=sys.stderr)
-    out = Path(args.out) if args.out else trace.parent
-    try:
-        doc = write_report(res, scene, trace, out, coverage=cov)
-    except (ValueError, OSError) as e:
-        print(f"gauss6 certify: {e}", file=sys.stderr)
-        return 2
-    print(json.dumps(doc, indent=2) if args.json else to_markdown(doc))
-    return 0 if res.passed else 1
-
-
-def register(subparsers) -> None:
-    p = subparsers.add_parser("certify", help="exactly certify a recorded run: every pose free, every motion "
-                                              "between poses free of contact, separations within the bound "
-                                              "(exit 1 on a violation)")
-    from .cli import input_file, output_dir
-
-    p.add_argument("trace", nargs="?", type=input_file("trace"), help="a .g6trace")
-    p.add_argument("--scene", type=input_file("scene"), help="the run's scene TOML file (a witness names its own)")
-    p.add_argument("--witness", type=input_file("witness"),
-                   help="re-check a witness file of `gauss6 validate` exactly instead (exit 0: the violation stands)")
-    p.add_argument("--out", type=output_dir, help="directory for certify.json and certify.md (default: the trace's)")
-    p.add_argument("--ticks", type=tick_range_arg, help="only the ticks A:B (a chunk, as a campaign runs it)")
-    p.add_argument("--json", action="store_true", help="print certify.json instead of the table")
-    p.add_argument("--quiet", action="store_true", help="no progress on stderr")
-    p.set_defaults(func=cmd_certify)

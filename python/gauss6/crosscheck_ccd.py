@@ -54,7 +54,6 @@ stops are counted against the same exact u*.
 """
 from __future__ import annotations
 
-import argparse
 import functools
 import json
 import math
@@ -468,25 +467,6 @@ def format_table(result: dict, ours: dict[str, SetResult], peers: list[PeerResul
                          f"{1e6 * p.seconds / max(p.steps, 1):9.1f} us/step")
     lines.append("ok" if result["ok"] else "FAILED")
     return "\n".join(lines)
-
-
-def run_cli(args: argparse.Namespace) -> int:
-    names = [args.set_name] if args.set_name else None
-    try:
-        result, failures, peers, ours = crosscheck(names, with_peers=not args.json or args.peers,
-                                                   show_progress=not (args.json or args.peers))
-    except ValueError as e:
-        print(f"gauss6: error: {e}", file=sys.stderr)
-        return 2
-    if args.peers:
-        print(json.dumps({"ok": result["ok"], "fcl": None if peers is None else [p.as_json() for p in peers]}))
-    elif args.json:
-        print(json.dumps(result))
-    else:
-        print(format_table(result, ours, peers))
-    for f in failures[:50]:
-        print(f"FAIL {f}", file=sys.stderr)
-    return 0 if result["ok"] else 1
 
 
 # --------------------------------------------------------------------------------------

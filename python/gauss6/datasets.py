@@ -1,6 +1,6 @@
 """The generated datasets (METHOD.md section 7): making them and checking them.
 
-Each dataset lives in datasets_generated/<name>/ with a MANIFEST.json:
+Each dataset lives in datasets_generated/<name>/ (paths.DATASETS_DIR, or --out) with a MANIFEST.json:
 
     {"generator": path of the generator source, relative to the repository,
      "generator_version": "1",
@@ -13,38 +13,36 @@ Generation is deterministic: the same parameters give byte-identical files, so
 `check_all()` can regenerate each dataset and compare checksums.
 
 - peg_in_hole: peg.off (288 triangles) and box_with_hole.off (280 triangles),
-  from datasets_generated/generators/peg_in_hole.py (Python, numpy).
+  from gauss6.generators.peg_in_hole (Python, numpy).
 - bunny: bunny.off (about 27,000 triangles, 15 cm tall, metres), from
   glmark2-data's bunny.obj by the CGAL program gauss6_make_bunny
-  (datasets_generated/generators/make_bunny.cpp, built by CMake).
+  (datasets_generated/generators/make_bunny.cpp, built by CMake; a wheel carries the program
+  and its source, paths.tool and BUNNY_SOURCE).
 - surfaces: faceted_cylinder.off, slab.off, probe.off and the hand scripts of the
   Figure 8 and 9 analogues (cylinder_slide.json, texture_slow.json, texture_fast.json), the
   height map bumps.png with its bump list bumps.json, from
-  datasets_generated/generators/surfaces.py (Python, numpy, Pillow; reuses the peg generator).
+  gauss6.generators.surfaces (Python, numpy, Pillow; reuses the peg generator).
 - battery: the conformance battery's meshes and hand scripts (docs/conformance-battery.md), one
   scene each in datasets_generated/scenes/ (BATTERY_SCENES), from
-  datasets_generated/generators/battery.py (Python, numpy; reuses the peg generator).
+  gauss6.generators.battery (Python, numpy; reuses the peg generator).
 - bunny_x4, bunny_x16 (ON_DEMAND: not in DATASETS, not committed, tens of MB): bunny_full's
   bunny.off with each triangle split into 4 or 16 (the same surface), from
-  datasets_generated/generators/subdivide.py; `gauss6 datasets generate --only NAME`.
+  gauss6.generators.subdivide; `gauss6 datasets generate --only NAME`.
 """
 from __future__ import annotations
 
 import hashlib
-import importlib.util
 import json
 import subprocess
-import sys
 import tempfile
 from pathlib import Path
-from types import ModuleType
 
 from tqdm import tqdm
 
 from . import paths
+from .generators import battery, peg_in_hole, source, subdivide, surfaces
 
 DATASETS = ("peg_in_hole", "bunny", "bunny_full", "surfaces", "battery")
-GENERATORS_DIR = paths.DATASETS_DIR / "generators"
 # The conformance battery's scenes (datasets_generated/scenes/NAME.toml), one failure mode each.
 BATTERY_SCENES = ("thin_wall", "slot", "wedge", "pry_hook", "knife_vertex", "dense_plate", "cup", "lever")
 
@@ -57,6 +55,9 @@ BUNNY_TARGET_FACES = 27000
 BUNNY_FULL_TARGET_FACES = 69666
 BUNNY_HEIGHT = 0.15  # metres
 BUNNY_TOOL = "datasets_generated/gauss6_make_bunny"
+# The bunny program's source, as its files record it (path in the repository, sha256): the
+# checkout's, or the copy a wheel carries beside the generators.
+BUNNY_SOURCE = "datasets_generated/generators/make_bunny.cpp"
 # Generated on demand only (large): name -> levels of midpoint subdivision of bunny_full.
 ON_DEMAND = {"bunny_x4": 1, "bunny_x16": 2}
 
@@ -65,50 +66,28 @@ def sha256_file(path: Path) -> str:
     return hashlib.sha256(Path(path).read_bytes()).hexdigest()
 
 
-def peg_in_hole_generator() -> ModuleType:
-    """The peg-in-a-hole generator module (datasets_generated/generators/peg_in_hole.py)."""
-    name, path = "gauss6_generators_peg_in_hole", GENERATORS_DIR / "peg_in_hole.py"
-    if name in sys.modules:
-        return sys.modules[name]
-    spec = importlib.util.spec_from_file_location(name, path)
-    if spec is None or spec.loader is None:
-        raise ImportError(f"{path}: cannot load the generator")
-    module = importlib.util.module_from_spec(spec)
-    sys.modules[name] = module  # dataclasses look their module up there
-    try:
-        spec.loader.exec_module(module)
-    except BaseException:
-        del sys.modules[name]
-        raise
-    return module
+def bunny_source_file() -> Path:
+    """make_bunny.cpp: the checkout's, else the installed package's copy."""
+    in_tree = paths.REPO_ROOT / BUNNY_SOURCE
+    return in_tree if in_tree.exists() else Path(peg_in_hole.__file__).with_name("make_bunny.cpp")
 
 
-def _relative(path: Path) -> str:
-    return path.resolve().relative_to(paths.REPO_ROOT).as_posix()
-
-
-def _write_manifest(out: Path, generator: Path, version: str, parameters: dict, files: list[str]) -> dict:
+def _write_manifest(out: Path, generator: tuple[str, str], version: str, parameters: dict, files: list[str]) -> dict:
+    """MANIFEST.json of out/: generator is (its path in the repository, the sha256 of its source)."""
     manifest = {
-        "generator": _relative(generator),
+        "generator": generator[0],
         "generator_version": version,
         "parameters": parameters,
-        "source_sha256": sha256_file(generator),
+        "source_sha256": generator[1],
         "outputs": {f: sha256_file(out / f) for f in sorted(files)},
     }
     (out / "MANIFEST.json").write_text(json.dumps(manifest, indent=2) + "\n", encoding="ascii")
     return manifest
 
 
-def _generate_peg_in_hole(out: Path) -> dict:
-    gen = peg_in_hole_generator()
-    params = gen.PegInHoleParams()
-    files = gen.generate(out, params)
-    return _write_manifest(out, GENERATORS_DIR / "peg_in_hole.py", gen.GENERATOR_VERSION, params.to_json(), list(files))
-
-
 def _generate_bunny(out: Path, target_faces: int = BUNNY_TARGET_FACES) -> dict:
-    gen = peg_in_hole_generator()  # owns the OFF provenance header's format
-    source = GENERATORS_DIR / "make_bunny.cpp"
+    gen = peg_in_hole  # owns the OFF provenance header's format
+    bunny_source = (BUNNY_SOURCE, sha256_file(bunny_source_file()))
     if not BUNNY_INPUT.exists():
         raise FileNotFoundError(f"{BUNNY_INPUT}: missing; install the Debian package glmark2-data")
     parameters = {
@@ -117,7 +96,7 @@ def _generate_bunny(out: Path, target_faces: int = BUNNY_TARGET_FACES) -> dict:
         "target_faces": target_faces,
         "height": BUNNY_HEIGHT,
     }
-    header = gen.provenance_header(_relative(source), parameters, sha256_file(source))
+    header = gen.provenance_header(bunny_source[0], parameters, bunny_source[1])
     cmd = [str(paths.tool(BUNNY_TOOL)), str(BUNNY_INPUT), str(out / "bunny.off"),
            str(target_faces), repr(BUNNY_HEIGHT)]
     for line in header:
@@ -125,42 +104,31 @@ def _generate_bunny(out: Path, target_faces: int = BUNNY_TARGET_FACES) -> dict:
     r = subprocess.run(cmd, capture_output=True, text=True)
     if r.returncode != 0:
         raise RuntimeError(f"{' '.join(cmd[:5])} failed (exit {r.returncode}): {r.stderr.strip()}")
-    return _write_manifest(out, source, gen.GENERATOR_VERSION, parameters, ["bunny.off"])
+    return _write_manifest(out, bunny_source, gen.GENERATOR_VERSION, parameters, ["bunny.off"])
 
 
-def _generator_module(stem: str) -> ModuleType:
-    """A Python generator that reuses the peg generator (datasets_generated/generators/STEM.py)."""
-    peg_in_hole_generator()  # loaded first: the others reuse its meshes and header
-    source = GENERATORS_DIR / f"{stem}.py"
-    name = f"gauss6_generators_{stem}"
-    module = sys.modules.get(name)
-    if module is None:
-        spec = importlib.util.spec_from_file_location(name, source)
-        module = importlib.util.module_from_spec(spec)
-        sys.modules[name] = module  # dataclasses look their module up there
-        spec.loader.exec_module(module)
-    return module
-
-
-def _generate_python(out: Path, stem: str, params_class: str) -> dict:
-    module = _generator_module(stem)
+def _generate_python(out: Path, module, params_class: str) -> dict:
+    """A Python generator's dataset: module.generate(out, its default parameters), the manifest."""
     params = getattr(module, params_class)()
     files = module.generate(out, params)
-    return _write_manifest(out, GENERATORS_DIR / f"{stem}.py", module.GENERATOR_VERSION, params.to_json(), list(files))
+    return _write_manifest(out, source(module.__name__), module.GENERATOR_VERSION, params.to_json(), list(files))
 
 
 def _generate_subdivided(out: Path, levels: int) -> dict:
-    gen = peg_in_hole_generator()  # owns the OFF provenance header's format
-    source = GENERATORS_DIR / "subdivide.py"
-    module = _generator_module("subdivide")
-    full = paths.DATASETS_DIR / "bunny_full" / "bunny.off"
-    parameters = {"input": _relative(full), "input_sha256": sha256_file(full), "levels": levels}
-    V, F = module.subdivide(*module.read_off(full), levels)
-    module.write_off(out / "bunny.off", V, F, gen.provenance_header(_relative(source), parameters, sha256_file(source)))
+    """bunny_full's bunny.off (beside out/, in the same datasets folder) split `levels` times."""
+    full = out.parent / "bunny_full" / "bunny.off"
+    if not full.exists():
+        raise FileNotFoundError(f"{full}: missing; generate bunny_full first (`gauss6 datasets generate --only "
+                                "bunny_full`)")
+    parameters = {"input": "datasets_generated/bunny_full/bunny.off", "input_sha256": sha256_file(full),
+                  "levels": levels}
+    V, F = subdivide.subdivide(*subdivide.read_off(full), levels)
+    generator = source(subdivide.__name__)
+    subdivide.write_off(out / "bunny.off", V, F, peg_in_hole.provenance_header(generator[0], parameters, generator[1]))
     r = subprocess.run([str(paths.tool(BUNNY_TOOL)), "--check", str(out / "bunny.off")], capture_output=True, text=True)
     if r.returncode != 0:
         raise RuntimeError(f"{out / 'bunny.off'}: the exact checks fail: {r.stderr.strip()}")
-    return _write_manifest(out, source, module.GENERATOR_VERSION, parameters, ["bunny.off"])
+    return _write_manifest(out, generator, subdivide.GENERATOR_VERSION, parameters, ["bunny.off"])
 
 
 def generate(name: str, out_dir: Path) -> dict:
@@ -168,9 +136,10 @@ def generate(name: str, out_dir: Path) -> dict:
     and MANIFEST.json); returns the manifest. Raises ValueError for an unknown name,
     FileNotFoundError when the bunny tool is not built, RuntimeError when a generator's
     own checks fail."""
-    makers = {"peg_in_hole": _generate_peg_in_hole, "bunny": _generate_bunny,
-              "bunny_full": lambda out: _generate_bunny(out, BUNNY_FULL_TARGET_FACES), "surfaces": lambda out: _generate_python(out, "surfaces", "SurfacesParams"),
-              "battery": lambda out: _generate_python(out, "battery", "BatteryParams"),
+    makers = {"peg_in_hole": lambda out: _generate_python(out, peg_in_hole, "PegInHoleParams"),
+              "bunny": _generate_bunny, "bunny_full": lambda out: _generate_bunny(out, BUNNY_FULL_TARGET_FACES),
+              "surfaces": lambda out: _generate_python(out, surfaces, "SurfacesParams"),
+              "battery": lambda out: _generate_python(out, battery, "BatteryParams"),
               **{n: (lambda out, levels=levels: _generate_subdivided(out, levels)) for n, levels in ON_DEMAND.items()}}
     if name not in makers:
         raise ValueError(f"unknown dataset {name!r}; expected one of {', '.join([*DATASETS, *ON_DEMAND])}")

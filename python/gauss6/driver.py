@@ -96,7 +96,7 @@ def drive(engine, scene: EngineScene, script_json: str, out_path, duration: floa
     dev = _device.SimulatedDevice(script_json, rate_hz=scene.rate_hz, max_force=scene.max_force,
                                   max_torque=scene.max_torque)
     end = dev.end_time if duration is None or duration < 0 else duration
-    from .cli import check_run_span  # a script spanning 1e9 s would be a run without end
+    from .cli_args import check_run_span  # a script spanning 1e9 s would be a run without end
 
     check_run_span(end, "the hand script")
     num_ticks = int(math.floor(end * scene.rate_hz + 1e-9)) + 1

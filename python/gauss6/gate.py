@@ -1,6 +1,6 @@
 """`gauss6 gate --base REV [--json]`: the regression gate on speed, accuracy and properties.
 
-    python -m gauss6.gate --base REV [--json] [--config benchmarks/gate.toml]
+    gauss6 gate --base REV [--json] [--config benchmarks/gate.toml]
                           [--cache-dir DIR] [--work-build DIR] [--base-build DIR]
                           [--filter REGEX] [--rounds N] [--repetitions N] [--no-accuracy]
 
@@ -565,65 +565,16 @@ def run_gate(args: argparse.Namespace, log=print) -> dict:
     return result
 
 
-def _finite(x):
+def finite(x):
     """NaN and infinities as null: strict JSON."""
     if isinstance(x, float) and not math.isfinite(x):
         return None
     if isinstance(x, dict):
-        return {k: _finite(v) for k, v in x.items()}
+        return {k: finite(v) for k, v in x.items()}
     if isinstance(x, (list, tuple)):
-        return [_finite(v) for v in x]
+        return [finite(v) for v in x]
     return x
 
 
 def bench_exists(build_dir) -> bool:
     return (Path(build_dir) / bench.BENCH_RELPATH).exists()
-
-
-def add_arguments(p: argparse.ArgumentParser) -> None:
-    p.add_argument("--base", help="the revision to compare against (any git revision: HEAD~1, main, a sha)")
-    p.add_argument("--json", action="store_true", help="machine-readable result on stdout")
-    p.add_argument("--config", type=Path, default=DEFAULT_CONFIG, help="thresholds (default benchmarks/gate.toml)")
-    p.add_argument("--cache-dir", help="keep exported trees and builds here (reused when the revision matches); "
-                                       "default: a new temporary folder")
-    p.add_argument("--base-build", help="build tree of the base (reused as is when it holds the benchmarks)")
-    p.add_argument("--base-source", help="with a prebuilt --base-build: its source tree (default: this repository)")
-    p.add_argument("--work-build", help="build tree of the working tree (default <cache>/work-build)")
-    p.add_argument("--no-build-work", action="store_true", help="use --work-build as it is, without building")
-    p.add_argument("--filter", default=None, help="override [speed] filter")
-    p.add_argument("--rounds", type=int, default=None, help="override [speed] rounds")
-    p.add_argument("--repetitions", type=int, default=None, help="override [speed] repetitions")
-    p.add_argument("--min-time", type=float, default=None, help="override [speed] min_time")
-    p.add_argument("--no-count", action="store_true", help="skip the instruction counts (callgrind)")
-    p.add_argument("--no-accuracy", action="store_true", help="skip the accuracy checks (speed and bench properties only)")
-
-
-def run_cli(args: argparse.Namespace) -> int:
-    def log(message: str) -> None:  # progress on stderr: stdout holds only the result
-        print(message, file=sys.stderr)
-
-    try:
-        result = run_gate(args, log)
-    except (GateError, FileNotFoundError, RuntimeError) as e:
-        print(f"gauss6: error: {e}", file=sys.stderr)
-        return 2
-    print(json.dumps(_finite(result), indent=1, default=str) if args.json else format_report(result))
-    return 0 if result["passed"] else 1
-
-
-def register(subparsers) -> None:
-    """Adds `gauss6 gate` to the CLI's subparsers."""
-    p = subparsers.add_parser("gate", help="fail when the working tree is slower, less accurate or violates a "
-                                           "property compared with --base REV (thresholds: benchmarks/gate.toml)")
-    add_arguments(p)
-    p.set_defaults(func=run_cli)
-
-
-def main(argv: list[str] | None = None) -> int:
-    parser = argparse.ArgumentParser(prog="gauss6 gate", description=__doc__.split("\n")[0])
-    add_arguments(parser)
-    return run_cli(parser.parse_args(argv))
-
-
-if __name__ == "__main__":
-    sys.exit(main())

@@ -30,10 +30,8 @@ minus update time):
 """
 from __future__ import annotations
 
-import argparse
 import json
 import os
-import sys
 from pathlib import Path
 
 import numpy as np
@@ -116,33 +114,3 @@ def format_result(r: dict) -> str:
         "", f"Sim update (us), wall {q(s['update_wall_us'])}, the sim thread's CPU {q(s['update_cpu_us'])}; "
         f"haptic tick work mean {h['work_us']['mean']:.3g} us, max {h['work_us']['max']:.3g} us; trace rows dropped "
         f"{r['rows_dropped']}."])
-
-
-def register(subparsers) -> None:
-    p = subparsers.add_parser("rate", help="a threaded run at a high haptic rate (10 kHz): deadline misses, jitter")
-    p.add_argument("--scene", choices=sorted(SCENES), default="peg")
-    p.add_argument("--rate-hz", type=float, default=10000.0)
-    from .cli import output_dir, run_seconds
-
-    p.add_argument("--duration", type=run_seconds, default=60.0,
-                   help="s of run time (the hand holds still after the script)")
-    p.add_argument("--priority", type=int, default=80, help="SCHED_FIFO priority of the haptic loop")
-    p.add_argument("--no-realtime", action="store_true", help="leave the default scheduling policy")
-    p.add_argument("--no-pin", action="store_true", help="no CPU affinity")
-    p.add_argument("--spin-us", type=float, default=None,
-                   help="us of each haptic period waited busily before the tick (RuntimeSettings::spin_wait; "
-                        "default: one period when pinned, else 0)")
-    p.add_argument("--out", type=lambda text: Path(output_dir(text)), required=True)
-    p.set_defaults(func=run_cli)
-
-
-def run_cli(args: argparse.Namespace) -> int:
-    try:
-        spin_us = args.spin_us if args.spin_us is not None else (0.0 if args.no_pin else 1e6 / args.rate_hz)
-        r = run(args.scene, args.rate_hz, args.duration, 0 if args.no_realtime else args.priority, not args.no_pin,
-                args.out, spin_us)
-    except ValueError as e:
-        print(f"gauss6: error: {e}", file=sys.stderr)
-        return 2
-    print(format_result(r))
-    return 0

@@ -1,7 +1,9 @@
-"""Where gauss6 finds its own files: the repository, the CMake build tree and its tools.
+"""Where gauss6 finds its own files: the repository, the CMake build tree and its tools, the datasets.
 
-The package is installed editable from python/, so the repository root is two
-levels above this file; GAUSS6_BUILD_DIR overrides the build tree (default build/).
+In a checkout the package is python/gauss6 (tools/setup.sh puts python/ on the venv's path), so
+the repository root is two levels above this file; GAUSS6_BUILD_DIR overrides the build tree
+(default build/). An installed wheel has no checkout: its programs are in the package's bin/
+(tool()), and the datasets folder is GAUSS6_DATASETS_DIR, else ./datasets_generated.
 """
 from __future__ import annotations
 
@@ -9,6 +11,9 @@ import os
 from pathlib import Path
 
 REPO_ROOT = Path(__file__).resolve().parents[2]
+# Whether this package is a checkout's python/gauss6 (not an installed copy).
+IN_CHECKOUT = (REPO_ROOT / "python" / "gauss6" / "paths.py").resolve() == Path(__file__).resolve()
+_PACKAGE_BIN = Path(__file__).resolve().parent / "bin"  # the programs a wheel carries
 
 
 def build_dir() -> Path:
@@ -17,17 +22,23 @@ def build_dir() -> Path:
 
 
 def tool(relpath: str) -> Path:
-    """A program built by CMake, e.g. tool("datasets_generated/gauss6_make_bunny").
+    """A program built by CMake, e.g. tool("datasets_generated/gauss6_make_bunny"): in the build
+    tree, else (an installed wheel) the package's bin/ copy.
 
     Raises FileNotFoundError naming the missing program and how to build it.
     """
     path = build_dir() / relpath
+    if not path.exists() and (_PACKAGE_BIN / Path(relpath).name).exists():
+        return _PACKAGE_BIN / Path(relpath).name
     if not path.exists():
         raise FileNotFoundError(f"{path}: not built; run `make test` or `cmake --build {build_dir()}`")
     return path
 
 
-DATASETS_DIR = REPO_ROOT / "datasets_generated"
+# The datasets: GAUSS6_DATASETS_DIR, else the checkout's datasets_generated/, else (an installed
+# package) ./datasets_generated, where `gauss6 datasets generate` writes them.
+DATASETS_DIR = Path(os.environ.get("GAUSS6_DATASETS_DIR") or (REPO_ROOT / "datasets_generated" if IN_CHECKOUT
+                                                                else Path.cwd() / "datasets_generated"))
 SHARED_DATA_DIR = REPO_ROOT.parent / "shared" / "data"
 
 

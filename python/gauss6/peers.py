@@ -36,10 +36,8 @@ Writes DIR/peers.json and DIR/peers.md (the tables; the ratios to gauss6 are the
 """
 from __future__ import annotations
 
-import argparse
 import json
 import math
-import sys
 import time
 from collections import defaultdict
 from pathlib import Path
@@ -291,46 +289,3 @@ def run(out_dir: Path, repeats: int = 3, do_ccd: bool = True, do_qp: bool = True
     (out_dir / "peers.json").write_text(json.dumps(result, indent=1) + "\n")
     (out_dir / "peers.md").write_text("\n\n".join(text) + "\n")
     return result
-
-
-def add_arguments(p: argparse.ArgumentParser) -> None:
-    p.add_argument("--out", type=Path, default=paths.REPO_ROOT / "out" / "bench" / "peers", help="output folder")
-    p.add_argument("--repeats", type=int, default=3, help="calls per query; its time is the fastest")
-    p.add_argument("--sample", type=int, default=1, help="CCD: every K-th query of each file (default: all)")
-    g = p.add_mutually_exclusive_group()
-    g.add_argument("--ccd-only", action="store_true")
-    g.add_argument("--qp-only", action="store_true")
-
-
-def run_cli(args: argparse.Namespace) -> int:
-    try:
-        if args.sample < 1 or args.repeats < 1:
-            raise ValueError("--sample and --repeats must be >= 1")
-        result = run(args.out, args.repeats, not args.qp_only, not args.ccd_only, sample=args.sample)
-    except (FileNotFoundError, ValueError, ImportError) as e:
-        print(f"gauss6: error: {e}", file=sys.stderr)
-        return 2
-    if "ccd" in result:
-        print(format_ccd(result["ccd"]))
-    if "qp" in result:
-        print(format_qp(result["qp"]))
-    print(f"written to {args.out}")
-    return 0
-
-
-def register(report_subparsers) -> None:
-    """Adds `gauss6 report peers` to the `report` subparsers."""
-    p = report_subparsers.add_parser("peers", help="CCD per query against Tight-Inclusion, the projection against "
-                                                   "DAQP, quadprog and proxsuite, in one run")
-    add_arguments(p)
-    p.set_defaults(func=run_cli)
-
-
-def main(argv: list[str] | None = None) -> int:
-    parser = argparse.ArgumentParser(prog="gauss6 report peers", description=__doc__.split("\n")[0])
-    add_arguments(parser)
-    return run_cli(parser.parse_args(argv))
-
-
-if __name__ == "__main__":
-    sys.exit(main())

@@ -17,6 +17,7 @@ from __future__ import annotations
 
 import hashlib
 import json
+import os
 import subprocess
 import sys
 import tempfile
@@ -28,6 +29,7 @@ import numpy as np
 from .paths import DATASETS_DIR
 
 FAMILIES_DIR = DATASETS_DIR / "qp"
+GENERATOR_MODULE = "gauss6.generators.qp"
 FORMAT = "gauss6-qp-instances"
 FORMAT_VERSION = 1
 PUSH_LABELS = ("all", "some", "none")
@@ -174,17 +176,17 @@ def _sha256(path: Path) -> str:
     return hashlib.sha256(path.read_bytes()).hexdigest()
 
 
-def generate(out_dir: Path | None = None) -> None:
-    """Run the generator (datasets_generated/qp/generate.py): every family and
-    MANIFEST.json into out_dir (default: in place). It runs in a process of its own, so
-    that it loads numpy's OpenBLAS with the kernels it pins (see the generator's imports):
-    the files are then the same bytes on every x86-64 machine. Raises RuntimeError with
-    the generator's own error output when it fails."""
-    gen_path = FAMILIES_DIR / "generate.py"
-    cmd = [sys.executable, str(gen_path), "--out", str(out_dir if out_dir is not None else FAMILIES_DIR)]
-    r = subprocess.run(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
+def generate(out_dir: Path | None = None, datasets_dir: Path | None = None) -> None:
+    """Run the generator (gauss6.generators.qp): every family and MANIFEST.json into out_dir
+    (default: in place), on the meshes of datasets_dir (default: paths.DATASETS_DIR). It runs
+    in a process of its own, so that it loads numpy's OpenBLAS with the kernels it pins (see
+    the generator's imports): the files are then the same bytes on every x86-64 machine.
+    Raises RuntimeError with the generator's own error output when it fails."""
+    cmd = [sys.executable, "-m", GENERATOR_MODULE, "--out", str(out_dir if out_dir is not None else FAMILIES_DIR)]
+    env = {**os.environ, "GAUSS6_DATASETS_DIR": str(datasets_dir if datasets_dir is not None else DATASETS_DIR)}
+    r = subprocess.run(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True, env=env)
     if r.returncode != 0:
-        raise RuntimeError(f"{gen_path} failed (exit {r.returncode}):\n{r.stderr}")
+        raise RuntimeError(f"{GENERATOR_MODULE} failed (exit {r.returncode}):\n{r.stderr}")
     sys.stderr.write(r.stderr)
 
 
@@ -193,10 +195,12 @@ def check_all() -> list[str]:
 
     Returns one line per problem (a generator source, committed file or regenerated file
     whose checksum differs from the manifest); an empty list when everything matches."""
+    from .generators import source
+
     manifest = json.loads((FAMILIES_DIR / "MANIFEST.json").read_text())
-    gen_path = FAMILIES_DIR / "generate.py"
+    gen_path, gen_sha = source(GENERATOR_MODULE)
     problems = []
-    if _sha256(gen_path) != manifest["source_sha256"]:
+    if gen_sha != manifest["source_sha256"]:
         problems.append(f"{gen_path}: source changed since MANIFEST.json was written")
     with tempfile.TemporaryDirectory() as tmp:
         generate(Path(tmp))

@@ -1,6 +1,6 @@
 """Projection instances generated from seeds on the fly (not stored), for campaigns.
 
-The families of datasets_generated/qp/generate.py (README.md there), drawn by the
+The families of gauss6.generators.qp (datasets_generated/qp/README.md), drawn by the
 generator's own family builders, a chunk at a time: chunk `index` of family F in a
 campaign of seed S is `size` instances (CHUNK_SIZE by default) drawn from
 PCG64([S, seed of F, index]). The family's m, labels, ratios and kinds cycle within a
@@ -25,14 +25,13 @@ Instance ids: "F-sS-cINDEX-NNNN".
 from __future__ import annotations
 
 import functools
-import importlib.util
+import importlib
 import os
-import sys
 
 import numpy as np
 from numpy.random import PCG64, Generator
 
-from .qp_instances import (FAMILIES_DIR, ROW_SCALED, ROW_SCALED_LEFT_OUT, ROW_SCALED_SEED, Instance, from_record,
+from .qp_instances import (GENERATOR_MODULE, ROW_SCALED, ROW_SCALED_LEFT_OUT, ROW_SCALED_SEED, Instance, from_record,
                            row_scaled)
 
 CHUNK_SIZE = 360      # a multiple of 36 (m 1..12 x 3 labels), 24 (redundant), 10 (offsets), 4 (inertia)
@@ -41,11 +40,8 @@ WARM_STEPS = 50
 
 @functools.cache
 def generator():
-    """datasets_generated/qp/generate.py as a module (loaded once per process). Its
+    """The families' generator, gauss6.generators.qp (imported once per process). Its
     mesh bodies (the bunny's takes a second to read) are cached per process."""
-    spec = importlib.util.spec_from_file_location("gauss6_qp_generate", FAMILIES_DIR / "generate.py")
-    gen = importlib.util.module_from_spec(spec)
-    sys.modules[spec.name] = gen  # dataclasses look their module up by name
     # The generator pins numpy's OpenBLAS kernels for the stored files (OPENBLAS_CORETYPE,
     # read when numpy loads: no effect here, numpy is loaded). Left set, it would reach the
     # worker processes a campaign spawns later, whose numpy would then run other kernels
@@ -54,7 +50,7 @@ def generator():
     # serial and distributed. So this process's environment is left as it was.
     before = os.environ.get("OPENBLAS_CORETYPE")
     try:
-        spec.loader.exec_module(gen)
+        gen = importlib.import_module(GENERATOR_MODULE)
     finally:
         if before is None:
             os.environ.pop("OPENBLAS_CORETYPE", None)

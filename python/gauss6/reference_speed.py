@@ -12,9 +12,7 @@ wall time: the machines this runs on are shared. Exit 1 when the paths disagree 
 """
 from __future__ import annotations
 
-import argparse
 import json
-import sys
 import time
 
 import numpy as np
@@ -83,26 +81,3 @@ def format_table(result: dict) -> str:
         lines.append(f"| {name} | {r['steps']} | {f(r['filtered_ms'])} | {f(r['exact_only_ms'])} | "
                      f"{p['candidate']}, {p['filtered']}, {p['exact']} | {len(r['mismatches'])} |")
     return "\n".join(lines)
-
-
-def run_cli(args: argparse.Namespace) -> int:
-    def progress(name, done, total):
-        if not args.json:
-            print(f"\r{name}: {done}/{total}", end="", file=sys.stderr, flush=True)
-
-    result = measure(args.set, args.steps, args.both, progress)
-    if not args.json:
-        print(file=sys.stderr)
-    print(json.dumps(result, indent=2) if args.json else format_table(result))
-    return 1 if any(r["mismatches"] for r in result.values()) else 0
-
-
-def register(subparsers) -> None:
-    p = subparsers.add_parser("reference-speed", help="the exact first contact's CPU time per CCD step set, "
-                                                      "filtered and (--both) exact-only, checked equal")
-    p.add_argument("--set", action="append", help="a set of datasets_generated/ccd/ (repeatable; default: all)")
-    p.add_argument("--steps", type=int, help="only the first N steps of each set")
-    p.add_argument("--both", action="store_true", help="also the exact-only path (slow: minutes on the large "
-                                                       "rotations), and check the answers are the same")
-    p.add_argument("--json", action="store_true")
-    p.set_defaults(func=run_cli)

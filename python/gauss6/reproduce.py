@@ -1,7 +1,6 @@
-"""`gauss6 reproduce peg|bunny|bunny_full|surfaces|all --out DIR [--threaded]`: the paper's scenarios, figures and numbers
-(bunny_full: the full-resolution bunnies, issue 20's third scenario, not in `all`).
-
-Also the `gauss6 trace export|import` commands (CSV and HAPI device logs: gauss6.logs).
+"""The paper's scenarios, figures and numbers, as `gauss6 reproduce peg|bunny|bunny_full|surfaces|all
+--out DIR [--threaded]` runs them (commands/reproduce.py; bunny_full: the full-resolution bunnies,
+issue 20's third scenario, not in `all`).
 
 Each scenario (METHOD.md section 7) runs its scene with the simulated device following the
 scene's hand script (datasets_generated/scripts/), through the runtime's three loops
@@ -33,9 +32,7 @@ penetrating_poses, max_rel_force_dot_ac, energy_injected). The paper's scenes ad
 """
 from __future__ import annotations
 
-import argparse
 import json
-import sys
 import time
 from pathlib import Path
 
@@ -44,7 +41,7 @@ import numpy as np
 from . import paths
 # gauss6 run's path; LOCKSTEP_RUNS, least_update_times and machine are part of this module's interface too.
 from .run import (COMMON_KEYS as RUN_KEYS, DEFINITIONS, LOCKSTEP_RUNS, _fmt, failures,  # noqa: F401
-                  add_budget_arguments, least_update_times, machine, machine_line, report_footer, report_section,
+                  least_update_times, machine, machine_line, report_footer, report_section,
                   run_scene, summarize as summarize_run)
 
 SCENES = {
@@ -234,98 +231,3 @@ def reproduce(which: str, out: Path, threaded: bool = False, show_progress: bool
     (out / "details.json").write_text(json.dumps(details, indent=2) + "\n")
     write_report(out, summary, details, time.monotonic() - start, surfaces)
     return full
-
-
-def cmd_reproduce(args: argparse.Namespace) -> int:
-    if args.scenario == "engines":
-        from .reproduce_engines import cmd
-
-        return cmd(args)
-    summary = reproduce(args.scenario, Path(args.out), threaded=args.threaded, show_progress=not args.quiet,
-                        budget_seconds=args.budget_cpu or 0.0, budget_units=args.budget_units)
-    print(json.dumps(summary, indent=2))
-    details = json.loads((Path(args.out) / "details.json").read_text())
-    problems = [p for n in details for p in failures(n, summary[n], details[n])]  # gauss6 run's rule
-    for p in problems:
-        print(f"gauss6: error: {p}", file=sys.stderr)
-    failed = []
-    for kind, runs in summary.get("surfaces", {}).items():
-        # Property 7 at its stated tolerance (runtime_events.h), plain runs included.
-        failed += [f"{kind}/{label}" for label, s in runs.items()
-                   if s["penetrating_poses"] != 0 or not s["max_rel_constraint_violation"] <= 1e-9]
-    for n in failed:
-        print(f"gauss6: error: {n}: god-object poses interpenetrate or violate the true constraints "
-              "(property 7)", file=sys.stderr)
-    print(f"written to {args.out}/ (summary.json, report.md, figures, traces)")
-    return 1 if failed or problems else 0
-
-
-def cmd_trace_export(args: argparse.Namespace) -> int:
-    from . import LoadError
-    from .logs import export_trace
-
-    if not (args.csv or args.hapi):
-        print("gauss6: error: trace export: give --csv DIR and/or --hapi FILE", file=sys.stderr)
-        return 2
-    try:
-        print(export_trace(args.trace, hapi=args.hapi, csv=args.csv))
-    except (LoadError, ValueError, OSError) as e:
-        print(f"gauss6: error: {e}", file=sys.stderr)
-        return 2
-    return 0
-
-
-def cmd_trace_import(args: argparse.Namespace) -> int:
-    from . import LoadError
-    from .logs import import_log
-
-    try:
-        out, tr = import_log(args.file, args.format, args.out, scene=args.scene or "")
-    except (LoadError, ValueError, OSError) as e:
-        print(f"gauss6: error: {e}", file=sys.stderr)
-        return 2
-    print(f"{args.file}: {len(tr.ticks)} ticks ({args.format}), {tr.ticks['t'][0]:g} to {tr.ticks['t'][-1]:g} s "
-          f"-> {out} (a trace the replay device plays back)")
-    return 0
-
-
-def register(subparsers) -> None:
-    """Adds `reproduce` and `trace export` to the gauss6 command's subparsers."""
-    rep = subparsers.add_parser("reproduce", help="run the paper's scenarios and write figures and summaries")
-    rep.add_argument("scenario", choices=["peg", "bunny", "bunny_full", "surfaces", "all", "engines"],
-                     help="all: peg, bunny and surfaces; bunny_full (the full-resolution bunnies) and engines (gauss6, MuJoCo, "
-                          "PyBullet, Drake, DART, Rapier, Bullet side by side: reproduce_engines.py) run alone")
-    from .cli import input_file, output_dir, output_file, run_seconds
-
-    rep.add_argument("--out", required=True, type=output_dir, help="output directory")
-    rep.add_argument("--threaded", action="store_true", help="real threads and the wall clock (default: lockstep)")
-    rep.add_argument("--quiet", action="store_true", help="no progress bars")
-    add_budget_arguments(rep)  # (the paper's scenes; the surface scenes run unbudgeted)
-    rep.add_argument("--slice", type=run_seconds, default=None,
-                     help="engines: run only the first S seconds of each script (default: whole)")
-    rep.set_defaults(func=cmd_reproduce)
-    tr = subparsers.add_parser("trace", help="run traces").add_subparsers(dest="action", required=True)
-    ex = tr.add_parser("export", help="write a trace as CSV files (one per stream) and/or a HAPI device log")
-    ex.add_argument("trace", type=input_file("trace"), help="trace file (.g6trace)")
-    ex.add_argument("--csv", type=output_dir,
-                    help="output directory (ticks.csv, steps.csv, contacts.csv, events.csv, meta.json)")
-    ex.add_argument("--hapi", type=output_file,
-                    help="output HAPI DeviceLog, ASCII (TIME POSITION ORIENTATION FORCE TORQUE BUTTONS)")
-    ex.set_defaults(func=cmd_trace_export)
-    im = tr.add_parser("import", help="a HAPI device log or CSV recorded elsewhere -> a trace for replay")
-    im.add_argument("file", type=input_file("log", directory_ok=True), help="HAPI DeviceLog (ASCII), or a CSV directory (to_csv's files) or ticks CSV")
-    im.add_argument("--format", required=True, choices=["hapi", "csv"])
-    im.add_argument("--out", required=True, type=output_file, help="the trace to write (.g6trace)")
-    im.add_argument("--scene", help="scene name to record in the trace's metadata (for gauss6 view)")
-    im.set_defaults(func=cmd_trace_import)
-
-
-def main(argv: list[str] | None = None) -> int:
-    p = argparse.ArgumentParser(prog="python -m gauss6.reproduce", description=__doc__.splitlines()[0])
-    register(p.add_subparsers(dest="command", required=True))
-    args = p.parse_args(argv)
-    return args.func(args)
-
-
-if __name__ == "__main__":
-    sys.exit(main())

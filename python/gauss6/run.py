@@ -438,7 +438,7 @@ def cmd_run(args: argparse.Namespace) -> int:
 
 def register(subparsers) -> None:
     """Adds `run` to the gauss6 command's subparsers."""
-    from .cli import input_file, output_dir, run_seconds
+    from .cli_args import input_file, output_dir, run_seconds
 
     p = subparsers.add_parser("run", help="run a scene with a hand script: trace, figure, certification, "
                                           "viewer page and report (as `gauss6 reproduce` runs the paper's)")

@@ -1,6 +1,6 @@
 """`gauss6 sweep`: speed against error for each accuracy knob, as Pareto fronts.
 
-    python -m gauss6.sweeps [--out out/bench/sweeps] [--build DIR] [--knob NAME ...] [--quick]
+    gauss6 sweep [--out out/bench/sweeps] [--build DIR] [--knob NAME ...] [--quick]
 
 Knobs, each swept with the others at their defaults, on the same data for speed
 and error, the error measured against the exact reference (reference/):
@@ -28,10 +28,8 @@ and results.json into --out.
 """
 from __future__ import annotations
 
-import argparse
 import json
 import math
-import sys
 import time
 from pathlib import Path
 
@@ -39,7 +37,7 @@ import numpy as np
 
 import gauss6
 
-from . import bench, paths
+from . import bench
 
 CCD_SETS = ["peg_script", "grazing", "zero_rotation", "random", "bunny_script"]
 DELTA_SETS = ["peg_script", "grazing"]  # exact separations are costly on the bunny
@@ -368,39 +366,3 @@ def run(out: Path, build: Path | None, knobs: list[str], quick: bool = False) ->
                                                  default=str) + "\n")
     (out / "table.md").write_text(format_table(results))
     return results
-
-
-def add_arguments(p: argparse.ArgumentParser) -> None:
-    p.add_argument("--out", type=Path, default=paths.REPO_ROOT / "out" / "bench" / "sweeps")
-    p.add_argument("--build", type=Path, default=None, help="build tree with the benchmarks (default: GAUSS6_BUILD_DIR or build/)")
-    p.add_argument("--knob", action="append", choices=KNOBS, help="one knob (repeatable; default: all)")
-    p.add_argument("--quick", action="store_true", help="fewer values and data (a smoke run)")
-
-
-def run_cli(args: argparse.Namespace) -> int:
-    try:
-        results = run(args.out, args.build, args.knob or KNOBS, args.quick)
-    except (FileNotFoundError, RuntimeError, ValueError) as e:
-        print(f"gauss6: error: {e}", file=sys.stderr)
-        return 2
-    print(format_table(results))
-    print(f"written to {args.out}")
-    bad = sum(r.get("violations", 0) for res in results.values() for r in res["rows"])
-    return 1 if bad else 0
-
-
-def register(subparsers) -> None:
-    """Adds `gauss6 sweep` to the CLI's subparsers."""
-    p = subparsers.add_parser("sweep", help="speed against error per accuracy knob (Pareto plots, table)")
-    add_arguments(p)
-    p.set_defaults(func=run_cli)
-
-
-def main(argv: list[str] | None = None) -> int:
-    parser = argparse.ArgumentParser(prog="gauss6 sweep", description=__doc__.split("\n")[0])
-    add_arguments(parser)
-    return run_cli(parser.parse_args(argv))
-
-
-if __name__ == "__main__":
-    sys.exit(main())

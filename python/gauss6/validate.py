@@ -329,7 +329,7 @@ def cmd_validate(args: argparse.Namespace) -> int:
 
 
 def register(subparsers) -> None:
-    from .cli import input_file, nonnegative_int, output_dir, run_seconds
+    from .cli_args import input_file, nonnegative_int, output_dir, run_seconds
 
     p = subparsers.add_parser("validate", help="drive an engine with the simulated device and judge its run, or "
                                                "judge a recorded run (exit 1: a check failed, 2: the engine "

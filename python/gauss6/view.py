@@ -18,13 +18,11 @@ and the page draws them as gaps in the plots, a hidden body and "NaN"/"inf" in i
 """
 from __future__ import annotations
 
-import argparse
 import base64
 import html
 import json
 import shutil
 import subprocess
-import sys
 import warnings
 from pathlib import Path
 
@@ -239,34 +237,3 @@ def write_view(traces, scene=None, out=None, labels=None, title: str | None = No
     except OSError as e:
         raise paths.PathError(f"{out}: cannot write the page: {e.strerror or e}") from None
     return out
-
-
-def cmd_view(args: argparse.Namespace) -> int:
-    from . import LoadError
-
-    traces = list(args.traces) + list(args.trace or [])
-    try:
-        out = write_view(traces, args.scene, args.out, labels=args.label, max_frames=args.max_frames)
-    except (LoadError, ValueError, ViewerBuildError) as e:
-        print(f"gauss6: error: {e}", file=sys.stderr)
-        return 2
-    print(f"written {out} ({out.stat().st_size / 1e6:.1f} MB); open it in a web browser (works from file://)")
-    return 0
-
-
-def register(subparsers) -> None:
-    """Adds `view` to the gauss6 command's subparsers."""
-    v = subparsers.add_parser("view", help="a self-contained web page of one or more runs (3D, timeline, plots)")
-    from .cli import input_file, output_file, positive_int
-
-    v.add_argument("traces", nargs="+", type=input_file("trace"),
-                   help="trace file(s) (.g6trace); several are drawn side by side")
-    v.add_argument("--trace", action="append", type=input_file("trace"),
-                   help="another trace to draw beside the first (repeatable)")
-    v.add_argument("--scene", type=input_file("scene"),
-                   help="scene TOML (default: the generated scene the trace's metadata names)")
-    v.add_argument("--out", type=output_file, help="the page to write (default: the first trace with .html)")
-    v.add_argument("--label", action="append", help="a run's label, in the order of the traces (repeatable)")
-    v.add_argument("--max-frames", type=positive_int, default=MAX_FRAMES,
-                   help=f"ticks (and sim steps) per run kept in the page (default {MAX_FRAMES}); more are down-sampled")
-    v.set_defaults(func=cmd_view)

@@ -136,7 +136,7 @@ def test_committed_convex_parts_are_convex_and_inside_the_mesh(peg, bunnies):
 def test_convex_parts_are_reproducible(peg, tmp_path):
     """CoACD with the fixed seed makes byte-identical parts: the box with the hole (8 parts,
     about 20 s) remade into a temporary folder equals the committed file."""
-    gen = common._generator()
+    gen = common.generator
     box = peg.obstacles[0]
     path = gen.generate(box.V, box.F, tmp_path, source=f"{peg.name}:{box.name}")
     assert path.read_bytes() == common.convex_parts_file(box.V, box.F).read_bytes()

@@ -16,6 +16,7 @@ import numpy as np
 import pytest
 
 from gauss6 import datasets, paths
+from gauss6.generators import battery as battery_generator
 
 from test_datasets import assert_regenerates, edge_use_problems, read_off, signed_volume
 
@@ -24,7 +25,7 @@ SCENES_DIR = paths.DATASETS_DIR / "scenes"
 
 
 def battery():
-    return datasets._generator_module("battery")
+    return battery_generator
 
 
 def test_battery_regenerates_byte_identical(tmp_path):

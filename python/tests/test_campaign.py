@@ -174,6 +174,18 @@ def test_ccd_plan_covers_every_family_in_proportion():
                                                                                       if c["family"] == f])))
 
 
+def test_ccd_plan_without_the_hand_scripts_names_them(monkeypatch, tmp_path):
+    """Without a checkout's datasets (an installed package's generated folder has no hand
+    scripts), a campaign of the scenario families is refused up front, the script named;
+    the other families plan as before."""
+    from gauss6 import ccd_seeded, paths
+
+    monkeypatch.setattr(paths, "DATASETS_DIR", tmp_path)
+    with pytest.raises(ValueError, match=r"scripts/bunny\.json: missing.*--family"):
+        ccd_seeded.plan(ccd_seeded.STEPS_PER_ROUND, seed=1)
+    assert ccd_seeded.plan(50, seed=1, families=["random"])
+
+
 def test_seeded_ccd_steps_start_free_and_near_parallel_is_tilted():
     from gauss6 import ccd_seeded
 

@@ -10,6 +10,7 @@ import subprocess
 import sys
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 from gauss6 import adapters, conformance, paths
@@ -24,8 +25,9 @@ SLICE = 0.5
 RATE_HZ = 1000.0  # the battery scenes' device rate (datasets_generated/scenes/*.toml)
 # gauss6's own defects the battery finds inside SLICE (issue 43: to be fixed in gauss6, not in the
 # thresholds); strict, so that the fix makes this test fail until the mark is removed.
-KNOWN_DEFECTS = {"thin_wall": "after the fast head-on hit, the displayed tool lags the hand (tracking) with a "
-                              "force jump and an energy deficit"}
+KNOWN_DEFECTS = {"thin_wall": "at the 2 m/s hit the hand's 1.5 mm a tick into the 500 N/m coupling adds 0.75 N a "
+                              "tick (force_jumps), and in free space at that speed the god-object's ks = 0.5 "
+                              "step falls between the handle's samples (tracking, 120 delta)"}
 
 
 def gauss6_cli(*args) -> subprocess.CompletedProcess:
@@ -132,3 +134,21 @@ def test_an_engine_failure_is_a_row_and_exit_2(tmp_path):
 def test_suite_usage_errors(tmp_path, args, message):
     p = gauss6_cli("validate", *args, "--out", tmp_path / "o")
     assert p.returncode == EXIT_USAGE and message in p.stderr
+
+
+def test_an_adapter_reports_the_deepest_contacts_within_the_contracts_capacity():
+    # Rapier found 46,883 manifold points on the dense plate: the adapters report the deepest
+    # CONTACT_CAPACITY of them, in the framework's order, and fewer unchanged.
+    from gauss6.adapters.common import reported_contacts
+    from gauss6.engine import CONTACT_CAPACITY
+
+    rng = np.random.default_rng(43)
+    rows = rng.normal(size=(3 * CONTACT_CAPACITY, 7))
+    out = reported_contacts(rows)
+    assert out.shape == (CONTACT_CAPACITY, 7)
+    deepest = np.sort(rows[:, 6])[:CONTACT_CAPACITY]
+    assert np.array_equal(np.sort(out[:, 6]), deepest)
+    kept = [i for i in range(len(rows)) if rows[i, 6] <= deepest[-1]]
+    assert np.array_equal(out, rows[kept])
+    assert np.array_equal(reported_contacts(rows[:5]), rows[:5])
+    assert reported_contacts([]).shape == (0, 7)

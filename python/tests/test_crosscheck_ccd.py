@@ -10,7 +10,6 @@ from __future__ import annotations
 import hashlib
 import importlib.util
 import json
-import sys
 
 import numpy as np
 import pytest
@@ -22,12 +21,9 @@ MANIFEST = json.loads((cc.SETS_DIR / "MANIFEST.json").read_text())
 
 
 def _generator():
-    path = cc.SETS_DIR / "generate.py"
-    spec = importlib.util.spec_from_file_location("gauss6_ccd_generate", path)
-    module = importlib.util.module_from_spec(spec)
-    sys.modules["gauss6_ccd_generate"] = module  # dataclasses look their module up there
-    spec.loader.exec_module(module)
-    return module
+    from gauss6.generators import ccd
+
+    return ccd
 
 
 def test_every_set_is_in_the_manifest_with_its_checksum():

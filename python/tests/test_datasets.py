@@ -16,6 +16,7 @@ import pytest
 
 import gauss6
 from gauss6 import datasets, paths
+from gauss6.generators import peg_in_hole
 
 PEG_DIR = paths.DATASETS_DIR / "peg_in_hole"
 BUNNY_DIR = paths.DATASETS_DIR / "bunny"
@@ -137,7 +138,7 @@ def test_peg_and_box_triangle_counts_and_topology():
 
 
 def test_peg_and_box_are_outward_with_the_solids_volumes():
-    p = datasets.peg_in_hole_generator().PegInHoleParams()
+    p = peg_in_hole.PegInHoleParams()
     _, peg_V, peg_F = read_off(PEG_DIR / "peg.off")
     _, box_V, box_F = read_off(PEG_DIR / "box_with_hole.off")
 
@@ -153,7 +154,7 @@ def test_peg_and_box_are_outward_with_the_solids_volumes():
 
 
 def test_peg_fits_the_hole_with_the_stated_clearance():
-    gen = datasets.peg_in_hole_generator()
+    gen = peg_in_hole
     p = gen.PegInHoleParams()
     assert p.clearance == pytest.approx(0.02 * p.peg_radius, rel=1e-15)
     _, peg_V, _ = read_off(PEG_DIR / "peg.off")

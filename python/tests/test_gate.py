@@ -220,7 +220,7 @@ def _build_with_bench() -> Path | None:
 @pytest.mark.skipif(_build_with_bench() is None, reason="benchmarks not built (-DGAUSS6_BUILD_BENCHMARKS=ON)")
 def test_real_identical_run_passes_and_planted_slowdown_fails(tmp_path):
     build = _build_with_bench()
-    cmd = [sys.executable, "-m", "gauss6.gate", "--base-build", str(build), "--work-build", str(build),
+    cmd = [sys.executable, "-m", "gauss6", "gate", "--base-build", str(build), "--work-build", str(build),
            "--no-build-work", "--no-accuracy", "--no-count", "--json",
            "--filter", "ForceWarm/box/m|CcdQuery/unit-tests/vf", "--rounds", "3", "--repetitions", "3",
            "--min-time", "0.02"]

@@ -1,7 +1,10 @@
 """The pip-installable package: a wheel built from this checkout (pyproject.toml,
-scikit-build-core), installed into a fresh venv, gives a working `gauss6` command whose
-version is the top-level CMakeLists.txt's project() version, and whose `gauss6 view`
-writes a page with the viewer bundled into the wheel.
+scikit-build-core), installed into a fresh venv outside the checkout, gives a working `gauss6`
+command whose version is the top-level CMakeLists.txt's project() version, whose `gauss6 view`
+writes a page with the viewer bundled into the wheel, and which, with no checkout, generates
+every dataset byte for byte as committed (`gauss6 datasets generate`: the generators are a
+package of the library, the bunny's CGAL program is in the wheel) and runs seeded campaigns
+on them (`crosscheck qp --seeded`, `crosscheck ccd --seeded`). `make wheel-test` runs it alone.
 
 The wheel's CMake build of the extension (build-<wheel tag>/) goes through the compiler
 cache that tools/setup.sh fills (tools/ccache.env), without build isolation (the venv's
@@ -83,3 +86,29 @@ def test_wheel_installs_into_a_fresh_venv_and_runs(tmp_path: Path):
     doc = json.loads(r.stdout)
     assert doc["pass"] and "site-packages/gauss6/engines/" in doc["engine"]["library"]
     assert doc["thresholds"]["file"].endswith("gauss6/data/oracle.toml")
+    check_datasets_and_campaigns(venv / "bin" / "gauss6", tmp_path / "data")
+
+
+# The datasets `gauss6 datasets generate` writes (qp after the meshes it samples); bunny and
+# bunny_full need the system's glmark2-data (tools/debian-packages.txt).
+GENERATED = ("peg_in_hole", "bunny", "bunny_full", "surfaces", "battery", "qp")
+
+
+def check_datasets_and_campaigns(gauss6: Path, cwd: Path) -> None:
+    """In an empty folder outside the checkout: every dataset generated into ./datasets_generated
+    (the installed package's default), each file the same bytes as the committed one; then a
+    seeded projection campaign and a seeded CCD campaign on those meshes, both passing."""
+    cwd.mkdir()
+    env = {k: v for k, v in os.environ.items() if k not in ("GAUSS6_DATASETS_DIR", "GAUSS6_BUILD_DIR")}
+    subprocess.run([gauss6, "datasets", "generate"], cwd=cwd, env=env, check=True, capture_output=True, text=True)
+    for name in GENERATED:
+        manifest = json.loads((paths.DATASETS_DIR / name / "MANIFEST.json").read_text())
+        for filename in ["MANIFEST.json", *manifest["outputs"]]:
+            made = (cwd / "datasets_generated" / name / filename).read_bytes()
+            assert made == (paths.DATASETS_DIR / name / filename).read_bytes(), f"{name}/{filename}"
+    for what, extra in (("qp", ["--seeded", "360"]), ("ccd", ["--seeded", "25", "--family", "random"])):
+        r = subprocess.run([gauss6, "crosscheck", what, *extra, "--seed", "1", "--workers", "0", "--json"], cwd=cwd,
+                           env=env, capture_output=True, text=True)
+        assert r.returncode == 0, r.stderr
+        result = json.loads(r.stdout)
+        assert result["ok"] and result["chunks_run"] >= 1, result

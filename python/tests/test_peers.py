@@ -7,7 +7,7 @@ from __future__ import annotations
 
 import pytest
 
-from gauss6 import paths, peers
+from gauss6 import cli, paths, peers
 
 pytest.importorskip("ipctk")
 needs_data = pytest.mark.skipif(not peers.CCD_DATA.is_dir(), reason=f"{peers.CCD_DATA} not present")
@@ -38,5 +38,5 @@ def test_qp_peers_on_one_family():
 
 
 def test_cli_refuses_bad_arguments(capsys):
-    assert peers.main(["--sample", "0", "--out", str(paths.REPO_ROOT / "out" / "never")]) == 2
+    assert cli.main(["report", "peers", "--sample", "0", "--out", str(paths.REPO_ROOT / "out" / "never")]) == 2
     assert "--sample" in capsys.readouterr().err

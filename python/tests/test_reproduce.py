@@ -11,7 +11,7 @@ import json
 import numpy as np
 import pytest
 
-from gauss6 import reproduce
+from gauss6 import cli, reproduce
 from gauss6.trace import COLUMNS, DTYPES, Trace, read_trace
 
 runtime = pytest.importorskip("gauss6._gauss6").runtime
@@ -95,7 +95,7 @@ def test_trace_round_trip_and_csv_export(peg_run, tmp_path):
     assert [p["name"] for p in tr.meta["phases"]] == ["a", "b", "c", "d", "e"]
     assert list(tr.events["code"]) == [1.0]  # phase (a) only, within 1.2 s
     # The CSV export reads back to the same doubles.
-    assert reproduce.main(["trace", "export", str(out / "peg.g6trace"), "--csv", str(tmp_path)]) == 0
+    assert cli.main(["trace", "export", str(out / "peg.g6trace"), "--csv", str(tmp_path)]) == 0
     ticks = np.loadtxt(tmp_path / "ticks.csv", delimiter=",", skiprows=1)
     assert ticks.shape == (1201, sum(w for _, w in COLUMNS["ticks"]))
     assert np.array_equal(ticks[:, 0], tr.ticks["t"])

@@ -8,10 +8,13 @@ import sys
 import numpy as np
 import pytest
 
-from gauss6 import cli, paths
+from gauss6 import paths
 
 BODY_KEYS = ["name", "role", "triangles", "vertices", "closed", "manifold", "self_intersections",
              "mass", "center_of_mass", "inertia", "bbox_min", "bbox_max"]
+
+SCENES = {"peg": paths.DATASETS_DIR / "scenes" / "peg_in_hole.toml",
+          "bunny": paths.DATASETS_DIR / "scenes" / "bunnies.toml"}
 
 
 def run_cli(*args: str) -> subprocess.CompletedProcess:
@@ -23,7 +26,7 @@ def run_cli(*args: str) -> subprocess.CompletedProcess:
     ("bunny", None, None),
 ])
 def test_scene_info_json_form(scene, obstacle_tris, god_tris):
-    r = run_cli("scene", "info", str(cli.SCENES[scene]), "--json")
+    r = run_cli("scene", "info", str(SCENES[scene]), "--json")
     assert r.returncode == 0, r.stderr
     info = json.loads(r.stdout)
     assert list(info) == ["scene", "bodies"]
@@ -54,7 +57,7 @@ def test_scene_info_json_form(scene, obstacle_tris, god_tris):
 
 def test_self_intersection_check_can_be_skipped():
     # The scene summary must at least place the god-object somewhere finite.
-    r = run_cli("scene", "info", str(cli.SCENES["peg"]), "--json", "--no-self-intersections")
+    r = run_cli("scene", "info", str(SCENES["peg"]), "--json", "--no-self-intersections")
     assert r.returncode == 0, r.stderr
     info = json.loads(r.stdout)
     assert all(b["self_intersections"] == -1 for b in info["bodies"])
@@ -62,7 +65,7 @@ def test_self_intersection_check_can_be_skipped():
 
 
 def test_bad_scene_is_a_clear_error(tmp_path):
-    text = cli.SCENES["peg"].read_text().replace("[gains]", "[gains]\nbogus = 1", 1)
+    text = SCENES["peg"].read_text().replace("[gains]", "[gains]\nbogus = 1", 1)
     bad = tmp_path / "bad.toml"
     bad.write_text(text)
     r = run_cli("scene", "info", str(bad))
@@ -98,7 +101,7 @@ def test_scene_info_effective_settings(scene):
     """The settings a run uses, derived from the scene's delta as runtime_model.h states.
     Exact equality: each is one product of delta by a constant, computed the same way
     (doubles) on both sides; 0.2 delta is added after delta (1 + contact_factor)."""
-    r = run_cli("scene", "info", str(cli.SCENES[scene]), "--json", "--settings", "--no-self-intersections")
+    r = run_cli("scene", "info", str(SCENES[scene]), "--json", "--settings", "--no-self-intersections")
     assert r.returncode == 0, r.stderr
     info = json.loads(r.stdout)
     assert list(info) == ["scene", "bodies", "effective_settings"]
@@ -117,7 +120,7 @@ def test_scene_info_effective_settings(scene):
     assert s["ccd"]["time_tolerance"] == shipped["ccd"]["time_tolerance"]
     assert s["projection"]["feasibility_tol"] == shipped["projection"]["feasibility_tol"]
     # The text form lists them too.
-    text = run_cli("scene", "info", str(cli.SCENES[scene]), "--no-self-intersections")
+    text = run_cli("scene", "info", str(SCENES[scene]), "--no-self-intersections")
     assert text.returncode == 0 and "effective settings (delta = " in text.stdout
 
 
@@ -128,7 +131,7 @@ def test_scene_info_texture_speed_bound():
     scene's own numbers are read back from its TOML; a plain scene has no texture group."""
     import tomllib
 
-    path = cli.SCENES["peg"].parent / "texture_slow.toml"
+    path = SCENES["peg"].parent / "texture_slow.toml"
     toml = tomllib.loads(path.read_text())
     r = run_cli("scene", "info", str(path), "--json", "--settings", "--no-self-intersections")
     assert r.returncode == 0, r.stderr
@@ -136,5 +139,5 @@ def test_scene_info_texture_speed_bound():
     L, f = toml["surface"]["wavelength"], toml["device"]["rate_hz"]
     assert t["shortest_wavelength"] == L and t["sim_rate_hz"] == f
     assert t["max_exploration_speed"] == 0.5 * L * f
-    r = run_cli("scene", "info", str(cli.SCENES["peg"]), "--json", "--settings", "--no-self-intersections")
+    r = run_cli("scene", "info", str(SCENES["peg"]), "--json", "--settings", "--no-self-intersections")
     assert "texture" not in json.loads(r.stdout)["effective_settings"]

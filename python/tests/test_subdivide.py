@@ -1,11 +1,10 @@
-"""Tests of the dense bunnies' generator (datasets_generated/generators/subdivide.py): one level of
+"""Tests of the dense bunnies' generator (gauss6.generators.subdivide): one level of
 midpoint subdivision on the peg (the bunny's 1.1M triangles take minutes: `gauss6 datasets generate
 --only bunny_x16`) keeps a closed, manifold, outward mesh with no self-intersection, the same surface
 (volume and area), four times the triangles; the output is deterministic.
 """
 from __future__ import annotations
 
-import importlib.util
 import json
 import subprocess
 
@@ -13,13 +12,11 @@ import numpy as np
 import pytest
 
 from gauss6 import datasets, paths
+from gauss6.generators import subdivide
 
 
 def generator():
-    spec = importlib.util.spec_from_file_location("gauss6_test_subdivide", datasets.GENERATORS_DIR / "subdivide.py")
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module
+    return subdivide
 
 
 def area_volume(V, F):

@@ -1,9 +1,11 @@
 // Contact set generation at a stop pose: BVH descent with boxes grown by the
 // contact distance (axis-aligned, then oriented) or the CCD's near pairs,
 // closest points of the owned vertex/face and edge/edge pairs, normals signed
-// out of the obstacle, merging of duplicates, Jacobian rows.
+// out of the obstacle, merging of duplicates, the reduction of a full set to
+// its patches' supports, Jacobian rows.
 #include "gauss6/contact/contacts.h"
 
+#include <algorithm>
 #include <cmath>
 
 #include "gauss6/geometry/distance.h"
@@ -31,6 +33,37 @@ Vec3 unit_normal(const Vec3& a, const Vec3& b, const Vec3& c) {
   return len > 0 && std::isfinite(len) ? Vec3(n / len) : Vec3::Zero();
 }
 
+// Whether a -> b -> c turns left by more than rounding: twice the signed area
+// of the triangle above kCollinearSine |b - a| |c - a|. Points along a hull
+// edge (the contacts of a tool's edge crossing a plate's edges) are collinear
+// only to the rounding of their coordinates, which would keep them all.
+constexpr double kCollinearSine = 1e-12;
+bool turns_left(const Eigen::Vector2d& a, const Eigen::Vector2d& b, const Eigen::Vector2d& c) {
+  const Eigen::Vector2d u = b - a, w = c - a;
+  return u.x() * w.y() - u.y() * w.x() > kCollinearSine * u.norm() * w.norm();
+}
+
+// Marks keep[] for the vertices of the convex hull of plane[idx[0 .. n))
+// (Andrew's monotone chain; points on a hull edge between two vertices, to
+// kCollinearSine, and repeated points are not vertices). idx is sorted in
+// place; hull: scratch of n + 1 entries.
+void mark_hull(const std::vector<Eigen::Vector2d>& plane, int* idx, int n, int* hull, std::vector<unsigned char>* keep) {
+  std::sort(idx, idx + n, [&](int a, int b) {
+    return plane[a].x() < plane[b].x() || (plane[a].x() == plane[b].x() && plane[a].y() < plane[b].y());
+  });
+  int h = 0;
+  for (int pass = 0; pass < 2; ++pass) {  // the lower chain, then the upper one
+    const int floor = h;
+    for (int i = 0; i < n; ++i) {
+      const int p = idx[pass == 0 ? i : n - 1 - i];
+      while (h >= floor + 2 && !turns_left(plane[hull[h - 2]], plane[hull[h - 1]], plane[p])) --h;
+      hull[h++] = p;
+    }
+    --h;  // the chain's last point starts the other chain
+  }
+  for (int i = 0; i < std::max(h, 1); ++i) (*keep)[hull[i]] = 1;
+}
+
 struct Collector {
   const ContactSettings& settings;
   double merge_distance, merge_cos;
@@ -47,8 +80,11 @@ struct Collector {
       }
     }
     if (set->num_contacts == set->capacity()) {
-      overflow = true;
-      return;
+      ++set->num_reductions;
+      if (reduce_to_patch_supports(settings.patch_angle, set) == 0) {
+        overflow = true;
+        return;
+      }
     }
     set->contacts[set->num_contacts++] = c;
   }
@@ -56,11 +92,48 @@ struct Collector {
 
 }  // namespace
 
+int reduce_to_patch_supports(double patch_angle, ContactSet* set) noexcept {
+  const int m = set->num_contacts;
+  const double patch_cos = std::cos(patch_angle);
+  std::fill(set->patch.begin(), set->patch.begin() + m, -1);
+  std::fill(set->keep.begin(), set->keep.begin() + m, 0);
+  for (int r = 0; r < m; ++r) {
+    if (set->patch[r] >= 0) continue;
+    // The patch of r: the contacts not yet in a patch whose normals agree with r's.
+    const Vec3& n = set->contacts[r].normal;
+    int* idx = set->order.data();
+    int count = 0, closest = r;
+    for (int i = r; i < m; ++i) {
+      if (set->patch[i] >= 0 || set->contacts[i].normal.dot(n) < patch_cos) continue;
+      set->patch[i] = r;
+      idx[count++] = i;
+      if (set->contacts[i].separation < set->contacts[closest].separation) closest = i;
+    }
+    set->keep[closest] = 1;
+    if (count < 3) {
+      for (int k = 0; k < count; ++k) set->keep[idx[k]] = 1;
+      continue;
+    }
+    // Coordinates in the plane normal to n (the normal's part of a point does
+    // not enter its row: n x n = 0).
+    const Vec3 u = n.unitOrthogonal(), v = n.cross(u);
+    for (int k = 0; k < count; ++k)
+      set->plane[idx[k]] = Eigen::Vector2d(set->contacts[idx[k]].point.dot(u), set->contacts[idx[k]].point.dot(v));
+    mark_hull(set->plane, idx, count, set->hull.data(), &set->keep);
+  }
+  int kept = 0;
+  for (int i = 0; i < m; ++i)
+    if (set->keep[i]) set->contacts[kept++] = set->contacts[i];
+  set->num_contacts = kept;
+  return m - kept;
+}
+
 ContactStatus generate_contacts(const CcdBody* obstacles, int num_obstacles, const CcdBody& god, const Pose& X_WB,
                                 const ContactSettings& settings, ContactWorkspace* ws, ContactSet* set,
                                 const NearPairs& near) noexcept {
   set->num_contacts = 0;
   set->num_pairs_within = 0;
+  set->num_reductions = 0;
   if (!god.mesh || !god.bvh || !ws || !is_valid_pose(X_WB) || !(settings.distance > 0) ||
       !std::isfinite(settings.distance) || ws->god_world.size() != static_cast<size_t>(god.mesh->V.rows()) ||
       (num_obstacles > 0 && !obstacles) || (near.num_pairs > 0 && !near.pairs))
@@ -188,6 +261,10 @@ ContactStatus generate_contacts(const CcdBody* obstacles, int num_obstacles, con
         TraversalStatus::kStackFull)
       status = ContactStatus::kStackFull;
   }
+  // A set that was reduced while it was searched holds the contacts found
+  // since its last reduction as they came: reduced once more, it is its
+  // patches' supports alone (the fewer rows, the cheaper the projections).
+  if (set->num_reductions > 0) reduce_to_patch_supports(settings.patch_angle, set);
   // Jacobian rows J_k = [n_k^T, ((I_k - G) x n_k)^T].
   for (int k = 0; k < set->num_contacts; ++k) {
     const Contact& c = set->contacts[k];

@@ -195,7 +195,12 @@ int release_offsets(double energy_scale, const Vec6& au, const Vec6& hand, const
   int nonzero = 0;
   for (int k = 0; k < s->num_rows; ++k) {
     nonzero += s->rhs[k] != 0.0 ? 1 : 0;
-    if (!lent || !(s->last_lambda[k] > 0)) continue;
+    // Every row below its surface goes down, pushing or not: a row that did
+    // not push would take the force over as the pushing ones went down (the
+    // thin wall's probe: its face's row given back, the four edge/edge rows at
+    // its tip held 3.5 N and the account gave nothing back). A row that does
+    // not push gives and takes nothing.
+    if (!lent || !(s->rhs[k] < 0 || s->last_lambda[k] > 0)) continue;
     const Eigen::Map<const Vec6> Jk(J + 6 * k);
     const double x = Jk.dot(au);
     const double back = Jk.dot(hand);

@@ -1,6 +1,7 @@
 """What the adapters share: their config text, the scene's convex parts (CoACD, made by
-datasets_generated/generators/convex_parts.py, committed or cached), mesh files for the
-frameworks that read meshes from files, and the quaternion conventions.
+gauss6.generators.convex_parts, committed or cached), mesh files for the frameworks that read
+meshes from files, the quaternion conventions, and the contacts an adapter reports (at most the
+contract's capacity: reported_contacts).
 
 Convex parts are looked up by the key of the mesh and the parameters (the generator's
 mesh_key): datasets_generated/convex_parts/<key>.obj (committed for the shipped scenes), then
@@ -9,7 +10,6 @@ has it, the generator makes it into the cache (minutes for a large mesh: said on
 """
 from __future__ import annotations
 
-import importlib.util
 import os
 import sys
 from pathlib import Path
@@ -17,6 +17,8 @@ from pathlib import Path
 import numpy as np
 
 from .. import paths
+from ..engine import CONTACT_CAPACITY
+from ..generators import convex_parts as generator
 
 
 def parse_config(text: str, defaults: dict) -> dict:
@@ -41,22 +43,12 @@ def cache_dir() -> Path:
     return Path(os.environ.get("GAUSS6_CACHE_DIR", Path.home() / ".cache" / "gauss6"))
 
 
-def _generator():
-    name = "gauss6_generators_convex_parts"
-    if name not in sys.modules:
-        spec = importlib.util.spec_from_file_location(name, paths.DATASETS_DIR / "generators" / "convex_parts.py")
-        module = importlib.util.module_from_spec(spec)
-        sys.modules[name] = module  # dataclasses look their module up there
-        spec.loader.exec_module(module)
-    return sys.modules[name]
-
-
 COMMITTED_PARTS = paths.DATASETS_DIR / "convex_parts"
 
 
 def convex_parts_file(V: np.ndarray, F: np.ndarray, source: str = "") -> Path:
     """The OBJ of a mesh's convex parts (one object a part): committed, cached, or made now."""
-    gen = _generator()
+    gen = generator
     key = gen.mesh_key(V, F, gen.ConvexPartsParams())
     for folder in (COMMITTED_PARTS, cache_dir() / "convex_parts"):
         if (folder / f"{key}.obj").exists():
@@ -68,7 +60,7 @@ def convex_parts_file(V: np.ndarray, F: np.ndarray, source: str = "") -> Path:
 
 def convex_parts(V: np.ndarray, F: np.ndarray, source: str = "") -> list[tuple[np.ndarray, np.ndarray]]:
     """A mesh's convex parts [(vertices, faces)], in the mesh's frame."""
-    return _generator().read_obj(convex_parts_file(V, F, source))
+    return generator.read_obj(convex_parts_file(V, F, source))
 
 
 def mesh_file(V: np.ndarray, F: np.ndarray, name: str) -> Path:
@@ -81,7 +73,7 @@ def mesh_file(V: np.ndarray, F: np.ndarray, name: str) -> Path:
     if not path.exists():
         path.parent.mkdir(parents=True, exist_ok=True)
         tmp = path.with_suffix(f".tmp{os.getpid()}")
-        _generator().write_obj(tmp, [(np.asarray(V, float), np.asarray(F, np.int64))], [f"{name}"])
+        generator.write_obj(tmp, [(np.asarray(V, float), np.asarray(F, np.int64))], [f"{name}"])
         tmp.replace(path)
     return path
 
@@ -102,3 +94,16 @@ def xyzw_to_wxyz(q) -> np.ndarray:
 def unit(q) -> np.ndarray:
     q = np.asarray(q, float)
     return q / np.linalg.norm(q)
+
+
+def reported_contacts(rows) -> np.ndarray:
+    """A framework's contacts as the contract takes them: (k, 7) rows of point (3), normal (3),
+    separation, k <= CONTACT_CAPACITY (docs/engine-contract.md; the C ABI's buffer). A framework
+    may find more (Rapier: 507 on the bunnies, 46,883 on the dense plate, one manifold point per
+    triangle): then the CONTACT_CAPACITY deepest are reported (smallest separation first, ties in
+    the framework's order), the contacts that carry the framework's force; the contacts are what
+    the viewer draws, the oracle judges the engine by its own contact generation."""
+    contacts = np.asarray(rows, float).reshape(-1, 7)
+    if len(contacts) <= CONTACT_CAPACITY:
+        return contacts
+    return contacts[np.sort(np.argsort(contacts[:, 6], kind="stable")[:CONTACT_CAPACITY])]

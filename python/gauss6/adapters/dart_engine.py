@@ -126,7 +126,7 @@ class DartEngine:
             n = np.array(ct.normal, float)  # DART: from object 2 to object 1
             normal = n if tool_first else -n
             rows.append((*np.array(ct.point, float), *normal, -float(ct.penetrationDepth)))
-        contacts = np.array(rows, float).reshape(-1, 7)
+        contacts = common.reported_contacts(rows)
         return EngineStep(p, q, np.concatenate([-force, -torque]), contacts, seconds)
 
     def close(self) -> None:

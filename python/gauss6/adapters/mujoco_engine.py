@@ -124,4 +124,4 @@ class MuJoCoEngine:
             c = d.contact[i]
             n = c.frame[0:3] if m.geom_bodyid[c.geom1] == 0 else -c.frame[0:3]
             contacts[i] = (*c.pos, *n, c.dist)
-        return EngineStep(xs_p, xs_q, wrench, contacts, seconds)
+        return EngineStep(xs_p, xs_q, wrench, common.reported_contacts(contacts), seconds)

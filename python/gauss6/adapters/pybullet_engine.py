@@ -124,7 +124,7 @@ class PyBulletEngine:
         applied[3:] = rotation_matrices(q)[0] @ applied[3:]  # the torque comes in the frame of G
         seconds = time.perf_counter() - start
         points = b.getContactPoints(bodyA=self.tool)
-        contacts = np.array([(*cp[5], *(-np.asarray(cp[7])), cp[8]) for cp in points], float).reshape(-1, 7)
+        contacts = common.reported_contacts([(*cp[5], *(-np.asarray(cp[7])), cp[8]) for cp in points])
         return EngineStep(p, q, -applied, contacts, seconds)
 
     def close(self) -> None:

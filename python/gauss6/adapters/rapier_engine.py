@@ -17,7 +17,9 @@ adapter's):
 with M = diag(m I, R I_B R^T), v_h the handle's velocity by backward difference, applied as the
 body's force and torque for one step; the wrench
 sent to the user is -F_tool. Contacts: the narrow phase's manifolds of the tool's colliders
-(point on the tool, normal from the obstacle to the tool, Rapier's distance).
+(point on the tool, normal from the obstacle to the tool, Rapier's distance); Rapier makes a
+manifold point per triangle of a concave mesh, thousands on a dense one, so the deepest of them
+are reported, the contract's capacity (common.reported_contacts).
 
 Parameters (config keys) and how they were chosen:
   kc          4000 1/s^2, the coupling stiffness: the swept parameter (250 to 64000, the Drake
@@ -136,7 +138,7 @@ class RapierEngine:
                         local = pt.local_p1 if tool_first else pt.local_p2
                         w = pos.transform_point(local)
                         rows.append((w.x, w.y, w.z, *normal, pt.dist))
-        contacts = np.array(rows, float).reshape(-1, 7)
+        contacts = common.reported_contacts(rows)
         return EngineStep(p, q, np.concatenate([-force, -torque]), contacts, seconds)
 
     def close(self) -> None:

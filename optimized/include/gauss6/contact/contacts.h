@@ -16,9 +16,24 @@
 // merge_angle) are merged, keeping the smallest separation: a vertex on an edge
 // shared by two coplanar faces gives one contact, not two.
 //
+// A set that would exceed its capacity is reduced to the support of each patch
+// (reduce_to_patch_supports): contacts whose normals agree within patch_angle
+// form a patch, and a contact of a patch that lies inside the convex hull of
+// the patch's other points (seen along the normal) is left out, except the
+// patch's smallest separation. Its row [n, (I - G) x n] is affine in I, so it is
+// a convex combination of the hull vertices' rows: the cone {J a >= 0} and the
+// cone of contact wrenches {J^T lambda} are the same with or without it, to the
+// angle between the normals (at most patch_angle: a tool tilted by 1e-5 rad on
+// a plate turns its edge/edge normals by as much, each a patch of its own at
+// merge_angle). A dense coplanar patch (a flat tool on a finely
+// tessellated plate: thousands of pairs) is then its corners, wherever the
+// search met them first. A set that fits is never reduced: every pair within
+// the distance is in it.
+//
 // Real time: no allocation (ContactSet and ContactWorkspace are sized once), no
-// locks, no exceptions. When more contacts are found than the set holds, the
-// set keeps the first ones found and says so (overflow).
+// locks, no exceptions. When the reduced set still has no room (more distinct
+// normals than the set holds), the set keeps the first ones found and says so
+// (overflow).
 #pragma once
 
 #include <cstdint>
@@ -36,6 +51,7 @@ struct ContactSettings {
   double distance = 0;            // pairs within this distance: delta (1 + a small factor) (scene units, > 0)
   double merge_distance = 0;      // merge contacts closer than this (scene units; 0: 1e-3 distance)
   double merge_angle = 1e-6;      // ... whose normals differ by less than this (radians)
+  double patch_angle = 1e-3;      // a full set's patches: normals within this (radians; reduce_to_patch_supports)
   double parallel_sine = 1e-9;    // edges with |e1 x e2| <= this |e1| |e2| count as parallel
 };
 
@@ -52,13 +68,33 @@ const char* to_string(ContactStatus s);
 // A fixed-capacity contact set: contacts[0 .. num_contacts) and the rows
 // J.topRows(num_contacts) (J has capacity rows and 6 columns: linear then angular).
 struct ContactSet {
-  explicit ContactSet(int capacity = 64) : contacts(static_cast<size_t>(capacity)), J(capacity, 6) {}
+  explicit ContactSet(int capacity = 64)
+      : contacts(static_cast<size_t>(capacity)),
+        J(capacity, 6),
+        patch(contacts.size()),
+        order(contacts.size()),
+        hull(contacts.size() + 1),
+        keep(contacts.size()),
+        plane(contacts.size()) {}
   int capacity() const { return static_cast<int>(contacts.size()); }
   int num_contacts = 0;
   int num_pairs_within = 0;       // pairs found within distance, before merging
+  int num_reductions = 0;         // times the set was reduced to its patches' supports (0: every pair is in it)
   std::vector<Contact> contacts;
   Eigen::Matrix<double, Eigen::Dynamic, 6, Eigen::RowMajor> J;
+  // Scratch of reduce_to_patch_supports (one entry a contact).
+  std::vector<int> patch, order, hull;
+  std::vector<unsigned char> keep;
+  std::vector<Eigen::Vector2d> plane;
 };
+
+// Reduces contacts[0 .. num_contacts) to the support of each patch (above):
+// keeps, in their order, the contacts of patches of one or two contacts, and of
+// larger ones the vertices of the convex hull of their points projected on the
+// plane normal to the patch's first normal, and the smallest separation.
+// Contacts of one patch: normals within patch_angle (radians) of its first
+// contact's. Rows J are not touched. Returns the number of contacts left out.
+int reduce_to_patch_supports(double patch_angle, ContactSet* set) noexcept;
 
 // World positions of the god-object's vertices, posed on first use in each call
 // (a vertex is current when its stamp equals `stamp`), the god nodes' world

@@ -142,7 +142,9 @@ int fill_offsets(const OffsetSettings& settings, double t, OffsetState* s) noexc
 // does not back off with energy lent: then b_k = f_k - give_k.
 
 // Before the projection (after fill_offsets): lowers the right-hand sides of
-// the pushing rows the hand backs off from while energy is lent. hand: the
+// the rows the hand backs off from while energy is lent: those that pushed at
+// the last step and those below their surface (b_k < 0) that did not, which
+// would otherwise take the force over. hand: the
 // hand's motion since the last step in a-units, ks (xh (-) xh_last); J: the
 // cached rows (num_rows x 6); energy_scale = kh / ks (> 0). Returns the number
 // of rows with a non-zero right-hand side after it (as fill_offsets).

@@ -28,33 +28,20 @@ self-intersections by the tests, with exact predicates); coordinates that need c
 from the peg generator's 40-digit arithmetic, so the files do not depend on the platform's libm,
 and the same parameters give byte-identical files. The seeded parts draw from numpy's PCG64.
 
-Usage as a program: python battery.py OUT_DIR
+Made by `gauss6 datasets generate [--only battery]` (gauss6.datasets).
 """
 from __future__ import annotations
 
 import decimal
-import hashlib
-import importlib.util
 import json
-import sys
 from dataclasses import asdict, dataclass
 from pathlib import Path
 
 import numpy as np
 
+from . import peg_in_hole as peg, source
+
 GENERATOR_VERSION = "1"
-
-
-def _peg_module():
-    name = "gauss6_generators_peg_in_hole"
-    if name in sys.modules:
-        return sys.modules[name]
-    path = Path(__file__).with_name("peg_in_hole.py")
-    spec = importlib.util.spec_from_file_location(name, path)
-    module = importlib.util.module_from_spec(spec)
-    sys.modules[name] = module
-    spec.loader.exec_module(module)
-    return module
 
 
 # ---------------------------------------------------------------- parameters
@@ -152,7 +139,6 @@ class BatteryParams:
 def _oriented(V: list, F: list) -> tuple[np.ndarray, np.ndarray]:
     """(V, F) as arrays with every face flipped when the mesh encloses a negative volume: the
     makers below build a consistent orientation and this makes it the outward one."""
-    peg = _peg_module()
     V, F = np.array(V, dtype=np.float64) + 0.0, np.array(F, dtype=np.int64)
     if peg.signed_volume(V, F) < 0:
         F = F[:, ::-1].copy()
@@ -253,7 +239,6 @@ def _clean(x: float, scale: float) -> float:
 def revolve(profile: list, segments: int) -> tuple[np.ndarray, np.ndarray]:
     """The solid of revolution about the Z axis of a profile [(r, z)] that starts and ends on the
     axis (r = 0) and has r > 0 in between: segments sides, a fan at each pole, outward."""
-    peg = _peg_module()
     ctx = peg._CTX
     cs = [peg._cos_sin(k, segments) for k in range(segments)]
     inner = profile[1:-1]
@@ -282,7 +267,6 @@ def octahedron(r: float) -> tuple[np.ndarray, np.ndarray]:
 def _arc(cx: float, cz: float, radius: float, from_deg: int, to_deg: int, steps: int) -> list:
     """Points (cx + r cos a, cz + r sin a) for a from from_deg to to_deg in `steps` equal steps
     (angles in 1/(4 steps) degree units so that every angle is an exact fraction of the turn)."""
-    peg = _peg_module()
     ctx = peg._CTX
     rd = decimal.Decimal(radius)
     pts = []
@@ -295,7 +279,6 @@ def _arc(cx: float, cz: float, radius: float, from_deg: int, to_deg: int, steps:
 
 def _tan_deg(num: int, den: int) -> float:
     """tan(num / den degrees) from the 40-digit cos/sin."""
-    peg = _peg_module()
     c, s = peg._cos_sin(num, 360 * den)
     return float(peg._CTX.divide(s, c))
 
@@ -305,7 +288,6 @@ def _tan_deg(num: int, den: int) -> float:
 
 def _quat(axis: str, deg: float) -> list:
     """The unit quaternion of a rotation of `deg` degrees (a multiple of 1/4) about x, y or z."""
-    peg = _peg_module()
     k = round(deg * 4)
     if abs(k - deg * 4) > 1e-12:
         raise ValueError(f"angle {deg} is not a multiple of a quarter degree")
@@ -502,7 +484,6 @@ def cup_script(p: BatteryParams) -> dict:
     s.phase("floor").to(0.3, p=(0.0, 0.0, floor + rb - press)).to(0.2)
     rad = inner - rb + press
     s.phase("corner").to(0.6, p=(rad, 0.0, floor + rb - press))
-    peg = _peg_module()
     s.phase("drag")
     for deg in range(10, 361, 10):
         c, sn = peg._cos_sin(deg, 360)
@@ -609,7 +590,6 @@ def scripts(p: BatteryParams) -> dict[str, dict]:
 
 def check_mesh(name: str, V: np.ndarray, F: np.ndarray) -> None:
     """Fails loudly unless (V, F) is closed, 2-manifold, outward and free of degenerate triangles."""
-    peg = _peg_module()
     problems = peg.check_closed_manifold(F)
     areas = 0.5 * np.linalg.norm(np.cross(V[F[:, 1]] - V[F[:, 0]], V[F[:, 2]] - V[F[:, 0]]), axis=1)
     size = float(np.ptp(V, axis=0).max())
@@ -627,9 +607,8 @@ def generate(out_dir: Path, params: BatteryParams | None = None) -> dict[str, st
     """Writes the battery's meshes and hand scripts into out_dir; returns {filename: text}."""
     p = params or BatteryParams()
     p.validate()
-    peg = _peg_module()
-    header = peg.provenance_header("datasets_generated/generators/battery.py", p.to_json(),
-                                   hashlib.sha256(Path(__file__).read_bytes()).hexdigest())
+    relpath, sha = source(__spec__.name)
+    header = peg.provenance_header(relpath, p.to_json(), sha)
     header[1] = f"generator_version: {GENERATOR_VERSION}"
     out = {}
     for name, (V, F) in meshes(p).items():
@@ -643,9 +622,3 @@ def generate(out_dir: Path, params: BatteryParams | None = None) -> dict[str, st
         (out_dir / name).write_text(text, encoding="ascii")
     return out
 
-
-if __name__ == "__main__":
-    if len(sys.argv) != 2:
-        sys.exit("usage: battery.py OUT_DIR")
-    for name in generate(Path(sys.argv[1])):
-        print(Path(sys.argv[1]) / name)

@@ -28,31 +28,19 @@ meshes and hand scripts.
 Coordinates are correctly rounded doubles (angles through the peg generator's
 40-digit cos/sin), so the files do not depend on the platform's libm.
 
-Usage as a program: python surfaces.py OUT_DIR
+Made by `gauss6 datasets generate [--only surfaces]` (gauss6.datasets).
 """
 from __future__ import annotations
 
-import importlib.util
 import json
-import sys
 from dataclasses import asdict, dataclass
 from pathlib import Path
 
 import numpy as np
 
+from . import peg_in_hole as peg, source
+
 GENERATOR_VERSION = "3"  # 3: the height map bumps.png, bumps.json; 2: the texture scripts press 6 mm (1: 3 mm)
-
-
-def _peg_module():
-    name = "gauss6_generators_peg_in_hole"
-    if name in sys.modules:
-        return sys.modules[name]
-    path = Path(__file__).with_name("peg_in_hole.py")
-    spec = importlib.util.spec_from_file_location(name, path)
-    module = importlib.util.module_from_spec(spec)
-    sys.modules[name] = module
-    spec.loader.exec_module(module)
-    return module
 
 
 @dataclass(frozen=True)
@@ -112,7 +100,6 @@ def _key(t: float, p: tuple) -> dict:
 
 def cylinder_script(p: SurfacesParams) -> dict:
     """The tip (G) around the cylinder's axis at the flats' apothem less `press`."""
-    peg = _peg_module()
     n = p.cylinder_sides
     c15, _ = peg._cos_sin(1, 2 * n)                 # cos(pi / n): apothem / circumradius
     import decimal
@@ -195,12 +182,11 @@ def png_bytes(image: np.ndarray) -> bytes:
 def generate(out_dir: Path, params: SurfacesParams | None = None) -> dict[str, str]:
     """Writes the meshes and scripts into out_dir; returns {filename: text}."""
     p = params or SurfacesParams()
-    peg = _peg_module()
     cyl = peg.PegInHoleParams(peg_radius=p.cylinder_radius, peg_length=p.cylinder_length,
                               peg_sides=p.cylinder_sides)
     meshes = {"faceted_cylinder.off": peg.make_peg(cyl), "slab.off": make_slab(p), "probe.off": make_probe(p)}
-    header = peg.provenance_header("datasets_generated/generators/surfaces.py", p.to_json(),
-                                   __import__("hashlib").sha256(Path(__file__).read_bytes()).hexdigest())
+    relpath, sha = source(__spec__.name)
+    header = peg.provenance_header(relpath, p.to_json(), sha)
     header[1] = f"generator_version: {GENERATOR_VERSION}"
     out = {}
     for name, (V, F) in meshes.items():
@@ -226,6 +212,3 @@ def generate(out_dir: Path, params: SurfacesParams | None = None) -> dict[str, s
     (out_dir / "bumps.png").write_bytes(png_bytes(image))
     return {**out, "bumps.png": "(binary)"}
 
-
-if __name__ == "__main__":
-    generate(Path(sys.argv[1]))

@@ -10,7 +10,7 @@ C order) and of the parameters: the adapters (python/gauss6/adapters/geometry.py
 datasets_generated/convex_parts/ (committed, with its MANIFEST.json) or make it into their
 cache on first use. The bunny takes about 7 minutes on the 2-core machine, the box 20 s.
 
-Usage as a program: python convex_parts.py MESH.off OUT_DIR (writes OUT_DIR/<key>.obj).
+Usage as a program: python -m gauss6.generators.convex_parts MESH.off OUT_DIR (writes OUT_DIR/<key>.obj).
 """
 from __future__ import annotations
 
@@ -21,6 +21,8 @@ from dataclasses import asdict, dataclass
 from pathlib import Path
 
 import numpy as np
+
+from . import source as source_of
 
 GENERATOR_VERSION = "1"
 
@@ -108,7 +110,7 @@ def generate(V, F, out_dir: Path, params: ConvexPartsParams = ConvexPartsParams(
     key = mesh_key(V, F, params)
     parts = decompose(V, F, params)
     header = [f"convex parts of {source or 'a mesh'} ({len(V)} vertices, {len(F)} faces): {len(parts)} parts",
-              f"generator: datasets_generated/generators/convex_parts.py version {GENERATOR_VERSION}",
+              f"generator: {source_of(__spec__.name)[0]} version {GENERATOR_VERSION}",
               f"coacd {version('coacd')}, parameters {json.dumps(params.to_json(), sort_keys=True)}"]
     path = out_dir / f"{key}.obj"
     write_obj(path, parts, header)
@@ -125,6 +127,6 @@ def _read_off(path: Path) -> tuple[np.ndarray, np.ndarray]:
 
 if __name__ == "__main__":
     if len(sys.argv) != 3:
-        sys.exit("usage: convex_parts.py MESH.off OUT_DIR")
+        sys.exit("usage: python -m gauss6.generators.convex_parts MESH.off OUT_DIR")
     V, F = _read_off(Path(sys.argv[1]))
     print(generate(V, F, Path(sys.argv[2]), source=Path(sys.argv[1]).name))

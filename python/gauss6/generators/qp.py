@@ -6,12 +6,12 @@ m x 6 contact Jacobian (row k = [n_k^T, (G I_k x n_k)^T], n_k unit, pointing fro
 the obstacle into the god-object), au the unconstrained step and b the offsets
 (zeros except in the `offsets` family). Units: metres, kilograms, radians.
 
-The families and the file format are described in README.md (next to this file).
+The families and the file format are described in datasets_generated/qp/README.md.
 Everything is drawn from numpy's PCG64 with a fixed seed per family, so running
-`python generate.py` twice writes byte-identical files; MANIFEST.json records the
+the generator twice writes byte-identical files; MANIFEST.json records the
 sha256 of each output and of this source.
 
-Usage:  python datasets_generated/qp/generate.py [--out DIR]
+Usage:  python -m gauss6.generators.qp [--out DIR]   (gauss6.qp_instances.generate runs it)
 """
 from __future__ import annotations
 
@@ -39,13 +39,15 @@ import numpy as np  # noqa: E402
 from numpy.random import PCG64, Generator  # noqa: E402
 from scipy.optimize import linprog  # noqa: E402
 
+from .. import paths  # noqa: E402
+from . import source  # noqa: E402
+
 FORMAT = "gauss6-qp-instances"
 FORMAT_VERSION = 1
-GENERATOR = "datasets_generated/qp/generate.py"
+GENERATOR = source(__spec__.name)[0]
 GENERATOR_VERSION = "1"
 
-HERE = Path(__file__).resolve().parent
-REPO_ROOT = HERE.parents[1]
+# The meshes as the files name them; read from the datasets folder (mesh_file).
 PEG_MESH = "datasets_generated/peg_in_hole/peg.off"
 BUNNY_MESH = "datasets_generated/bunny/bunny.off"
 
@@ -169,10 +171,16 @@ def mesh_mass_properties(V: np.ndarray, F: np.ndarray, density: float) -> tuple[
     return float(mass), o + com_rel, inertia
 
 
+def mesh_file(relpath: str) -> Path:
+    """A mesh named as the files record it (datasets_generated/...), in the datasets folder
+    (paths.DATASETS_DIR: GAUSS6_DATASETS_DIR, else the checkout's)."""
+    return paths.DATASETS_DIR / Path(relpath).relative_to("datasets_generated")
+
+
 def mesh_body(name: str, relpath: str) -> Body:
     """A body from an OFF mesh: mass properties at DENSITY, G its centre of mass,
     contacts area-weighted on the triangles with the face normal."""
-    path = REPO_ROOT / relpath
+    path = mesh_file(relpath)
     V, F = read_off(path)
     mass, com, inertia = mesh_mass_properties(V, F, DENSITY)
     P = V - com
@@ -621,14 +629,14 @@ BUILDERS = {
 
 
 def source_sha256() -> str:
-    return hashlib.sha256(Path(__file__).read_bytes()).hexdigest()
+    return source(__spec__.name)[1]
 
 
 def mesh_inputs(name: str) -> dict:
     """The meshes a family reads, with their sha256 (so a changed mesh shows in the manifest)."""
     used = {"peg": [PEG_MESH], "bunny": [BUNNY_MESH], "m50": [PEG_MESH], "redundant": [PEG_MESH],
             "offsets": [PEG_MESH], "warm": [PEG_MESH]}.get(name, [])
-    return {m: hashlib.sha256((REPO_ROOT / m).read_bytes()).hexdigest() for m in used}
+    return {m: hashlib.sha256(mesh_file(m).read_bytes()).hexdigest() for m in used}
 
 
 def generate_family(name: str) -> dict:
@@ -650,7 +658,8 @@ def dumps(doc: dict) -> str:
 
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--out", type=Path, default=HERE, help="output directory (default: next to this file)")
+    ap.add_argument("--out", type=Path, default=paths.DATASETS_DIR / "qp",
+                    help="output directory (default: the datasets folder's qp/)")
     ap.add_argument("--family", action="append", choices=list(SEEDS), help="only these families (no manifest)")
     args = ap.parse_args(argv)
     args.out.mkdir(parents=True, exist_ok=True)

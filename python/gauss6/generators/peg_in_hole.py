@@ -19,17 +19,18 @@ least `clearance`; it equals `clearance` where a peg vertex faces the middle of
 a hole edge, which the default side counts (72 and 54) make happen (at 0, 20,
 40, ... degrees).
 
-Usage as a program: python peg_in_hole.py OUT_DIR (writes peg.off, box_with_hole.off).
+Made by `gauss6 datasets generate [--only peg_in_hole]` (gauss6.datasets).
 """
 from __future__ import annotations
 
 import decimal
 import json
-import sys
 from dataclasses import asdict, dataclass
 from pathlib import Path
 
 import numpy as np
+
+from . import source
 
 GENERATOR_VERSION = "1"
 
@@ -299,15 +300,6 @@ def _polygon_area(circumradius: float, n: int) -> float:
 # ------------------------------------------------------------------- output
 
 
-def source_sha256() -> str:
-    import hashlib
-    return hashlib.sha256(Path(__file__).read_bytes()).hexdigest()
-
-
-def generator_relpath() -> str:
-    return "datasets_generated/generators/peg_in_hole.py"
-
-
 def off_text(V: np.ndarray, F: np.ndarray, header: list[str]) -> str:
     """OFF text: 'OFF', '# ' header lines, counts, vertices (shortest round-trip decimal
     of each double: exact), triangles."""
@@ -335,16 +327,11 @@ def generate(out_dir: Path, params: PegInHoleParams | None = None) -> dict[str, 
     box_volume = p.box_size[1] * (p.box_size[0] * p.box_size[2] - _polygon_area(p.hole_circumradius(), p.hole_sides))
     _self_check(p, "box_with_hole", box_V, box_F, box_volume)
 
-    header = provenance_header(generator_relpath(), p.to_json(), source_sha256())
+    relpath, sha = source(__spec__.name)
+    header = provenance_header(relpath, p.to_json(), sha)
     texts = {"peg.off": off_text(peg_V, peg_F, header), "box_with_hole.off": off_text(box_V, box_F, header)}
     out_dir.mkdir(parents=True, exist_ok=True)
     for name, text in texts.items():
         (out_dir / name).write_bytes(text.encode("ascii"))
     return texts
 
-
-if __name__ == "__main__":
-    if len(sys.argv) != 2:
-        sys.exit("usage: peg_in_hole.py OUT_DIR")
-    for name in generate(Path(sys.argv[1])):
-        print(Path(sys.argv[1]) / name)

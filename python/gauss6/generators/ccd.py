@@ -5,7 +5,7 @@ G, the centre of mass) along the Cayley in-between motion, against one static
 obstacle. Each set probes one kind of motion (near-contact haptic steps, grazing,
 parallel features, pure rotation, no rotation, large rotation, tunnelling paths,
 and the steps of scripted peg-in-hole and bunny motions). The format and the sets
-are described in README.md (next to this file).
+are described in datasets_generated/ccd/README.md.
 
 Everything random is drawn from numpy's PCG64 with a fixed seed per set. Start
 poses are kept only when the exact reference says they are free (no intersecting
@@ -14,7 +14,7 @@ depend only on numpy and exact predicates: running this twice writes
 byte-identical files; MANIFEST.json records the sha256 of each output, of this
 source and of the meshes read.
 
-Usage:  PYTHONPATH=python python datasets_generated/ccd/generate.py [--out DIR] [--set NAME]
+Usage:  python -m gauss6.generators.ccd [--out DIR] [--set NAME]   (default: the datasets folder's ccd/)
 """
 from __future__ import annotations
 
@@ -29,14 +29,12 @@ from pathlib import Path
 import numpy as np
 from numpy.random import PCG64, Generator
 
-HERE = Path(__file__).resolve().parent
-REPO_ROOT = HERE.parents[1]
-sys.path.insert(0, str(REPO_ROOT / "python"))
-from gauss6 import _gauss6  # noqa: E402  (the C++ core: mesh reader, mass properties, exact predicates)
+from .. import _gauss6, paths  # the C++ core: mesh reader, mass properties, exact predicates
+from . import source
 
 FORMAT = "gauss6-ccd-steps"
 FORMAT_VERSION = 1
-GENERATOR = "datasets_generated/ccd/generate.py"
+GENERATOR = source(__spec__.name)[0]
 GENERATOR_VERSION = "1"
 
 PEG = "peg_in_hole/peg.off"
@@ -140,7 +138,7 @@ class Pair:
 
 
 def load_pair(obstacle: str, god: str, delta: float) -> Pair:
-    datasets = REPO_ROOT / "datasets_generated"
+    datasets = paths.DATASETS_DIR
     V_obs, F_obs = _gauss6.read_mesh(str(datasets / obstacle))
     V_mesh, F_god = _gauss6.read_mesh(str(datasets / god))
     offset = np.asarray(_gauss6.mass_properties(V_mesh, F_god, DENSITY)["center_of_mass"], dtype=float)
@@ -414,7 +412,7 @@ def sha256_file(path: Path) -> str:
 
 def parameters(name: str) -> dict:
     _, params, (obstacle, god, delta) = SETS[name]
-    ds = REPO_ROOT / "datasets_generated"
+    ds = paths.DATASETS_DIR
     return {**params, "obstacle": obstacle, "god": god, "delta": delta, "lin_step_m": list(LIN_STEP),
             "ang_step_rad": list(ANG_STEP), "gap_m": list(GAP),
             "inputs": {m: sha256_file(ds / m) for m in sorted({obstacle, god})}}
@@ -431,7 +429,7 @@ def generate_set(name: str) -> dict:
     steps = fn(Generator(PCG64(SEEDS[name])), pair, params)
     return {"format": FORMAT, "version": FORMAT_VERSION, "set": name, "generator": GENERATOR,
             "generator_version": GENERATOR_VERSION, "seed": SEEDS[name], "parameters": parameters(name),
-            "source_sha256": sha256_file(Path(__file__)), "delta": pair.delta, "steps": steps}
+            "source_sha256": source(__spec__.name)[1], "delta": pair.delta, "steps": steps}
 
 
 def dumps(doc: dict) -> str:
@@ -448,7 +446,7 @@ def write(out: Path, names: list[str]) -> dict:
     manifest_path = out / "MANIFEST.json"
     manifest = json.loads(manifest_path.read_text()) if manifest_path.exists() else {}
     manifest.update({"generator": GENERATOR, "generator_version": GENERATOR_VERSION,
-                     "source_sha256": sha256_file(Path(__file__))})
+                     "source_sha256": source(__spec__.name)[1]})
     manifest.setdefault("parameters", {})
     manifest.setdefault("outputs", {})
     for name in names:
@@ -462,7 +460,7 @@ def write(out: Path, names: list[str]) -> dict:
 
 def main() -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--out", type=Path, default=HERE)
+    ap.add_argument("--out", type=Path, default=paths.DATASETS_DIR / "ccd")
     ap.add_argument("--set", dest="sets", action="append", choices=list(SETS), help="one set (repeatable; default all)")
     args = ap.parse_args()
     write(args.out, args.sets or list(SETS))
