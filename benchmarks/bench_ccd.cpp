@@ -24,6 +24,15 @@
 // slab bound (no pair test), contacts at the stop pose (of the step's last leg);
 // the slowest step's index and counts (slowest_*), and the steps over 1 ms and
 // over 100 us of CPU time (cpu_steps_over_*).
+// Budgeted replays (scenario_cpu_budget, scenario_unit_budget: the scenario
+// recorded and replayed under RuntimeSettings::budget, update_budget.h;
+// scenario_counted: under a count that never runs out, the scenario's own
+// steps with their work units, for the calibration and the profiles): the
+// steps that ran out of it (budget_hits), their work units (work_units,
+// max_work_units), and against a CPU budget the largest overrun of any step
+// (cpu_max_overrun_ns: its CPU time less the budget) and the steps beyond the
+// budget plus the stated overrun bound (steps_over_bound, kUpdateOverrunBound:
+// must stay 0 in every pass).
 // Profiles of the tail: GAUSS6_BENCH_STEP_LOG=<file> writes one line per step;
 // GAUSS6_BENCH_COLLECT=<i,j,...> switches callgrind's collection on around
 // those steps only (run under valgrind --tool=callgrind --collect-atstart=no),
@@ -227,6 +236,8 @@ std::vector<ScenarioStep> synthetic_steps(const RuntimeModel& s, const std::stri
 // size each iteration replays the whole set (its time: the sum of its steps).
 void time_steps(benchmark::State& state, const RuntimeModel& model, const std::vector<ScenarioStep>& steps,
                 size_t steps_per_iteration) {
+  const double budget_ns = model.settings.budget.cpu_seconds * 1e9;
+  double max_overrun_ns = -INFINITY, over_bound = 0, max_units = 0;
   if (steps.empty()) return state.SkipWithError("no steps");
   SimState sim(model);
   SimStepInfo info;
@@ -235,8 +246,10 @@ void time_steps(benchmark::State& state, const RuntimeModel& model, const std::v
   PerCallCounters counters;
   // The slowest step (CPU time) and what it did; GAUSS6_BENCH_STEP_LOG=<file>
   // writes one line per step (index, CPU ns and the same counts, then the
-  // settling step's shortenings, and whether the leg filled the proximity
-  // cache at once and put a background fill in use) for profiles.
+  // settling step's shortenings, whether the leg filled the proximity
+  // cache at once and put a background fill in use, the work units, whether
+  // the budget ran out, the contacts, and the update's pieces of work of each
+  // kind: node pairs, triangle pairs, pair tests, boxes) for profiles.
   double slowest_ns = -1, over_1ms = 0, over_100us = 0;
   std::FILE* log = std::getenv("GAUSS6_BENCH_STEP_LOG") ? std::fopen(std::getenv("GAUSS6_BENCH_STEP_LOG"), "w") : nullptr;
   size_t i = 0;
@@ -269,6 +282,13 @@ void time_steps(benchmark::State& state, const RuntimeModel& model, const std::v
       const CcdStepResult& r = sim.step4.leg.ccd;  // the leg the step ended on
       over_1ms += cpu_ns > 1e6;
       over_100us += cpu_ns > 1e5;
+      if (budget_ns > 0) {
+        max_overrun_ns = std::max(max_overrun_ns, cpu_ns - budget_ns);
+        over_bound += cpu_ns > budget_ns + kUpdateOverrunBound * 1e9;
+      }
+      max_units = std::max(max_units, static_cast<double>(info.work_units));
+      counters.add("budget_hits", info.budget_exhausted);
+      counters.add("work_units", static_cast<double>(info.work_units));
       if (cpu_ns > slowest_ns) {
         slowest_ns = cpu_ns;
         state.counters["slowest_step"] = static_cast<double>(index);
@@ -280,10 +300,14 @@ void time_steps(benchmark::State& state, const RuntimeModel& model, const std::v
         state.counters["slowest_settled"] = info.settled;
       }
       if (log != nullptr)
-        std::fprintf(log, "%zu %.0f %d %ld %d %d %d %d %d %d %d %d %d\n", index, cpu_ns, r.num_pair_tests, r.num_box_iterations,
-                     r.num_node_pairs, r.num_fill_node_pairs, r.num_triangle_pairs, static_cast<int>(info.settled),
-                     static_cast<int>(info.status == SimStepStatus::kContact), r.num_sub_intervals,
-                     info.num_shortenings, int(r.cache_filled), int(r.cache_refilled));
+        std::fprintf(log, "%zu %.0f %d %ld %d %d %d %d %d %d %d %d %d %ld %d %d %ld %ld %ld %ld\n", index, cpu_ns,
+                     r.num_pair_tests,
+                     r.num_box_iterations, r.num_node_pairs, r.num_fill_node_pairs, r.num_triangle_pairs,
+                     static_cast<int>(info.settled), static_cast<int>(info.status == SimStepStatus::kContact),
+                     r.num_sub_intervals, info.num_shortenings, int(r.cache_filled), int(r.cache_refilled),
+                     info.work_units, int(info.budget_exhausted), info.num_contacts,
+                     sim.step4.budget.pieces(Work::kNodePair), sim.step4.budget.pieces(Work::kTrianglePair),
+                     sim.step4.budget.pieces(Work::kPairTest), sim.step4.budget.pieces(Work::kBox));
       counters.add("hits", info.status == SimStepStatus::kContact);
       counters.add("settling_legs", info.settled);
       // Step 4's paths (docs/sim-step.md's table: these means times `steps`).
@@ -312,15 +336,32 @@ void time_steps(benchmark::State& state, const RuntimeModel& model, const std::v
   state.counters["steps"] = static_cast<double>(steps.size());
   state.counters["cpu_steps_over_1ms"] = over_1ms;
   state.counters["cpu_steps_over_100us"] = over_100us;
+  state.counters["max_work_units"] = max_units;
+  if (budget_ns > 0) {
+    state.counters["cpu_max_overrun_ns"] = max_overrun_ns;
+    state.counters["steps_over_bound"] = over_bound;
+  }
 }
 
 void BM_CcdStep(benchmark::State& state, const std::string& scene_name, const std::string& script) {
-  const RuntimeModel& model = scene_model(scene_name);
-  if (script == "scenario") {
-    const std::vector<ScenarioStep>& steps = scenario_steps(scene_name);
+  const Budget budget = script == "scenario_cpu_budget"    ? Budget::kCpu
+                        : script == "scenario_unit_budget" ? Budget::kUnits
+                        : script == "scenario_counted"     ? Budget::kCounted
+                                                           : Budget::kNone;
+  const RuntimeModel& model = scene_model(scene_name, budget);
+  if (script.rfind("scenario", 0) == 0) {
+    const std::vector<ScenarioStep>& steps = scenario_steps(scene_name, budget);
     return time_steps(state, model, steps, steps.size());
   }
   time_steps(state, model, synthetic_steps(model, script), 1);
+}
+
+// The dense bunnies' meshes are generated, not committed (`gauss6 datasets
+// generate --only bunny_x4|bunny_x16`): their cases only when present.
+bool scene_meshes_present(const std::string& scene) {
+  if (scene == "bunnies_278k") return std::ifstream(datasets_dir() + "/bunny_x4/bunny.off").good();
+  if (scene == "bunnies_1m") return std::ifstream(datasets_dir() + "/bunny_x16/bunny.off").good();
+  return true;
 }
 
 void register_all() {
@@ -336,6 +377,18 @@ void register_all() {
     register_latency(std::string("CcdStep/") + c.scene + "/" + c.script, BM_CcdStep, std::string(c.scene),
                      std::string(c.script))
         ->Iterations(c.iterations);
+  // The dense bunnies (issue 46's large scenes), and every scenario replayed under each budget.
+  for (const char* scene : {"bunnies_278k", "bunnies_1m"})
+    if (scene_meshes_present(scene))
+      register_latency(std::string("CcdStep/") + scene + "/scenario", BM_CcdStep, std::string(scene),
+                       std::string("scenario"))
+          ->Iterations(1);
+  for (const char* scene : {"peg_in_hole", "bunnies", "bunnies_full", "bunnies_278k", "bunnies_1m"})
+    for (const char* script : {"scenario_counted", "scenario_cpu_budget", "scenario_unit_budget"})
+      if (scene_meshes_present(scene))
+        register_latency(std::string("CcdStep/") + scene + "/" + script, BM_CcdStep, std::string(scene),
+                         std::string(script))
+            ->Iterations(1);
 }
 
 const int registered = (register_all(), 0);

@@ -14,7 +14,9 @@
 #include <cmath>
 #include <cstdlib>
 #include <fstream>
+#include <limits>
 #include <map>
+#include <utility>
 #include <memory>
 #include <stdexcept>
 #include <string>
@@ -154,11 +156,24 @@ void for_each_set_step(const CcdSet& set, Visit&& visit) {
 // RuntimeSettings (delta from the scene; ccd.narrow.min_separation = delta,
 // distance_tolerance = 0.1 delta; contacts within delta (1 + contact_factor)).
 // Cached per name; never freed (fixtures hold references).
-inline const RuntimeModel& scene_model(const std::string& name) {
-  static std::map<std::string, std::unique_ptr<RuntimeModel>> cache;
-  auto& slot = cache[name];
+// The budgets of the budgeted replays (docs/benchmarks.md, "Budgeted updates"):
+// none, the recommended CPU time per update, a count of work units, or a
+// count that never runs out (the unbudgeted run, bit for bit, its work counted).
+enum class Budget { kNone, kCpu, kUnits, kCounted };
+inline constexpr long kBenchWorkUnits = 2000;  // about 1.3 M instructions (update_budget.h's ratio)
+inline RuntimeSettings budget_settings(Budget b) {
+  RuntimeSettings s;
+  if (b == Budget::kCpu) s.budget.cpu_seconds = kRecommendedUpdateCpuSeconds;
+  if (b == Budget::kUnits) s.budget.work_units = kBenchWorkUnits;
+  if (b == Budget::kCounted) s.budget.work_units = std::numeric_limits<long>::max() / 4;
+  return s;
+}
+
+inline const RuntimeModel& scene_model(const std::string& name, Budget budget = Budget::kNone) {
+  static std::map<std::pair<std::string, Budget>, std::unique_ptr<RuntimeModel>> cache;
+  auto& slot = cache[{name, budget}];
   if (!slot) slot = std::make_unique<RuntimeModel>(load_scene(datasets_dir() + "/scenes/" + name + ".toml"),
-                                                   RuntimeSettings{});
+                                                   budget_settings(budget));
   return *slot;
 }
 
@@ -174,11 +189,13 @@ struct ScenarioStep {
 // the scene's scripted scenario (scene.device.script), run to the script's end
 // in lockstep (one sim step per haptic tick, as `gauss6 reproduce` runs it) on
 // the simulated device with its default parameters, through the runtime API
-// with an observer: the same run as run_scenario, without its trace.
-inline std::vector<ScenarioStep> record_scenario_steps(const std::string& scene_name) {
+// with an observer: the same run as run_scenario, without its trace; under
+// `budget` (the steps a budgeted run takes: a cut-short update leaves the
+// rest of its command to the next ones).
+inline std::vector<ScenarioStep> record_scenario_steps(const std::string& scene_name, Budget budget) {
   const Scene scene = load_scene(datasets_dir() + "/scenes/" + scene_name + ".toml");
   const HandScript script = load_scene_script(scene);
-  const RuntimeModel& model = scene_model(scene_name);
+  const RuntimeModel& model = scene_model(scene_name, budget);
   SimulatedHandleParams handle;
   handle.rate_hz = scene.device.rate_hz;
   handle.max_force = scene.device.max_force;
@@ -201,11 +218,12 @@ inline std::vector<ScenarioStep> record_scenario_steps(const std::string& scene_
   return steps;
 }
 
-// Cached per scene name.
-inline const std::vector<ScenarioStep>& scenario_steps(const std::string& scene_name) {
-  static std::map<std::string, std::unique_ptr<std::vector<ScenarioStep>>> cache;
-  auto& slot = cache[scene_name];
-  if (!slot) slot = std::make_unique<std::vector<ScenarioStep>>(record_scenario_steps(scene_name));
+// Cached per scene name and budget.
+inline const std::vector<ScenarioStep>& scenario_steps(const std::string& scene_name,
+                                                       Budget budget = Budget::kNone) {
+  static std::map<std::pair<std::string, Budget>, std::unique_ptr<std::vector<ScenarioStep>>> cache;
+  auto& slot = cache[{scene_name, budget}];
+  if (!slot) slot = std::make_unique<std::vector<ScenarioStep>>(record_scenario_steps(scene_name, budget));
   return *slot;
 }
 

@@ -8,7 +8,8 @@ include(CMakePackageConfigHelpers)
 
 set(GAUSS6_INSTALL_CMAKEDIR ${CMAKE_INSTALL_LIBDIR}/cmake/gauss6)
 # Installs TARGET as gauss6::COMPONENT, with the headers under the optional HEADERS_DIR
-# (a folder holding gauss6/, installed whole so that new headers need no list). Include
+# (a folder holding gauss6/, installed whole so that new headers need no list; the
+# caller's GAUSS6_PRIVATE_HEADERS, names of headers private to the library, stay out). Include
 # folders of the source tree are kept for the build only; installed users get include/.
 function(gauss6_export component target)
   get_target_property(dirs ${target} INTERFACE_INCLUDE_DIRECTORIES)
@@ -28,9 +29,13 @@ function(gauss6_export component target)
   install(TARGETS ${target} EXPORT gauss6-${component}-targets
     ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR} COMPONENT devel
     LIBRARY DESTINATION ${CMAKE_INSTALL_LIBDIR} COMPONENT devel)
+  set(excluded)
+  foreach(name IN LISTS GAUSS6_PRIVATE_HEADERS)
+    list(APPEND excluded PATTERN ${name} EXCLUDE)
+  endforeach()
   foreach(headers_dir IN LISTS ARGN)
     install(DIRECTORY ${headers_dir}/gauss6 DESTINATION ${CMAKE_INSTALL_INCLUDEDIR} COMPONENT devel
-      FILES_MATCHING PATTERN "*.h")
+      FILES_MATCHING PATTERN "*.h" ${excluded})
   endforeach()
   install(EXPORT gauss6-${component}-targets NAMESPACE gauss6::
     DESTINATION ${GAUSS6_INSTALL_CMAKEDIR} COMPONENT devel)

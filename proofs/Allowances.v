@@ -1,4 +1,4 @@
-(* The named error allowances of optimized/include/gauss6/numeric/error_allowances.h,
+(* The named error allowances of optimized/gauss6/numeric/error_allowances.h,
    proved in Flocq: for each, the rounding error of the expression at its
    sites, evaluated as the code evaluates it (the same operations in the same
    order, each rounded to nearest binary64: Rounding.v's `fl`), is within the
@@ -112,8 +112,8 @@ Proof.
   - unfold u in *; lra.
 Qed.
 
-(* covers optimized/src/ccd/ccd.cpp "LinearPoints make_linear_points(" sha256:badaaa4fc2f7da52 *)
-(* covers optimized/src/ccd/ccd.cpp "void enclose_linear(" sha256:b914611386face38 *)
+(* covers optimized/gauss6/ccd/ccd.cpp "LinearPoints make_linear_points(" sha256:badaaa4fc2f7da52 *)
+(* covers optimized/gauss6/ccd/ccd.cpp "void enclose_linear(" sha256:b914611386face38 *)
 Theorem linear_corner_rounding M t a b
     xw0 yw0 xw1 yw1 xa0 ya0 xa1 ya1 xb0 yb0 xb1 yb1 :
   0 <= t <= 1 -> 0 <= a <= 1 -> 0 <= b <= 1 ->
@@ -169,7 +169,7 @@ Qed.
    as the least corner value (and the mirror for the largest) instead of all
    four: that value is one of the four computed corner values, and no larger
    than any of them, rounding being monotone. *)
-(* covers optimized/src/ccd/ccd.cpp "void enclose_linear(" sha256:b914611386face38 *)
+(* covers optimized/gauss6/ccd/ccd.cpp "void enclose_linear(" sha256:b914611386face38 *)
 Theorem linear_corner_selection w pa0 pa1 pb0 pb1 :
   let corner pa pb := fl (fl (w + pa) - pb) in
   let least := fl (fl (w + Rmin pa0 pa1) - Rmax pb0 pb1) in
@@ -196,7 +196,7 @@ Qed.
 (* make_linear_points' p.error = kLinearCornerRounding * Upper{M} +
    Upper{kLinearCornerUnderflow}, rounded up (Rounding.v): at least the bound
    of linear_corner_rounding. *)
-(* covers optimized/src/ccd/ccd.cpp "LinearPoints make_linear_points(" sha256:badaaa4fc2f7da52 *)
+(* covers optimized/gauss6/ccd/ccd.cpp "LinearPoints make_linear_points(" sha256:badaaa4fc2f7da52 *)
 Theorem linear_corner_error_bound M :
   0 <= M ->
   kLinearCornerRounding * M + kLinearCornerUnderflow
@@ -452,22 +452,22 @@ Proof.
 Qed.
 
 (* The code's forms, at its sites. *)
-(* covers optimized/include/gauss6/numeric/rounding.h "GAUSS6_ALWAYS_INLINE Upper norm_up(double norm, double relative)" sha256:b4b3280a1e614758 *)
-(* covers optimized/src/ccd/motion_bounds.cpp "void StartFrame::set(const CcdMotion& m, double u, double rho_in)" sha256:cfac9ee869768b2c *)
-(* covers optimized/include/gauss6/ccd/motion_bounds.h "PosedObb pose(const Obb& b) const" sha256:d9a738b735b2fff9 *)
-(* covers optimized/include/gauss6/ccd/motion_bounds.h "double radius(double r2) const" sha256:6689317b141e2024 *)
+(* covers optimized/gauss6/numeric/rounding.h "GAUSS6_ALWAYS_INLINE Upper norm_up(double norm, double relative)" sha256:b4b3280a1e614758 *)
+(* covers optimized/gauss6/ccd/motion_bounds.cpp "void StartFrame::set(const CcdMotion& m, double u, double rho_in)" sha256:cfac9ee869768b2c *)
+(* covers optimized/gauss6/ccd/motion_bounds.h "PosedObb pose(const Obb& b) const" sha256:d9a738b735b2fff9 *)
+(* covers optimized/gauss6/ccd/motion_bounds.h "double radius(double r2) const" sha256:6689317b141e2024 *)
 Theorem norm_up_relative x y z :
   sqrt (x * x + y * y + z * z) <= Rmax (next_up (fl (norm_c x y z * fl (1 + kRelativeRounding)))) kNormFloor.
 Proof. apply norm_upper_bound, one_plus_relative. Qed.
 
-(* covers optimized/include/gauss6/numeric/rounding.h "GAUSS6_ALWAYS_INLINE Upper norm_up(double norm, double relative)" sha256:b4b3280a1e614758 *)
-(* covers optimized/include/gauss6/geometry/distance.h "GAUSS6_ALWAYS_INLINE void for_each_separating_axis(const SatSide& A" sha256:823fc811c899d033 *)
+(* covers optimized/gauss6/numeric/rounding.h "GAUSS6_ALWAYS_INLINE Upper norm_up(double norm, double relative)" sha256:b4b3280a1e614758 *)
+(* covers optimized/gauss6/geometry/distance.h "GAUSS6_ALWAYS_INLINE void for_each_separating_axis(const SatSide& A" sha256:823fc811c899d033 *)
 Theorem norm_up_wide x y z :
   sqrt (x * x + y * y + z * z) <= Rmax (next_up (fl (norm_c x y z * fl (1 + kRelativeRoundingWide)))) kNormFloor.
 Proof. apply norm_upper_bound, one_plus_wide. Qed.
 
-(* covers optimized/include/gauss6/numeric/rounding.h "GAUSS6_ALWAYS_INLINE Lower norm_down(double norm, double relative)" sha256:981268e19c3ba706 *)
-(* covers optimized/include/gauss6/ccd/motion_bounds.h "inline double triangle_time_lower_bound(const SatSide& A, const Vec3 r[3]" sha256:e6fe43232891e550 *)
+(* covers optimized/gauss6/numeric/rounding.h "GAUSS6_ALWAYS_INLINE Lower norm_down(double norm, double relative)" sha256:981268e19c3ba706 *)
+(* covers optimized/gauss6/ccd/motion_bounds.h "inline double triangle_time_lower_bound(const SatSide& A, const Vec3 r[3]" sha256:e6fe43232891e550 *)
 Theorem norm_down_wide x y z :
   let d := next_down (fl (norm_c x y z * fl (1 - kRelativeRoundingWide))) in
   (if Rlt_dec kNormFloor d then d else 0) <= sqrt (x * x + y * y + z * z).
@@ -544,7 +544,7 @@ Proof. apply fl_decimal_ge; pose proof bpow_m1000; unfold u; lra. Qed.
    computed coordinates' largest magnitude, exact): within it of the exact
    (u1 - u0) d, for every double input (the underflow of the product, eta,
    is covered by next_up's absolute 2^-600). *)
-(* covers optimized/src/ccd/motion_bounds.cpp "SweptObbFrame StartFrame::obb_frame(double u1, double d) const" sha256:935ff5487d4e9f12 *)
+(* covers optimized/gauss6/ccd/motion_bounds.cpp "SweptObbFrame StartFrame::obb_frame(double u1, double d) const" sha256:935ff5487d4e9f12 *)
 Theorem step_rounding u0 u1 d m :
   F u0 -> F u1 -> F d -> Rabs (fl (fl (u1 - u0) * d)) <= m ->
   Rabs (fl (fl (u1 - u0) * d) - (u1 - u0) * d) <= next_up (fl (fl (kRelativeRounding * m) * 2)).
@@ -688,7 +688,7 @@ Proof.
   - replace (-1 * x) with (- x) by ring. apply fl_F, F_opp, Fx.
 Qed.
 
-(* covers optimized/include/gauss6/ccd/motion_bounds.h "inline double triangle_time_lower_bound(const SatSide& A, const Vec3 r[3]" sha256:e6fe43232891e550 *)
+(* covers optimized/gauss6/ccd/motion_bounds.h "inline double triangle_time_lower_bound(const SatSide& A, const Vec3 r[3]" sha256:e6fe43232891e550 *)
 Theorem axis_velocity_rounding side a0 a1 a2 v0 v1 v2 vinf :
   (side = 1 \/ side = -1) -> F a0 -> F a1 -> F a2 ->
   Rabs v0 <= vinf -> Rabs v1 <= vinf -> Rabs v2 <= vinf ->

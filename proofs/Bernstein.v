@@ -1,4 +1,4 @@
-(* The Bernstein positivity certificate of optimized/include/gauss6/numeric/bernstein.h,
+(* The Bernstein positivity certificate of optimized/gauss6/numeric/bernstein.h,
    over the reals: for degree N <= 6 (the code's static_assert) and
    0 <= u0 <= u1 <= 1, the weights w_ij that BernsteinBasis computes (in exact
    arithmetic here) turn the power coefficients k_j of a polynomial into its
@@ -109,8 +109,8 @@ Proof.
   destruct N as [|[|[|[|[|[|[|N]]]]]]]; try lia; unfold bern, C; simpl; ring.
 Qed.
 
-(* covers optimized/include/gauss6/numeric/bernstein.h "BernsteinBasis(double u0, double u1)" sha256:b969cc1766b1bb97 *)
-(* covers optimized/include/gauss6/numeric/bernstein.h "void inner() const" sha256:c8219bc0710128e9 *)
+(* covers optimized/gauss6/numeric/bernstein.h "BernsteinBasis(double u0, double u1)" sha256:b969cc1766b1bb97 *)
+(* covers optimized/gauss6/numeric/bernstein.h "void inner() const" sha256:c8219bc0710128e9 *)
 Theorem bernstein_blossom N k u0 u1 t :
   degree_ok N -> poly N k (u0 + t * (u1 - u0)) = bform N (bcoef N k u0 u1) t.
 Proof.
@@ -139,7 +139,7 @@ Qed.
 (* Theorem bernstein_certificate (bernstein.h, positive_on, over the reals):
    for N <= 6 and 0 <= u0 <= u1, if S_i = sum_j lo_j w_ij > 0 for every i, then
    every polynomial sum_j k_j u^j with k_j >= lo_j is > 0 on [u0, u1]. *)
-(* covers optimized/include/gauss6/numeric/bernstein.h "bool positive_on(const LowerCoefficients<N>& c, const BernsteinBasis<N>& basis)" sha256:50828dd06bd8f6db *)
+(* covers optimized/gauss6/numeric/bernstein.h "bool positive_on(const LowerCoefficients<N>& c, const BernsteinBasis<N>& basis)" sha256:50828dd06bd8f6db *)
 Theorem bernstein_certificate N k lo u0 u1 u :
   degree_ok N -> 0 <= u0 <= u1 -> (forall j, (j <= N)%nat -> lo j <= k j) ->
   (forall i, (i <= N)%nat -> 0 < sum N (fun j => lo j * weight N i j u0 u1)) ->

@@ -1,4 +1,4 @@
-(* Outward rounding of optimized/include/gauss6/numeric/rounding.h, proved in Flocq:
+(* Outward rounding of optimized/gauss6/numeric/rounding.h, proved in Flocq:
    binary64 (53-bit significand, least subnormal 2^-1074), round to nearest
    even, as SSE2 computes on x86-64. Each theorem speaks for one function of
    rounding.h and says that its result encloses the exact result of the same
@@ -103,7 +103,7 @@ Qed.
 
 (* next_up_ge (rounding.h, next_up): for every real x, the double
    next_up(fl x) is >= x, fl x being the double nearest x. *)
-(* covers optimized/include/gauss6/numeric/rounding.h "double next_up(double x)" sha256:f7f39b665daf7c8b *)
+(* covers optimized/gauss6/numeric/rounding.h "double next_up(double x)" sha256:f7f39b665daf7c8b *)
 Theorem next_up_ge x : x <= next_up (fl x).
 Proof.
   unfold next_up. eapply Rle_trans.
@@ -112,7 +112,7 @@ Proof.
 Qed.
 
 (* next_down_le (rounding.h, next_down): next_down(fl x) <= x. *)
-(* covers optimized/include/gauss6/numeric/rounding.h "double next_down(double x)" sha256:073c1384ed8f3ceb *)
+(* covers optimized/gauss6/numeric/rounding.h "double next_down(double x)" sha256:073c1384ed8f3ceb *)
 Theorem next_down_le x : next_down (fl x) <= x.
 Proof.
   unfold next_down. rewrite <- fl_opp. pose proof (next_up_ge (- x)). lra.
@@ -127,7 +127,7 @@ Proof. intros Fr. rewrite <- (fl_F r Fr) at 1. apply next_down_le. Qed.
 (* next_up_ge_fma (rounding.h, next_up, contracted): if a compiler
    fuses the product that made r = fl x with the sum "+ t" (one rounding of
    x + t), or the widening's own product and sum, the result is still >= x. *)
-(* covers optimized/include/gauss6/numeric/rounding.h "double next_up(double x)" sha256:f7f39b665daf7c8b *)
+(* covers optimized/gauss6/numeric/rounding.h "double next_up(double x)" sha256:f7f39b665daf7c8b *)
 Theorem next_up_ge_fma x :
   let r := fl x in
   let t1 := widening r in
@@ -222,19 +222,19 @@ Definition holds (I : Interval) (x : R) := lo I <= x <= hi I.
 
 (* operator+(Interval, Interval) *)
 Definition iadd I J := {| lo := next_down (fl (lo I + lo J)); hi := next_up (fl (hi I + hi J)) |}.
-(* covers optimized/include/gauss6/numeric/rounding.h "Interval operator+(Interval a, Interval b)" sha256:75cee5110dc23935 *)
+(* covers optimized/gauss6/numeric/rounding.h "Interval operator+(Interval a, Interval b)" sha256:75cee5110dc23935 *)
 Theorem interval_add_encloses I J x y : holds I x -> holds J y -> holds (iadd I J) (x + y).
 Proof. unfold holds; simpl; intros; split; [apply down_le | apply up_ge]; lra. Qed.
 
 (* operator-(Interval, Interval) *)
 Definition isub I J := {| lo := next_down (fl (lo I - hi J)); hi := next_up (fl (hi I - lo J)) |}.
-(* covers optimized/include/gauss6/numeric/rounding.h "Interval operator-(Interval a, Interval b)" sha256:9864ba0a2e8b49d1 *)
+(* covers optimized/gauss6/numeric/rounding.h "Interval operator-(Interval a, Interval b)" sha256:9864ba0a2e8b49d1 *)
 Theorem interval_sub_encloses I J x y : holds I x -> holds J y -> holds (isub I J) (x - y).
 Proof. unfold holds; simpl; intros; split; [apply down_le | apply up_ge]; lra. Qed.
 
 (* operator-(Interval): {-hi, -lo}, exact (negating a double is exact). *)
 Definition ineg I := {| lo := - hi I; hi := - lo I |}.
-(* covers optimized/include/gauss6/numeric/rounding.h "Interval operator-(Interval a)" sha256:c8d557b635f019ad *)
+(* covers optimized/gauss6/numeric/rounding.h "Interval operator-(Interval a)" sha256:c8d557b635f019ad *)
 Theorem interval_neg_encloses I x : holds I x -> holds (ineg I) (- x).
 Proof. unfold holds; simpl; intros; lra. Qed.
 Lemma interval_neg_exact I : F (lo I) -> F (hi I) -> F (lo (ineg I)) /\ F (hi (ineg I)).
@@ -245,7 +245,7 @@ Proof. simpl; intros; split; apply F_opp; assumption. Qed.
 Definition imul I J :=
   {| lo := next_down (min4 (fl (lo I * lo J)) (fl (lo I * hi J)) (fl (hi I * lo J)) (fl (hi I * hi J)));
      hi := next_up (max4 (fl (lo I * lo J)) (fl (lo I * hi J)) (fl (hi I * lo J)) (fl (hi I * hi J))) |}.
-(* covers optimized/include/gauss6/numeric/rounding.h "Interval operator*(Interval a, Interval b)" sha256:3f3f93e6ecd32c67 *)
+(* covers optimized/gauss6/numeric/rounding.h "Interval operator*(Interval a, Interval b)" sha256:3f3f93e6ecd32c67 *)
 Theorem interval_mul_encloses I J x y : holds I x -> holds J y -> holds (imul I J) (x * y).
 Proof.
   unfold holds, imul; simpl; intros Hx Hy.
@@ -257,7 +257,7 @@ Qed.
 Definition iscale s I :=
   {| lo := next_down (Rmin (fl (s * lo I)) (fl (s * hi I)));
      hi := next_up (Rmax (fl (s * lo I)) (fl (s * hi I))) |}.
-(* covers optimized/include/gauss6/numeric/rounding.h "Interval operator*(double s, Interval a)" sha256:772f29f9ea65e0b5 *)
+(* covers optimized/gauss6/numeric/rounding.h "Interval operator*(double s, Interval a)" sha256:772f29f9ea65e0b5 *)
 Theorem interval_scale_encloses s I x : holds I x -> holds (iscale s I) (s * x).
 Proof.
   unfold holds, iscale; simpl; intros Hx. rewrite fl_min, fl_max.
@@ -271,7 +271,7 @@ Qed.
 Definition idiv I J :=
   {| lo := next_down (min4 (fl (lo I / lo J)) (fl (lo I / hi J)) (fl (hi I / lo J)) (fl (hi I / hi J)));
      hi := next_up (max4 (fl (lo I / lo J)) (fl (lo I / hi J)) (fl (hi I / lo J)) (fl (hi I / hi J))) |}.
-(* covers optimized/include/gauss6/numeric/rounding.h "Interval div_positive(Interval a, Interval b)" sha256:1a34809825b530c2 *)
+(* covers optimized/gauss6/numeric/rounding.h "Interval div_positive(Interval a, Interval b)" sha256:1a34809825b530c2 *)
 Theorem interval_div_positive_encloses I J x y :
   0 < lo J -> holds I x -> holds J y -> holds (idiv I J) (x / y).
 Proof.
@@ -289,7 +289,7 @@ Definition isqr I :=
   if Rle_dec 0 (lo I) then {| lo := next_down (fl (lo I * lo I)); hi := next_up (fl (hi I * hi I)) |}
   else if Rle_dec (hi I) 0 then {| lo := next_down (fl (hi I * hi I)); hi := next_up (fl (lo I * lo I)) |}
   else {| lo := 0; hi := next_up (fl (Rmax (- lo I) (hi I) * Rmax (- lo I) (hi I))) |}.
-(* covers optimized/include/gauss6/numeric/rounding.h "Interval sqr(Interval a)" sha256:0738a9253ed1e9ba *)
+(* covers optimized/gauss6/numeric/rounding.h "Interval sqr(Interval a)" sha256:0738a9253ed1e9ba *)
 Theorem interval_sqr_encloses I x : holds I x -> holds (isqr I) (x * x).
 Proof.
   unfold holds, isqr; intros Hx.
@@ -300,7 +300,7 @@ Qed.
 
 (* hull(Interval, Interval): exact min / max. *)
 Definition ihull I J := {| lo := Rmin (lo I) (lo J); hi := Rmax (hi I) (hi J) |}.
-(* covers optimized/include/gauss6/numeric/rounding.h "Interval hull(Interval a, Interval b)" sha256:efa4509bb8adc7a9 *)
+(* covers optimized/gauss6/numeric/rounding.h "Interval hull(Interval a, Interval b)" sha256:efa4509bb8adc7a9 *)
 Theorem interval_hull_encloses I J x : holds I x \/ holds J x -> holds (ihull I J) x.
 Proof.
   unfold holds, ihull; simpl; intros H.
@@ -309,7 +309,7 @@ Proof.
 Qed.
 
 (* Interval::point(x): the double x holds itself. *)
-(* covers optimized/include/gauss6/numeric/rounding.h "static Interval point(double x)" sha256:545ba5673b13aaef *)
+(* covers optimized/gauss6/numeric/rounding.h "static Interval point(double x)" sha256:545ba5673b13aaef *)
 Theorem interval_point_encloses x : holds {| lo := x; hi := x |} x.
 Proof. unfold holds; simpl; lra. Qed.
 
@@ -317,32 +317,32 @@ Proof. unfold holds; simpl; lra. Qed.
    x it stands for; a double l with l <= x. ---- *)
 
 (* round_up(x) / round_down(x): a value within its last rounding of x. *)
-(* covers optimized/include/gauss6/numeric/rounding.h "Upper round_up(double x)" sha256:bad8791bfbed5152 *)
+(* covers optimized/gauss6/numeric/rounding.h "Upper round_up(double x)" sha256:bad8791bfbed5152 *)
 Theorem round_up_bounds x : x <= next_up (fl x).
 Proof. apply next_up_ge. Qed.
-(* covers optimized/include/gauss6/numeric/rounding.h "Lower round_down(double x)" sha256:4f93442ea04e06c7 *)
+(* covers optimized/gauss6/numeric/rounding.h "Lower round_down(double x)" sha256:4f93442ea04e06c7 *)
 Theorem round_down_bounds x : next_down (fl x) <= x.
 Proof. apply next_down_le. Qed.
 
 (* operator+(Upper, Upper) and operator-(Upper, Lower) *)
-(* covers optimized/include/gauss6/numeric/rounding.h "Upper operator+(Upper a, Upper b)" sha256:9b65569393f5d5ca *)
+(* covers optimized/gauss6/numeric/rounding.h "Upper operator+(Upper a, Upper b)" sha256:9b65569393f5d5ca *)
 Theorem upper_add x y a b : x <= a -> y <= b -> x + y <= next_up (fl (a + b)).
 Proof. intros; apply up_ge; lra. Qed.
-(* covers optimized/include/gauss6/numeric/rounding.h "Upper operator-(Upper a, Lower b)" sha256:72a5f1bc466a3d4f *)
+(* covers optimized/gauss6/numeric/rounding.h "Upper operator-(Upper a, Lower b)" sha256:72a5f1bc466a3d4f *)
 Theorem upper_sub x y a b : x <= a -> b <= y -> x - y <= next_up (fl (a - b)).
 Proof. intros; apply up_ge; lra. Qed.
 (* operator*(Upper, Upper), of nonnegative reals *)
-(* covers optimized/include/gauss6/numeric/rounding.h "Upper operator*(Upper a, Upper b)" sha256:4911751a1879188b *)
+(* covers optimized/gauss6/numeric/rounding.h "Upper operator*(Upper a, Upper b)" sha256:4911751a1879188b *)
 Theorem upper_mul x y a b : 0 <= x <= a -> 0 <= y <= b -> x * y <= next_up (fl (a * b)).
 Proof. intros; apply up_ge; nra. Qed.
 (* operator*(double s, Upper), s >= 0 *)
-(* covers optimized/include/gauss6/numeric/rounding.h "Upper operator*(double s, Upper a)" sha256:f644b35d800c0055 *)
+(* covers optimized/gauss6/numeric/rounding.h "Upper operator*(double s, Upper a)" sha256:f644b35d800c0055 *)
 Theorem upper_scale s x a : 0 <= s -> x <= a -> s * x <= next_up (fl (s * a)).
 Proof. intros; apply up_ge; nra. Qed.
 (* operator/(Upper, Lower): a nonnegative real over a positive one. The
    Lower's double b must itself be > 0 (a Lower of a positive real may be 0
    or below): the sites guarantee it (proofs/README.md). *)
-(* covers optimized/include/gauss6/numeric/rounding.h "Upper operator/(Upper a, Lower b)" sha256:eaf3d64f67bdbf7f *)
+(* covers optimized/gauss6/numeric/rounding.h "Upper operator/(Upper a, Lower b)" sha256:eaf3d64f67bdbf7f *)
 Theorem upper_div x y a b : 0 <= x <= a -> 0 < b <= y -> x / y <= next_up (fl (a / b)).
 Proof.
   intros Hx Hy; apply up_ge. unfold Rdiv.
@@ -350,38 +350,38 @@ Proof.
   assert (0 < / y) by (apply Rinv_0_lt_compat; lra). nra.
 Qed.
 (* operator/(Upper, double s), s > 0 *)
-(* covers optimized/include/gauss6/numeric/rounding.h "Upper operator/(Upper a, double s)" sha256:b3c6d35922a660e1 *)
+(* covers optimized/gauss6/numeric/rounding.h "Upper operator/(Upper a, double s)" sha256:b3c6d35922a660e1 *)
 Theorem upper_div_scalar x a s : x <= a -> 0 < s -> x / s <= next_up (fl (a / s)).
 Proof.
   intros; apply up_ge; unfold Rdiv.
   assert (0 < / s) by (apply Rinv_0_lt_compat; lra). nra.
 Qed.
 (* sqr(Upper), of a nonnegative real *)
-(* covers optimized/include/gauss6/numeric/rounding.h "Upper sqr(Upper a)" sha256:2131f3f0fb191df5 *)
+(* covers optimized/gauss6/numeric/rounding.h "Upper sqr(Upper a)" sha256:2131f3f0fb191df5 *)
 Theorem upper_sqr x a : 0 <= x <= a -> x * x <= next_up (fl (a * a)).
 Proof. intros; apply up_ge; nra. Qed.
 (* sqrt(Upper), of a nonnegative real *)
-(* covers optimized/include/gauss6/numeric/rounding.h "Upper sqrt(Upper a)" sha256:cce2cae9470dd236 *)
+(* covers optimized/gauss6/numeric/rounding.h "Upper sqrt(Upper a)" sha256:cce2cae9470dd236 *)
 Theorem upper_sqrt x a : 0 <= x <= a -> sqrt x <= next_up (fl (sqrt a)).
 Proof. intros; apply up_ge, sqrt_le_1_alt; lra. Qed.
 (* max(Upper, Upper), min(Upper, Upper): exact *)
-(* covers optimized/include/gauss6/numeric/rounding.h "Upper max(Upper a, Upper b)" sha256:5553571db6d61a7e *)
+(* covers optimized/gauss6/numeric/rounding.h "Upper max(Upper a, Upper b)" sha256:5553571db6d61a7e *)
 Theorem upper_max x y a b : x <= a -> y <= b -> Rmax x y <= Rmax a b.
 Proof. intros; apply Rmax_lub; [eapply Rle_trans; [|apply Rmax_l] | eapply Rle_trans; [|apply Rmax_r]]; eassumption. Qed.
-(* covers optimized/include/gauss6/numeric/rounding.h "Upper min(Upper a, Upper b)" sha256:0516ea767307c6f4 *)
+(* covers optimized/gauss6/numeric/rounding.h "Upper min(Upper a, Upper b)" sha256:0516ea767307c6f4 *)
 Theorem upper_min x y a b : x <= a -> y <= b -> Rmin x y <= Rmin a b.
 Proof. intros; apply Rmin_glb; [eapply Rle_trans; [apply Rmin_l|] | eapply Rle_trans; [apply Rmin_r|]]; eassumption. Qed.
 
 (* operator+(Lower, Lower) and operator-(Lower, Upper) *)
-(* covers optimized/include/gauss6/numeric/rounding.h "Lower operator+(Lower a, Lower b)" sha256:9c6fde7cd2f35cf1 *)
+(* covers optimized/gauss6/numeric/rounding.h "Lower operator+(Lower a, Lower b)" sha256:9c6fde7cd2f35cf1 *)
 Theorem lower_add x y a b : a <= x -> b <= y -> next_down (fl (a + b)) <= x + y.
 Proof. intros; apply down_le; lra. Qed.
-(* covers optimized/include/gauss6/numeric/rounding.h "Lower operator-(Lower a, Upper b)" sha256:0f44c8ff9fb6d6a1 *)
+(* covers optimized/gauss6/numeric/rounding.h "Lower operator-(Lower a, Upper b)" sha256:0f44c8ff9fb6d6a1 *)
 Theorem lower_sub x y a b : a <= x -> y <= b -> next_down (fl (a - b)) <= x - y.
 Proof. intros; apply down_le; lra. Qed.
 (* operator/(Lower, Upper): a nonnegative real over a positive one (the
    Upper's double is then positive too). *)
-(* covers optimized/include/gauss6/numeric/rounding.h "Lower operator/(Lower a, Upper b)" sha256:db5f15e3da44f8a0 *)
+(* covers optimized/gauss6/numeric/rounding.h "Lower operator/(Lower a, Upper b)" sha256:db5f15e3da44f8a0 *)
 Theorem lower_div x y a b : a <= x -> 0 <= x -> 0 < y <= b -> next_down (fl (a / b)) <= x / y.
 Proof.
   intros Ha Hx Hy; apply down_le. unfold Rdiv.
@@ -392,12 +392,12 @@ Qed.
 (* sqr(Lower): the Lower's double a must be >= 0 (a Lower of a nonnegative
    real may be negative, and then a * a may exceed x * x): the one site,
    excludes in ccd.cpp, enters a distance m >= 0. *)
-(* covers optimized/include/gauss6/numeric/rounding.h "Lower sqr(Lower a)" sha256:852741653cf3b95a *)
+(* covers optimized/gauss6/numeric/rounding.h "Lower sqr(Lower a)" sha256:852741653cf3b95a *)
 Theorem lower_sqr x a : 0 <= a <= x -> next_down (fl (a * a)) <= x * x.
 Proof. intros; apply down_le; nra. Qed.
 (* sqrt(Lower) of a nonnegative real (a negative double a gives NaN in IEEE,
    which fails safe; over the reals sqrt is monotone on all of R). *)
-(* covers optimized/include/gauss6/numeric/rounding.h "Lower sqrt(Lower a)" sha256:a105fc859c7040bb *)
+(* covers optimized/gauss6/numeric/rounding.h "Lower sqrt(Lower a)" sha256:a105fc859c7040bb *)
 Theorem lower_sqrt x a : a <= x -> next_down (fl (sqrt a)) <= sqrt x.
 Proof.
   intros; apply down_le. destruct (Rle_or_lt a 0).
@@ -405,19 +405,19 @@ Proof.
   - apply sqrt_le_1_alt; lra.
 Qed.
 (* operator>(Lower, Upper): proves the exact order. *)
-(* covers optimized/include/gauss6/numeric/rounding.h "bool operator>(Lower a, Upper b)" sha256:70fdb8d7f0fd530c *)
+(* covers optimized/gauss6/numeric/rounding.h "bool operator>(Lower a, Upper b)" sha256:70fdb8d7f0fd530c *)
 Theorem lower_gt_upper x y a b : a <= x -> y <= b -> a > b -> x > y.
 Proof. intros; lra. Qed.
 
 (* widen(Interval a, Upper e): [lo - e, hi + e], e >= 0, rounded outward. *)
 Definition iwiden I e := {| lo := next_down (fl (lo I - e)); hi := next_up (fl (hi I + e)) |}.
-(* covers optimized/include/gauss6/numeric/rounding.h "Interval widen(Interval a, Upper e)" sha256:af31ca9120c0c9e1 *)
+(* covers optimized/gauss6/numeric/rounding.h "Interval widen(Interval a, Upper e)" sha256:af31ca9120c0c9e1 *)
 Theorem interval_widen_encloses I e E x :
   0 <= E <= e -> lo I - E <= x <= hi I + E -> holds (iwiden I e) x.
 Proof. unfold holds, iwiden; simpl; intros; split; [apply down_le | apply up_ge]; lra. Qed.
 
 (* magnitude(Interval): max(|lo|, |hi|), exact. *)
-(* covers optimized/include/gauss6/numeric/rounding.h "Upper magnitude(Interval a)" sha256:8b1e8d73539e3617 *)
+(* covers optimized/gauss6/numeric/rounding.h "Upper magnitude(Interval a)" sha256:8b1e8d73539e3617 *)
 Theorem magnitude_bounds I x : holds I x -> Rabs x <= Rmax (Rabs (lo I)) (Rabs (hi I)).
 Proof.
   unfold holds; intros H. pose proof (Rmax_l (Rabs (lo I)) (Rabs (hi I))).
@@ -426,7 +426,7 @@ Proof.
 Qed.
 
 (* distance_from(Interval a, double x): max(Upper{hi} - Lower{x}, Upper{x} - Lower{lo}). *)
-(* covers optimized/include/gauss6/numeric/rounding.h "Upper distance_from(Interval a, double x)" sha256:35e8cf51074b7db7 *)
+(* covers optimized/gauss6/numeric/rounding.h "Upper distance_from(Interval a, double x)" sha256:35e8cf51074b7db7 *)
 Theorem distance_from_bounds I x y :
   holds I y -> Rabs (y - x) <= Rmax (next_up (fl (hi I - x))) (next_up (fl (x - lo I))).
 Proof.
@@ -446,7 +446,7 @@ Definition norm_upper I0 I1 I2 :=
   let s1 := next_up (fl (s0 + next_up (fl (mag I1 * mag I1)))) in
   let s2 := next_up (fl (s1 + next_up (fl (mag I2 * mag I2)))) in
   next_up (fl (sqrt s2)).
-(* covers optimized/include/gauss6/numeric/rounding.h "Upper norm_upper(const IVec3& v)" sha256:dca29cba64a96a85 *)
+(* covers optimized/gauss6/numeric/rounding.h "Upper norm_upper(const IVec3& v)" sha256:dca29cba64a96a85 *)
 Theorem norm_upper_bounds I0 I1 I2 x0 x1 x2 :
   holds I0 x0 -> holds I1 x1 -> holds I2 x2 ->
   sqrt (x0 * x0 + x1 * x1 + x2 * x2) <= norm_upper I0 I1 I2.

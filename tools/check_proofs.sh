@@ -79,7 +79,7 @@ if [ -n "$stale" ]; then
   echo "$stale" | awk -F'|' '{print "proofs: " $1 " \"" $2 "\": code hash " $3 ", proof states " $4}' >&2
   echo "proofs: FAILED: the code above changed since its theorem was checked against it" >&2; exit 1
 fi
-allowances="$root/optimized/include/gauss6/numeric/error_allowances.h"
+allowances="$root/optimized/gauss6/numeric/error_allowances.h"
 while IFS= read -r line; do
   name=$(sed -E 's/.*allowance ([A-Za-z0-9_]+) = (.*) \*\).*/\1/' <<<"$line")
   value=$(sed -E 's/.*allowance ([A-Za-z0-9_]+) = (.*) \*\).*/\2/' <<<"$line")

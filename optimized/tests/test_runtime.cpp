@@ -935,4 +935,8 @@ TEST_CASE("runtime: docs/sim-step.md states step 4's constants as the code defin
   stated("kMaxSettleShortenings", kMaxSettleShortenings);
   stated("kMaxKeepHalvings", kMaxKeepHalvings);
   stated("kSettleLeadSweep", kSettleLeadSweep);
+  // Budgeted updates (update_budget.h).
+  stated("kRecommendedUpdateCpuSeconds", kRecommendedUpdateCpuSeconds);
+  stated("kDefaultBudgetCheckInterval", static_cast<double>(kDefaultBudgetCheckInterval));
+  stated("kUpdateOverrunBound", kUpdateOverrunBound);
 }

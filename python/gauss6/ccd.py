@@ -1,6 +1,6 @@
 """Continuous collision detection from Python: per-query calls, and `gauss6 ccd queries`.
 
-Per query (the optimized narrow phase of optimized/include/gauss6/ccd/ccd.h, one call
+Per query (the optimized narrow phase of optimized/gauss6/ccd/ccd.h, one call
 each; the exact twin of reference/ccd.h beside it):
 
     from gauss6 import ccd
@@ -47,7 +47,7 @@ line and exact as arrays.
 
 The files are those of ../shared/data/ccd-sample-queries (the Tight-Inclusion
 benchmark format: 8 rows per query, exact rational coordinates, exact ground
-truth; read by the C++ reader, optimized/include/gauss6/io/ccd_queries.h). Every
+truth; read by the C++ reader, optimized/gauss6/io/ccd_queries.h). Every
 query runs through the linear-motion primitive of the chosen implementation:
 
 - optimized: ccd_linear_vertex_face / ccd_linear_edge_edge (conservative:

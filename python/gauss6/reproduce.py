@@ -41,8 +41,8 @@ import numpy as np
 from . import paths
 # gauss6 run's path; LOCKSTEP_RUNS, least_update_times and machine are part of this module's interface too.
 from .run import (COMMON_KEYS as RUN_KEYS, DEFINITIONS, LOCKSTEP_RUNS, _fmt, failures,  # noqa: F401
-                  least_update_times, machine, machine_line, report_footer, report_section, run_scene,
-                  summarize as summarize_run)
+                  least_update_times, machine, machine_line, report_footer, report_section,
+                  run_scene, summarize as summarize_run)
 
 SCENES = {
     "peg": paths.DATASETS_DIR / "scenes" / "peg_in_hole.toml",
@@ -165,7 +165,7 @@ def summarize(name: str, trace, run: dict, penetrating: int, threaded: bool) -> 
 
 def run_scenario(name: str, out: Path, threaded: bool = False, duration: float = -1.0,
                  lockstep_sim_period: int = 1, show_progress: bool = True, check_poses: bool = True,
-                 figure: bool = True) -> tuple[dict, dict]:
+                 figure: bool = True, budget_seconds: float = 0.0, budget_units: int = 0) -> tuple[dict, dict]:
     """Runs one scenario through `gauss6 run`'s path (run.run_scene: the trace, the lockstep repeats, the
     certification, the figure, the viewer page, in out); returns (summary entry, details) with the paper's
     figures and the scenario's own checks (scenario_checks)."""
@@ -173,7 +173,8 @@ def run_scenario(name: str, out: Path, threaded: bool = False, duration: float =
 
     s, extra = run_scene(SCENES[name], out, name=name, title=TITLES[name], threaded=threaded, duration=duration,
                          lockstep_sim_period=lockstep_sim_period, show_progress=show_progress,
-                         check_poses=check_poses, figure=figure, force_axes="YZ")  # the paper's figures' rows
+                         check_poses=check_poses, figure=figure, force_axes="YZ",  # the paper's figures' rows
+                         budget_seconds=budget_seconds, budget_units=budget_units)
     more, more_extra = scenario_checks(name, read_trace(out / f"{name}.g6trace"), extra["let_go_time"])
     s, extra = {**s, **more}, {**extra, **more_extra}
     _check_keys(name, s)
@@ -210,14 +211,16 @@ def write_report(out: Path, summary: dict, details: dict, wall: float, surfaces:
     return path
 
 
-def reproduce(which: str, out: Path, threaded: bool = False, show_progress: bool = True) -> dict:
+def reproduce(which: str, out: Path, threaded: bool = False, show_progress: bool = True,
+              budget_seconds: float = 0.0, budget_units: int = 0) -> dict:
     """Runs 'peg', 'bunny' or 'all'; writes the traces, figures, summary.json and report.md."""
     start = time.monotonic()
     names = ["peg", "bunny"] if which == "all" else ([] if which == "surfaces" else [which])
     out.mkdir(parents=True, exist_ok=True)
     summary, details = {}, {}
     for name in names:
-        summary[name], details[name] = run_scenario(name, out, threaded=threaded, show_progress=show_progress)
+        summary[name], details[name] = run_scenario(name, out, threaded=threaded, show_progress=show_progress,
+                                                    budget_seconds=budget_seconds, budget_units=budget_units)
     surfaces = None
     if which in ("all", "surfaces"):
         from .reproduce_surfaces import reproduce_surfaces

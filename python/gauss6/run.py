@@ -40,7 +40,14 @@ The numbers (also `gauss6 reproduce`'s, which runs the paper's scenes through th
                          the sum over coupling steps of max(0, au . Fc) (METHOD.md 5.4: au . Fc =
                          -kh |ac - au|_M^2 <= 0); the device-port passivity observer is in report.md
 The report also states the process's peak resident memory (ru_maxrss) after the runs and its growth
-over the run, per triangle of the scene.
+over the run, per triangle of the scene, and the force's continuity: the largest and the 99th percentile
+change of the force sent between successive haptic ticks (N).
+--budget-cpu S / --budget-units N run every god-object update under a budget (RuntimeSettings::budget,
+docs/sim-step.md "Budgeted updates"; --budget-cpu without a value: the recommended 0.4 ms); the report
+gives its statistics: the updates that ran out of it, the most in a row, the command they left to the
+next updates (distance from the target: travel plus turn times the god-object's radius), the most work
+units and CPU time of an update. A CPU budget's cut points depend on the machine's speed and load: such
+a lockstep run is not repeatable, and is run once (no least-of-repeats); a work-unit budget is.
 """
 from __future__ import annotations
 
@@ -123,12 +130,22 @@ def summarize(trace, run: dict, penetrating: int, threaded: bool) -> tuple[dict,
         "ticks_with_contacts": int(np.count_nonzero(ticks["num_contacts"] > 0)),
         "max_force_n": float(np.max(np.linalg.norm(ticks["wrench"][:, :3], axis=1))) if len(ticks) else 0.0,
         "let_go_time": run["let_go_time"],
+        "force_jump_n": force_jumps(ticks["wrench"]),
+        "budget": run["sim"]["budget"],
     }
     return s, extra
 
 
+def force_jumps(wrench: np.ndarray) -> dict:
+    """The force's continuity: the change of the force sent (N) between successive haptic ticks, max and p99."""
+    if len(wrench) < 2:
+        return {"max": 0.0, "p99": 0.0}
+    jump = np.linalg.norm(np.diff(np.asarray(wrench)[:, :3], axis=0), axis=1)
+    return {"max": float(jump.max()), "p99": float(np.percentile(jump, 99))}
+
+
 def least_update_times(name: str, scene: Path, trace, out: Path, duration: float, lockstep_sim_period: int,
-                       script: Path | None = None, progress=None) -> dict:
+                       script: Path | None = None, progress=None, budget_units: int = 0) -> dict:
     """The lockstep run again, LOCKSTEP_RUNS - 1 times: each must repeat `trace` tick for tick (handle, god-object,
     wrench; else RuntimeError), and each step's update time (CPU and wall) is the least over the runs."""
     from ._gauss6 import runtime
@@ -139,7 +156,8 @@ def least_update_times(name: str, scene: Path, trace, out: Path, duration: float
     try:
         for _ in range(LOCKSTEP_RUNS - 1):
             runtime.run_scenario(str(scene), str(repeat_path), threaded=False, duration=duration,
-                                 lockstep_sim_period=lockstep_sim_period, script=str(script or ""))
+                                 lockstep_sim_period=lockstep_sim_period, script=str(script or ""),
+                                 budget_units=budget_units)
             again = read_trace(repeat_path)
             for col in ("xh_p", "xh_q", "xs_p", "xs_q", "wrench"):
                 if not np.array_equal(again.ticks[col], trace.ticks[col]):
@@ -167,7 +185,8 @@ def _rss_bytes() -> int:
 def run_scene(scene: Path, out: Path, name: str | None = None, title: str | None = None, script: Path | None = None,
               threaded: bool = False, duration: float = -1.0, lockstep_sim_period: int = 1,
               show_progress: bool = True, check_poses: bool = True, figure: bool = True,
-              extra_json: dict | None = None, force_axes: str = "XYZ") -> tuple[dict, dict]:
+              extra_json: dict | None = None, force_axes: str = "XYZ", budget_seconds: float = 0.0,
+              budget_units: int = 0) -> tuple[dict, dict]:
     """Runs one scene (with `script`, a hand script file, instead of the scene's when given), writes its trace,
     certification, figure and viewer page into out; returns (summary entry: COMMON_KEYS, details).
     gauss6.LoadError for a scene or hand script that does not load (before anything runs)."""
@@ -193,16 +212,16 @@ def run_scene(scene: Path, out: Path, name: str | None = None, title: str | None
                                lockstep_sim_period=lockstep_sim_period, script=str(script or ""),
                                extra_json=json.dumps({"scenario": name, "mode": "threaded" if threaded else "lockstep",
                                                       "script": hand["origin"], **(extra_json or {})}),
-                               progress=progress)
+                               progress=progress, budget_seconds=budget_seconds, budget_units=budget_units)
     bar.close()
     with warnings.catch_warnings():
         warnings.simplefilter("error", TraceWarning)  # the writer closed cleanly: a warning is a bug
         trace = read_trace(trace_path)
     least = None
-    if not threaded:
+    if not threaded and budget_seconds == 0:
         lbar = progress_bar(LOCKSTEP_RUNS - 1, f"{name}: lockstep repeats", "run", show_progress)
         least = least_update_times(name, scene, trace, out, duration, lockstep_sim_period, script,
-                                   progress=lambda: lbar.update(1))
+                                   progress=lambda: lbar.update(1), budget_units=budget_units)
         lbar.close()
     memory = {"peak_rss_bytes": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * 1024,
               "rss_before_run_bytes": rss_before}
@@ -236,6 +255,9 @@ def run_scene(scene: Path, out: Path, name: str | None = None, title: str | None
                             {"kind": first.kind, "tick": first.tick, "t": first.t, "detail": first.detail}}
     extra["distinct_poses"] = int(len(distinct_poses(trace)))
     extra["mode"] = "threaded" if threaded else f"lockstep (sim step every {lockstep_sim_period} tick(s))"
+    if budget_seconds > 0 or budget_units > 0:
+        extra["mode"] += (f"; each update's budget: {budget_seconds * 1e3:g} ms of CPU" if budget_seconds > 0 else
+                          "; each update's budget:") + (f" {budget_units} work units" if budget_units > 0 else "")
     if figure:
         from .figures import plot_run
         from .view import write_view
@@ -332,6 +354,16 @@ def report_section(name: str, s: dict, d: dict, paper: dict | None = None) -> li
     row("device-port passivity observer max(W + V) (J); final",
         f"{_fmt(d['port_energy_max_j'])}; {_fmt(d['port_energy_final_j'])}")
     row("max force (N)", _fmt(d["max_force_n"]))
+    if "force_jump_n" in d:
+        row("the force's change between successive haptic ticks (N), p99 / max",
+            f"{_fmt(d['force_jump_n']['p99'])} / {_fmt(d['force_jump_n']['max'])}")
+    b = d.get("budget")
+    if b and b["max_work_units"] > 0:
+        row("budgeted updates: run out of their budget; the most in a row (ms at 1 kHz); the command left "
+            "to the next updates (mm, max / mean); the most work units and CPU time (ms) of an update",
+            f"{b['exhausted']} of {b['updates']}; {b['longest_run']}; "
+            f"{_fmt(b['deferred_max'] * 1e3)} / {_fmt(b['deferred_sum'] * 1e3 / max(b['exhausted'], 1))}; "
+            f"{b['max_work_units']}, {_fmt(b['max_cpu'] * 1e3)}")
     if "mass_kg" in d:
         row("god-object mass (kg); the coupling's stiffness kh M (N/m: the force is about kh M ks times how far the "
             "hand is past the contact)", f"{_fmt(d['mass_kg'])}; {_fmt(d['coupling_stiffness_n_per_m'])}")
@@ -386,7 +418,8 @@ def cmd_run(args: argparse.Namespace) -> int:
             raise ValueError(f"{scene}: no such scene file")
         summary, details = run_scene(scene, out, name=args.name, script=script, threaded=args.threaded,
                                      duration=args.duration, show_progress=not args.quiet,
-                                     check_poses=not args.no_certify)
+                                     check_poses=not args.no_certify, budget_seconds=args.budget_cpu or 0.0,
+                                     budget_units=args.budget_units)
     except (LoadError, ValueError) as e:
         print(f"gauss6 run: error: {e}", file=sys.stderr)
         return 2
@@ -419,5 +452,33 @@ def register(subparsers) -> None:
     p.add_argument("--name", help="the run's name in the output files (default: the scene file's stem)")
     p.add_argument("--no-certify", action="store_true",
                    help="skip the exact certification (slow on large scenes); the report says so")
+    add_budget_arguments(p)
     p.add_argument("--quiet", action="store_true", help="no progress bars")
     p.set_defaults(func=cmd_run)
+
+
+def add_budget_arguments(p: argparse.ArgumentParser) -> None:
+    """--budget-cpu [S] and --budget-units N (gauss6 run, gauss6 reproduce)."""
+    p.add_argument("--budget-cpu", type=_budget_seconds, nargs="?", const=RECOMMENDED_BUDGET_S, default=None,
+                   metavar="S", help="each god-object update's CPU budget in seconds (alone: the recommended "
+                   f"{RECOMMENDED_BUDGET_S * 1e3:g} ms; docs/sim-step.md, \"Budgeted updates\")")
+    p.add_argument("--budget-units", type=_budget_units, default=0, metavar="N",
+                   help="each god-object update's budget in work units (deterministic: repeats bit for bit)")
+
+
+# The recommended CPU budget of an update (update_budget.h kRecommendedUpdateCpuSeconds; a test keeps them equal).
+RECOMMENDED_BUDGET_S = 0.4e-3
+
+
+def _budget_seconds(text: str) -> float:
+    v = float(text)
+    if not (v > 0 and v < 1):
+        raise argparse.ArgumentTypeError(f"{text}: a CPU budget is in seconds, > 0 and < 1")
+    return v
+
+
+def _budget_units(text: str) -> int:
+    v = int(text)
+    if v < 1:
+        raise argparse.ArgumentTypeError(f"{text}: a budget in work units is >= 1")
+    return v

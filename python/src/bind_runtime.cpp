@@ -86,6 +86,11 @@ py::dict loop_dict(const LoopStats& s) {
   for (int k = 0; k < kNumRuntimeEventKinds; ++k)
     if (s.event_counts[k]) events[to_string(static_cast<RuntimeEventKind>(k))] = s.event_counts[k];
   d["events"] = events;
+  const BudgetStats& b = s.budget;
+  d["budget"] = py::dict(py::arg("updates") = b.updates, py::arg("exhausted") = b.exhausted,
+                         py::arg("longest_run") = b.longest_run, py::arg("deferred_max") = b.deferred_max,
+                         py::arg("deferred_sum") = b.deferred_sum, py::arg("max_work_units") = b.max_work_units,
+                         py::arg("max_cpu") = b.max_cpu);
   return d;
 }
 
@@ -199,7 +204,7 @@ py::dict hand_script(const std::string& scene_path, const std::string& script_pa
 py::dict run(const std::string& scene_path, const std::string& trace_path, bool threaded, double duration,
              int lockstep_sim_period, const std::string& extra_json, const std::function<void(double)>& progress,
              double rate_hz, int realtime_priority, bool pin_threads, double hold_until, int max_contacts,
-             double spin_wait, const std::string& script_path) {
+             double spin_wait, const std::string& script_path, double budget_seconds, long budget_units) {
   Scene scene = load(scene_path);
   if (rate_hz != 0) {
     if (!(rate_hz >= 1 && rate_hz <= 1e5)) throw py::value_error("rate_hz must be in [1, 1e5] (0: the scene's)");
@@ -214,6 +219,8 @@ py::dict run(const std::string& scene_path, const std::string& trace_path, bool 
   options.runtime.realtime_priority = realtime_priority;
   options.runtime.pin_threads = pin_threads;
   options.runtime.spin_wait = spin_wait;  // checked by the RuntimeModel ([0, 1] s): a ValueError naming it
+  options.runtime.budget.cpu_seconds = budget_seconds;  // (checked likewise: update_budget_settings_problem)
+  options.runtime.budget.work_units = budget_units;
   const ScenarioResult r = run_released([&] { return run_scenario(scene, script, options); });
   py::dict d = result_dict(r, script.phases);
   d["let_go_time"] = script.let_go_time;
@@ -319,6 +326,7 @@ void bind_runtime(py::module_& parent) {
         py::arg("progress") = nullptr, py::arg("rate_hz") = 0.0, py::arg("realtime_priority") = 0,
         py::arg("pin_threads") = false, py::arg("hold_until") = -1.0,
         py::arg("max_contacts") = kDefaultMaxContacts, py::arg("spin_wait") = 0.0, py::arg("script") = "",
+        py::arg("budget_seconds") = 0.0, py::arg("budget_units") = 0L,
         "Runs the scene with its hand script (or the JSON file `script` in its place) (lockstep by default, or threaded) and writes the trace. Returns a dict "
         "of run statistics and property checks (orthogonality, constraint energy, passivity observer). "
         "progress(run_time_s) is called about every 0.2 s of wall time. rate_hz overrides the scene's haptic rate "
@@ -326,7 +334,9 @@ void bind_runtime(py::module_& parent) {
         "outcome in its dict: realtime 1 applied / 0 not asked / -errno, pinned_cpu, pin_error); hold_until (s): "
         "the hand holds still after the script until then. max_contacts: RuntimeSettings::max_contacts, the "
         "contact capacity of the loops (a larger set is truncated and reported as contact_overflow). spin_wait (s, "
-        "in [0, 1]): RuntimeSettings::spin_wait, the haptic loop's busy wait before each tick (threaded runs).");
+        "in [0, 1]): RuntimeSettings::spin_wait, the haptic loop's busy wait before each tick (threaded runs). budget_seconds, "
+        "budget_units: RuntimeSettings::budget, each god-object update's CPU time and work units (0: none; "
+        "update_budget.h); its statistics in the sim loop's dict (budget).");
   m.def("hand_script", &hand_script, py::arg("scene"), py::arg("script") = "",
         "The hand script a run of the scene follows (the scene's, or the JSON file `script`): a dict of origin (the "
         "file, or the scene's [device.script] table), num_keys, start_time, end_time, let_go_time (< 0: none) and "

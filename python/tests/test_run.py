@@ -234,3 +234,32 @@ def test_threaded_without_certification_says_so(scene_dir, tmp_path):
     assert details["mode"] == "threaded" and "update_least" not in details and "certify" not in details
     report = (tmp_path / "report.md").read_text()
     assert "not run (--no-certify)" in report and "not checked" in report
+
+
+def test_a_budgeted_run_is_certified_and_reports_its_budget(scene_dir, tmp_path):
+    # A work-unit budget small enough that some updates of the landing and the slide run out of it:
+    # certified all the same, its cost in the report.
+    r = run_cli("run", str(scene_dir / "scene.toml"), "--out", str(tmp_path), "--quiet",
+                "--budget-units", str(BUDGET_UNITS), "--duration", "0.6")
+    assert r.returncode == 0, r.stderr
+    details = json.loads((tmp_path / "details.json").read_text())["scene"]
+    assert details["certify"]["certified"]
+    b = details["budget"]
+    assert b["exhausted"] > 0 and b["deferred_max"] > 0 and b["longest_run"] >= 1
+    assert "update_least" in details  # a work-unit budget repeats bit for bit: the repeats ran
+    assert "work units" in details["mode"]
+    report = (tmp_path / "report.md").read_text()
+    assert "run out of their budget" in report and "between successive haptic ticks" in report
+
+
+BUDGET_UNITS = 100
+
+
+def test_the_recommended_budget_is_the_libraries(scene_dir, tmp_path):
+    from gauss6 import paths
+
+    header = (paths.REPO_ROOT / "optimized/gauss6/step/update_budget.h").read_text()
+    line = next(l for l in header.splitlines() if "kRecommendedUpdateCpuSeconds =" in l)
+    assert float(line.split("=")[1].strip().rstrip(";")) == run_mod.RECOMMENDED_BUDGET_S
+    r = run_cli("run", str(scene_dir / "scene.toml"), "--out", str(tmp_path), "--budget-cpu", "2")
+    assert r.returncode == 2 and "a CPU budget is in seconds" in r.stderr

@@ -18,6 +18,9 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
     rep.add_argument("--out", required=True, type=output_dir, help="output directory")
     rep.add_argument("--threaded", action="store_true", help="real threads and the wall clock (default: lockstep)")
     rep.add_argument("--quiet", action="store_true", help="no progress bars")
+    from ..run import add_budget_arguments
+
+    add_budget_arguments(rep)  # (the paper's scenes; the surface scenes run unbudgeted)
     rep.add_argument("--slice", type=run_seconds, default=None,
                      help="engines: run only the first S seconds of each script (default: whole)")
     return rep
@@ -31,7 +34,8 @@ def run(args: argparse.Namespace) -> int:
     from ..reproduce import reproduce
     from ..run import failures
 
-    summary = reproduce(args.scenario, Path(args.out), threaded=args.threaded, show_progress=not args.quiet)
+    summary = reproduce(args.scenario, Path(args.out), threaded=args.threaded, show_progress=not args.quiet,
+                        budget_seconds=args.budget_cpu or 0.0, budget_units=args.budget_units)
     print(json.dumps(summary, indent=2))
     details = json.loads((Path(args.out) / "details.json").read_text())
     problems = [p for n in details for p in failures(n, summary[n], details[n])]  # gauss6 run's rule

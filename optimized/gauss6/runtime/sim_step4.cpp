@@ -26,6 +26,8 @@ GodObjectStep::GodObjectStep(const RuntimeModel& model)
   // The legs of one update share their descents' cuts (cleared at each update).
   legs_ws.front.carry = true;
   check_ws.front.carry = true;
+  // Every CCD of an update charges its budget, when it has one.
+  legs_ws.budget = check_ws.budget = model.settings.budget.active() ? &budget : nullptr;
 }
 
 namespace {
@@ -58,7 +60,10 @@ bool ccd_leg(const RuntimeModel& model, const Pose& x0, const Pose& x1, bool fil
   CcdStepResult& r = leg.ccd;
   CcdStepRequest request{x0, x1, g->hints.data(), g->num_hints};
   request.fill_cache = fill;
-  request.lead_sweep = settling ? kSettleLeadSweep : 0.0;
+  // A settling leg, or any leg after an update that ran out of its budget (its
+  // command grew while the god-object lagged: proven piece by piece from the
+  // start, each cheap, the update goes as far as its budget proves).
+  request.lead_sweep = settling || g->budget_ran_out ? kSettleLeadSweep : 0.0;
   leg.from = x0;
   leg.one_piece = true;
   // Run 0: the whole motion; on a half turn, run 1 its first half, and run 2
@@ -270,7 +275,7 @@ bool first_leg(const RuntimeModel& model, const Pose& x_start, const Pose& targe
     serve_proven(model, u, g);
   } else {
     moved = ccd_leg(model, x_start, target, /*fill=*/k == 0, /*settling=*/false, g, &info->num_halves);
-    if (moved && k == 0 && grazed(model, contacts, *g)) {
+    if (moved && k == 0 && !g->budget.exhausted() && grazed(model, contacts, *g)) {
       g->paths.grazed = true;
       g->paths.lifted = lift_out_of_graze(model, x_start, target, M, contacts, g, &info->num_halves);
     }
@@ -305,6 +310,29 @@ bool settle(const RuntimeModel& model, const Pose& x_start, const Vec6& residual
   return true;
 }
 
+// Budgeted updates (docs/sim-step.md): once the budget ran out, every later CCD
+// of the update stops at once (a detour is then refused, a check not free)
+// and the schedule ends at the leg it stands on: the first leg's stop pose at
+// the end of what its CCD proved free (or the first leg's end, after a
+// refused settle), the contact set already taken there. A stop on the budget
+// is no contact: the step is kContact only when that set is not empty. The
+// update's work, and what of the command it left for the next ones (the
+// distance of xs from x_target: travel plus turn times the god-object's radius).
+void end_on_budget(const RuntimeModel& model, const Pose& x_target, const ContactSet& contacts, GodObjectStep* g,
+                   SimStepInfo* info) {
+  info->work_units = g->budget.used();
+  info->budget_exhausted = false;
+  info->budget_deferred = 0;
+  g->budget_ran_out = g->budget.exhausted();
+  if (!g->budget.exhausted()) return;
+  info->budget_exhausted = true;
+  if (g->leg.ccd.budget_exhausted)
+    info->status = contacts.num_contacts > 0 ? SimStepStatus::kContact : SimStepStatus::kFree;
+  const Vec6 left = pose_difference(x_target, info->xs);
+  info->budget_deferred = left.head<3>().norm() + left.tail<3>().norm() * model.god_radius;
+  g->events |= event_bit(RuntimeEventKind::kUpdateBudgetExhausted);
+}
+
 }  // namespace
 
 void advance_god_object(const RuntimeModel& model, const Pose& x_start, const Pose& x_target, const Vec6& residual,
@@ -318,6 +346,7 @@ void advance_god_object(const RuntimeModel& model, const Pose& x_start, const Po
   info->num_halves = 1;
   g.paths = StepPaths{};
   g.events = 0;
+  g.budget.start(model.settings.budget);
   // The descents' cuts serve this update's legs (DescentFront): a cut only
   // refines, so none outlives the update that made it.
   g.legs_ws.front.clear();
@@ -337,6 +366,7 @@ void advance_god_object(const RuntimeModel& model, const Pose& x_start, const Po
       info->num_shortenings = k;
       const bool moved = first_leg(model, x_start, target, k, u, M, *contacts, &g, info);
       update_contacts(model, &g, contacts);
+      if (g.budget.exhausted()) break;  // the first leg's proven end (end_on_budget)
       // Settling leg: the linearised constraints J a >= 0 hold to first order
       // only, so a motion along a contact's tangent plane lifts off a surface
       // that curves or creases away under it: the god-object moves on by what
@@ -345,6 +375,7 @@ void advance_god_object(const RuntimeModel& model, const Pose& x_start, const Po
       if (!(lifted_off && settling)) break;
       if (u == 1 && servable(g.leg, x_start)) keep_proven(&g);
       if (settle(model, x_start, residual, &g, contacts, info)) break;
+      if (g.budget.exhausted()) break;  // the refused settle: back at the first leg's end, its contacts
       info->u_hit = g.leg.ccd.u_hit;  // back at the first leg's end
       if (k == kMaxSettleShortenings && !servable(g.leg, x_start)) {
         stay_at_start(model, x_start, &g, contacts, info);
@@ -369,6 +400,7 @@ void advance_god_object(const RuntimeModel& model, const Pose& x_start, const Po
   }
   info->xs = g.leg.xs;
   info->num_contacts = contacts->num_contacts;
+  end_on_budget(model, x_target, *contacts, &g, info);
 }
 
 }  // namespace gauss6

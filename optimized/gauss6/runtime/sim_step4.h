@@ -25,6 +25,7 @@
 #include "gauss6/geometry/pose.h"
 #include "gauss6/runtime/runtime_events.h"
 #include "gauss6/runtime/runtime_model.h"
+#include "gauss6/step/update_budget.h"
 
 namespace gauss6 {
 
@@ -78,7 +79,9 @@ struct GodObjectStep {
   ProjectionWorkspace lift_ws;
   ProjectionResult lift;
   StepPaths paths;
-  uint32_t events = 0;                // this step's events (event_bit: kContactOverflow)
+  uint32_t events = 0;                // this step's events (event_bit: kContactOverflow, kUpdateBudgetExhausted)
+  UpdateBudget budget;                // the update's (RuntimeSettings::budget; docs/sim-step.md, "Budgeted updates")
+  bool budget_ran_out = false;        // the last update's did: this one's first leg searches in lead pieces
 };
 
 // Step 4 of a sim step, from its inputs (SimStepInfo::x_start, x_target,
@@ -95,7 +98,9 @@ struct GodObjectStep {
 // last try), u_hit, num_halves, status, xs and num_contacts, and g->paths and
 // g->events. Real time: no allocation; at most 5 CCDs a try (two a leg, split
 // at a half turn, and one check) over 1 + kMaxSettleShortenings tries, and 3
-// more out of a graze.
+// more out of a graze. Under a budget (RuntimeSettings::budget) the update
+// ends when it runs out, at the end of what its CCDs proved free, with the
+// contact set there (info's budget_exhausted, work_units, budget_deferred).
 void advance_god_object(const RuntimeModel& model, const Pose& x_start, const Pose& x_target, const Vec6& residual,
                         const Mat6& M, ContactSet* contacts, GodObjectStep* g, SimStepInfo* info) noexcept;
 

@@ -20,6 +20,7 @@ const char* to_string(RuntimeEventKind k) {
     case RuntimeEventKind::kDeviceNotConnected: return "device_not_connected";
     case RuntimeEventKind::kDeviceWriteFailed: return "device_write_failed";
     case RuntimeEventKind::kHapticStalled: return "haptic_stalled";
+    case RuntimeEventKind::kUpdateBudgetExhausted: return "update_budget_exhausted";
   }
   return "unknown";
 }

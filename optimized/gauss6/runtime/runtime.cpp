@@ -34,6 +34,7 @@ void run_sim_step(const RuntimeModel& model, double t, const RuntimeObserver& ob
   const SimStepInfo& info = sim_step(model, t, &data->channels, &data->sim);
   data->stats.sim.add_start(t);
   data->stats.sim.work.add(info.update_seconds);
+  data->stats.sim.budget.add(info);
   uint32_t events = data->sim.step_events;
   if (info.ccd != CcdStatus::kOk) events |= event_bit(RuntimeEventKind::kCcdGaveUp);
   if (projection_failed(info.projection)) events |= event_bit(RuntimeEventKind::kProjectionFailed);

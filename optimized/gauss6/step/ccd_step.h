@@ -29,6 +29,7 @@
 #include "gauss6/step/near_pairs.h"
 #include "gauss6/geometry/pose.h"
 #include "gauss6/step/proximity_cache.h"
+#include "gauss6/step/update_budget.h"
 
 namespace gauss6 {
 
@@ -113,6 +114,11 @@ struct CcdStepResult {
   bool cache_refilled = false;             // a background fill of the cache was completed and put in use
   int num_fill_node_pairs = 0;             // node pairs that the cache's fills (at once or in the background) tested
   double u_cached = 0;                     // [0, u_cached] searched from the proximity cache (0: not used)
+  // The update's budget (CcdStepWorkspace::budget) ran out in this step or before it: the step stopped
+  // at the end of what it had proven, a conservative hit at u_hit with no pair (pair FeaturePair{},
+  // distance_reached NaN), unless the first contact was already found (then hit, u_hit and pair are
+  // that contact's). status stays kOk: nothing was given up, only left for the next update.
+  bool budget_exhausted = false;
 };
 
 // The cut where a descent of the trees stopped (resume_candidate_pairs: the
@@ -245,6 +251,9 @@ struct CcdStepWorkspace {
   // never fills, refills or otherwise changes it (the runtime's check of a
   // settling step's direct motion borrows the legs' list). nullptr: none.
   const ProximityCache* borrowed = nullptr;
+  // The god-object update's budget (update_budget.h), charged with the work the steps run here do;
+  // once it has run out a step searches no further (CcdStepResult::budget_exhausted). nullptr: none.
+  UpdateBudget* budget = nullptr;
 };
 
 // The first contact of the god-object moving from X0 to X1 (the Cayley motion)

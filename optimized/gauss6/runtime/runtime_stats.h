@@ -20,6 +20,20 @@ struct DurationStats {
   void add(double seconds);
 };
 
+// The god-object updates' budget (RuntimeSettings::budget, docs/sim-step.md):
+// how often it ran out, for how many updates in a row, what it left of the
+// command, and the updates' CPU time and work against it.
+struct BudgetStats {
+  long updates = 0;                    // updates recorded (add)
+  long exhausted = 0;                  // ... that ran out of their budget
+  long longest_run = 0;                // most updates in a row that ran out
+  long run = 0;                        // internal: the current run
+  double deferred_max = 0, deferred_sum = 0;  // SimStepInfo::budget_deferred over the updates that ran out
+  long max_work_units = 0;             // SimStepInfo::work_units, max
+  double max_cpu = 0;                  // SimStepInfo::update_cpu_seconds, max (s): the whole sim step
+  void add(const SimStepInfo& info);
+};
+
 // One loop's statistics, written only by the thread that runs the loop. In
 // lockstep runs, periods are virtual (exact) and work times are real.
 struct LoopStats {
@@ -29,6 +43,7 @@ struct LoopStats {
   double max_jitter = 0;               // paced loops: max |actual start - scheduled start| (s)
   long overruns = 0;                   // paced loops: starts more than one period late (the schedule then resyncs)
   long event_counts[kNumRuntimeEventKinds] = {};  // events reported by this loop (onsets)
+  BudgetStats budget;                  // the sim loop: its updates' budget
   // Threaded runs (RuntimeSettings::realtime_priority, pin_threads): 1 SCHED_FIFO applied at
   // realtime_priority_applied, 0 not asked, -errno refused (EPERM: no CAP_SYS_NICE, no RT budget);
   // pinned_cpu the CPU the thread is bound to (-1: not pinned), pin_error -errno when refused.

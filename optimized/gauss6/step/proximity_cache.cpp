@@ -112,6 +112,7 @@ bool fill_some(StepState* s, long budget) {
     const TraversalStatus ts = traverse(*s, frame, enc, pf.swept, 0.0, fill_dist, pf.obstacle, &pf.stack, &pf.pending,
                                         budget, &used, [&](int gf, int of, int o) {
       double radius = 0;
+      charge(s, Work::kTrianglePair, 1);  // (the chunks' ends check: fill_within_budget)
       const double gap = frame.gap(frame.posed_face(*god.mesh, gf, &pf.swept), *s->obstacles[o].mesh, of, fill_dist,
                                    &radius);
       if (gap > fill_dist) return true;
@@ -136,6 +137,30 @@ bool fill_some(StepState* s, long budget) {
   return true;
 }
 
+// The list's index by gap (ProximityCache::by_gap): a counting sort of its
+// ids into kGapBuckets buckets, stable (each bucket in increasing id order).
+int gap_bucket(const ProximityCache& pc, double gap) {
+  const double b = gap / pc.gap_width;  // (NaN, negative: the first)
+  return b >= ProximityCache::kGapBuckets - 1 ? ProximityCache::kGapBuckets - 1 : (b > 0 ? static_cast<int>(b) : 0);
+}
+void index_by_gap(ProximityCache* pc) {
+  constexpr int K = ProximityCache::kGapBuckets;
+  pc->gap_width = (pc->reach + pc->margin) / K;
+  pc->max_radius = 0;
+  int count[K + 1] = {};
+  for (int k = 0; k < pc->num_pairs; ++k) {
+    const ProximityCache::Pair& c = pc->pairs[static_cast<size_t>(k)];
+    ++count[gap_bucket(*pc, c.gap) + 1];
+    pc->max_radius = std::max(pc->max_radius, c.radius);
+  }
+  for (int b = 0; b < K; ++b) count[b + 1] += count[b];
+  std::copy(count, count + K + 1, pc->bucket_begin);
+  for (int k = 0; k < pc->num_pairs; ++k) {
+    const int b = gap_bucket(*pc, pc->pairs[static_cast<size_t>(k)].gap);
+    pc->by_gap[static_cast<size_t>(count[b]++)] = k;
+  }
+}
+
 void put_fill(StepState* s) {
   ProximityCache& pc = s->ws->cache;
   ProximityCache::Fill& pf = pc.fill;
@@ -149,7 +174,25 @@ void put_fill(StepState* s) {
   pc.god = s->god;
   pc.obstacles.assign(s->obstacles, s->obstacles + s->num_obstacles);
   pc.uses = 0;
+  pc.budget_cut = false;
   pf.active = false;
+  index_by_gap(&pc);
+}
+
+// The ids of the list's pairs that a step whose points move at most `moving`
+// from the list's pose may bring within the reach, in list order, into
+// ids (near_ids): the buckets whose gaps start below reach + the largest
+// move (and the next, for the rounding of the bucket's index); a pair of a
+// later bucket is farther apart than that (each pair is checked again).
+int near_pairs_of(const ProximityCache& pc, const Displacement& moving, double reach, std::vector<int32_t>* ids) {
+  const double reached = (Upper{reach} + Upper{moving.bound(pc.max_radius)}).v;
+  constexpr int K = ProximityCache::kGapBuckets;
+  const int last = reached <= std::numeric_limits<double>::max() ? std::min(gap_bucket(pc, reached) + 1, K - 1)
+                                                                   : K - 1;  // (infinite, NaN: every bucket)
+  const int n = pc.bucket_begin[last + 1];
+  std::copy(pc.by_gap.begin(), pc.by_gap.begin() + n, ids->begin());
+  std::sort(ids->begin(), ids->begin() + n);
+  return n;
 }
 
 // The ranges of the step's start that a list can serve.
@@ -193,7 +236,7 @@ void take_background_fill(StepState* s, const CacheRanges& r, Displacement* sinc
   const bool needed = !r.usable(s->u_cached) && r.usable(r.range(moved_ahead, pf.margin));
   if (!r.usable(s->u_cached) && !needed) {
     pf.active = false;  // the god-object went elsewhere
-  } else if ((better && pf.complete) || (needed && fill_some(s, std::numeric_limits<long>::max()))) {
+  } else if ((better && pf.complete) || (needed && fill_within_budget(s, std::numeric_limits<long>::max()))) {
     put_fill(s);
     s->result->cache_refilled = true;
     *since = ahead;
@@ -219,7 +262,9 @@ void refill_if_worth(StepState* s, const CacheRanges& r, Displacement* since) {
   const double fresh_margin =
       list_margin(*s, pc.has_last ? Displacement(pc.last_x0, s->X0).bound(rho) : 0.0, margin, step_margin_max(*s));
   bool fill = !fresh && r.usable(r.range(Displacement(s->X0, s->X0).bound(rho), fresh_margin));
-  if (fill && s->start.speed <= policy(*s).slow_fraction * margin) {
+  if (fill && pc.budget_cut && pc.fill.active) {
+    fill = false;  // the fill the budget cut short goes on (take_background_fill)
+  } else if (fill && s->start.speed <= policy(*s).slow_fraction * margin) {
     pc.rest = 0;
   } else if (fill && pc.rest > 0) {
     fill = --pc.rest == 0;
@@ -229,7 +274,17 @@ void refill_if_worth(StepState* s, const CacheRanges& r, Displacement* since) {
   }
   if (!fill) return;
   start_fill(s, /*ahead=*/nullptr, fresh_margin);
-  const bool filled = fill_some(s, std::numeric_limits<long>::max());
+  const bool filled = fill_within_budget(s, std::numeric_limits<long>::max());
+  // A fill the update's budget cut short goes on at the next updates as a
+  // background fill (while the list in use keeps the keys: take_background_fill
+  // finishes it, within their budgets, and puts it in use), and none starts
+  // at once meanwhile: no update spends its budget on the same fill again.
+  // Without a list in use (the first fill) it is dropped.
+  if (!filled && out_of_budget(*s) && pc.fill.active && pc.num_pairs >= 0) {
+    pc.budget_cut = true;
+    s->u_cached = 0;
+    return;
+  }
   pc.clear();
   s->u_cached = 0;
   s->cache_keyed = false;
@@ -262,9 +317,15 @@ void search_cached_pairs(StepState* s, const ProximityCache& pc, const Displacem
   Displacement moving = since;
   moving.add(s->start, s->u_cached);
   int num_cand = 0;
-  for (int k = 0; k < pc.num_pairs; ++k) {
-    const ProximityCache::Pair& c = pc.pairs[static_cast<size_t>(k)];
+  std::vector<int32_t>& ids = s->ws->cache.near_ids;  // this workspace's (pc may be borrowed)
+  const int num_near = near_pairs_of(pc, moving, s->reach, &ids);
+  for (int i = 0; i < num_near; ++i) {
+    const ProximityCache::Pair& c = pc.pairs[static_cast<size_t>(ids[static_cast<size_t>(i)])];
     ++result->num_triangle_pairs;
+    if (charge(s, Work::kTrianglePair, 1)) {  // nothing of [u0, u_cached] proven, the candidates' buffer in part
+      result->num_near_pairs = -1;
+      return stop_on_budget(s, u0);
+    }
     if (Lower{c.gap} - Upper{moving.bound(c.radius)} > Upper{s->reach}) {
       ++result->num_axis_culls;
       continue;
@@ -278,10 +339,25 @@ void search_cached_pairs(StepState* s, const ProximityCache& pc, const Displacem
     cand[num_cand++] = {{c.god_face, c.obstacle_face, c.obstacle}, t};  // fits: the cache has cand's capacity
   }
   set_near_pairs(s, num_cand, 0.0);
-  test_candidates(s, num_cand);
+  test_candidates(s, num_cand);  // (the budget's end: stop_on_budget)
 }
 
 }  // namespace
+
+// Node pairs a fill descends between two charges to the update's budget.
+constexpr long kFillChunk = 64;
+bool fill_within_budget(StepState* s, long max_node_pairs) {
+  if (s->ws->budget == nullptr) return fill_some(s, max_node_pairs);
+  const ProximityCache::Fill& pf = s->ws->cache.fill;
+  for (long left = max_node_pairs; left > 0 && !out_of_budget(*s);) {
+    const long cost = pf.cost;
+    const bool complete = fill_some(s, std::min(left, kFillChunk));
+    left -= pf.cost - cost;
+    charge(s, Work::kNodePair, pf.cost - cost);
+    if (complete || !pf.active) return complete;  // done, or dropped (does not fit)
+  }
+  return false;
+}
 
 // Coherence (proximity_cache.h): [0, u_cached] is the range
 // over which no point moves farther than the margin from the cache's pose;
@@ -376,9 +452,10 @@ void fill_cache_in_background(StepState* s) {
         start_fill(s, &ahead, m);
       }
     }
-    if (pf.active && !pf.complete) fill_some(s, settings.cache.fill_budget);
+    if (pf.active && !pf.complete) fill_within_budget(s, settings.cache.fill_budget);
   }
   // The next step's background fill and list margin follow this step's motion.
+  pc.budget_cut = pc.budget_cut && out_of_budget(*s);  // this step's search completed within its budget
   pc.last_x0 = X0;
   pc.has_last = true;
 }

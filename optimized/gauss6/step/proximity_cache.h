@@ -5,7 +5,7 @@
 // (ProximityCacheSettings: the margins, the background fill's budget and the
 // named policy constants) and its storage (ProximityCache, allocated once).
 // The stages that serve, refill and fill it in the background are in
-// src/step/proximity_cache.cpp; the step calls them (src/step/ccd_step.cpp).
+// gauss6/step/proximity_cache.cpp; the step calls them (gauss6/step/ccd_step.cpp).
 //
 // Lengths in scene units; the runtime states its margins in units of the
 // scene's delta (RuntimeSettings) and resolves them here.
@@ -30,7 +30,7 @@ struct ProximityCacheSettings {
                             // (0: every list's margin is `margin`; the runtime uses 256 delta)
   long fill_budget = 0;     // node pairs per step that fill the next list in the background while the
                             // one in use serves (0: no background fill; the runtime uses 300)
-  // The policy, dimensionless (src/step/proximity_cache.cpp states where each acts).
+  // The policy, dimensionless (gauss6/step/proximity_cache.cpp states where each acts).
   double steps_per_list = 6;       // a new list's margin spans about this many steps like the last one
   double slow_fraction = 0.25;     // a step that moves at most this fraction of the margin refills at once;
                                    // a first search from the list covers at most the range over which no
@@ -61,6 +61,8 @@ bool valid_proximity_cache_settings(const ProximityCacheSettings& s);
 struct ProximityCache {
   ProximityCache(int capacity, int stack_capacity, int obstacle_capacity)
       : pairs(static_cast<size_t>(std::max(capacity, 0))),
+        by_gap(static_cast<size_t>(std::max(capacity, 0))),
+        near_ids(static_cast<size_t>(std::max(capacity, 0))),
         fill(std::max(capacity, 0), stack_capacity),
         obstacle_capacity(std::max(obstacle_capacity, 0)) {
     obstacles.reserve(static_cast<size_t>(this->obstacle_capacity));
@@ -75,11 +77,28 @@ struct ProximityCache {
   };
   std::vector<Pair> pairs;
   int num_pairs = -1;            // -1: empty (never filled, or the pairs did not fit)
+  // The list's pairs by gap, indexed when it is put in use: the ids of
+  // pairs[0 .. num_pairs) in kGapBuckets buckets of gap_width each over
+  // [0, reach + margin] (the last takes the rest), each in increasing id order
+  // (bucket k: by_gap[bucket_begin[k] .. bucket_begin[k + 1])), and the
+  // largest radius of its pairs: a step searches only the buckets that can
+  // hold a pair within its reach, not the whole list (a list grows faster than
+  // the meshes: pairs within a margin of delta's per area, the square of the
+  // triangles' density once the margin outgrows them). near_ids: a step's
+  // ids, put back in list order (the same candidates in the same order as a
+  // scan of the whole list).
+  static constexpr int kGapBuckets = 16;
+  std::vector<int32_t> by_gap, near_ids;
+  int bucket_begin[kGapBuckets + 1] = {};
+  double gap_width = 0, max_radius = 0;
   Pose ref;
   double reach = 0, margin = 0;  // margin: this list's
   double margin_min = 0, margin_max = 0;  // the settings it was filled under (keys)
   int uses = 0;  // later steps served since the fill
   int rest = 0;  // chances to refill still to pass over (ProximityCacheSettings::skip_after_poor_fill)
+  bool budget_cut = false;  // a fill at once was cut short by an update's budget: it goes on in the
+                            // background, and no other starts at once, until it is put in use or a step's
+                            // search completes within its budget
   CcdBody god;
   std::vector<CcdBody> obstacles;  // the keys; capacity obstacle_capacity, reserved here (never grows)
   // A fill in progress (ProximityCacheSettings::fill_budget): the same kind

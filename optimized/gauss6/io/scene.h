@@ -91,7 +91,7 @@ struct Scene {
 };
 
 // The rules a scene's settings must meet (docs/scene-format.md, "Rules"), stated
-// once (src/io/scene_rules.cpp, in the core): the loader applies them and names the
+// once (gauss6/io/scene_rules.cpp, in the core): the loader applies them and names the
 // file, line and key; the runtime model (runtime_model.h) applies them to any
 // Scene, one built in code included. Each check returns the first broken rule, or an
 // empty problem when every rule holds. NaN and infinities break every rule.
@@ -103,7 +103,7 @@ struct SettingsProblem {
   std::string message() const { return table + "." + key + ": " + problem; }  // "gains.kh: must be > 0"
 };
 // Coordinates (positions, mesh vertices, in the world frame too) beyond this are
-// refused: the CCD's pair tests refuse coordinates beyond 1e30 (src/ccd/ccd.cpp);
+// refused: the CCD's pair tests refuse coordinates beyond 1e30 (gauss6/ccd/ccd.cpp);
 // 1e12 leaves room for poses and motions.
 inline constexpr double kMaxSceneCoordinate = 1e12;
 SettingsProblem check_gains(const Gains& gains);                         // 0 < ks <= 1, kh > 0

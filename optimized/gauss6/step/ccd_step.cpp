@@ -131,8 +131,10 @@ void search_hints(StepState* s) {
                        f.obstacle_face < s->obstacles[f.obstacle].mesh->F.rows();
     if (!valid || among(hints, h, f.god_face, f.obstacle_face, f.obstacle)) continue;  // each distinct pair once
     const CcdBody& ob = s->obstacles[f.obstacle];
+    const long boxes = s->result->num_box_iterations;
     tester.test(*god.mesh, *god.bvh, f.god_face, *ob.mesh, *ob.bvh, f.obstacle_face, f.obstacle);
     if (k > 0 || lead == 0) s->num_searched = h + 1;  // (the lead alone is not hints[0 .. lead])
+    if (charge_test(s, boxes)) return;  // the step stops at s->searched (ccd_step)
   }
 }
 
@@ -143,7 +145,10 @@ void search_hints(StepState* s) {
 // its own cut for the next. A descent stopped by visit leaves as its cut the
 // pairs it stopped at, those still pending and the old cut's pairs not yet
 // pushed; a full stack or a cut that does not fit leaves none (the next
-// descent starts at the root).
+// descent starts at the root). Under the update's budget the descent runs
+// kDescentChunk node pairs at a time, each chunk charged: kPaused when the
+// budget ran out (no cut written).
+constexpr long kDescentChunk = 64;
 template <class Visit>
 TraversalStatus descend(StepState* s, double u_end, const Visit& visit) {
   DescentFront& f = s->ws->front;
@@ -178,8 +183,15 @@ TraversalStatus descend(StepState* s, double u_end, const Visit& visit) {
       } else {
         for (; k < n && pending < part; ++k) stack.items[static_cast<size_t>(pending++)] = old[k];
       }
-      const TraversalStatus ts = traverse(*s, s->start, s->e, s->ws->swept, u_end, s->reach, o, &stack, &pending,
-                                          std::numeric_limits<long>::max(), &s->result->num_node_pairs, visit, record);
+      const long chunk = s->ws->budget ? kDescentChunk : std::numeric_limits<long>::max();
+      TraversalStatus ts;
+      do {
+        const int before = s->result->num_node_pairs;
+        ts = traverse(*s, s->start, s->e, s->ws->swept, u_end, s->reach, o, &stack, &pending, chunk,
+                      &s->result->num_node_pairs, visit, record);
+        if (charge(s, Work::kNodePair, s->result->num_node_pairs - before) && ts == TraversalStatus::kPaused)
+          return ts;
+      } while (ts == TraversalStatus::kPaused);
       if (ts == TraversalStatus::kStopped && keep) {
         // The cut: what it stopped at, what is pending, the rest of the old
         // cut, and the later obstacles' cuts as they were.
@@ -204,8 +216,8 @@ TraversalStatus descend(StepState* s, double u_end, const Visit& visit) {
 }
 
 // The sub-intervals (and lead pieces) past the cached range, each descended and
-// its candidates tested. False when the descent's stack overflowed (the step then stops
-// conservatively, result final).
+// its candidates tested. False when the descent's stack overflowed or the
+// update's budget ran out (the step then stops conservatively, result final).
 bool search_sub_intervals(StepState* s) {
   const CcdBody& god = s->god;
   CcdStepResult* result = s->result;
@@ -232,6 +244,7 @@ bool search_sub_intervals(StepState* s) {
     const TraversalStatus ts = descend(s, std::min(u1, result->u_hit), [&](int gf, int of, int o) {
       const CcdBody& ob = s->obstacles[o];
       ++result->num_triangle_pairs;
+      if (charge(s, Work::kTrianglePair, 1)) return false;
       const double t = s->start.earliest(s->start.posed_face(*god.mesh, gf, &s->ws->swept), *ob.mesh, of, s->reach,
                                          tester.end());
       if (t > tester.end()) {
@@ -243,9 +256,10 @@ bool search_sub_intervals(StepState* s) {
         return true;
       }
       listed = false;
+      const long boxes = result->num_box_iterations;
       if (!searched(*s, gf, of, o)) tester.test(*god.mesh, *god.bvh, gf, *ob.mesh, *ob.bvh, of, o);
-      // A hit at the sub-interval's start cannot be bettered: stop.
-      return !tester.done() && !answered(*s);
+      // A hit at the sub-interval's start cannot be bettered: stop. So does the budget's end.
+      return !charge_test(s, boxes) && !tester.done() && !answered(*s);
     });
     if (ts == TraversalStatus::kStackFull) {
       // Unknown beyond here: stop conservatively at the sub-interval's start.
@@ -254,9 +268,14 @@ bool search_sub_intervals(StepState* s) {
       result->u_hit = std::min(result->u_hit, u0);
       return false;
     }
+    if (out_of_budget(*s)) {  // a descent cut short: proven up to the piece's start
+      result->num_near_pairs = -1;  // the candidates' buffer holds part of this piece's: no list
+      stop_on_budget(s, u0);
+      return false;
+    }
     if (ts == TraversalStatus::kStopped) listed = false;
     set_near_pairs(s, listed ? num_cand : -1, u0);
-    test_candidates(s, num_cand);
+    if (!test_candidates(s, num_cand)) return false;
   }
   return true;
 }
@@ -297,7 +316,7 @@ bool answered(const StepState& s) { return s.any_hit && s.result->hit; }
 
 // Earliest-first: each hit shortens the windows of the pairs after it, and
 // once a pair's bound passes the best u so far, so do all the rest.
-void test_candidates(StepState* s, int num_cand) {
+bool test_candidates(StepState* s, int num_cand) {
   CcdStepWorkspace::Candidate* const cand = s->ws->candidates.data();
   PairTester& tester = s->tester;
   const CcdBody& god = s->god;
@@ -307,8 +326,33 @@ void test_candidates(StepState* s, int num_cand) {
     const TrianglePair& p = cand[c].pair;
     if (searched(*s, p.god_face, p.obstacle_face, p.obstacle)) continue;
     const CcdBody& ob = s->obstacles[p.obstacle];
+    const long boxes = s->result->num_box_iterations;
     tester.test(*god.mesh, *god.bvh, p.god_face, *ob.mesh, *ob.bvh, p.obstacle_face, p.obstacle);
+    if (charge_test(s, boxes)) {
+      // The rest cannot come within the reach before the next one's bound
+      // (sorted), nor past the range the candidates were listed for.
+      const double next = c + 1 < num_cand ? cand[c + 1].earliest : tester.u1;
+      stop_on_budget(s, std::max(tester.u0, std::min(next, tester.u1)));
+      return false;
+    }
   }
+  return true;
+}
+
+void stop_on_budget(StepState* s, double u) {
+  CcdStepResult* r = s->result;
+  if (s->budget_stopped) return;  // once
+  s->budget_stopped = true;
+  if (!r->hit && u >= 1) return finish(s);  // the whole motion searched: no hit
+  // Every pair tested was searched up to end(): a hit whose reported u_hit
+  // (less the tolerance) is no later than u is the first contact.
+  if (r->hit && r->u_hit - s->settings.narrow.time_tolerance <= u) return finish(s);
+  r->budget_exhausted = true;
+  r->hit = true;
+  r->u_hit = std::max(u, 0.0);
+  r->pair = FeaturePair{};
+  r->distance_reached = std::numeric_limits<double>::quiet_NaN();
+  r->time_tolerance_reached = 0;
 }
 
 // Whatever the testing finds, u_hit stays <= the end of the window the near
@@ -375,14 +419,23 @@ void ccd_step(const CcdBody* obstacles, int num_obstacles, const CcdBody& god, c
   if ((s.hints && s.num_hints > 0) || cached || borrowing) s.start.set(s.motion, 0.0, god.bvh->radius);
   // Search the hints over the whole step (a hit among them answers a check:
   // CcdQuestion::kFreeOfContact).
+  // An update whose budget has run out (now or in a stage) searches no further:
+  // the step stops at what it has proven (stop_on_budget, result final).
+  const auto stopped = [&] {
+    if (out_of_budget(s)) stop_on_budget(&s, s.searched);
+    return out_of_budget(s);
+  };
+  if (stopped()) return;
   search_hints(&s);
+  if (stopped()) return;
   if (!answered(s)) {
     // Serve the step's start from the proximity cache, refilled first if worth it
     // (or from another workspace's list, read-only).
     if (cached) serve_proximity_cache(&s);
     if (borrowing) serve_borrowed_list(&s);
+    if (stopped()) return;
     // Descend the trees per sub-interval past the cached range, and test the
-    // candidate pairs earliest-first (a full stack stops the step there).
+    // candidate pairs earliest-first (a full stack or the budget's end stops the step there).
     if (!search_sub_intervals(&s)) return;
   }
   // Fill the next list in the background while this one serves.

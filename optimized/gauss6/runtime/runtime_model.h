@@ -15,6 +15,7 @@
 #include "gauss6/contact/quasistatics.h"
 #include "gauss6/io/scene.h"
 #include "gauss6/contact/surface.h"
+#include "gauss6/step/update_budget.h"
 
 namespace gauss6 {
 
@@ -82,6 +83,7 @@ struct RuntimeSettings {
                                        // timer's wake-up can land 50-100 us late (a VM's, measured:
                                        // docs/benchmarks.md): at 10 kHz, a period. Pinned alone to its CPU,
                                        // the busy wait takes nothing from the other loops.
+  UpdateBudgetSettings budget;         // each god-object update's budget (update_budget.h; default: none)
 };
 
 // The immutable model: built once from a Scene, shared read-only by every loop.

@@ -36,8 +36,10 @@ enum class RuntimeEventKind {
   kDeviceWriteFailed,      // write() failed: zero written at once (Device::halt_force() if that fails too)
   kHapticStalled,          // watchdog thread (threaded runs): no haptic tick finished for device_timeout, a
                            // read() or write() that blocks: Device::halt_force() from the watchdog's thread
+  kUpdateBudgetExhausted,  // a god-object update ran out of its budget (RuntimeSettings::budget): it ended at the
+                           // end of what it had proven free, the rest of the command left to the next updates
 };
-inline constexpr int kNumRuntimeEventKinds = 15;
+inline constexpr int kNumRuntimeEventKinds = 16;
 // An event kind as a bit of the loops' event masks (a uint32_t).
 constexpr uint32_t event_bit(RuntimeEventKind k) { return 1u << static_cast<int>(k); }
 static_assert(kNumRuntimeEventKinds <= 32, "event kinds are bits of a uint32_t");
@@ -115,6 +117,13 @@ struct SimStepInfo {
   // (it cut a convex crease the two legs went round; property 5 holds for the
   // motion between published poses). 0 when it was kept or did not run.
   int num_shortenings = 0;
+  // Budgeted updates (RuntimeSettings::budget, docs/sim-step.md): the update's work units
+  // (update_budget.h; 0 without a budget), whether it ran out of
+  // its budget (then it ended at the end of what it had proven free), and how far from x_target
+  // the displayed xs was left then (scene units: travel plus turn times the god-object's radius).
+  long work_units = 0;
+  bool budget_exhausted = false;
+  double budget_deferred = 0;
   double update_seconds = 0;           // wall time of the whole step (steady_clock)
   double update_cpu_seconds = 0;       // the sim thread's CPU time in the step (CLOCK_THREAD_CPUTIME_ID):
                                        // the step's work without the time the thread was preempted

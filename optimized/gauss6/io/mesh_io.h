@@ -1,5 +1,5 @@
 // Mesh files (OBJ, OFF, PLY, STL) and the self-intersection test, both through
-// CGAL (optimized/src/io/, one translation unit each). Scene-load time only:
+// CGAL (optimized/gauss6/io/, one translation unit each). Scene-load time only:
 // never called from a real-time loop.
 #pragma once
 

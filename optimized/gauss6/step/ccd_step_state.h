@@ -77,6 +77,7 @@ struct StepState {
   // how far a point may have moved from its pose to X0 (infinite: unknown).
   bool cache_keyed = false;
   double cache_moved = std::numeric_limits<double>::infinity();
+  bool budget_stopped = false;  // stop_on_budget ran: the result is final
 };
 
 // The triangle pair was searched over the whole step among the hints (then it
@@ -85,8 +86,32 @@ bool searched(const StepState& s, int gf, int of, int o);
 // A check (CcdQuestion::kFreeOfContact) has its answer: a hit.
 bool answered(const StepState& s);
 // Tests cand[0 .. num_cand) earliest-first (ws->candidates), skipping the
-// pairs searched with the hints.
-void test_candidates(StepState* s, int num_cand);
+// pairs searched with the hints. False when the update's budget ran out
+// first: the step then stopped where the untested candidates' time bounds
+// prove it free (stop_on_budget).
+bool test_candidates(StepState* s, int num_cand);
+
+// The update's budget (CcdStepWorkspace::budget, update_budget.h): charges
+// `count` pieces of work, true when it has run out (now or before); false without one.
+inline bool charge(StepState* s, Work kind, long count) {
+  return s->ws->budget != nullptr && s->ws->budget->spend(kind, count);
+}
+inline bool out_of_budget(const StepState& s) { return s.ws->budget != nullptr && s.ws->budget->exhausted(); }
+// A narrow-phase test just run, begun with `boxes_before` boxes counted: its set-up and boxes.
+inline bool charge_test(StepState* s, long boxes_before) {
+  charge(s, Work::kPairTest, 1);
+  return charge(s, Work::kBox, s->result->num_box_iterations - boxes_before);
+}
+// The budget ran out with the motion proven free of every pair not yet
+// tested up to u (at the step's reach), every pair tested searched to the
+// window's end: the step stops there, a conservative hit with no pair, unless
+// the first contact found is no later than u (then that hit is the step's
+// answer). Either way the result says so (CcdStepResult::budget_exhausted).
+void stop_on_budget(StepState* s, double u);
+// A fill of the proximity cache of at most max_node_pairs node pairs, spread
+// over chunks charged to the budget (proximity_cache.cpp fill_some: true once
+// complete); without a budget one call.
+bool fill_within_budget(StepState* s, long max_node_pairs);
 // Records cand[0 .. num_cand) as the near pairs for [u0, u_hit] (-1: none).
 void set_near_pairs(StepState* s, int num_cand, double u0);
 

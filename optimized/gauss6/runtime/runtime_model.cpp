@@ -111,6 +111,7 @@ RuntimeModel::RuntimeModel(const Scene& scene, const RuntimeSettings& s) : setti
   if (s.max_contacts < 1 || s.max_contacts > kMaxContactCapacity)
     fail("settings: max_contacts must be in [1, " + std::to_string(kMaxContactCapacity) + "]");
   if (!(s.spin_wait >= 0 && s.spin_wait <= 1)) fail("settings: spin_wait must be in [0, 1] s");
+  if (const char* problem = update_budget_settings_problem(s.budget)) fail(std::string("settings: ") + problem);
   // A loop paced slower than its own watchdog would trip it on every step.
   if (!(s.sim_min_period >= 0 && s.sim_min_period < s.sim_timeout) ||
       !(s.coupling_min_period >= 0 && s.coupling_min_period < s.coupling_timeout))
