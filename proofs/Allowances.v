@@ -819,8 +819,8 @@ Definition kCornerOffsetRounding := fl (/ 1000000000000).
 Lemma abs_sq t : Rabs t * Rabs t = t * t.
 Proof. rewrite <- Rabs_mult. apply Rabs_pos_eq. nra. Qed.
 
-(* covers optimized/include/gauss6/ccd/motion_bounds.h "GAUSS6_ALWAYS_INLINE double corner_offsets(" sha256:a6814e84c72b62d0 *)
-(* covers optimized/include/gauss6/ccd/motion_bounds.h "bool motion(double r, double u_limit" sha256:e360e4764b160611 *)
+(* covers optimized/gauss6/ccd/motion_bounds.h "GAUSS6_ALWAYS_INLINE double corner_offsets(" sha256:a6814e84c72b62d0 *)
+(* covers optimized/gauss6/ccd/motion_bounds.h "bool motion(double r, double u_limit" sha256:e360e4764b160611 *)
 Theorem corner_offset_rounding x y z px py pz r s :
   F x -> F y -> F z -> F px -> F py -> F pz ->
   sqrt ((x - px) * (x - px) + (y - py) * (y - py) + (z - pz) * (z - pz)) <= r + s ->
@@ -945,7 +945,7 @@ Proof.
   pose proof (prod_lower (fl (a + q)) (fl (Rabs c + h)) H10 H11). nra.
 Qed.
 
-(* covers optimized/src/ccd/motion_bounds.cpp "Aabb swept_box(const MotionEnclosure& e, const Aabb& body)" sha256:17e777d36e576019 *)
+(* covers optimized/gauss6/ccd/motion_bounds.cpp "Aabb swept_box(const MotionEnclosure& e, const Aabb& body)" sha256:17e777d36e576019 *)
 Theorem swept_box_rounding m0 m1 m2 q0 q1 q2 c0 c1 c2 h0 h1 h2 R0 R1 R2 r0 r1 r2 :
   (forall x, In x [m0; m1; m2; q0; q1; q2; c0; c1; c2; h0; h1; h2] -> F x) ->
   0 <= q0 -> 0 <= q1 -> 0 <= q2 -> 0 <= h0 -> 0 <= h1 -> 0 <= h2 ->
