@@ -415,14 +415,19 @@ TEST_CASE("faults: a non-finite force from inside the pipeline is zeroed and rep
 }
 
 TEST_CASE("faults: contact overflow truncates the set, reported, the god-object stays out", "[runtime][faults]") {
-  // 121 bottom vertices rest on the slab: more than the default capacity (64) contacts.
+  // 121 bottom vertices rest on the slab. A full set is first reduced to its
+  // patches' supports (contacts.h: here the bottom's corners, and the closest
+  // contact); with room for fewer rows than that support (4), the set still
+  // overflows and is truncated.
   const Scene sc = make_grid_bottom_scene(10);
   ScriptedDevice device(press_script(0.2, 0.04, 0.4));
+  RuntimeSettings settings;
+  settings.max_contacts = 4;
   Run r;
-  run(&r, sc, RuntimeSettings{}, &device, 700);
+  run(&r, sc, settings, &device, 700);
   CHECK(r.rec.count(RuntimeEventKind::kContactOverflow) >= 1);
   for (const SimStepInfo& s : r.rec.sims) {
-    CHECK(s.num_contacts <= kDefaultMaxContacts);
+    CHECK(s.num_contacts <= settings.max_contacts);
     CHECK(lowest_z(*r.model, s.xs) >= kDelta * (1 - 1e-3));
   }
   check_bounded(device);
