@@ -172,7 +172,7 @@ def test_offline_validate_refuses_a_zero_quaternion_by_tick(tmp_path, capsys, pe
 
 
 def test_the_coordinate_bound_is_the_cpp_one():
-    text = (paths.REPO_ROOT / "optimized" / "include" / "gauss6" / "scene.h").read_text()
+    text = (paths.REPO_ROOT / "optimized" / "gauss6" / "io" / "scene.h").read_text()
     assert f"kMaxSceneCoordinate = {trace.MAX_COORDINATE:.0e}".replace("+", "") in text
 
 
