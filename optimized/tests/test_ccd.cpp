@@ -587,11 +587,13 @@ TEST_CASE("motion distance bound: no body point of one motion strays farther fro
     if (i % 3 == 0) a0.q = Quat{-a0.q.w, -a0.q.x, -a0.q.y, -a0.q.z};  // the same rotation
     const Pose a1 = related ? make_stop_pose(b, ub, radius).pose
                             : Pose{b0.p + Vec3(n(rng), n(rng), n(rng)), normalized(Quat{n(rng), n(rng), n(rng), n(rng)})};
-    const double bound = motion_distance_bound(a0, a1, b0, b, ub, radius);
-    if (!std::isfinite(bound)) {  // a1 half a turn or more from a0 (unrelated motions only)
+    CcdMotion a;
+    if (make_ccd_motion(a0, a1, &a) != MotionStatus::kOk) {  // a1 half a turn or more from a0 (unrelated only)
       CHECK(!related);
       continue;
     }
+    const double bound = motion_distance_bound(a0, a, b0, b, ub, radius);
+    REQUIRE(std::isfinite(bound));
     if (related && lift <= 2e-5) tight += bound < 1e-3 * radius;
     const test::ExactMotion ea(a0, a1), eb(b0, target);
     for (int k = 0; k < 40; ++k) {
@@ -603,7 +605,7 @@ TEST_CASE("motion distance bound: no body point of one motion strays farther fro
     }
     // The first parts, a over [0, ua] and b over [0, ua ub].
     const double ua = k_first_parts[static_cast<size_t>(i) % k_first_parts.size()];
-    const double part = motion_distance_bound(a0, a1, b0, b, ua * ub, radius, ua);
+    const double part = motion_distance_bound(a0, a, b0, b, ua * ub, radius, ua);
     REQUIRE(std::isfinite(part));
     for (int k = 0; k < 20; ++k) {
       const mpq_class u = (k == 0 ? mpq_class(1) : Q(unit(rng))) * Q(ua);
@@ -623,20 +625,29 @@ TEST_CASE("motion distance bound: no body point of one motion strays farther fro
                   normalized(quat_exp(0.3 * unit(rng) * Vec3(n(rng), n(rng), n(rng)).normalized()) * x0.q)};
     const Pose x2{x1.p + 1e-5 * Vec3(n(rng), n(rng), n(rng)),
                   normalized(quat_exp(1e-4 * Vec3(n(rng), n(rng), n(rng))) * x1.q)};
-    CcdMotion b;
+    CcdMotion a, b;
     REQUIRE(make_ccd_motion(x0, x1, &b) == MotionStatus::kOk);
-    const double whole = motion_distance_bound(x0, x2, x0, b, 1.0, radius);
-    const double quarter = motion_distance_bound(x0, x2, x0, b, 0.25, radius, 0.25);
+    REQUIRE(make_ccd_motion(x0, x2, &a) == MotionStatus::kOk);
+    const double whole = motion_distance_bound(x0, a, x0, b, 1.0, radius);
+    const double quarter = motion_distance_bound(x0, a, x0, b, 0.25, radius, 0.25);
     CHECK(quarter < 0.26 * whole);
     CHECK(quarter > 0.24 * whole);
+    // proven_prefix: below d the whole motion, far above it none, in between a
+    // prefix whose bound is below d.
+    CHECK(proven_prefix(x0, a, x0, b, 1.0, radius, 2 * whole) == 1.0);
+    const double ua = proven_prefix(x0, a, x0, b, 1.0, radius, 0.5 * whole);
+    CHECK(ua > 0.4);
+    CHECK(ua < 0.5);
+    CHECK(motion_distance_bound(x0, a, x0, b, ua, radius, ua) < 0.5 * whole);
+    CHECK(proven_prefix(x0, a, x0, b, 1.0, radius, 0.0) == 0.0);
   }
-  // Cannot bound: an invalid pose or a half turn for a.
+  // Cannot bound: a start pose that is not one, or parameters out of [0, 1].
   CcdMotion b;
   const Pose x{{0, 0, 0}, {1, 0, 0, 0}};
   REQUIRE(make_ccd_motion(x, x, &b) == MotionStatus::kOk);
-  CHECK(std::isinf(motion_distance_bound(x, Pose{{0, 0, 0}, {0, 1, 0, 0}}, x, b, 1.0, 1.0)));
-  CHECK(std::isinf(motion_distance_bound(x, Pose{{0, 0, 0}, {0, 0, 0, 0}}, x, b, 1.0, 1.0)));
-  CHECK(std::isinf(motion_distance_bound(x, x, x, b, 1.5, 1.0)));
+  CHECK(std::isinf(motion_distance_bound(Pose{{0, 0, 0}, {0, 0, 0, 0}}, b, x, b, 1.0, 1.0)));
+  CHECK(std::isinf(motion_distance_bound(x, b, x, b, 1.5, 1.0)));
+  CHECK(std::isinf(motion_distance_bound(x, b, x, b, 1.0, 1.0, -0.5)));
 }
 
 TEST_CASE("shared sample queries: no false negative with the linear primitives", "[ccd]") {

@@ -487,7 +487,7 @@ TEST_CASE("ccd_step: a ball wandering among blocks, lists filled ahead of it in 
 TEST_CASE("ccd_step: a step served read-only from another workspace's list agrees with the brute force", "[ccd_step]") {
   // The runtime's check of a settling step's direct motion (sim_loop.cpp,
   // motion_free): min_separation 0, no cache of its own, the legs' list
-  // borrowed (CcdStepWorkspace::borrowed). A ball kept near a slab with a
+  // borrowed (CcdStepWorkspace::lender). A ball kept near a slab with a
   // block on it by the legs' chain of steps (cached, as the runtime's), and
   // after each leg a check step from the leg's start to a pose nearby (in
   // the list's margin or, every fifth step, far beyond it) that must agree
@@ -511,7 +511,7 @@ TEST_CASE("ccd_step: a step served read-only from another workspace's list agree
   legs.cache.fill_budget = 12;
   check.narrow.min_separation = 0;
   CcdStepWorkspace ws, ws_check, ws_alone, ws_any;
-  ws_check.borrowed = ws_any.borrowed = &ws.cache;
+  ws_check.lender = ws_any.lender = &ws;
   const CcdBody obstacle{&slab, &sb};
   Pose x{Vec3(0.1, 0, 0.5 + 2e-4), Quat{}};
   std::vector<FeaturePair> hints = {in_contact_hint()};
@@ -781,7 +781,7 @@ TEST_CASE("ccd_step: a step told its first part is free searches only the rest",
           CcdStepResult r_fill;
           ccd_step(&obstacle, 1, body, {x0, x0}, cached, &ws_list, &r_fill);
           REQUIRE(ws_list.cache.num_pairs > 0);
-          ws.borrowed = ws_told.borrowed = &ws_list.cache;
+          ws.lender = ws_told.lender = &ws_list;
         }
         CcdStepResult r_plain, r_told;
         CcdStepRequest request{x0, x1, hints.data(), static_cast<int>(hints.size())};

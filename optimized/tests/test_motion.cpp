@@ -7,6 +7,7 @@
 #include <string>
 
 #include "gauss6/ccd/motion.h"
+#include "gauss6/runtime/sim_step4.h"  // split_step: where step 4 cuts a half turn
 
 using namespace gauss6;
 

@@ -63,7 +63,7 @@ enum class CcdStatus {
   kMaxIterations,   // gave up after max_iterations boxes: hit reported conservatively
   kWorkspaceFull,   // box stack full: hit reported conservatively
   kInvalidInput,    // a non-finite or huge coordinate, or an empty window
-  kHalfTurn,        // mesh step only: relative rotation near 180 degrees, split_step() it
+  kHalfTurn,        // mesh step only: relative rotation near 180 degrees, split the step in halves
 };
 const char* to_string(CcdStatus s);
 

@@ -60,12 +60,6 @@ Pose motion_pose(const CayleyMotion& m, double u) {
 
 double motion_angle(const CayleyMotion& m, double u) { return 2.0 * std::atan(u * m.g.norm()); }
 
-Pose split_step(const Pose& x0, const Pose& x1) {
-  // Half of the relative rotation vector (shortest way), applied to q0.
-  const Vec3 half = 0.5 * quat_log(x1.q * conjugate(x0.q));
-  return {0.5 * (x0.p + x1.p), normalized(quat_exp(half) * normalized(x0.q))};
-}
-
 // ---------------------------------------------------------------------------
 // The Cayley motion, enclosed.
 // ---------------------------------------------------------------------------
@@ -221,14 +215,12 @@ Upper difference_norm(const std::array<Interval, N>& a, const std::array<Interva
 
 }  // namespace
 
-double motion_distance_bound(const Pose& a0, const Pose& a1, const Pose& b0, const CcdMotion& b, double ub,
+double motion_distance_bound(const Pose& a0, const CcdMotion& a, const Pose& b0, const CcdMotion& b, double ub,
                              double body_radius, double ua) {
   constexpr double kNone = std::numeric_limits<double>::infinity();
-  CcdMotion a;
   IQuat qa, qb;
-  if (!(ub >= 0 && ub <= 1 && ua >= 0 && ua <= 1 && body_radius >= 0) ||
-      make_ccd_motion(a0, a1, &a) != MotionStatus::kOk ||
-      !unit_quaternion(a0.q, &qa) || !unit_quaternion(b0.q, &qb))
+  if (!(ub >= 0 && ub <= 1 && ua >= 0 && ua <= 1 && body_radius >= 0) || !unit_quaternion(a0.q, &qa) ||
+      !unit_quaternion(b0.q, &qb))
     return kNone;
   // q and -q are the same rotation: b's quaternions taken on a's side.
   if (a0.q.w * b0.q.w + a0.q.x * b0.q.x + a0.q.y * b0.q.y + a0.q.z * b0.q.z < 0)
@@ -251,6 +243,15 @@ double motion_distance_bound(const Pose& a0, const Pose& a1, const Pose& b0, con
   const Upper shift = max(difference_norm(a.p0, to_interval(b0.p)), difference_norm(pa1, pb1));
   const double bound = (shift + 2.0 * (turn * Upper{body_radius})).v;
   return std::isfinite(bound) ? bound : kNone;
+}
+
+double proven_prefix(const Pose& a0, const CcdMotion& a, const Pose& b0, const CcdMotion& b, double ub,
+                     double body_radius, double d) {
+  const double whole = motion_distance_bound(a0, a, b0, b, ub, body_radius);
+  if (whole < d) return 1;
+  const double ua = kPrefixShare * d / whole;
+  if (!(ua > 0 && ua < 1)) return 0;  // also NaN, an unbounded whole
+  return motion_distance_bound(a0, a, b0, b, ua * ub, body_radius, ua) < d ? ua : 0;
 }
 
 }  // namespace gauss6

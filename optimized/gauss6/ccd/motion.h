@@ -11,8 +11,8 @@
 //
 // The rotation angle is 2 atan(u |g|): monotone in u. A relative rotation of
 // (nearly) 180 degrees has scalar(qr) ~ 0 and no finite Gibbs vector: such a
-// step is refused with MotionStatus::kHalfTurn; split_step() cuts a step into
-// two halves whose relative rotations are each below 90 degrees.
+// step is refused with MotionStatus::kHalfTurn; its caller cuts it at its
+// midpoint into two halves, each turning by at most 90 degrees.
 #pragma once
 
 #include <array>
@@ -55,10 +55,6 @@ Vec3 motion_point(const CayleyMotion& m, double u, const Vec3& r_B);
 Pose motion_pose(const CayleyMotion& m, double u);
 // Rotation angle of R(u) R0^T: 2 atan(u |g|).
 double motion_angle(const CayleyMotion& m, double u);
-
-// Splits the step x0 -> x1 at its midpoint (position halfway, rotation half the
-// relative angle, shortest way): both halves then rotate by at most 90 degrees.
-Pose split_step(const Pose& x0, const Pose& x1);
 
 // ---------------------------------------------------------------------------
 // Interval vectors, and the coordinates the CCD accepts.
@@ -133,11 +129,10 @@ struct StopPose {
 StopPose make_stop_pose(const CcdMotion& motion, double u, double body_radius);
 
 // A bound on how far apart two Cayley motions keep each body point: the exact
-// motion a from a0 to a1, and the exact motion b (from b0, its start pose) over
-// [0, ub] run at the same pace (b at u ub when a is at u); for every u in
-// [0, 1] and |r_B| <= body_radius, |(p_a(u) + R_a(u) r_B) - (p_b(u ub) +
-// R_b(u ub) r_B)| <= the result (infinity when a cannot be made: invalid pose,
-// half turn). Why it holds: b over [0, ub] is the Cayley motion of Gibbs vector
+// motion a (make_ccd_motion) from a0, and the exact motion b (from b0, its
+// start pose) over [0, ub] run at the same pace (b at u ub when a is at u); for
+// every u in [0, 1] and |r_B| <= body_radius, |(p_a(u) + R_a(u) r_B) - (p_b(u
+// ub) + R_b(u ub) r_B)| <= the result (infinity on invalid input). Why it holds: b over [0, ub] is the Cayley motion of Gibbs vector
 // ub g_b; each motion's quaternion (1, u g) (x) q0 / |q0| is affine in u and of
 // norm >= 1, and x -> x / |x| is the nearest point of the unit ball for such
 // x (a projection on a convex set: it does not lengthen distances), so the unit
@@ -149,7 +144,18 @@ StopPose make_stop_pose(const CcdMotion& motion, double u, double body_radius);
 // With ua < 1, a over [0, ua] only (its Cayley motion of Gibbs vector ua g_a,
 // run at the same pace: a at u ua when b is at u ub): when the bound is below
 // d, a is free of contact on [0, ua].
-double motion_distance_bound(const Pose& a0, const Pose& a1, const Pose& b0, const CcdMotion& b, double ub,
+double motion_distance_bound(const Pose& a0, const CcdMotion& a, const Pose& b0, const CcdMotion& b, double ub,
                              double body_radius, double ua = 1.0);
+
+// How much of the motion a (from a0) the motion b (from b0), proven free of
+// contact at min_separation d over [0, ub], proves free without a search of
+// its own: the largest ua found for which no body point of a on [0, ua] strays
+// by d or more from where b puts it at the same pace (motion_distance_bound);
+// 1 for the whole motion, 0 for none. ua is taken at kPrefixShare of the share
+// in which the bound grows about in proportion to ua (both motions start
+// close), then the bound is computed for it.
+constexpr double kPrefixShare = 0.9;
+double proven_prefix(const Pose& a0, const CcdMotion& a, const Pose& b0, const CcdMotion& b, double ub,
+                     double body_radius, double d);
 
 }  // namespace gauss6

@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "gauss6/ccd/ccd.h"
 #include "gauss6/ccd/motion.h"
@@ -26,19 +27,36 @@ GodObjectStep::GodObjectStep(const RuntimeModel& model)
   // The legs of one update share their descents' cuts (cleared at each update).
   legs_ws.front.carry = true;
   check_ws.front.carry = true;
+  // The checks borrow the legs' proximity list and start from their last cut.
+  check_ws.lender = &legs_ws;
   // Every CCD of an update charges its budget, when it has one.
   legs_ws.budget = check_ws.budget = model.settings.budget.active() ? &budget : nullptr;
 }
 
+Pose split_step(const Pose& x0, const Pose& x1) {
+  // Half of the relative rotation vector (shortest way), applied to q0.
+  const Vec3 half = 0.5 * quat_log(x1.q * conjugate(x0.q));
+  return {0.5 * (x0.p + x1.p), normalized(quat_exp(half) * normalized(x0.q))};
+}
+
 namespace {
 
-// The leg stands at u of its motion: the stop pose there, and how far that
-// double pose may lie from the exact motion's.
-void stand_at(const RuntimeModel& model, double u, LegEnd* leg) {
-  const StopPose stop = make_stop_pose(leg->ccd.motion, u, model.god_radius);
-  leg->u = u;
+// The leg stands at leg->u of its motion: the stop pose there, and how far a
+// body point posed in doubles at it may lie from where the exact motion puts
+// it (the stop pose's deviation, and the rounding of posing: kPoseRounding).
+void stand_at(const RuntimeModel& model, LegEnd* leg) {
+  const StopPose stop = make_stop_pose(leg->ccd.motion, leg->u, model.god_radius);
   leg->xs = stop.pose;
-  leg->deviation = stop.deviation;
+  leg->posing_error =
+      round_up(stop.deviation + kPoseRounding * (leg->xs.p.cwiseAbs().maxCoeff() + model.god_radius)).v;
+}
+
+// The leg stands at its start, with no motion: no near pairs to serve.
+void stand_at_start(const Pose& x0, LegEnd* leg) {
+  leg->u = 0;
+  leg->xs = x0;
+  leg->posing_error = std::numeric_limits<double>::infinity();
+  leg->near = NearPairs{};
 }
 
 // Every CCD of the step: the model's bodies and settings, the request's motion and question.
@@ -86,15 +104,14 @@ bool ccd_leg(const RuntimeModel& model, const Pose& x0, const Pose& x1, bool fil
       break;
     }
   }
-  leg.near = moved ? g->legs_ws.near_pairs(r.num_near_pairs) : NearPairs{};
-  if (moved) {
-    stand_at(model, r.hit ? r.u_hit : 1.0, &leg);
-  } else {
-    leg.u = 0;
-    leg.xs = x0;
-    leg.deviation = 0;
+  if (!moved) {
+    stand_at_start(x0, &leg);
+    return false;
   }
-  return moved;
+  leg.near = g->legs_ws.near_pairs(r.num_near_pairs);
+  leg.u = r.hit ? r.u_hit : 1.0;
+  stand_at(model, &leg);
+  return true;
 }
 
 // The leg is the first leg from x_start, whole: its parts are parts of the
@@ -121,39 +138,20 @@ void serve_proven(const RuntimeModel& model, double u, GodObjectStep* g) {
   LegEnd& leg = g->leg;
   leg = g->proven;
   if (!(u >= leg.ccd.near_u0 && u <= (leg.ccd.hit ? leg.ccd.u_hit : 1.0))) leg.near = NearPairs{};
-  stand_at(model, u, &leg);
-}
-
-// How much of the motion a0 -> a1 the leg `ref` already proves free of contact
-// without a search of its own: the largest ua found for which no body point of
-// a0 -> a1 on [0, ua] strays by as much as min_separation from where ref's
-// motion puts it at the same pace (motion_distance_bound, ref run from ref.from
-// up to ref.u); 1 for the whole motion, 0 for none. ua is taken at
-// kPrefixShare of the share in which the bound grows about in proportion to
-// ua (both motions start close), then the bound is computed for it.
-constexpr double kPrefixShare = 0.9;
-double proven_prefix(const RuntimeModel& model, const Pose& a0, const Pose& a1, const LegEnd& ref) {
-  if (!ref.one_piece || ref.ccd.status != CcdStatus::kOk) return 0;
-  const double d = model.settings.ccd.narrow.min_separation;
-  const double whole = motion_distance_bound(a0, a1, ref.from, ref.ccd.motion, ref.u, model.god_radius);
-  if (whole < d) return 1;
-  const double ua = kPrefixShare * d / whole;
-  if (!(ua > 0 && ua < 1)) return 0;  // also NaN, an unbounded whole
-  return motion_distance_bound(a0, a1, ref.from, ref.ccd.motion, ua * ref.u, model.god_radius, ua) < d ? ua : 0;
+  leg.u = u;
+  stand_at(model, &leg);
 }
 
 // Whether the CCD proves the Cayley motion x0 -> x1 free of contact (it never
-// misses one: u_hit <= u*), from known_free on ([0, known_free] already
-// proven: proven_prefix; a motion proven whole needs no search). Its own
-// workspace, starting from the legs' last cut (the direct motion sweeps the
-// proximity they swept). A hit, a give-up, invalid input or a half turn answer false.
-bool motion_free(const RuntimeModel& model, const Pose& x0, const Pose& x1, double known_free, GodObjectStep* g) {
-  if (known_free >= 1) return true;
+// misses one: u_hit <= u*), past the prefix the leg `ref` proves free (where
+// the two motions stay within min_separation of each other: proven_prefix,
+// motion.h; a motion proven whole needs no search). Its own workspace, lent
+// the legs' list and last cut (the direct motion sweeps the proximity they
+// swept). A hit, a give-up, invalid input or a half turn answer false.
+bool motion_free(const RuntimeModel& model, const Pose& x0, const Pose& x1, const LegEnd& ref, GodObjectStep* g) {
   CcdStepRequest request{x0, x1, g->hints.data(), g->num_hints};
-  request.known_free = known_free;
+  if (ref.one_piece && ref.ccd.status == CcdStatus::kOk) request.proven = {ref.from, &ref.ccd.motion, ref.u};
   request.question = CcdQuestion::kFreeOfContact;
-  g->check_ws.borrowed = &g->legs_ws.cache;
-  g->check_ws.front.copy_from(g->legs_ws.front);
   run_ccd(model, request, &g->check_ws, &g->check);
   return g->check.status == CcdStatus::kOk && !g->check.hit;
 }
@@ -178,7 +176,7 @@ DetourResult take_detour(const RuntimeModel& model, const Pose& x_start, const P
   *halves = 1;
   const bool ran = ccd_leg(model, from, to, /*fill=*/false, settling, g, halves);
   const LegEnd& ref = settling ? back : g->leg;
-  if (ran && motion_free(model, x_start, g->leg.xs, proven_prefix(model, x_start, g->leg.xs, ref), g))
+  if (ran && motion_free(model, x_start, g->leg.xs, ref, g))
     return {Detour::kKept, g->leg.ccd.status, g->leg.ccd.u_hit};
   const DetourResult result{ran ? Detour::kRefused : Detour::kNotRun, g->leg.ccd.status, g->leg.ccd.u_hit};
   g->leg = back;
@@ -229,18 +227,18 @@ bool lift_out_of_graze(const RuntimeModel& model, const Pose& x_start, const Pos
 
 // The contact set at the leg's end: every pair within delta (1 +
 // contact_factor), and at least the pair that stopped the leg. The leg's near
-// pairs hold every pair within its near reach there, less how far the double
-// pose may lie from the motion's (its deviation, and the rounding of posing
-// the vertices in doubles): when the contact distance is within that, they
-// are the only pairs to test. Sets the overflow event.
+// pairs hold every pair within its near reach there, less how far a vertex
+// posed at xs may lie from the motion's (LegEnd::posing_error): when the
+// contact distance is within that, they are the only pairs to test. Sets the
+// overflow event.
 void update_contacts(const RuntimeModel& model, GodObjectStep* g, ContactSet* contacts) {
   const LegEnd& leg = g->leg;
   const CcdStepResult& r = leg.ccd;
   ContactSettings cs = model.contact_generation;
   if (r.hit && std::isfinite(r.distance_reached))
     cs.distance = std::max(cs.distance, r.distance_reached + model.contact.delta * model.settings.contact_factor);
-  const double slack = round_up(leg.deviation + kPoseRounding * (leg.xs.p.cwiseAbs().maxCoeff() + model.god_radius)).v;
-  const bool near = leg.near.listed() && (r.hit ? r.u_hit : 1.0) >= r.near_u0 && cs.distance + slack <= r.near_reach;
+  const bool near =
+      leg.near.listed() && (r.hit ? r.u_hit : 1.0) >= r.near_u0 && cs.distance + leg.posing_error <= r.near_reach;
   const ContactStatus status = generate_contacts(model.obstacles.data(), static_cast<int>(model.obstacles.size()),
                                                  model.god, leg.xs, cs, &g->contact_ws, contacts,
                                                  near ? leg.near : NearPairs{});
@@ -255,10 +253,8 @@ void update_contacts(const RuntimeModel& model, GodObjectStep* g, ContactSet* co
 void stay_at_start(const RuntimeModel& model, const Pose& x_start, GodObjectStep* g, ContactSet* contacts,
                    SimStepInfo* info) {
   LegEnd& leg = g->leg;
-  leg.xs = x_start;
-  leg.deviation = 0;
+  stand_at_start(x_start, &leg);  // the near pairs are the legs', not x_start's: a full search
   leg.ccd.hit = false;
-  leg.near = NearPairs{};  // the near pairs are the legs', not x_start's: a full search
   update_contacts(model, g, contacts);
   g->paths.stayed = true;
   info->u_hit = 0;

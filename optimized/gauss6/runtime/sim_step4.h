@@ -49,7 +49,7 @@ struct LegEnd {
   double u = 1;                 // the end's parameter on that motion
   bool one_piece = true;        // the motion from `from` is ccd.motion (no split)
   Pose xs;                      // the pose at u (make_stop_pose)
-  double deviation = 0;         // of xs from the motion's exact pose at u
+  double posing_error = 0;      // a vertex posed at xs from the exact motion's at u (inf: none served)
   NearPairs near;               // every pair within ccd.near_reach at xs (num_pairs -1: none)
 };
 
@@ -66,6 +66,8 @@ struct StepPaths {
 // Step 4's buffers, built once.
 struct GodObjectStep {
   explicit GodObjectStep(const RuntimeModel& model);
+  GodObjectStep(const GodObjectStep&) = delete;  // check_ws lends from legs_ws: never moved
+  GodObjectStep& operator=(const GodObjectStep&) = delete;
   CcdStepWorkspace legs_ws;           // every leg's (with the proximity cache)
   CcdStepWorkspace check_ws;          // the checks' (borrowing the legs' list and cut)
   CcdStepResult check;
@@ -83,6 +85,12 @@ struct GodObjectStep {
   UpdateBudget budget;                // the update's (RuntimeSettings::budget; docs/sim-step.md, "Budgeted updates")
   bool budget_ran_out = false;        // the last update's did: this one's first leg searches in lead pieces
 };
+
+// The midpoint of the step x0 -> x1 (position halfway, rotation half the
+// relative angle, shortest way): where a leg that turns by half a turn or more
+// is cut (each half then turns by at most 90 degrees), and where the halving
+// schedule halves a target it cannot serve from a proven leg.
+Pose split_step(const Pose& x0, const Pose& x1);
 
 // Step 4 of a sim step, from its inputs (SimStepInfo::x_start, x_target,
 // residual; M the mass matrix at x_start, *contacts the set there): info->xs

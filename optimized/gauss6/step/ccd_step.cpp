@@ -1,6 +1,6 @@
 // The mesh-level CCD step (ccd_step.h) as the pipeline it runs: validate the
 // input, plan the sub-intervals, search the hinted pairs, serve or refill the
-// proximity cache (proximity_cache.cpp), descend the trees per sub-interval of
+// proximity cache (proximity_stages.cpp), descend the trees per sub-interval of
 // the motion, test the candidate triangle pairs (a time bound for each, then
 // for each of its owned feature pairs, and the narrow-phase tests of the rest,
 // earliest first, earliest hit kept), and finish the result.
@@ -310,6 +310,29 @@ void finish(StepState* s) {
 
 }  // namespace
 
+StepState::StepState(const CcdBody* obstacles_in, int num_obstacles_in, const CcdBody& god_in,
+                     const CcdStepRequest& request, const CcdStepSettings& settings_in, CcdStepWorkspace* ws_in,
+                     CcdStepResult* result_in)
+    : obstacles(obstacles_in),
+      num_obstacles(num_obstacles_in),
+      god(god_in),
+      X0(request.X0),
+      settings(settings_in),
+      ws(ws_in),
+      result(result_in),
+      hints(request.hints),
+      num_hints(request.num_hints),
+      lead_sweep(request.lead_sweep),
+      any_hit(request.question == CcdQuestion::kFreeOfContact),
+      motion(result_in->motion),
+      // The boxes and the pairs' time bounds take the larger of d and the near
+      // distance: the candidates are then the near pairs too (a pair that cannot
+      // come within the near distance cannot come within d).
+      reach(std::max(settings_in.narrow.min_separation, settings_in.near_distance)),
+      rho(god_in.bvh->radius),
+      tester{&motion, &e, &settings, &ws->narrow, result, 0, 0, &ws->swept, &start,
+             settings_in.narrow.min_separation} {}
+
 bool searched(const StepState& s, int gf, int of, int o) { return among(s.hints, s.num_searched, gf, of, o); }
 
 bool answered(const StepState& s) { return s.any_hit && s.result->hit; }
@@ -366,6 +389,20 @@ void set_near_pairs(StepState* s, int num_cand, double u0) {
 
 }  // namespace detail
 
+void DescentFront::copy_from(const DescentFront& other) {
+  const int num_obs = static_cast<int>(other.obstacles.size());
+  ready = other.ready && num_obs <= obstacle_capacity();
+  if (!ready) return;
+  const std::vector<int>& b = other.begin[other.cur];
+  const int n = b[static_cast<size_t>(num_obs)];
+  ready = n <= static_cast<int>(pairs[cur].size());
+  if (!ready) return;
+  std::copy(b.begin(), b.begin() + num_obs + 1, begin[cur].begin());
+  std::copy(other.pairs[other.cur].begin(), other.pairs[other.cur].begin() + n, pairs[cur].begin());
+  god = other.god;
+  obstacles.assign(other.obstacles.begin(), other.obstacles.end());  // within the reserved capacity
+}
+
 const char* ccd_step_settings_problem(const CcdStepSettings& s) {
   const auto positive = [](double x) { return x > 0 && std::isfinite(x); };
   const auto non_negative = [](double x) { return x >= 0 && std::isfinite(x); };
@@ -402,12 +439,24 @@ void ccd_step(const CcdBody* obstacles, int num_obstacles, const CcdBody& god, c
     result->status = ms == MotionStatus::kHalfTurn ? CcdStatus::kHalfTurn : CcdStatus::kInvalidInput;
     return;
   }
+  // The part of [0, 1] already proven free: the caller's, and what a proven
+  // motion nearby proves (at the legs' separation, min_separation).
+  double known_free = request.known_free;
+  const ProvenMotion& proven = request.proven;
+  if (proven.motion)
+    known_free = std::max(known_free, proven_prefix(request.X0, result->motion, proven.from, *proven.motion,
+                                                    proven.u, god.bvh->radius, settings.narrow.min_separation));
+  if (known_free >= 1) {  // proven whole: free, nothing to search
+    result->u_hit = 1;
+    return;
+  }
   CcdStepSettings step_settings = settings_asked(request, settings);
   const double asked_tolerance = step_settings.narrow.time_tolerance;
   step_settings.narrow.time_tolerance = step_time_tolerance(result->motion, god, step_settings);
   if (!(step_settings.narrow.time_tolerance > 0)) step_settings.narrow.time_tolerance = asked_tolerance;
   StepState s(obstacles, num_obstacles, god, request, step_settings, ws, result);
-  s.searched = request.known_free;
+  s.searched = known_free;
+  if (ws->lender) ws->front.copy_from(ws->lender->front);  // the lender's last cut
   if (!ws->front.carry) ws->front.clear();  // the last step's cut serves only when carried (DescentFront)
   // Plan the sub-intervals.
   s.n = plan_sub_intervals(s.motion, god, step_settings);
@@ -415,7 +464,7 @@ void ccd_step(const CcdBody* obstacles, int num_obstacles, const CcdBody& god, c
   result->num_sub_intervals = s.n + s.lead;
   // The hints and the proximity cache both start from the god-object at u = 0.
   const bool cached = step_settings.cache.margin > 0;
-  const bool borrowing = !cached && ws->borrowed != nullptr;
+  const bool borrowing = !cached && ws->lender != nullptr;
   if ((s.hints && s.num_hints > 0) || cached || borrowing) s.start.set(s.motion, 0.0, god.bvh->radius);
   // Search the hints over the whole step (a hit among them answers a check:
   // CcdQuestion::kFreeOfContact).

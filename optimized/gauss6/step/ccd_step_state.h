@@ -3,7 +3,7 @@
 // range being searched, the pair tester, and what one stage hands the next
 // (the hints searched, the range served by the proximity cache). The stages
 // are in ccd_step.cpp (validate, plan, hints, descent, candidates, finish) and
-// proximity_cache.cpp (serve or refill the cache, its background fill); the
+// proximity_stages.cpp (serve or refill the cache, its background fill); the
 // tree descent they share is traverse() below.
 #pragma once
 
@@ -12,7 +12,7 @@
 
 #include "gauss6/geometry/bvh.h"
 #include "gauss6/ccd/ccd.h"
-#include "gauss6/step/ccd_step.h"
+#include "gauss6/step/ccd_step_types.h"
 #include "gauss6/geometry/feature_pair.h"
 #include "gauss6/ccd/motion_bounds.h"
 #include "gauss6/geometry/pose.h"
@@ -22,26 +22,7 @@ namespace gauss6::detail {
 
 struct StepState {
   StepState(const CcdBody* obstacles_in, int num_obstacles_in, const CcdBody& god_in, const CcdStepRequest& request,
-            const CcdStepSettings& settings_in, CcdStepWorkspace* ws_in, CcdStepResult* result_in)
-      : obstacles(obstacles_in),
-        num_obstacles(num_obstacles_in),
-        god(god_in),
-        X0(request.X0),
-        settings(settings_in),
-        ws(ws_in),
-        result(result_in),
-        hints(request.hints),
-        num_hints(request.num_hints),
-        lead_sweep(request.lead_sweep),
-        any_hit(request.question == CcdQuestion::kFreeOfContact),
-        motion(result_in->motion),
-        // The boxes and the pairs' time bounds take the larger of d and the near
-        // distance: the candidates are then the near pairs too (a pair that cannot
-        // come within the near distance cannot come within d).
-        reach(std::max(settings_in.narrow.min_separation, settings_in.near_distance)),
-        rho(god_in.bvh->radius),
-        tester{&motion, &e, &settings, &ws->narrow, result, 0, 0, &ws->swept, &start,
-               settings_in.narrow.min_separation} {}
+            const CcdStepSettings& settings_in, CcdStepWorkspace* ws_in, CcdStepResult* result_in);
   StepState(const StepState&) = delete;
   StepState& operator=(const StepState&) = delete;
 
@@ -109,7 +90,7 @@ inline bool charge_test(StepState* s, long boxes_before) {
 // answer). Either way the result says so (CcdStepResult::budget_exhausted).
 void stop_on_budget(StepState* s, double u);
 // A fill of the proximity cache of at most max_node_pairs node pairs, spread
-// over chunks charged to the budget (proximity_cache.cpp fill_some: true once
+// over chunks charged to the budget (proximity_stages.cpp fill_some: true once
 // complete); without a budget one call.
 bool fill_within_budget(StepState* s, long max_node_pairs);
 // Records cand[0 .. num_cand) as the near pairs for [u0, u_hit] (-1: none).
@@ -152,7 +133,7 @@ TraversalStatus traverse(const StepState& s, const StartFrame& frame, const Moti
                                 num_node_pairs, separated, cut);
 }
 
-// The stages of the proximity cache (proximity_cache.cpp; settings.cache.margin > 0):
+// The stages of the proximity cache (proximity_stages.cpp; settings.cache.margin > 0):
 // serve this step from the cache's list, or refill it at X0 first, searching
 // [0, u_cached] from it (sets s->u_cached).
 void serve_proximity_cache(StepState* s);
@@ -160,7 +141,7 @@ void serve_proximity_cache(StepState* s);
 // next list, and note the step's start for the next step.
 void fill_cache_in_background(StepState* s);
 // Without a cache of its own (settings.cache.margin 0): [0, u_cached] from
-// ws->borrowed, read-only, when that list covers the rest of the step.
+// ws->lender's, read-only, when that list covers the rest of the step.
 void serve_borrowed_list(StepState* s);
 
 }  // namespace gauss6::detail

@@ -7,7 +7,7 @@
 
 #include "gauss6/geometry/bvh.h"
 #include "gauss6/ccd/ccd.h"
-#include "gauss6/step/ccd_step.h"
+#include "gauss6/step/ccd_step_types.h"
 #include "gauss6/geometry/mesh.h"
 #include "gauss6/ccd/motion_bounds.h"
 

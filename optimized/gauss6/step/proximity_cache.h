@@ -5,7 +5,7 @@
 // (ProximityCacheSettings: the margins, the background fill's budget and the
 // named policy constants) and its storage (ProximityCache, allocated once).
 // The stages that serve, refill and fill it in the background are in
-// gauss6/step/proximity_cache.cpp; the step calls them (gauss6/step/ccd_step.cpp).
+// gauss6/step/proximity_stages.cpp; the step calls them (gauss6/step/ccd_step.cpp).
 //
 // Lengths in scene units; the runtime states its margins in units of the
 // scene's delta (RuntimeSettings) and resolves them here.
@@ -30,7 +30,7 @@ struct ProximityCacheSettings {
                             // (0: every list's margin is `margin`; the runtime uses 256 delta)
   long fill_budget = 0;     // node pairs per step that fill the next list in the background while the
                             // one in use serves (0: no background fill; the runtime uses 300)
-  // The policy, dimensionless (gauss6/step/proximity_cache.cpp states where each acts).
+  // The policy, dimensionless (gauss6/step/proximity_stages.cpp states where each acts).
   double steps_per_list = 6;       // a new list's margin spans about this many steps like the last one
   double slow_fraction = 0.25;     // a step that moves at most this fraction of the margin refills at once;
                                    // a first search from the list covers at most the range over which no

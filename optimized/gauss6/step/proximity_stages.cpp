@@ -402,7 +402,7 @@ void serve_proximity_cache(StepState* s) {
   if (s->u_cached > 0) search_cached_pairs(s, pc, since);
 }
 
-// The borrowed list (CcdStepWorkspace::borrowed) serves the step when it
+// The borrowed list (CcdStepWorkspace::lender's) serves the step when it
 // holds what this step needs: the same god-object and obstacles, filled for a
 // reach at least this step's (it holds every pair not proven farther than
 // its reach plus its margin apart at its pose, so every pair that can come
@@ -411,7 +411,7 @@ void serve_proximity_cache(StepState* s) {
 // point leaves its margin that covers the rest of the step (up to a hint's
 // hit). Nothing of the list changes: no use counted, no fill.
 void serve_borrowed_list(StepState* s) {
-  const ProximityCache* pc = s->ws->borrowed;
+  const ProximityCache* pc = &s->ws->lender->cache;
   if (s->tester.done() || pc == nullptr || pc->num_pairs < 0) return;
   if (!(pc->reach >= s->reach && pc->num_pairs <= static_cast<int>(s->ws->candidates.size()) && same_bodies(*pc, *s)))
     return;
