@@ -73,7 +73,7 @@ Lemma abs_scale_le t A B : 0 <= t <= 1 -> Rabs A <= B -> Rabs (t * A) <= B.
 Proof. intros Ht H. rewrite Rabs_mult, Rabs_pos_eq by lra. pose proof (Rabs_pos A). nra. Qed.
 
 (* ---- kLinearCornerRounding, kLinearCornerUnderflow ----
-   The code (ccd.cpp): make_linear_points computes dx = fl(x1 - x0) per
+   The code (ccd/linear_queries.cpp): make_linear_points computes dx = fl(x1 - x0) per
    coordinate of each of the four points; enclose_linear, at a box corner
    (t, a, b) (doubles in [0, 1]), p = fl(x0 + fl(t dx)) for each point,
    w = fl(p_w0 - p_w1), ea = fl(p_a0 - p_a1), eb = fl(p_b0 - p_b1), and the
@@ -112,8 +112,8 @@ Proof.
   - unfold u in *; lra.
 Qed.
 
-(* covers optimized/gauss6/ccd/ccd.cpp "LinearPoints make_linear_points(" sha256:badaaa4fc2f7da52 *)
-(* covers optimized/gauss6/ccd/ccd.cpp "void enclose_linear(" sha256:b914611386face38 *)
+(* covers optimized/gauss6/ccd/linear_queries.cpp "LinearPoints make_linear_points(" sha256:badaaa4fc2f7da52 *)
+(* covers optimized/gauss6/ccd/linear_queries.cpp "void enclose_linear(" sha256:b914611386face38 *)
 Theorem linear_corner_rounding M t a b
     xw0 yw0 xw1 yw1 xa0 ya0 xa1 ya1 xb0 yb0 xb1 yb1 :
   0 <= t <= 1 -> 0 <= a <= 1 -> 0 <= b <= 1 ->
@@ -169,7 +169,7 @@ Qed.
    as the least corner value (and the mirror for the largest) instead of all
    four: that value is one of the four computed corner values, and no larger
    than any of them, rounding being monotone. *)
-(* covers optimized/gauss6/ccd/ccd.cpp "void enclose_linear(" sha256:b914611386face38 *)
+(* covers optimized/gauss6/ccd/linear_queries.cpp "void enclose_linear(" sha256:b914611386face38 *)
 Theorem linear_corner_selection w pa0 pa1 pb0 pb1 :
   let corner pa pb := fl (fl (w + pa) - pb) in
   let least := fl (fl (w + Rmin pa0 pa1) - Rmax pb0 pb1) in
@@ -196,7 +196,7 @@ Qed.
 (* make_linear_points' p.error = kLinearCornerRounding * Upper{M} +
    Upper{kLinearCornerUnderflow}, rounded up (Rounding.v): at least the bound
    of linear_corner_rounding. *)
-(* covers optimized/gauss6/ccd/ccd.cpp "LinearPoints make_linear_points(" sha256:badaaa4fc2f7da52 *)
+(* covers optimized/gauss6/ccd/linear_queries.cpp "LinearPoints make_linear_points(" sha256:badaaa4fc2f7da52 *)
 Theorem linear_corner_error_bound M :
   0 <= M ->
   kLinearCornerRounding * M + kLinearCornerUnderflow

@@ -391,7 +391,7 @@ Proof.
 Qed.
 (* sqr(Lower): the Lower's double a must be >= 0 (a Lower of a nonnegative
    real may be negative, and then a * a may exceed x * x): the one site,
-   excludes in ccd.cpp, enters a distance m >= 0. *)
+   excludes in ccd/bisection.h, enters a distance m >= 0. *)
 (* covers optimized/gauss6/numeric/rounding.h "Lower sqr(Lower a)" sha256:852741653cf3b95a *)
 Theorem lower_sqr x a : 0 <= a <= x -> next_down (fl (a * a)) <= x * x.
 Proof. intros; apply down_le; nra. Qed.

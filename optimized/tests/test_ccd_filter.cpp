@@ -1,5 +1,5 @@
 // Tests of the u-filter of the rigid CCD queries (coplanarity cubic and
-// separating axis, ccd.cpp): on contacts built into random motions and
+// separating axis, u_filter.h): on contacts built into random motions and
 // verified in exact rationals (GMP) against the exact Cayley motion of the
 // input doubles, the filtered query must report a hit no later than the
 // contact's parameter; and on haptic-size steps the filtered and the plain

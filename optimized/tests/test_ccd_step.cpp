@@ -887,7 +887,7 @@ TEST_CASE("ccd_step: a box falling flat onto a slab, and one tipping onto it", "
 
 TEST_CASE("ccd_step: a pair test that refuses its input is a conservative hit, never a miss", "[ccd_step]") {
   // A box falling onto a triangle of the plane z = 0 whose corners reach 2e30:
-  // the pair tests refuse coordinates beyond 1e30 (ccd.cpp). The step must not
+  // the pair tests refuse coordinates beyond 1e30 (kMaxCoordinate). The step must not
   // report a free motion through it: kInvalidInput, with a hit no later than
   // the true contact (u = 1/3).
   const TriangleMesh god = make_box(1, 1, 1);

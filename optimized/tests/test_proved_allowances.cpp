@@ -45,7 +45,7 @@ double parameter(std::mt19937_64& rng) {
 
 }  // namespace
 
-// linear_corner_rounding: ccd.cpp's make_linear_points (dx = x1 - x0) and
+// linear_corner_rounding: linear_queries.cpp's make_linear_points (dx = x1 - x0) and
 // enclose_linear (p = x0 + t dx, w / ea / eb differences of points, the corner
 // value (w + a ea) - b eb) stay within kLinearCornerRounding M +
 // kLinearCornerUnderflow of the exact corner value of the exact points.

@@ -26,7 +26,7 @@
 // form (the coplanarity cubic, the slabs; edge/edge, also the lines' distance
 // as a polynomial of degree 6, which decides a sliding pair whole); linear
 // queries that a short bisection (64 boxes) does not decide continue with the
-// same filters and guides (sliding contacts, nearly parallel edges: ccd.cpp); with early_hit the
+// same filters and guides (sliding contacts, nearly parallel edges: linear_queries.cpp); with early_hit the
 // earliest kept u-interval is accepted without the bisection when a feature
 // pair there is proven within min_separation + distance_tolerance (the same
 // acceptance rule; everything before it was proven free, so u_hit <= u*).

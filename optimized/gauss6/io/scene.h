@@ -103,7 +103,7 @@ struct SettingsProblem {
   std::string message() const { return table + "." + key + ": " + problem; }  // "gains.kh: must be > 0"
 };
 // Coordinates (positions, mesh vertices, in the world frame too) beyond this are
-// refused: the CCD's pair tests refuse coordinates beyond 1e30 (gauss6/ccd/ccd.cpp);
+// refused: the CCD's pair tests refuse coordinates beyond 1e30 (kMaxCoordinate, gauss6/ccd/motion.h);
 // 1e12 leaves room for poses and motions.
 inline constexpr double kMaxSceneCoordinate = 1e12;
 SettingsProblem check_gains(const Gains& gains);                         // 0 < ks <= 1, kh > 0

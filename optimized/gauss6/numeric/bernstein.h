@@ -1,5 +1,5 @@
 // Certified positivity of a polynomial on an interval, from its Bernstein
-// coefficients in doubles: the u-filter of the narrow phase (ccd.cpp) tests
+// coefficients in doubles: the u-filter of the narrow phase (ccd/u_filter.h) tests
 // each of its exclusion conditions, cubics and a sextic in u, with these.
 // Depends on rounding.h and error_allowances.h only; no allocation.
 #pragma once

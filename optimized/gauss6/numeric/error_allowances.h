@@ -157,7 +157,7 @@ constexpr double kBoxProductRounding = 2e-15;
 constexpr double kUnderflowFloor = 1e-300;
 
 // A corner value of F = (w + a ea) - b eb for linearly moving points (the
-// narrow phase's enclose_linear, ccd.cpp), every input coordinate bounded by M
+// narrow phase's enclose_linear, ccd/linear_queries.cpp), every input coordinate bounded by M
 // and u, a, b in [0, 1], is computed within 128 u M + 64 2^-1022 of the exact
 // one (69 u M + 44 2^-1075 proved): proofs/Allowances.v, linear_corner_rounding
 // (and linear_corner_selection, linear_corner_error_bound for the min / max
@@ -192,7 +192,7 @@ constexpr double kBernsteinUnderflow = 0x1p-1000;  // times 1 + sum_j |lo_j|
 // to the query's largest coordinate: F's enclosures are at least a few units
 // of u of the coordinates wide (128 u for linear motion, kLinearCornerRounding),
 // so a tolerance below that could never be met; 1e-12 stays 70 times above it.
-// Sites: bisect and filtered_bisect (ccd.cpp).
+// Sites: bisect (ccd/bisection.h) and filtered_bisect (ccd/u_filter.h).
 constexpr double kDistanceToleranceFloor = 1e-12;
 
 }  // namespace gauss6

@@ -51,7 +51,7 @@ namespace gauss6 {
 // flushes subnormals to zero (FTZ and DAZ, as audio and game hosts often set):
 // a result flushed to zero errs by < 2^-1022; a subnormal operand read as zero
 // errs by < 2^-1022 times the other operand, which the collision pipeline
-// keeps under 1e30 (2^100: ccd.cpp refuses larger coordinates), so by < 2^-922;
+// keeps under 1e30 (2^100: the CCD queries refuse larger coordinates), so by < 2^-922;
 // the widening covers both, where 2^-1074, read as zero, widened nothing.
 // No -frounding-math is needed: the rounding mode is never changed. A NaN bound
 // makes every exclusion test false (comparisons with NaN are false, and the max
