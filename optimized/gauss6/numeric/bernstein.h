@@ -18,8 +18,8 @@ namespace gauss6 {
 //
 // Proof (over the reals machine-checked in proofs/Bernstein.v:
 // bernstein_certificate, from bernstein_positive, bernstein_blossom and
-// bernstein_end_rows; the doubles' part, kBernsteinRounding, argued below and
-// not yet machine-checked). On [u0, u1] (0 <= u0 <= u1 <= 1) a polynomial sum_j k_j u^j of degree
+// bernstein_end_rows; the doubles' part in proofs/BernsteinRounding.v:
+// bernstein_rounding, bernstein_certificate_doubles). On [u0, u1] (0 <= u0 <= u1 <= 1) a polynomial sum_j k_j u^j of degree
 // N is sum_i b_i B_i(t), t = (u - u0) / (u1 - u0), with B_i >= 0 summing to 1
 // (the Bernstein basis), so it is >= min_i b_i there, and b_i = sum_j k_j w_ij
 // with w_ij = e_j(u0 repeated N - i times, u1 i times) / C(N, j) (the blossom
@@ -30,7 +30,8 @@ namespace gauss6 {
 // nonnegative terms, a quotient by an exact integer), and positive_on() the sum
 // S~_i; the allowances kBernsteinRounding (relative to T_i = sum_j |lo_j| w_ij)
 // and kBernsteinUnderflow (absolute, times 1 + sum_j |lo_j|) bound |S~_i - S_i|
-// (error_allowances.h), so S~_i minus them > 0, rounded, proves S_i > 0. NaN or
+// with their own roundings (error_allowances.h), so S~_i minus them > 0,
+// rounded, proves S_i > 0. NaN or
 // infinite coefficients make a comparison false or NaN: the interval is kept.
 // S_i is the exact least value of b_i over the coefficient box, where a
 // Taylor shift in interval arithmetic widens it; it costs a few products per

@@ -168,23 +168,13 @@ constexpr double kLinearCornerRounding = 0x1p-46;  // 128 u
 constexpr double kLinearCornerUnderflow = 64 * std::numeric_limits<double>::min();  // 2^-1016
 
 // The Bernstein lower bounds of the u-filter's polynomials (bernstein.h:
-// BernsteinBasis, positive_on), degree N <= 6 on [u0, u1] within [0, 1]:
-// S_i = sum_j lo_j w_ij, each weight w_ij a sum of at most N + 1 nonnegative
-// terms C C' u0^a u1^b divided by C(N, j) (exact integers). Computed: a power
-// within (N - 1) u, times the other power u, times the integer u, the sum N u,
-// the quotient u: each weight within (2N + 1) u of itself; the N + 1 products
-// lo_j w_ij (u each) and their sum (N u) then put S~_i within (3N + 2) u T_i
-// of S_i, T_i = sum_j |lo_j| w_ij (to first order; 20 u at N = 6). 2^-48 = 32 u
-// covers that 1.6 times, and the roundings of the bound itself (T~_i is
-// within (3N + 2) u of T_i too, the product by 2^-48 is exact, and the last
-// sum and difference round by u each).
-// Underflow: each underflowing operation errs by at most 2^-1022 (FTZ
-// included: rounding.h), and the factors it meets later are <= 1 (powers of
-// u <= 1) or <= 20 (the integers): a weight errs by < 2^-1012 more, S~_i by
-// < 2^-1012 sum_j |lo_j| + 16 2^-1022; a subnormal lo_j read as zero (DAZ)
-// by < 2^-1022 w_ij. 2^-1000 (1 + sum_j |lo_j|) covers all of it 2^11 times
-// and stays normal. A fused multiply-add, if a compiler contracted one, rounds
-// once instead of twice: within the same bound.
+// BernsteinBasis, LowerCoefficients::set, positive_on), degree N <= 6 on
+// [u0, u1] within [0, 1]: S~_i - (32 u T~_i + 2^-1000 (1 + sum_j |lo_j|)) > 0,
+// computed, proves the exact S_i = sum_j lo_j w_ij > 0: proofs/BernsteinRounding.v,
+// bernstein_rounding (S~_i within (1 + u)^(2N + 6) - 1 <= 19 u of T_i and
+// 2^-1024 (1 + sum_j |lo_j|) of S_i; gradual underflow, no fused multiply-add).
+// Not modelled, argued: flushed to zero (FTZ/DAZ), each underflow errs by
+// < 2^-1022, against factors <= 20: < 2^-1011 (1 + sum_j |lo_j|), 2^-11 of the floor.
 constexpr double kBernsteinRounding = 0x1p-48;    // 32 u
 constexpr double kBernsteinUnderflow = 0x1p-1000;  // times 1 + sum_j |lo_j|
 
