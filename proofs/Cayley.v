@@ -141,7 +141,7 @@ Definition c2 (g v : V3) := vsub (vscale (2 * dot g v) g) (vscale (dot g g) v).
 
 (* Theorem cayley_point_quadratic: D(u) C(u g) v = v + u c1 + u^2 c2, every
    coordinate a quadratic in u over D(u). *)
-(* covers optimized/gauss6/ccd/ccd.cpp "CayleyCoefficients cayley_coefficients(const CcdMotion& m, const IVec3& v)" sha256:23b6441de1e32afa *)
+(* covers optimized/gauss6/ccd/u_filter.h "CayleyCoefficients cayley_coefficients(const CcdMotion& m, const IVec3& v)" sha256:23b6441de1e32afa *)
 Theorem cayley_point_quadratic g v u :
   vscale (Du g u) (mvec (cayley (vscale u g)) v) = vadd v (vadd (vscale u (c1 g v)) (vscale (u * u) (c2 g v))).
 Proof.
@@ -157,7 +157,7 @@ Qed.
    with offset w, a static point f and direction m,
    D(u) (x(u) - f).m = (A + w.m) + (E + c1.m) u + (s A + c2.m) u^2 + s E u^3,
    A = (p0 - f).m, E = dp.m, s = |g|^2. *)
-(* covers optimized/gauss6/ccd/ccd.cpp "Cubic body_point_along(const CcdMotion& m, Interval A, Interval E, const CornerAlong& c)" sha256:c724140c237ab869 *)
+(* covers optimized/gauss6/ccd/u_filter.h "Cubic body_point_along(const CcdMotion& m, Interval A, Interval E, const CornerAlong& c)" sha256:c724140c237ab869 *)
 Theorem body_point_cubic g p0 dp w f m u :
   let x := vadd (vadd p0 (vscale u dp)) (mvec (cayley (vscale u g)) w) in
   let A := dot (vsub p0 f) m in let E := dot dp m in let s := dot g g in
@@ -178,7 +178,7 @@ Qed.
    oriented at u = 0), D(u) (y - x_f(u)).(C(u g) n') =
    (Y.n' - F) + (Y.c1 - dp.n') u + (Y.c2 - dp.c1 - s F) u^2 - dp.c2 u^3,
    Y = y - p0, F = f'.n', c1, c2 those of n' (C is a rotation). *)
-(* covers optimized/gauss6/ccd/ccd.cpp "Cubic static_point_along(const CcdMotion& m, const DirectionAlong& Y, const DirectionAlong& D," sha256:a8ad990e242f2207 *)
+(* covers optimized/gauss6/ccd/u_filter.h "Cubic static_point_along(const CcdMotion& m, const DirectionAlong& Y, const DirectionAlong& D," sha256:a8ad990e242f2207 *)
 Theorem static_point_cubic g p0 dp fw nw y u :
   let C := cayley (vscale u g) in
   let xf := vadd (vadd p0 (vscale u dp)) (mvec C fw) in
