@@ -343,6 +343,18 @@ Qed.
 Lemma sqrt_scale k S : 0 <= k -> 0 <= S -> sqrt (k * k * S) = k * sqrt S.
 Proof. intros. rewrite sqrt_mult by nra. rewrite sqrt_square by lra. reflexivity. Qed.
 
+(* A norm N >= 2^-501: the absolute errors of underflow, eta, are below
+   2^-20 u N. *)
+Lemma eta_norm N : bpow radix2 (-501) <= N -> 1000000 * eta <= u * N.
+Proof.
+  intros HN. pose proof eta_pos. assert (0 < u) by (unfold u; lra).
+  apply Rle_trans with (u * bpow radix2 (-501)); [|apply Rmult_le_compat_l; lra].
+  rewrite bpow_m53, <- bpow_plus. unfold eta.
+  apply Rle_trans with (bpow radix2 20 * bpow radix2 (-1075)).
+  - apply Rmult_le_compat_r; [apply bpow_ge_0 | simpl; lra].
+  - rewrite <- bpow_plus. apply bpow_le. lia.
+Qed.
+
 Definition norm_c x y z := fl (sqrt (fl (fl (fl (x * x) + fl (y * y)) + fl (z * z)))).
 
 (* allowance kNormFloor = 0x1p-500 *)
@@ -366,12 +378,8 @@ Proof.
     set (N := sqrt S).
     assert (HN : bpow radix2 (-500) <= N)
       by (unfold N; rewrite <- (sqrt_bpow2 (-500)); apply sqrt_le_1_alt; exact Hs).
-    assert (HeN : 1000000 * eta <= u * N).
-    { apply Rle_trans with (u * bpow radix2 (-500)); [|apply Rmult_le_compat_l; lra].
-      rewrite bpow_m53, <- bpow_plus. unfold eta.
-      apply Rle_trans with (bpow radix2 20 * bpow radix2 (-1075)).
-      - apply Rmult_le_compat_r; [apply bpow_ge_0 | simpl; lra].
-      - rewrite <- bpow_plus. apply bpow_le. lia. }
+    assert (HeN : 1000000 * eta <= u * N)
+      by (apply eta_norm; eapply Rle_trans; [apply bpow_le with (e2 := (-500)%Z); lia | exact HN]).
     assert (HN0 : 0 <= N) by apply sqrt_pos.
     assert (Hr : (1 - 3 * u) * N <= sqrt s).
     { unfold N. rewrite <- sqrt_scale by lra. apply sqrt_le_1_alt.
@@ -425,12 +433,7 @@ Proof.
       assert (HN0 : 0 <= N) by apply sqrt_pos.
       assert (HN : bpow radix2 (-501) <= N).
       { unfold N. rewrite <- (sqrt_bpow2 (-501)). apply sqrt_le_1_alt. simpl (2 * -501)%Z. exact Hs. }
-      assert (HeN : 1000000 * eta <= u * N).
-      { apply Rle_trans with (u * bpow radix2 (-501)); [|apply Rmult_le_compat_l; lra].
-        rewrite bpow_m53, <- bpow_plus. unfold eta.
-        apply Rle_trans with (bpow radix2 20 * bpow radix2 (-1075)).
-        - apply Rmult_le_compat_r; [apply bpow_ge_0 | simpl; lra].
-        - rewrite <- bpow_plus. apply bpow_le. lia. }
+      assert (HeN : 1000000 * eta <= u * N) by (apply eta_norm; exact HN).
       assert (Hr : sqrt s <= (1 + 3 * u) * N).
       { unfold N. rewrite <- sqrt_scale by lra. apply sqrt_le_1_alt.
         apply Rle_trans with ((1 + 5 * u) * S); [nra | apply Rmult_le_compat_r; nra]. }
@@ -454,7 +457,7 @@ Qed.
 (* The code's forms, at its sites. *)
 (* covers optimized/gauss6/numeric/rounding.h "GAUSS6_ALWAYS_INLINE Upper norm_up(double norm, double relative)" sha256:b4b3280a1e614758 *)
 (* covers optimized/gauss6/ccd/motion_bounds.cpp "void StartFrame::set(const CcdMotion& m, double u, double rho_in)" sha256:cfac9ee869768b2c *)
-(* covers optimized/gauss6/ccd/motion_bounds.h "PosedObb pose(const Obb& b) const" sha256:d9a738b735b2fff9 *)
+(* covers optimized/gauss6/ccd/motion_bounds.h "PosedObb pose(const Obb& b) const" sha256:80435f8b04136e0b *)
 (* covers optimized/gauss6/ccd/motion_bounds.h "double radius(double r2) const" sha256:6689317b141e2024 *)
 Theorem norm_up_relative x y z :
   sqrt (x * x + y * y + z * z) <= Rmax (next_up (fl (norm_c x y z * fl (1 + kRelativeRounding)))) kNormFloor.

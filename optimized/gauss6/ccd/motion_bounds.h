@@ -191,8 +191,9 @@ struct SweptObbFrame {
     const Vec3 c = R * b.center;
     out.center = c + p;
     out.half = b.half;
-    // |r_B| <= |center| + |half| for every point of the box.
-    const Upper radius = (1 + kRelativeRoundingWide) * round_up(b.center.norm() + b.half.norm());
+    // |r_B| <= |center| + |half| for every point of the box, each norm bounded
+    // with its floor (norm_up: the squares may underflow).
+    const Upper radius = norm_up(b.center.norm(), kRelativeRoundingWide) + norm_up(b.half.norm(), kRelativeRoundingWide);
     out.grow = turn > 0 ? (Upper{grow} + Upper{turn} * radius).v : grow;
     if (spread > 0) {
       const Vec3 node_step = step + spin.cross(c);

@@ -15,33 +15,21 @@
 
 namespace gauss6 {
 
-// Relative error of a value computed from exact doubles by a few rounded
-// operations that do not cancel. A Euclidean norm of a 3-vector (three
-// squares and two sums of nonnegative terms within (1 + u)^3, the square root
-// halving that, then rounding once more) is within 2.6 u (2.9e-16) of itself;
-// the product of a rounded difference and a double, within 2.01 u per
-// coordinate. 1e-15 covers a norm 3.4 times, and, taken twice, the two
-// roundings of the sub-interval's step (u1 - u0) dp_mid 9 times.
-// Sites: |omega| and the step's rounding (StartFrame::set, ::obb_frame), the
-// shift |p_b - p_a| (Displacement), |half| (SweptObbFrame::pose), and a
-// corner's |r_B| (StartFrame::radius).
-// Machine-checked at the norm sites (a double vector's norm, rounded up with
-// this allowance and the floor kNormFloor: norm_up in rounding.h):
-// proofs/Allowances.v, norm_upper_bound; the step's rounding
-// (StartFrame::obb_frame): step_rounding; the shift's rounded components are
-// not machine-checked yet.
+// Relative allowance of a norm or a rounded product computed from doubles
+// (a norm errs by under 3.6 u, the step's product by 2.01 u per coordinate).
+// Machine-checked at every site: proofs/Allowances.v norm_up_relative
+// (|omega|: StartFrame::set; |half|: SweptObbFrame::pose; |r_B|:
+// StartFrame::radius), step_rounding (StartFrame::obb_frame);
+// proofs/ObbAllowances.v shift_rounding (Displacement's |p_b - p_a|, whose
+// components are rounded differences).
 constexpr double kRelativeRounding = 1e-15;
 
-// The same roundings of a norm (or of a sum of two norms, its own rounding
-// covered by next_up) with the wider allowance the separating-axis and
-// box-radius sites take: 1e-12 covers 2.6 u 3400 times. Kept apart from
-// kRelativeRounding because merging either into the other would move the
-// lockstep runs; both are sound. Sites: |a| of a separating axis, rounded up
-// (for_each_separating_axis) and down (triangle_time_lower_bound), and
-// |center| + |half| of a god node's box (SweptObbFrame::pose).
-// Machine-checked at the norm sites (norm_up, norm_down in rounding.h):
-// proofs/Allowances.v, norm_upper_bound, norm_lower_bound; the sum of two norms
-// is not machine-checked yet.
+// The wider relative allowance of a norm at the separating-axis and box-radius
+// sites (kept apart from kRelativeRounding: merging them moves the lockstep
+// runs; both are proved). Machine-checked: proofs/Allowances.v norm_up_wide
+// (for_each_separating_axis), norm_down_wide (triangle_time_lower_bound);
+// proofs/ObbAllowances.v obb_radius_rounding (|center| + |half|,
+// SweptObbFrame::pose).
 constexpr double kRelativeRoundingWide = 1e-12;
 
 // The absolute floor of a norm's bounds (norm_up, norm_down in rounding.h):
@@ -144,7 +132,9 @@ constexpr double kBoxPoseRounding = 1e-12;
 // nonnegative terms, within 7.01 u of itself <= 7.01 u T; T itself is
 // computed within 7.01 u. Under 10.1 u (1.12e-15) of the computed T in all;
 // 2e-15 covers it 1.8 times (kUnderflowFloor below it). Site: swept_box.
-// Machine-checked: proofs/Allowances.v, swept_box_rounding (with kUnderflowFloor).
+// Machine-checked: proofs/Allowances.v, swept_box_rounding (with kUnderflowFloor);
+// the box then holds every pose of the motion: proofs/ObbAllowances.v,
+// swept_box_encloses.
 constexpr double kBoxProductRounding = 2e-15;
 
 // An absolute floor under the relative allowances of box extents, where the
