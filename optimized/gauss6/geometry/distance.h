@@ -36,9 +36,12 @@ void closest_segment_parameters(const Vec3& p0, const Vec3& p1, const Vec3& q0, 
 //
 // Proof. For convex sets and any vector a != 0, dist(A, B) >= (min_B a.y -
 // max_A a.x) / |a| (or the mirror). Whatever the rounded axis a is, the
-// computed difference of two projections is within kAxisProductRounding |a|_1
-// s of the exact one, s the largest coordinate of the six corners; so raw less
-// that is below the exact gap along a. Dividing by norm_up(|a|,
+// computed difference of two projections, less kAxisProductRounding |a|_1 s +
+// kUnderflowFloor (s the largest coordinate of the six corners) and rounded,
+// is below the exact gap along a, for |a|_1 >= kNormFloor (a shorter axis is
+// dropped: below it the product kAxisProductRounding |a|_1 underflows and the
+// slack no longer covers the projections' rounding, relative to |a|_1 s;
+// kUnderflowFloor covers the projections' own underflow). Dividing by norm_up(|a|,
 // kRelativeRoundingWide) (rounding.h; >= the exact |a|, also where the squares
 // underflow: proofs/Allowances.v, norm_upper_bound), the quotient rounded
 // down, covers the roundings of the norm and the quotient.
@@ -96,7 +99,11 @@ GAUSS6_ALWAYS_INLINE void for_each_separating_axis(const SatSide& A, const SatSi
       b_hi = std::max(b_hi, pb);
     }
     const double side = b_lo - a_hi >= a_lo - b_hi ? 1.0 : -1.0;
-    const double proven = std::max(b_lo - a_hi, a_lo - b_hi) - kAxisProductRounding * a.cwiseAbs().sum() * s;
+    // An axis with |a|_1 below kNormFloor proves nothing: kAxisProductRounding
+    // |a|_1 would underflow and no longer cover the projections' rounding.
+    const double a_1 = a.cwiseAbs().sum();
+    if (!(a_1 >= kNormFloor)) return false;
+    const double proven = std::max(b_lo - a_hi, a_lo - b_hi) - (kAxisProductRounding * a_1 * s + kUnderflowFloor);
     if (!(proven > 0)) return false;  // also on NaN
     const double g = (Lower{proven} / norm_up(a.norm(), kRelativeRoundingWide)).v;
     if (!(g < std::numeric_limits<double>::infinity())) return false;

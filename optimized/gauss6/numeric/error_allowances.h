@@ -45,12 +45,16 @@ constexpr double kNormFloor = 0x1p-500;
 // |a|_1 times the largest coordinates of the other factors. The difference of
 // two projections a.y - a.x of corners with coordinates <= s: each projection
 // within 3.01 u |a|_1 s, the difference rounding within 2 u |a|_1 s, under
-// 8.1 u (9e-16) of |a|_1 s. The turn term r.(a x omega), with T = |a|_1
-// |omega|_inf |r|_inf: the cross product's rounding moves it by 4.02 u T, its
-// own by 6.02 u T (|a x omega|_1 <= 2 |a|_1 |omega|_inf), the sums that join
-// it to a.v by 8 u T: under 19 u (2.1e-15) of T. 1e-13 covers the gap 110
-// times and the turn 47 times. Sites: for_each_separating_axis (distance.h),
-// triangle_time_lower_bound (motion_bounds.h).
+// 8.1 u (9e-16) of |a|_1 s, and the last subtraction of the slack within
+// 2 u |a|_1 s more; the projections' underflow (2^-1075 a product) is under
+// kUnderflowFloor, which the site adds, and the site drops an axis with
+// |a|_1 < kNormFloor, below which kAxisProductRounding |a|_1 underflows. The
+// turn term r.(a x omega), with T = |a|_1 |omega|_inf |r|_inf: the cross
+// product's rounding moves it by 4.02 u T, its own by 6.02 u T (|a x omega|_1
+// <= 2 |a|_1 |omega|_inf), the sums that join it to a.v by 8 u T: under 19 u
+// (2.1e-15) of T. 1e-13 covers the gap 89 times and the turn 47 times. Sites:
+// for_each_separating_axis (distance.h), triangle_time_lower_bound
+// (motion_bounds.h).
 constexpr double kAxisProductRounding = 1e-13;
 
 // The velocity term a.v of triangle_time_lower_bound and its share of the
@@ -142,8 +146,9 @@ constexpr double kBoxProductRounding = 2e-15;
 // underflowing product or sum errs by at most 2^-1075 (2.5e-324; 2^-1022,
 // 2.2e-308, on a thread that flushes subnormals to zero), and a box's few
 // dozen of them stay below 1e-306; 1e-300 covers them and is below any extent
-// that matters. Sites: fit_obb, generate_contacts, swept_box. Machine-checked
-// at swept_box: proofs/Allowances.v, swept_box_rounding.
+// that matters. Sites: fit_obb, generate_contacts, swept_box,
+// for_each_separating_axis. Machine-checked at swept_box: proofs/Allowances.v,
+// swept_box_rounding.
 constexpr double kUnderflowFloor = 1e-300;
 
 // A corner value of F = (w + a ea) - b eb for linearly moving points (the
