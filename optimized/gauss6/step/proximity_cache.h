@@ -30,6 +30,10 @@ struct ProximityCacheSettings {
                             // (0: every list's margin is `margin`; the runtime uses 256 delta)
   long fill_budget = 0;     // node pairs per step that fill the next list in the background while the
                             // one in use serves (0: no background fill; the runtime uses 300)
+  long fill_at_once = 1000;  // node pairs a step spends at most on a list it needs now while a list for the
+                             // same meshes and settings is kept: the rest goes on at the next steps, which
+                             // descend the trees meanwhile (no step pays a whole fill: at a million
+                             // triangles a list's fill costs several updates' time)
   // The policy, dimensionless (gauss6/step/proximity_stages.cpp states where each acts).
   double steps_per_list = 6;       // a new list's margin spans about this many steps like the last one
   double slow_fraction = 0.25;     // a step that moves at most this fraction of the margin refills at once;
@@ -44,7 +48,7 @@ struct ProximityCacheSettings {
 
 // The settings can be used: margins finite and >= 0, policy constants in range
 // (steps_per_list > 0, slow_fraction and fill_lead in (0, 1], max_probe_sub_intervals
-// in (0, 1], min_uses >= 1, skip_after_poor_fill >= 0, fill_budget >= 0).
+// in (0, 1], min_uses >= 1, skip_after_poor_fill >= 0, fill_budget >= 0, fill_at_once >= 1).
 bool valid_proximity_cache_settings(const ProximityCacheSettings& s);
 
 // The lists, allocated once (capacity: pairs a list holds; stack_capacity: the
@@ -96,9 +100,9 @@ struct ProximityCache {
   double margin_min = 0, margin_max = 0;  // the settings it was filled under (keys)
   int uses = 0;  // later steps served since the fill
   int rest = 0;  // chances to refill still to pass over (ProximityCacheSettings::skip_after_poor_fill)
-  bool budget_cut = false;  // a fill at once was cut short by an update's budget: it goes on in the
-                            // background, and no other starts at once, until it is put in use or a step's
-                            // search completes within its budget
+  bool budget_cut = false;  // a fill a step needed was cut short (budget, or its bound): it goes on in the
+                            // background, and no other starts at once, until it is put in use or dropped
+                            // (the god-object went elsewhere)
   CcdBody god;
   std::vector<CcdBody> obstacles;  // the keys; capacity obstacle_capacity, reserved here (never grows)
   // A fill in progress (ProximityCacheSettings::fill_budget): the same kind

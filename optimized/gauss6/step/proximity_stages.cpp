@@ -19,7 +19,7 @@ bool valid_proximity_cache_settings(const ProximityCacheSettings& s) {
   return s.margin >= 0 && std::isfinite(s.margin) && s.margin_max >= 0 && std::isfinite(s.margin_max) &&
          s.fill_budget >= 0 && s.steps_per_list > 0 && std::isfinite(s.steps_per_list) &&
          in_unit(s.slow_fraction) && in_unit(s.max_probe_sub_intervals) && in_unit(s.fill_lead) &&
-         s.min_uses >= 1 && s.skip_after_poor_fill >= 0;
+         s.min_uses >= 1 && s.skip_after_poor_fill >= 0 && s.fill_at_once >= 1;
 }
 
 namespace detail {
@@ -224,9 +224,11 @@ struct CacheRanges {
   bool usable(double u) const { return window(u) > 0; }
 };
 
-// The fill's pose is ahead of the god-object's path (fill_cache_in_background):
-// put it in use once it leaves more of its margin than the list in use does, or
-// (finished now if need be) when that list cannot serve this step.
+// The fill's pose is ahead of the god-object's path (fill_cache_in_background),
+// or at the start of a step that needed it (refill_if_worth): put it in use once
+// it leaves more of its margin than the list in use does, or, when that list
+// cannot serve this step, once complete (at most fill_at_once more node pairs
+// now: the step descends the trees meanwhile).
 void take_background_fill(StepState* s, const CacheRanges& r, Displacement* since) {
   ProximityCache& pc = s->ws->cache;
   ProximityCache::Fill& pf = pc.fill;
@@ -236,12 +238,14 @@ void take_background_fill(StepState* s, const CacheRanges& r, Displacement* sinc
   const bool needed = !r.usable(s->u_cached) && r.usable(r.range(moved_ahead, pf.margin));
   if (!r.usable(s->u_cached) && !needed) {
     pf.active = false;  // the god-object went elsewhere
-  } else if ((better && pf.complete) || (needed && fill_within_budget(s, std::numeric_limits<long>::max()))) {
+  } else if ((better && pf.complete) || (needed && fill_within_budget(s, policy(*s).fill_at_once))) {
     put_fill(s);
     s->result->cache_refilled = true;
     *since = ahead;
     s->cache_moved = moved_ahead;
     s->u_cached = r.range(s->cache_moved, pc.margin);
+  } else if (needed && pf.active) {
+    pc.budget_cut = true;  // cut short: it goes on, and no other fill starts at once (refill_if_worth)
   }
 }
 
@@ -253,7 +257,11 @@ void take_background_fill(StepState* s, const CacheRanges& r, Displacement* sinc
 // the one after that fills. A step that moves at most slow_fraction of the
 // margin fills regardless (the list then serves the next steps unless the
 // god-object speeds up).
-// The fill is at once, at X0 (u = 0).
+// The fill is at X0 (u = 0), at once but for its bound: while a list for
+// the same meshes and settings is kept (s->cache_keyed), it spends at most
+// fill_at_once node pairs now and goes on at the next steps (a list's pairs
+// grow faster than the meshes: at a million triangles a whole fill costs
+// several updates' time).
 void refill_if_worth(StepState* s, const CacheRanges& r, Displacement* since) {
   ProximityCache& pc = s->ws->cache;
   const double margin = step_margin(*s), rho = s->rho;
@@ -263,7 +271,7 @@ void refill_if_worth(StepState* s, const CacheRanges& r, Displacement* since) {
       list_margin(*s, pc.has_last ? Displacement(pc.last_x0, s->X0).bound(rho) : 0.0, margin, step_margin_max(*s));
   bool fill = !fresh && r.usable(r.range(Displacement(s->X0, s->X0).bound(rho), fresh_margin));
   if (fill && pc.budget_cut && pc.fill.active) {
-    fill = false;  // the fill the budget cut short goes on (take_background_fill)
+    fill = false;  // the fill cut short goes on (take_background_fill)
   } else if (fill && s->start.speed <= policy(*s).slow_fraction * margin) {
     pc.rest = 0;
   } else if (fill && pc.rest > 0) {
@@ -274,13 +282,15 @@ void refill_if_worth(StepState* s, const CacheRanges& r, Displacement* since) {
   }
   if (!fill) return;
   start_fill(s, /*ahead=*/nullptr, fresh_margin);
-  const bool filled = fill_within_budget(s, std::numeric_limits<long>::max());
-  // A fill the update's budget cut short goes on at the next updates as a
-  // background fill (while the list in use keeps the keys: take_background_fill
-  // finishes it, within their budgets, and puts it in use), and none starts
-  // at once meanwhile: no update spends its budget on the same fill again.
-  // Without a list in use (the first fill) it is dropped.
-  if (!filled && out_of_budget(*s) && pc.fill.active && pc.num_pairs >= 0) {
+  const bool filled =
+      fill_within_budget(s, s->cache_keyed ? policy(*s).fill_at_once : std::numeric_limits<long>::max());
+  // A fill cut short, by the update's budget or by fill_at_once, goes on at the
+  // next steps as a background fill (while the list in use keeps the keys:
+  // take_background_fill finishes it, within their budgets and fill_at_once, and
+  // puts it in use), and none starts at once meanwhile: no step spends its time
+  // on the same fill again. Without a list in use (the first fill) a fill the
+  // budget cut short is dropped.
+  if (!filled && (out_of_budget(*s) || s->cache_keyed) && pc.fill.active && pc.num_pairs >= 0) {
     pc.budget_cut = true;
     s->u_cached = 0;
     return;
@@ -455,7 +465,7 @@ void fill_cache_in_background(StepState* s) {
     if (pf.active && !pf.complete) fill_within_budget(s, settings.cache.fill_budget);
   }
   // The next step's background fill and list margin follow this step's motion.
-  pc.budget_cut = pc.budget_cut && out_of_budget(*s);  // this step's search completed within its budget
+  pc.budget_cut = pc.budget_cut && pc.fill.active;  // the fill cut short goes on (put in use: false)
   pc.last_x0 = X0;
   pc.has_last = true;
 }
