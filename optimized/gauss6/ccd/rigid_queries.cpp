@@ -247,7 +247,7 @@ void ccd_rigid_edge_edge(const RigidEdgeEdgeQuery& q, const CcdSettings& s, CcdW
   UFilter filter;
   filter.motion = &m;
   filter.g2 = m.g2;
-  const IVec3 a0W = mul(m.R0, a0), eaW = mul(m.R0, ea), Q = m.p0 - b0;
+  const IVec3 a0W = mul(m.R0, a0), eaW = mul(m.R0, ea);
   const IVec3 a1W = mul(m.R0, a0 + ea);
   const Vec3 A0 = motion_point(m.nominal, q.u_begin, q.edge_B[0]);
   const Vec3 A1 = motion_point(m.nominal, q.u_begin, q.edge_B[1]);
@@ -263,13 +263,12 @@ void ccd_rigid_edge_edge(const RigidEdgeEdgeQuery& q, const CcdSettings& s, CcdW
   }
   if (axis_clears(filter, q.u_begin, q.u_end, r)) return;  // before the coplanarity cubic's set-up
   const CayleyCoefficients ca = cayley_coefficients(m, eaW), cb = cayley_coefficients(m, eb);
-  const IVec3 T0 = cross(eaW, eb), T1 = cross(ca.c1, eb), T2 = cross(ca.c2, eb), Z = cross(a0W, eaW);
-  const Cubic P{{dot(Q, T0) + dot(Z, eb), (dot(Q, T1) + dot(m.dp, T0)) - dot(Z, cb.c1),
-                 (dot(Q, T2) + dot(m.dp, T1)) + dot(Z, cb.c2), dot(m.dp, T2)}};
+  const EdgeEdgeCubic ee = edge_edge_cubic(m, a0W, eaW, ca, b0, eb, cb);
+  const Cubic& P = ee.P;
   // L >= |C ea' x eb| on the window: |ea' x eb| + 2 u_end |g| |ea| |eb|.
   const Upper g_norm = sqrt(Upper{m.g2.hi});
   const Upper turn = (2 * q.u_end) * g_norm * (norm_upper(ea) * norm_upper(eb));
-  const double dL = (d * (norm_upper(T0) + turn)).v;
+  const double dL = (d * (norm_upper(ee.T0) + turn)).v;
   filter.at_most(P, dL);
   filter.at_least(P, dL);
   // End slabs. Every point of a segment lies between the planes through its
@@ -312,23 +311,7 @@ void ccd_rigid_edge_edge(const RigidEdgeEdgeQuery& q, const CcdSettings& s, CcdW
     f->at_least(static_point_along(m, Y1, D, F0), ra, /*join=*/true);
     f->at_most(static_point_along(m, Y0, D, F1), ra);
     f->at_most(static_point_along(m, Y1, D, F1), ra, /*join=*/true);
-    // The lines' distance (4): S = P^2 - d^2 |N|^2, N = T0 + u T1 + u^2 T2.
-    {
-      Sextic q6;
-      for (int i = 0; i < 4; ++i) {
-        q6.k[2 * i] = q6.k[2 * i] + sqr(P.k[i]);
-        for (int j = i + 1; j < 4; ++j) q6.k[i + j] = q6.k[i + j] + 2.0 * (P.k[i] * P.k[j]);
-      }
-      const Interval d2 = sqr(Interval::point(d));
-      for (int c = 0; c < 3; ++c) {
-        const Interval n[3] = {T0[c], T1[c], T2[c]};
-        for (int i = 0; i < 3; ++i) {
-          q6.k[2 * i] = q6.k[2 * i] - d2 * sqr(n[i]);
-          for (int j = i + 1; j < 3; ++j) q6.k[i + j] = q6.k[i + j] - d2 * (2.0 * (n[i] * n[j]));
-        }
-      }
-      f->set_lines(q6);
-    }
+    f->set_lines(lines_sextic(ee, d));  // the lines' distance (4), tried last
   }, Guides<decltype(guide_at), decltype(separated)>{guide_at, separated}, q.u_begin, q.u_end, s, ws, r);
 }
 

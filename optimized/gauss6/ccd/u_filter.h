@@ -120,6 +120,48 @@ struct Sextic {
   Interval k[7];
 };
 
+// The edge/edge coplanarity cubic of (1) for the body edge from a0W along eaW
+// (world-oriented offsets at u = 0; ca: eaW's Cayley coefficients) and the
+// static edge from b0 along eb (cb: eb's): P(u) = (x_a0(u) - b0).N(u), with
+// N(u) = Dc(u) eaW x eb = D(u) (C eaW x eb) = T0 + u T1 + u^2 T2 normal to both
+// lines at u (proofs/LinesDistance.v: edge_edge_normal, edge_edge_cubic).
+struct EdgeEdgeCubic {
+  Cubic P;
+  IVec3 T0, T1, T2;
+};
+GAUSS6_ALWAYS_INLINE EdgeEdgeCubic edge_edge_cubic(const CcdMotion& m, const IVec3& a0W, const IVec3& eaW,
+                                                   const CayleyCoefficients& ca, const IVec3& b0, const IVec3& eb,
+                                                   const CayleyCoefficients& cb) {
+  EdgeEdgeCubic e;
+  e.T0 = cross(eaW, eb);
+  e.T1 = cross(ca.c1, eb);
+  e.T2 = cross(ca.c2, eb);
+  const IVec3 Q = m.p0 - b0, Z = cross(a0W, eaW);
+  e.P = Cubic{{dot(Q, e.T0) + dot(Z, eb), (dot(Q, e.T1) + dot(m.dp, e.T0)) - dot(Z, cb.c1),
+               (dot(Q, e.T2) + dot(m.dp, e.T1)) + dot(Z, cb.c2), dot(m.dp, e.T2)}};
+  return e;
+}
+
+// The lines' distance (4): the coefficients of S(u) = P(u)^2 - d^2 |N(u)|^2
+// (proofs/LinesDistance.v: lines_sextic). S > 0 at u puts the two lines, and
+// so the two edges, more than d apart there (lines_filter_sound).
+GAUSS6_ALWAYS_INLINE Sextic lines_sextic(const EdgeEdgeCubic& e, double d) {
+  Sextic q6;
+  for (int i = 0; i < 4; ++i) {
+    q6.k[2 * i] = q6.k[2 * i] + sqr(e.P.k[i]);
+    for (int j = i + 1; j < 4; ++j) q6.k[i + j] = q6.k[i + j] + 2.0 * (e.P.k[i] * e.P.k[j]);
+  }
+  const Interval d2 = sqr(Interval::point(d));
+  for (int c = 0; c < 3; ++c) {
+    const Interval n[3] = {e.T0[c], e.T1[c], e.T2[c]};
+    for (int i = 0; i < 3; ++i) {
+      q6.k[2 * i] = q6.k[2 * i] - d2 * sqr(n[i]);
+      for (int j = i + 1; j < 3; ++j) q6.k[i + j] = q6.k[i + j] - d2 * (2.0 * (n[i] * n[j]));
+    }
+  }
+  return q6;
+}
+
 // D(u) (x(u) - f).m for the body point with world-oriented offset w = R0 r_B
 // (cw: its Cayley coefficients), a static point f and a static direction m:
 // D (p(u) - f).m + (Dc(u) w).m, with D = 1 + s u^2 and Dc(u) w = w + u c1 + u^2 c2.
