@@ -21,9 +21,11 @@ computed once, on first use):
   energy               passivity observer on the device port (Hannaford and Ryu 2002): the energy the
                        user has put in, which may not go below zero beyond what the device's own
                        damping absorbs (Colgate and Schenkel); no model of the engine
-  force_jumps          the force (torque) a tick adds
+  force_jumps          the force (torque) a tick adds beyond what the handle's motion explains at the
+                       scene's coupling
   wrench_sanity        non-finite or over-limit wrenches and poses
-  tracking             in free space the displayed pose is the handle's (of a recent tick)
+  tracking             in free space, with nothing between tool and hand, the displayed pose lies in the
+                       hull of the handle's recent poses
   latency              ticks from the handle's crossing into an obstacle to the force's response,
                        against the declared latency
   cost                 deadlines: the driver's timing of each step call against the haptic period,
@@ -64,6 +66,56 @@ def added_per_tick(V: np.ndarray) -> np.ndarray:
     pp = np.einsum("ij,ij->i", prev, prev)
     a = np.clip(np.einsum("ij,ij->i", cur, prev) / np.where(pp > 0, pp, 1.0), 0.0, 1.0)
     return np.linalg.norm(cur - a[:, None] * prev, axis=1)
+
+
+def unexplained_per_tick(W: np.ndarray, dx: np.ndarray, mass: float, inertia: np.ndarray, kh: float,
+                         ks: float, limits=(1.0, 1.0)) -> tuple[np.ndarray, np.ndarray]:
+    """The wrench each tick adds beyond what the handle's motion over that tick explains at the
+    scene's stiffness (oracle.toml [jumps], version 6): (force N, torque N m), shape (n - 1,) each.
+
+    W (n, 6): the wrenches; dx (n - 1, 6): the handle's motion over each tick, xh(k+1) (-) xh(k);
+    inertia (n - 1, 3, 3): the tool's world-frame inertia about G at each tick's end (M = diag(m I3,
+    I_G)). With the god-object and its constraints held, the coupling's wrench is W = -kh M Q(au),
+    au = ks (xh (-) xs), Q the M-metric projection onto the polar of the contacts' (offset)
+    constraints (METHOD.md s.3: Fc = kh M (ac - au), ac = au - Q(au)). A projection onto a closed
+    convex set is firmly non-expansive, |Q(a + d) - Q(a)|_M^2 <= <Q(a + d) - Q(a), d>_M: the change
+    z = Q(a + d) - Q(a) lies in the M-ball whose diameter is [0, d], d = ks dx. So the handle's
+    motion explains, through any contacts whatever, the wrench changes -kh M z of that ball: the ball
+    of centre c = -kh ks M dx / 2 and radius kh ks |dx|_M / 2 in the metric M^-1. Beside it, a
+    release of the last tick's wrench explains -s W(k), s in [0, 1], each part its own s (as
+    added_per_tick). The residual: the observed change less the nearest point of the release plus
+    the ball (M^-1), its force and torque parts returned. The torque's release is taken at its
+    Euclidean nearest (at rest this is added_per_tick exactly) and at its I^-1 nearest (which makes
+    the joint M^-1 distance least), keeping the one whose residual is smaller against `limits`
+    (force, torque): each is a point of what the hand and a release explain, so the residual is never
+    below the true one. A handle at rest explains nothing; a change along the push that outgrows the
+    handle's motion keeps its excess at any hand speed."""
+    prev = W[:-1]
+    M_dx = np.concatenate([mass * dx[:, :3], np.einsum("nij,nj->ni", inertia, dx[:, 3:])], axis=1)
+    u = np.diff(W, axis=0) + kh * ks * M_dx / 2
+    dx_M = np.sqrt(np.maximum(np.einsum("ij,ij->i", dx, M_dx), 0.0))
+    radius = kh * ks * dx_M / 2
+
+    def released(a, b, G=None):  # a + s b, s in [0, 1] nearest 0 in the metric G (Euclidean if None)
+        Gb = b if G is None else np.linalg.solve(G, b[..., None])[..., 0]
+        bb = np.einsum("ij,ij->i", b, Gb)
+        s = np.clip(-np.einsum("ij,ij->i", a, Gb) / np.where(bb > 0, bb, 1.0), 0.0, 1.0)
+        return a + s[:, None] * b
+
+    f_part = released(u[:, :3], prev[:, :3])
+    best = None
+    for G in (None, inertia):
+        v = np.concatenate([f_part, released(u[:, 3:], prev[:, 3:], G)], axis=1)
+        v_Minv = np.sqrt(np.einsum("ij,ij->i", v[:, :3], v[:, :3]) / mass
+                         + np.einsum("ni,ni->n", v[:, 3:], np.linalg.solve(inertia, v[:, 3:, None])[..., 0]))
+        keep = np.where(v_Minv > radius, 1.0 - radius / np.where(v_Minv > 0, v_Minv, 1.0), 0.0)
+        f, tau = np.linalg.norm(v[:, :3], axis=1) * keep, np.linalg.norm(v[:, 3:], axis=1) * keep
+        if best is None:
+            best = (f, tau)
+        else:
+            better = np.maximum(f / limits[0], tau / limits[1]) < np.maximum(best[0] / limits[0], best[1] / limits[1])
+            best = (np.where(better, f, best[0]), np.where(better, tau, best[1]))
+    return best
 
 
 def load_thresholds(path=None) -> dict:
@@ -693,26 +745,65 @@ def check_energy(r: RunData, th: dict) -> Verdict:
                    float(t[violations["first"]["tick"]]) if violations else None, note, details, violations)
 
 
+def handle_motion(r: RunData, lag: int) -> np.ndarray:
+    """The handle's motion over the tick `lag` ticks before each tick's end: row k (the tick from k to
+    k + 1) is xh(k + 1 - lag) (-) xh(k - lag), zero where that tick is before the run or either pose
+    is not finite. Shape (n - 1, 6)."""
+    n = r.n
+    dx = np.zeros((max(n - 1, 0), 6))
+    if n - 1 - lag <= 0:
+        return dx
+    good = r.finite_handle[1:] & r.finite_handle[:-1]
+    p = np.where(r.finite_handle[:, None], r.xh_p, 0.0)
+    q = np.where(r.finite_handle[:, None], r.xh_q, np.array([1.0, 0, 0, 0]))
+    d = np.where(good[:, None], pose_difference(p[1:], q[1:], p[:-1], q[:-1]), 0.0)
+    dx[lag:] = d[:n - 1 - lag]
+    return dx
+
+
 def check_force_jumps(r: RunData, th: dict) -> Verdict:
-    """The force (torque) a tick adds: its change less any release of the last tick's force
-    (added_per_tick); the whole change is reported beside it, with the time of the largest."""
+    """The force (torque) a tick adds beyond what the handle's motion over that tick explains at the
+    scene's stiffness (unexplained_per_tick: the change less any release of the last tick's force,
+    less the ball of changes the handle's motion makes through a coupling kh ks M onto any contacts);
+    with a declared latency L, the handle's motion of any of the L ticks before may explain it. The
+    force a tick adds with no discount (added_per_tick) and the whole change are reported beside it,
+    with the time of the largest."""
+    o = r.o
     both = r.finite_wrench[1:] & r.finite_wrench[:-1]
     Wf = np.where(r.finite_wrench[:, None], r.W, 0)
     df = np.where(both, np.linalg.norm(np.diff(Wf[:, :3], axis=0), axis=1), 0)
     dtau = np.where(both, np.linalg.norm(np.diff(Wf[:, 3:], axis=0), axis=1), 0)
     f_add = np.where(both, added_per_tick(Wf[:, :3]), 0)
     tau_add = np.where(both, added_per_tick(Wf[:, 3:]), 0)
-    jumps = np.flatnonzero((f_add > th["max_force_step"]) | (tau_add > th["max_torque_step"])) + 1
+    # The tool's world-frame inertia at each tick's end (the displayed orientation; the body frame's
+    # where that is not a pose).
+    qs = np.where(r.finite_pose[1:, None], r.xs_q[1:], np.array([1.0, 0, 0, 0]))
+    R = rotation_matrices(qs) if len(qs) else np.zeros((0, 3, 3))
+    inertia = R @ o.inertia @ np.transpose(R, (0, 2, 1))
+    limit = np.array([th["max_force_step"], th["max_torque_step"]])
+    f_un = tau_un = None
+    for lag in range(r.declared.get("latency_ticks", 0) + 1):
+        f, tau = unexplained_per_tick(Wf, handle_motion(r, lag), o.mass, inertia, o.kh, o.ks, limit)
+        if f_un is None:
+            f_un, tau_un = f, tau
+        else:  # the lag that explains most (the smaller excess over the thresholds)
+            better = np.maximum(f / limit[0], tau / limit[1]) < np.maximum(f_un / limit[0], tau_un / limit[1])
+            f_un, tau_un = np.where(better, f, f_un), np.where(better, tau, tau_un)
+    f_un, tau_un = np.where(both, f_un, 0), np.where(both, tau_un, 0)
+    jumps = np.flatnonzero((f_un > limit[0]) | (tau_un > limit[1])) + 1
     peak = {k: float(v.max()) if len(v) else 0.0
-            for k, v in (("force_added", f_add), ("torque_added", tau_add), ("force_step", df), ("torque_step", dtau))}
+            for k, v in (("force_unexplained", f_un), ("torque_unexplained", tau_un), ("force_added", f_add),
+                         ("torque_added", tau_add), ("force_step", df), ("torque_step", dtau))}
     largest_time = float(r.t[int(np.argmax(df)) + 1]) if len(df) else None
     # Worst: the larger excess over its threshold, force or torque.
-    excess = np.maximum(f_add / th["max_force_step"], tau_add / th["max_torque_step"])
+    excess = np.maximum(f_un / limit[0], tau_un / limit[1])
     return Verdict(
-        "force_jumps", "", len(jumps) == 0, len(jumps), peak["force_added"], "N added per tick",
-        float(r.t[jumps[0]]) if len(jumps) else None,
-        f"max force added {peak['force_added']:.3g} N, torque {peak['torque_added']:.3g} N m; "
-        f"largest change {peak['force_step']:.3g} N" + (f" at {largest_time:.3f} s" if peak["force_step"] > 0 else "")
+        "force_jumps", "", len(jumps) == 0, len(jumps), peak["force_unexplained"],
+        "N added per tick beyond the hand's motion", float(r.t[jumps[0]]) if len(jumps) else None,
+        f"max force added beyond the hand's motion (at kh ks M = {o.kh:g} x {o.ks:g} x M) "
+        f"{peak['force_unexplained']:.3g} N, torque {peak['torque_unexplained']:.3g} N m; added in all "
+        f"{peak['force_added']:.3g} N, torque {peak['torque_added']:.3g} N m; largest change "
+        f"{peak['force_step']:.3g} N" + (f" at {largest_time:.3f} s" if peak["force_step"] > 0 else "")
         + f", torque {peak['torque_step']:.3g} N m",
         {**{f"max_{k}": v for k, v in peak.items()}, "max_force_step_time": largest_time},
         _first_worst(jumps, excess[jumps - 1]))
@@ -739,12 +830,60 @@ def check_wrench_sanity(r: RunData, th: dict) -> Verdict:
         if len(insane) else {})
 
 
+def hull_error(D: np.ndarray, radius: float) -> tuple[float, np.ndarray]:
+    """The pose error of a displayed pose against the convex hull of handle poses: D (m, 6) the
+    handle poses relative to the displayed one (xh_j (-) xs: translation, rotation vector), the error
+    of a point y of the hull |y_p| + radius |y_r|. Returned at the hull's point nearest to the
+    displayed pose in the Euclidean 6-metric of (p, radius r) (non-negative least squares with the
+    weights' sum held at 1 by a heavy row, then the weights normalised): a point of the hull, so the
+    error is never below the hull's own, and at most sqrt(2) times it. Also the weights."""
+    Y = np.concatenate([D[:, :3], radius * D[:, 3:]], axis=1)
+    scale = float(np.abs(Y).max())
+    if not scale > 0:
+        w = np.zeros(len(D))
+        w[-1] = 1.0
+        return 0.0, w
+    heavy = 1e6
+    A = np.vstack([Y.T / scale, heavy * np.ones(len(D))])
+    b = np.concatenate([np.zeros(6), [heavy]])
+    w = _nnls(A, b)
+    w = w / w.sum() if w.sum() > 0 else np.full(len(D), 1.0 / len(D))
+    y = w @ Y
+    return float(np.linalg.norm(y[:3]) + np.linalg.norm(y[3:])), w
+
+
+def tool_blocked(r: RunData, k: int) -> bool:
+    """Whether an obstacle stands between the displayed tool and the hand at tick k: the in-between
+    motion (METHOD.md s.4) from the displayed pose to the handle's touches an obstacle, exactly
+    (swept boxes, then gauss6's conservative CCD, then the exact first contact on the motions it
+    stops; a half turn, which has no such motion, counts as free). A god-object held on the near side
+    of a wall the hand has gone through cannot follow the hand, whatever the force."""
+    o = r.o
+    p0, q0, p1, q1 = r.xs_p[k], r.xs_q[k], r.xh_p[k], r.xh_q[k]
+    near = o.exact.near(p0, p1)
+    min_sep = r.th["tunnelling"]["min_separation"] * r.delta
+    stopped = [i for i in near if (lambda c: c["hit"] or c["status"] != "ok")(o.exact.pairs[i].step(p0, q0, p1, q1,
+                                                                                                   min_sep))]
+    if not stopped:
+        return False
+    try:
+        return bool(o.exact.motion_hits(p0, q0, p1, q1, stopped))
+    except ValueError:
+        return False
+
+
 def check_tracking(r: RunData, th: dict) -> Verdict:
     """In free space the displayed pose follows the handle: at ticks without a wrench whose handle
-    pose is beyond free_space from every obstacle (the certified bracket), the displayed pose is the
-    handle's pose of one of the last max_lag_ticks ticks (plus a declared latency), within the bound:
-    error = min over the lag j of |p_s - p_h(k - j)| + radius x angle(q_s, q_h(k - j)), delta units.
-    A quaternion in another order, a frame offset or a pose that lags are named here."""
+    pose is beyond free_space from every obstacle (the certified bracket), the displayed pose lies
+    in the convex hull of the handle's poses of the last max_lag_ticks ticks (plus a declared
+    latency), within the bound: error = distance from the hull (hull_error), position plus radius x
+    angle, delta units. METHOD.md's god-object steps xs <- xs (+) ks (xh (-) xs) in free space: a
+    convex combination of past handle poses, between the samples of a fast hand and inside the
+    corner of a curved path, not on a sample. A quaternion in another order, a frame offset off the
+    hand's recent path, or a pose that lags beyond the window are named here. The distance to the
+    nearest of those handle poses (the rule up to version 5) is reported beside it. Ticks with an
+    obstacle between the displayed tool and the hand (tool_blocked) are not judged: the tool must not
+    follow there."""
     o, delta = r.o, r.delta
     lag = th["max_lag_ticks"] + r.declared.get("latency_ticks", 0)
     cand = np.flatnonzero(~r.forced & r.finite_pose & r.finite_handle & r.finite_wrench)
@@ -753,25 +892,35 @@ def check_tracking(r: RunData, th: dict) -> Verdict:
         cand = cand[np.unique(np.linspace(0, len(cand) - 1, th["max_poses"]).astype(int))]
     free_space = r.th["distance"]["free_space"] * delta
     err = np.full(r.n, np.nan)
-    judged = 0
+    nearest = np.full(r.n, np.nan)
+    judged = blocked = 0
     for c, k in enumerate(cand):
         s, _ = o.exact.separation_side(r.xh_p[k], r.xh_q[k], free_space, free_space)
         if math.isfinite(s):
             continue  # the handle is near an obstacle: not free space
+        if tool_blocked(r, k):
+            blocked += 1
+            continue  # an obstacle between the displayed tool and the hand: it may not follow
         judged += 1
         js = np.arange(k - lag, k + 1)
-        d = pose_difference(np.repeat(r.xs_p[k][None], len(js), 0), np.repeat(r.xs_q[k][None], len(js), 0),
-                            r.xh_p[js], r.xh_q[js])
-        err[k] = float(np.min(np.linalg.norm(d[:, :3], axis=1) + o.god_radius * np.linalg.norm(d[:, 3:], axis=1))) / delta
+        d = pose_difference(r.xh_p[js], r.xh_q[js], np.repeat(r.xs_p[k][None], len(js), 0),
+                            np.repeat(r.xs_q[k][None], len(js), 0))
+        sample = np.linalg.norm(d[:, :3], axis=1) + o.god_radius * np.linalg.norm(d[:, 3:], axis=1)
+        nearest[k] = float(sample.min()) / delta
+        err[k] = min(hull_error(d, o.god_radius)[0] / delta, nearest[k])
         if c % 200 == 0:
             r.say("tracking", c, len(cand))
     bad = np.flatnonzero(err > th["bound"])
     worst = float(np.nanmax(err)) if judged else 0.0
+    worst_sample = float(np.nanmax(nearest)) if judged else 0.0
     return Verdict(
         "tracking", "", len(bad) == 0, len(bad), worst, "delta (pose error)", float(r.t[bad[0]]) if len(bad) else None,
-        f"{judged} free-space ticks judged (of {len(cand)} sampled without force); displayed pose within "
-        f"{th['bound']:g} delta of the handle's of the last {lag} ticks; max error {worst:.3g} delta",
-        {"ticks": judged, "max_error_delta": worst, "lag_ticks": lag},
+        f"{judged} free-space ticks judged (of {len(cand)} sampled without force; {blocked} with an obstacle "
+        f"between the displayed tool and the hand, not judged); displayed pose within "
+        f"{th['bound']:g} delta of the hull of the handle's poses of the last {lag} ticks; max error "
+        f"{worst:.3g} delta (from the nearest of those poses: {worst_sample:.3g} delta)",
+        {"ticks": judged, "blocked_ticks": blocked, "max_error_delta": worst, "max_sample_error_delta": worst_sample,
+         "lag_ticks": lag},
         _first_worst(bad, err[bad]))
 
 
@@ -984,6 +1133,7 @@ class Oracle:
         self.delta = float(g["delta"])
         self.mass = float(g["mass"])
         self.inertia = np.asarray(g["inertia_G_B"], float)
+        self.kh, self.ks = float(g["kh"]), float(g["ks"])  # the scene's coupling: force_jumps' stiffness
         self.max_force = float(g["max_force"])
         self.max_torque = float(settings["device"]["max_torque"])
         self.rate_hz = float(g["rate_hz"])

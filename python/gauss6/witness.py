@@ -46,8 +46,8 @@ def window(check: str, v: dict, thresholds: dict, declared: dict) -> tuple[int, 
         return int(v["from_tick"]), k
     if check == "energy":
         return int(v["window_start"]), k
-    if check == "force_jumps":
-        return max(k - 1, 0), k
+    if check == "force_jumps":  # the tick's change, and the handle's motion up to a declared latency before
+        return max(k - 1 - declared.get("latency_ticks", 0), 0), k
     if check == "tracking":
         return max(k - thresholds["tracking"]["max_lag_ticks"] - declared.get("latency_ticks", 0), 0), k
     if check == "latency":

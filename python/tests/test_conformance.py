@@ -24,10 +24,8 @@ from gauss6.validate import EXIT_CHECK_FAILED, EXIT_ENGINE_FAILED, EXIT_PASS, EX
 SLICE = 0.5
 RATE_HZ = 1000.0  # the battery scenes' device rate (datasets_generated/scenes/*.toml)
 # gauss6's own defects the battery finds inside SLICE (issue 43: to be fixed in gauss6, not in the
-# thresholds); strict, so that the fix makes this test fail until the mark is removed.
-KNOWN_DEFECTS = {"thin_wall": "at the 2 m/s hit the hand's 1.5 mm a tick into the 500 N/m coupling adds 0.75 N a "
-                              "tick (force_jumps), and in free space at that speed the god-object's ks = 0.5 "
-                              "step falls between the handle's samples (tracking, 120 delta)"}
+# thresholds); strict, so that the fix makes this test fail until the mark is removed. None today.
+KNOWN_DEFECTS: dict[str, str] = {}
 
 
 def gauss6_cli(*args) -> subprocess.CompletedProcess:

@@ -3,12 +3,15 @@ on slices of both shipped scripts, and each planted fault must be named by the c
 (python/tests/engines; the tables in docs/engine-contract.md, "Honest variants and planted faults").
 
 Slices: the peg's first 1.0 s (first force at 0.388 s: the press and slide on the top) and the
-bunny's first 0.4 s (first contact at 0.145 s); the deadline faults run 0.3 s. Faults are judged by
+bunny's first 0.4 s (first contact at 0.145 s); the deadline faults run 0.3 s; the faults at speed run
+on the battery's thin wall's first 0.5 s (the hand at rest, then a 2 m/s hit at 0.3 s), and gauss6 itself on
+its first 1.4 s (two hits). Faults are judged by
 their check alone (Oracle.judge(checks=...)) to keep the cost of `make test` down; the variants by
 every check.
 """
 from __future__ import annotations
 
+import numpy as np
 import pytest
 
 from gauss6 import paths
@@ -21,16 +24,21 @@ from engines.run import declared, run
 
 PEG = paths.DATASETS_DIR / "scenes" / "peg_in_hole.toml"
 BUNNY = paths.DATASETS_DIR / "scenes" / "bunnies.toml"
+THIN_WALL = paths.DATASETS_DIR / "scenes" / "thin_wall.toml"  # the battery's 2 m/s hit, from 0.3 s
 SLICE = {PEG: 1.0, BUNNY: 0.4}
 
 
 @pytest.fixture(scope="module")
 def oracles():
-    return {PEG: Oracle(PEG), BUNNY: Oracle(BUNNY)}
+    return {PEG: Oracle(PEG), BUNNY: Oracle(BUNNY), THIN_WALL: Oracle(THIN_WALL)}
 
 
 def _delta(scene) -> float:
     return EngineScene.from_scene_file(scene).delta
+
+
+def _rate(scene) -> float:
+    return EngineScene.from_scene_file(scene).rate_hz
 
 
 # (id, factory(delta)): honest, each on both scripts.
@@ -85,6 +93,12 @@ FAULTS = [
     ("skin_undeclared", lambda d: F.undeclared_skin(d), PEG, 1.0, "force_at_distance"),
     ("skin_beyond_declared", lambda d: F.skin_beyond_declared(d), PEG, 1.0, "force_at_distance"),
     ("knock", lambda d: F.Knock(), PEG, 1.0, "force_jumps"),
+    # At speed (oracle.toml version 6 discounts the hand's own motion): each only while the hand moves
+    # over 1 m/s, on the thin wall's 2 m/s hit.
+    ("quaternion_order_fast", lambda d: F.WhileFast(F.QuaternionOrder()), THIN_WALL, 0.5, "tracking"),
+    ("free_space_offset_fast", lambda d: F.WhileFast(F.FreeOffset((0, 0, 3e-4))), THIN_WALL, 0.5, "tracking"),
+    ("free_space_lag_fast", lambda d: F.WhileFast(F.FreeLag()), THIN_WALL, 0.5, "tracking"),
+    ("knock_fast", lambda d: F.WhileFast(F.Knock(at=2)), THIN_WALL, 0.5, "force_jumps"),
     ("over_limit", lambda d: F.OverLimit(), PEG, 1.0, "wrench_sanity"),
     ("pose_far", lambda d: F.FarPose(300.0), PEG, 1.0, "wrench_sanity"),
     ("pose_1e300", lambda d: F.FarPose(1e300), PEG, 1.0, "engine_failure"),
@@ -105,6 +119,10 @@ def test_planted_fault_is_named_by_its_check(tmp_path, oracles, make, scene, dur
     v = result.verdict(check)
     assert not v.passed, v.to_json()
     assert v.violations and v.first_time is not None  # a witness can be written
+    if isinstance(engine, F.WhileFast):  # named at a tick the hand moves fast, where alone it was planted
+        k = v.violations["first"]["tick"]
+        speed = np.linalg.norm(trace.ticks["xh_p"][k] - trace.ticks["xh_p"][k - 1]) * _rate(scene)
+        assert speed > engine.speed, (k, speed)
 
 
 def test_the_contract_tables_list_every_variant_and_fault():
@@ -115,3 +133,23 @@ def test_the_contract_tables_list_every_variant_and_fault():
         assert f"| `{name}` |" in section, name
     for name, _, _, _, check in FAULTS:
         assert f"| `{name}` |" in section and f"`{check}`" in section, name
+
+
+def test_gauss6_passes_the_thin_walls_fast_hits(tmp_path):
+    """gauss6 on the thin wall's head-on 2 m/s hit and the first oblique one (1.4 s), every check, every
+    free-space tick judged: it passes, where the rules up to version 5 failed it on the hand's own
+    motion (the force it adds in a tick, pressing 2 mm a tick into the 500 N/m coupling; the
+    god-object between the fast hand's samples). The tool held on the near side while the hand,
+    through the wall, backs off with no force (the offsets) is not judged by tracking: it must not
+    follow there."""
+    from gauss6.oracle import load_thresholds
+
+    th = load_thresholds()
+    th["tracking"]["max_poses"] = 10 ** 6
+    trace = run(load_engine("gauss6"), THIN_WALL, tmp_path / "run.g6trace", 1.4)
+    result = Oracle(THIN_WALL, th).judge(trace)
+    assert result.failed() == [], [v.to_json() for v in result.verdicts if not v.passed]
+    jumps, tracking = result.verdict("force_jumps"), result.verdict("tracking")
+    assert jumps.details["max_force_added"] > th["jumps"]["max_force_step"]
+    assert tracking.details["max_sample_error_delta"] > th["tracking"]["bound"]
+    assert tracking.details["blocked_ticks"] > 0 and tracking.details["ticks"] > 500

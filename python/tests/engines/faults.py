@@ -59,13 +59,17 @@ class QuaternionOrder(Wrapped):
 
 
 class FreeOffset(Wrapped):
-    """In free space (no force) the displayed pose is offset 0.3 mm along x: a frame error."""
-    name = "free-space offset 0.3 mm"
+    """In free space (no force) the displayed pose is offset (0.3 mm along x by default): a frame error."""
+
+    def __init__(self, offset=(3e-4, 0.0, 0.0)):
+        super().__init__()
+        self.offset = np.asarray(offset, float)
+        self.name = f"free-space offset {np.round(self.offset * 1e3, 3).tolist()} mm"
 
     def modify(self, t, xh_p, xh_q, s):
         if np.any(np.asarray(s.wrench) != 0):
             return s
-        return EngineStep(np.asarray(s.xs_p) + np.array([3e-4, 0, 0]), s.xs_q, s.wrench, s.contacts, s.step_seconds)
+        return EngineStep(np.asarray(s.xs_p) + self.offset, s.xs_q, s.wrench, s.contacts, s.step_seconds)
 
 
 class FreeLag(Wrapped):
@@ -103,8 +107,11 @@ class LateOnset(Wrapped):
 
 
 class Knock(Wrapped):
-    """A 1 N knock along the force for one tick, 20 ticks into each contact episode."""
-    name = "1 N knock"
+    """A 1 N knock along the force for one tick, `at` ticks (20 by default) into each contact episode."""
+
+    def __init__(self, at: int = 20):
+        super().__init__()
+        self.at, self.name = at, f"1 N knock {at} ticks into each contact"
 
     def reset(self, scene):
         super().reset(scene)
@@ -113,7 +120,7 @@ class Knock(Wrapped):
     def modify(self, t, xh_p, xh_q, s):
         n = force_direction(s)
         self.run = self.run + 1 if n is not None else 0
-        if self.run == 20:
+        if self.run == self.at:
             return with_wrench(s, np.asarray(s.wrench) + np.concatenate([n, np.zeros(3)]))
         return s
 
@@ -204,6 +211,27 @@ class Adhesion(Wrapped):
         if force_direction(s) is not None and self.tick % 10 == 0:
             return with_wrench(s, -0.2 * np.asarray(s.wrench))
         return s
+
+
+class WhileFast(Wrapped):
+    """Another fault's change applied only while the hand moves faster than `speed` (m/s; over the last
+    tick), gauss6's answer otherwise: a fault that shows only at speed. The fault sees every tick (its
+    state, such as a history of poses, is kept) through its `modify`; its own inner engine is unused."""
+
+    def __init__(self, fault: Wrapped, speed: float = 1.0):
+        super().__init__()
+        self.fault, self.speed = fault, speed
+        self.name = f"{fault.name}, while the hand moves over {speed:g} m/s"
+        self.declarations = fault.declarations
+
+    def reset(self, scene):
+        super().reset(scene)
+        self.fault.reset(scene)
+
+    def modify(self, t, xh_p, xh_q, s):
+        self.fault.tick, self.fault.prev_p = self.tick, self.prev_p
+        out = self.fault.modify(t, xh_p, xh_q, s)
+        return out if np.linalg.norm(self.velocity(xh_p)) > self.speed else s
 
 
 def undeclared_friction():
