@@ -64,15 +64,9 @@ constexpr double kAxisProductRounding = 1e-13;
 // site's guard norm_down(|a|) > 0 ensures).
 constexpr double kAxisVelocityRounding = 1e-14;
 
-// Posing a body point in doubles, X = R r_B + p (R = rotation_matrix(q): each
-// entry, a sum of four squares over |q|^2, within 9 u of the exact rotation
-// of q), and projecting it on a unit n: R r_B within (15.6 + 5.2) u rho per
-// coordinate (the entries' error on |r_B|_1 <= sqrt(3) rho, the products and
-// sums), + p within u (|p|_inf + rho), n.X within 3.01 u sqrt(3) of |X|_inf:
-// under 45 u (5e-15) of |p|_inf + rho, Euclidean. 1e-13 covers it 20 times.
-// Sites: StartFrame::set (static_error, with the stop pose's deviation) and
-// the contact step's test of the CCD's near pairs (sim_loop.cpp), which
-// argue the same posing.
+// Posing a body point in doubles, X = R r_B + p, R = rotation_matrix(q):
+// proofs/PoseAllowances.v pose_rounding (with _start_frame, _stand_at for the
+// sites): within 309 u (|p|_inf + rho) of the exact p + R(q) r_B, |r_B|_inf <= rho.
 constexpr double kPoseRounding = 1e-13;
 
 // The turn between two double poses, 2 |vec(conj(qa) qb)| (Displacement),
