@@ -2,7 +2,8 @@
    model of Rounding.v (finite results, gradual underflow, no fused
    multiply-add): kPoseRounding (a body point posed at a double pose,
    X = R(q) r_B + p, with R(q) = rotation_matrix(q) of geometry/pose.cpp),
-   each expression evaluated as its site evaluates it (the same operations
+   and kQuaternionTurnRounding (the turn between two double poses,
+   Displacement), each expression evaluated as its site evaluates it (the same operations
    in the same order, each rounded to nearest: `fl`). *)
 
 From Coq Require Import Reals Psatz.
@@ -501,3 +502,326 @@ Proof.
   replace (fl (c / n) - C) with ((fl (c / n) - c / n) + (c / n - C)) by ring.
   eapply Rle_trans; [apply Rabs_triang|]. nra.
 Qed.
+
+(* A rounded product of two normalized components, each within 4.1 u
+   (relatively) + eta of the exact one, of magnitude <= 1. *)
+Lemma qprod_err a A b B :
+  Rabs (a - A) <= 41 / 10 * u * Rabs A + eta -> Rabs (b - B) <= 41 / 10 * u * Rabs B + eta ->
+  Rabs A <= 1 -> Rabs B <= 1 ->
+  Rabs (fl (a * b) - A * B) <= 93 / 10 * u * Rabs (A * B) + 5 * eta.
+Proof.
+  intros Ha Hb HA HB. pose proof u_small as Hu. pose proof eta_pos as He0.
+  assert (He : eta <= / 1000000 * u) by (rewrite bpow_m53; unfold eta; simpl bpow; simpl IZR; lra).
+  set (al := Rabs A) in *. set (be := Rabs B) in *.
+  assert (Hal : 0 <= al) by apply Rabs_pos. assert (Hbe : 0 <= be) by apply Rabs_pos.
+  set (da := Rabs (a - A)) in *. set (db := Rabs (b - B)) in *.
+  assert (0 <= da) by apply Rabs_pos. assert (0 <= db) by apply Rabs_pos.
+  set (e := 41 / 10 * u) in *.
+  assert (He' : 0 < e <= / 100000000000000) by (unfold e; lra).
+  assert (Hb1 : Rabs b <= (1 + e) * be + eta).
+  { pose proof (Rabs_triang B (b - B)) as Tr. replace (B + (b - B)) with b in Tr by ring. fold be db in Tr.
+    assert (e * be <= e * 1) by (apply mul_le_l; lra). nra. }
+  assert (0 <= Rabs b) by apply Rabs_pos.
+  assert (Hb2a : e * be <= e * 1) by (apply mul_le_l; lra).
+  assert (Hb2 : Rabs b <= 2) by lra.
+  assert (T1 : da * Rabs b <= (e * al + eta) * Rabs b) by (apply Rmult_le_compat_r; lra).
+  assert (0 <= e * al) by (apply Rmult_le_pos; lra).
+  assert (T2 : (e * al) * Rabs b <= (e * al) * ((1 + e) * be + eta)) by (apply mul_le_l; lra).
+  assert (T3 : eta * Rabs b <= eta * 2) by (apply mul_le_l; lra).
+  assert (T4 : (e * eta) * al <= (e * eta) * 1) by (apply mul_le_l; [apply Rmult_le_pos; lra | lra]).
+  assert (T5 : al * db <= al * (e * be + eta)) by (apply mul_le_l; lra).
+  assert (T6 : eta * al <= eta * 1) by (apply mul_le_l; lra).
+  set (P := al * be) in *.
+  assert (HP : 0 <= P) by (apply Rmult_le_pos; lra).
+  assert (HP1 : P <= 1) by (unfold P; rewrite <- (Rmult_1_l 1); apply Rmult_le_compat; lra).
+  assert (T7 : e * (e * P) <= / 100000000000000 * (e * P)) by (apply Rmult_le_compat_r; [apply Rmult_le_pos|]; lra).
+  assert (T8 : e * eta <= / 100000000000000 * eta) by (apply Rmult_le_compat_r; lra).
+  assert (D : Rabs (a * b - A * B) <= (2 * e + / 100000000000000 * e) * P + (3 + / 10000) * eta).
+  { replace (a * b - A * B) with ((a - A) * b + A * (b - B)) by ring.
+    eapply Rle_trans; [apply Rabs_triang|]. rewrite !Rabs_mult. fold da db al.
+    assert (E1 : (e * al + eta) * Rabs b = (e * al) * Rabs b + eta * Rabs b) by ring.
+    assert (E2 : (e * al) * ((1 + e) * be + eta) = e * P + e * (e * P) + (e * eta) * al) by (unfold P; ring).
+    assert (E3 : al * (e * be + eta) = e * P + eta * al) by (unfold P; ring).
+    lra. }
+  pose proof (fl_err (a * b)) as F.
+  assert (M : Rabs (a * b) <= (1 + / 10000) * P + 4 * eta).
+  { replace (a * b) with (A * B + (a * b - A * B)) by ring. pose proof (Rabs_triang (A * B) (a * b - A * B)) as Tr2.
+    rewrite (Rabs_mult A B) in Tr2. fold al be P in Tr2.
+    assert ((2 * e + / 100000000000000 * e) * P <= / 10000 * P) by (apply Rmult_le_compat_r; lra). lra. }
+  assert (M2 : u * Rabs (a * b) <= u * ((1 + / 10000) * P + 4 * eta)) by (apply mul_le_l; lra).
+  assert (T9 : u * eta <= / 100000000000000 * eta) by (apply Rmult_le_compat_r; lra).
+  assert (T10 : u * P <= e * P) by (apply Rmult_le_compat_r; unfold e; lra).
+  replace (fl (a * b) - A * B) with ((fl (a * b) - a * b) + (a * b - A * B)) by ring.
+  rewrite Rabs_mult. fold al be P.
+  eapply Rle_trans; [apply Rabs_triang|].
+  assert (T11 : e * P = 41 / 10 * (u * P)) by (unfold e; ring).
+  assert (T12 : 0 <= u * P) by (apply Rmult_le_pos; lra).
+  lra.
+Qed.
+
+(* One coordinate of vec(conj(qa) qb) as the code computes it: (p1 - p2) -
+   (p3 - p4) of four rounded products, each within 9.3 u of its exact one
+   + 5 eta, the exact products' magnitudes summing to at most 1. *)
+Lemma qcomp_err p1 P1 p2 P2 p3 P3 p4 P4 :
+  Rabs (p1 - P1) <= 93 / 10 * u * Rabs P1 + 5 * eta -> Rabs (p2 - P2) <= 93 / 10 * u * Rabs P2 + 5 * eta ->
+  Rabs (p3 - P3) <= 93 / 10 * u * Rabs P3 + 5 * eta -> Rabs (p4 - P4) <= 93 / 10 * u * Rabs P4 + 5 * eta ->
+  Rabs P1 + Rabs P2 + Rabs P3 + Rabs P4 <= 1 ->
+  Rabs (fl (fl (p1 - p2) - fl (p3 - p4)) - ((P1 - P2) - (P3 - P4))) <= 1132 / 100 * u.
+Proof.
+  intros H1 H2 H3 H4 HT. pose proof u_small as Hu. pose proof eta_pos as He0.
+  assert (He : eta <= / 1000000 * u) by (rewrite bpow_m53; unfold eta; simpl bpow; simpl IZR; lra).
+  pose proof (Rabs_pos P1). pose proof (Rabs_pos P2). pose proof (Rabs_pos P3). pose proof (Rabs_pos P4).
+  set (A1 := Rabs P1) in *. set (A2 := Rabs P2) in *. set (A3 := Rabs P3) in *. set (A4 := Rabs P4) in *.
+  assert (Ec := step (p3 - p4) (P3 - P4) (A3 + A4) (93 / 10 * u * (A3 + A4) + 10 * eta)
+                  ltac:(apply abs_diff_le; apply Rle_refl) ltac:(pose proof (abs_sub p3 P3 p4 P4 _ _ H3 H4); lra)).
+  assert (Et := step (p1 - p2) (P1 - P2) (A1 + A2) (93 / 10 * u * (A1 + A2) + 10 * eta)
+                  ltac:(apply abs_diff_le; apply Rle_refl) ltac:(pose proof (abs_sub p1 P1 p2 P2 _ _ H1 H2); lra)).
+  assert (Q1 : u * (A3 + A4 + (93 / 10 * u * (A3 + A4) + 10 * eta)) <= u * (A3 + A4) + / 100000000 * u).
+  { assert (u * (u * (A3 + A4)) <= / 1000000000000000 * u) by (apply Rle_trans with (u * (u * 1)); [apply mul_le_l; [lra | apply mul_le_l; lra] | rewrite Rmult_1_r; apply Rmult_le_compat_r; lra]).
+    assert (u * eta <= / 1000000000000000 * eta) by (apply Rmult_le_compat_r; lra). lra. }
+  assert (Q2 : u * (A1 + A2 + (93 / 10 * u * (A1 + A2) + 10 * eta)) <= u * (A1 + A2) + / 100000000 * u).
+  { assert (u * (u * (A1 + A2)) <= / 1000000000000000 * u) by (apply Rle_trans with (u * (u * 1)); [apply mul_le_l; [lra | apply mul_le_l; lra] | rewrite Rmult_1_r; apply Rmult_le_compat_r; lra]).
+    assert (u * eta <= / 1000000000000000 * eta) by (apply Rmult_le_compat_r; lra). lra. }
+  set (Bc := 93 / 10 * u * (A3 + A4) + 10 * eta + (u * (A3 + A4) + / 100000000 * u) + eta).
+  set (Bt := 93 / 10 * u * (A1 + A2) + 10 * eta + (u * (A1 + A2) + / 100000000 * u) + eta).
+  assert (Ec' : Rabs (fl (p3 - p4) - (P3 - P4)) <= Bc) by (unfold Bc; lra).
+  assert (Et' : Rabs (fl (p1 - p2) - (P1 - P2)) <= Bt) by (unfold Bt; lra).
+  assert (Ef := step (fl (p1 - p2) - fl (p3 - p4)) ((P1 - P2) - (P3 - P4)) (A1 + A2 + A3 + A4) (Bt + Bc)
+                  ltac:(pose proof (abs_diff_le (P1 - P2) (P3 - P4) (A1 + A2) (A3 + A4) ltac:(apply abs_diff_le; apply Rle_refl) ltac:(apply abs_diff_le; apply Rle_refl)); lra)
+                  ltac:(apply abs_sub; assumption)).
+  assert (0 <= u * A1) by (apply Rmult_le_pos; lra). assert (0 <= u * A2) by (apply Rmult_le_pos; lra).
+  assert (0 <= u * A3) by (apply Rmult_le_pos; lra). assert (0 <= u * A4) by (apply Rmult_le_pos; lra).
+  assert (Bt + Bc <= 1031 / 100 * u * (A1 + A2 + A3 + A4) + 23 * eta + / 10000000 * u) by (unfold Bt, Bc; lra).
+  assert (0 <= u * (A1 + A2 + A3 + A4)) by (apply Rmult_le_pos; lra).
+  assert (u * (A1 + A2 + A3 + A4) <= u * 1) by (apply mul_le_l; lra).
+  assert (u * (Bt + Bc) <= / 100000000 * u).
+  { apply Rle_trans with (u * (11 * / 1000000000000000)); [apply mul_le_l; [lra|] | lra].
+    assert (1031 / 100 * u * (A1 + A2 + A3 + A4) <= 1031 / 100 * u * 1) by (apply mul_le_l; lra). lra. }
+  assert (1031 / 100 * u * (A1 + A2 + A3 + A4) <= 1031 / 100 * (u * 1)) by (rewrite Rmult_assoc; apply mul_le_l; lra).
+  lra.
+Qed.
+
+Lemma cs3 a0 a1 a2 w0 w1 w2 :
+  a0 * w0 + a1 * w1 + a2 * w2 <= sqrt (a0 * a0 + a1 * a1 + a2 * a2) * sqrt (w0 * w0 + w1 * w1 + w2 * w2).
+Proof.
+  assert (0 <= a0 * a0 + a1 * a1 + a2 * a2) by nra.
+  assert (0 <= w0 * w0 + w1 * w1 + w2 * w2) by nra.
+  rewrite <- sqrt_mult by assumption.
+  destruct (Rle_or_lt (a0 * w0 + a1 * w1 + a2 * w2) 0) as [H1|H1].
+  - pose proof (sqrt_pos ((a0 * a0 + a1 * a1 + a2 * a2) * (w0 * w0 + w1 * w1 + w2 * w2))). lra.
+  - rewrite <- (sqrt_square (a0 * w0 + a1 * w1 + a2 * w2)) by lra. apply sqrt_le_1_alt.
+    assert (E : (a0 * a0 + a1 * a1 + a2 * a2) * (w0 * w0 + w1 * w1 + w2 * w2)
+                - (a0 * w0 + a1 * w1 + a2 * w2) * (a0 * w0 + a1 * w1 + a2 * w2)
+                = (a1 * w2 - a2 * w1) * (a1 * w2 - a2 * w1) + (a2 * w0 - a0 * w2) * (a2 * w0 - a0 * w2)
+                  + (a0 * w1 - a1 * w0) * (a0 * w1 - a1 * w0)) by ring.
+    pose proof (Rle_0_sqr (a1 * w2 - a2 * w1)). pose proof (Rle_0_sqr (a2 * w0 - a0 * w2)).
+    pose proof (Rle_0_sqr (a0 * w1 - a1 * w0)). unfold Rsqr in *. lra.
+Qed.
+
+(* The triangle inequality of the Euclidean norm of 3-vectors. *)
+Lemma minkowski3 x0 x1 x2 y0 y1 y2 :
+  sqrt ((x0 + y0) * (x0 + y0) + (x1 + y1) * (x1 + y1) + (x2 + y2) * (x2 + y2))
+  <= sqrt (x0 * x0 + x1 * x1 + x2 * x2) + sqrt (y0 * y0 + y1 * y1 + y2 * y2).
+Proof.
+  set (X := x0 * x0 + x1 * x1 + x2 * x2). set (Y := y0 * y0 + y1 * y1 + y2 * y2).
+  assert (0 <= X) by (unfold X; nra). assert (0 <= Y) by (unfold Y; nra).
+  pose proof (sqrt_pos X). pose proof (sqrt_pos Y).
+  rewrite <- (sqrt_square (sqrt X + sqrt Y)) by lra. apply sqrt_le_1_alt.
+  pose proof (cs3 x0 x1 x2 y0 y1 y2). fold X Y in H3.
+  pose proof (sqrt_sqrt X H). pose proof (sqrt_sqrt Y H0).
+  unfold X, Y in *. nra.
+Qed.
+
+(* Each coordinate within m: the Euclidean norm within 1.7321 m. *)
+Lemma norm_of_bounded e0 e1 e2 m :
+  Rabs e0 <= m -> Rabs e1 <= m -> Rabs e2 <= m -> sqrt (e0 * e0 + e1 * e1 + e2 * e2) <= 17321 / 10000 * m.
+Proof.
+  intros H0 H1 H2. pose proof (Rabs_pos e0). assert (0 <= m) by lra.
+  rewrite <- (sqrt_square (17321 / 10000 * m)) by lra. apply sqrt_le_1_alt.
+  rewrite <- (abs_sq e0), <- (abs_sq e1), <- (abs_sq e2).
+  pose proof (Rabs_pos e1). pose proof (Rabs_pos e2).
+  assert (Rabs e0 * Rabs e0 <= m * m) by (apply Rmult_le_compat; lra).
+  assert (Rabs e1 * Rabs e1 <= m * m) by (apply Rmult_le_compat; lra).
+  assert (Rabs e2 * Rabs e2 <= m * m) by (apply Rmult_le_compat; lra).
+  nra.
+Qed.
+
+(* The computed norm of a double vector (Allowances.v norm_c) is at least
+   the exact norm less 3.04 u of it, above 2^-501. *)
+Lemma norm_c_lower x y z :
+  sqrt (x * x + y * y + z * z) <= (1 + 304 / 100 * u) * norm_c x y z + bpow radix2 (-501).
+Proof.
+  pose proof u_small. pose proof eta_pos.
+  set (S := x * x + y * y + z * z). set (N := sqrt S).
+  assert (HS0 : 0 <= S) by (unfold S; nra). assert (HN0 : 0 <= N) by apply sqrt_pos.
+  assert (Hn0 : 0 <= norm_c x y z) by (unfold norm_c; apply fl_nonneg, sqrt_pos).
+  assert (0 <= 304 / 100 * u * norm_c x y z) by (apply Rmult_le_pos; lra).
+  pose proof (bpow_gt_0 radix2 (-501)).
+  destruct (Rlt_or_le S (bpow radix2 (-1002))) as [Hs|Hs].
+  - assert (N <= bpow radix2 (-501)).
+    { unfold N. rewrite <- (sqrt_bpow2 (-501)). apply sqrt_le_1_alt. replace (2 * -501)%Z with (-1002)%Z by lia. lra. }
+    lra.
+  - pose proof (sumsq_lower x y z Hs) as L. fold S in L.
+    set (s := fl (fl (fl (x * x) + fl (y * y)) + fl (z * z))) in *.
+    assert (HN : bpow radix2 (-501) <= N)
+      by (unfold N; rewrite <- (sqrt_bpow2 (-501)); apply sqrt_le_1_alt; exact Hs).
+    assert (HeN : 1000000 * eta <= u * N) by (apply eta_norm; exact HN).
+    assert (Hr : (1 - 201 / 100 * u) * N <= sqrt s).
+    { unfold N. rewrite <- sqrt_scale by lra. apply sqrt_le_1_alt.
+      apply Rle_trans with ((1 - 4 * u) * S); [apply Rmult_le_compat_r; nra | exact L]. }
+    pose proof (fl_lower (sqrt s) (sqrt_pos s)) as F.
+    unfold norm_c. fold s.
+    assert ((1 - u) * ((1 - 201 / 100 * u) * N) <= (1 - u) * sqrt s) by (apply mul_le_l; lra).
+    assert (K : (1 - 302 / 100 * u) * N <= fl (sqrt s)).
+    { assert (u * (u * N) <= / 1000000000000000 * (u * N)) by (apply Rmult_le_compat_r; nra). nra. }
+    assert (K2 : (1 + 304 / 100 * u) * ((1 - 302 / 100 * u) * N) <= (1 + 304 / 100 * u) * fl (sqrt s)) by (apply mul_le_l; lra).
+    assert (u * (u * N) <= / 1000000000000000 * (u * N)) by (apply Rmult_le_compat_r; nra).
+    nra.
+Qed.
+
+Lemma unit_component c S :
+  0 < S -> c * c <= S -> Rabs (c / sqrt S) <= 1.
+Proof.
+  intros HS Hc. pose proof (sqrt_lt_R0 S HS) as HN.
+  unfold Rdiv. rewrite Rabs_mult, Rabs_inv, (Rabs_pos_eq (sqrt S)) by lra.
+  apply Rmult_le_reg_r with (sqrt S); [lra|]. rewrite Rmult_assoc, Rinv_l, Rmult_1_r, Rmult_1_l by lra.
+  rewrite <- (sqrt_square (Rabs c)) by apply Rabs_pos. apply sqrt_le_1_alt. rewrite abs_sq. exact Hc.
+Qed.
+
+Lemma unit_sq c S : 0 < S -> (c / sqrt S) * (c / sqrt S) = c * c / S.
+Proof.
+  intros HS. pose proof (sqrt_lt_R0 S HS). pose proof (sqrt_sqrt S ltac:(lra)).
+  replace (c / sqrt S * (c / sqrt S)) with (c * c / (sqrt S * sqrt S)) by (field; lra).
+  rewrite H0. reflexivity.
+Qed.
+
+(* The sum of the magnitudes of the four products of one coordinate of
+   vec(conj(A) B), A and B unit quaternions: at most 1 (2 |a b| <= a^2 + b^2). *)
+Lemma four_products_le aw ax ay az bw bx by_ bz :
+  aw * aw + ax * ax + ay * ay + az * az = 1 -> bw * bw + bx * bx + by_ * by_ + bz * bz = 1 ->
+  Rabs (aw * bx) + Rabs (bw * ax) + Rabs (ay * bz) + Rabs (az * by_) <= 1.
+Proof.
+  intros HA HB. pose proof (two_ab aw bx). pose proof (two_ab bw ax). pose proof (two_ab ay bz). pose proof (two_ab az by_).
+  lra.
+Qed.
+
+Definition vcomp a1 b1 a2 b2 a3 b3 a4 b4 := fl (fl (fl (a1 * b1) - fl (a2 * b2)) - fl (fl (a3 * b3) - fl (a4 * b4))).
+
+(* allowance kQuaternionTurnRounding = 1e-14 *)
+Definition kQuaternionTurnRounding := fl (/ 100000000000000).
+Lemma kQuaternionTurnRounding_ge : 90 * u <= kQuaternionTurnRounding.
+Proof. apply fl_decimal_ge; pose proof bpow_m1000; unfold u; lra. Qed.
+
+(* quaternion_turn_rounding (Displacement::Displacement, motion_bounds.cpp):
+   turn = round_up(2 |v|) + Upper{kQuaternionTurnRounding}, v = vec(conj(qa)
+   qb) of the normalized doubles as the code computes it, is at least twice
+   the norm of the exact vec(conj(A) B), A = a / |a|, B = b / |b|: the turn
+   between the two poses' exact rotations (2 sin(theta / 2)). Each
+   coordinate of v is within 11.32 u of the exact one (the normalisations
+   4.1 u, the products 9.3 u, the three differences), the vector within
+   19.61 u, its computed norm within 3.04 u + 2^-501: 2 |V| <= 2 |v|~ + 52 u,
+   the allowance at least 90 u. *)
+(* covers optimized/gauss6/ccd/motion_bounds.cpp "Displacement::Displacement(const Pose& a, const Pose& b)" sha256:79b4d579aa69d2b4 *)
+(* covers optimized/gauss6/geometry/pose.cpp "Quat normalized(const Quat& q_in)" sha256:7d6163a1a0f15a70 *)
+(* covers optimized/gauss6/geometry/pose.cpp "Quat rescaled(const Quat& q)" sha256:fb74734e83856b0e *)
+Theorem quaternion_turn_rounding aw ax ay az bw bx by_ bz :
+  let Sa := aw * aw + ax * ax + ay * ay + az * az in
+  let Sb := bw * bw + bx * bx + by_ * by_ + bz * bz in
+  bpow radix2 (-802) <= Sa -> bpow radix2 (-802) <= Sb ->
+  let na := qnorm_c aw ax ay az in let nb := qnorm_c bw bx by_ bz in
+  let aw' := fl (aw / na) in let ax' := fl (ax / na) in let ay' := fl (ay / na) in let az' := fl (az / na) in
+  let bw' := fl (bw / nb) in let bx' := fl (bx / nb) in let by' := fl (by_ / nb) in let bz' := fl (bz / nb) in
+  let v0 := vcomp aw' bx' bw' ax' ay' bz' az' by' in
+  let v1 := vcomp aw' by' bw' ay' az' bx' ax' bz' in
+  let v2 := vcomp aw' bz' bw' az' ax' by' ay' bx' in
+  let Aw := aw / sqrt Sa in let Ax := ax / sqrt Sa in let Ay := ay / sqrt Sa in let Az := az / sqrt Sa in
+  let Bw := bw / sqrt Sb in let Bx := bx / sqrt Sb in let By := by_ / sqrt Sb in let Bz := bz / sqrt Sb in
+  let V0 := (Aw * Bx - Bw * Ax) - (Ay * Bz - Az * By) in
+  let V1 := (Aw * By - Bw * Ay) - (Az * Bx - Ax * Bz) in
+  let V2 := (Aw * Bz - Bw * Az) - (Ax * By - Ay * Bx) in
+  2 * sqrt (V0 * V0 + V1 * V1 + V2 * V2)
+    <= next_up (fl (next_up (fl (2 * norm_c v0 v1 v2)) + kQuaternionTurnRounding)).
+Proof.
+  intros Sa Sb HSa HSb na nb aw' ax' ay' az' bw' bx' by' bz' v0 v1 v2 Aw Ax Ay Az Bw Bx By Bz V0 V1 V2.
+  pose proof u_small as Hu. pose proof eta_pos as He0.
+  assert (He : eta <= / 1000000 * u) by (rewrite bpow_m53; unfold eta; simpl bpow; simpl IZR; lra).
+  pose proof (bpow_gt_0 radix2 (-802)).
+  assert (Sa0 : 0 < Sa) by lra. assert (Sb0 : 0 < Sb) by lra.
+  assert (0 <= aw * aw) by nra. assert (0 <= ax * ax) by nra. assert (0 <= ay * ay) by nra. assert (0 <= az * az) by nra.
+  assert (0 <= bw * bw) by nra. assert (0 <= bx * bx) by nra. assert (0 <= by_ * by_) by nra. assert (0 <= bz * bz) by nra.
+  (* the exact unit quaternions *)
+  assert (UA : Aw * Aw + Ax * Ax + Ay * Ay + Az * Az = 1).
+  { unfold Aw, Ax, Ay, Az. rewrite !unit_sq by lra. unfold Sa in *. field. lra. }
+  assert (UB : Bw * Bw + Bx * Bx + By * By + Bz * Bz = 1).
+  { unfold Bw, Bx, By, Bz. rewrite !unit_sq by lra. unfold Sb in *. field. lra. }
+  assert (BA : Rabs Aw <= 1 /\ Rabs Ax <= 1 /\ Rabs Ay <= 1 /\ Rabs Az <= 1).
+  { unfold Aw, Ax, Ay, Az. repeat split; apply unit_component; [lra | unfold Sa; lra | lra | unfold Sa; lra | lra | unfold Sa; lra | lra | unfold Sa; lra]. }
+  assert (BB : Rabs Bw <= 1 /\ Rabs Bx <= 1 /\ Rabs By <= 1 /\ Rabs Bz <= 1).
+  { unfold Bw, Bx, By, Bz. repeat split; apply unit_component; [lra | unfold Sb; lra | lra | unfold Sb; lra | lra | unfold Sb; lra | lra | unfold Sb; lra]. }
+  destruct BA as (BAw & BAx & BAy & BAz). destruct BB as (BBw & BBx & BBy & BBz).
+  (* the normalized doubles *)
+  assert (NA : forall c, Rabs (fl (c / na) - c / sqrt Sa) <= 41 / 10 * u * Rabs (c / sqrt Sa) + eta)
+    by (intros c; apply normalize_err; exact HSa).
+  assert (NB : forall c, Rabs (fl (c / nb) - c / sqrt Sb) <= 41 / 10 * u * Rabs (c / sqrt Sb) + eta)
+    by (intros c; apply normalize_err; exact HSb).
+  (* each coordinate *)
+  assert (C : forall a1 A1 b1 B1 a2 A2 b2 B2 a3 A3 b3 B3 a4 A4 b4 B4,
+     Rabs (a1 - A1) <= 41 / 10 * u * Rabs A1 + eta -> Rabs (b1 - B1) <= 41 / 10 * u * Rabs B1 + eta ->
+     Rabs (a2 - A2) <= 41 / 10 * u * Rabs A2 + eta -> Rabs (b2 - B2) <= 41 / 10 * u * Rabs B2 + eta ->
+     Rabs (a3 - A3) <= 41 / 10 * u * Rabs A3 + eta -> Rabs (b3 - B3) <= 41 / 10 * u * Rabs B3 + eta ->
+     Rabs (a4 - A4) <= 41 / 10 * u * Rabs A4 + eta -> Rabs (b4 - B4) <= 41 / 10 * u * Rabs B4 + eta ->
+     Rabs A1 <= 1 -> Rabs B1 <= 1 -> Rabs A2 <= 1 -> Rabs B2 <= 1 ->
+     Rabs A3 <= 1 -> Rabs B3 <= 1 -> Rabs A4 <= 1 -> Rabs B4 <= 1 ->
+     Rabs (A1 * B1) + Rabs (A2 * B2) + Rabs (A3 * B3) + Rabs (A4 * B4) <= 1 ->
+     Rabs (vcomp a1 b1 a2 b2 a3 b3 a4 b4 - ((A1 * B1 - A2 * B2) - (A3 * B3 - A4 * B4))) <= 1132 / 100 * u
+     /\ Rabs ((A1 * B1 - A2 * B2) - (A3 * B3 - A4 * B4)) <= 1).
+  { intros. split.
+    - apply qcomp_err; try apply qprod_err; assumption.
+    - eapply Rle_trans; [apply abs_diff_le; apply abs_diff_le; apply Rle_refl|]. lra. }
+  destruct (C aw' Aw bx' Bx bw' Bw ax' Ax ay' Ay bz' Bz az' Az by' By) as [E0 M0];
+    try (apply NA || apply NB); try assumption.
+  { pose proof (four_products_le Aw Ax Ay Az Bw Bx By Bz UA UB). lra. }
+  destruct (C aw' Aw by' By bw' Bw ay' Ay az' Az bx' Bx ax' Ax bz' Bz) as [E1 M1];
+    try (apply NA || apply NB); try assumption.
+  { pose proof (four_products_le Aw Ay Az Ax Bw By Bz Bx ltac:(lra) ltac:(lra)). lra. }
+  destruct (C aw' Aw bz' Bz bw' Bw az' Az ax' Ax by' By ay' Ay bx' Bx) as [E2 M2];
+    try (apply NA || apply NB); try assumption.
+  { pose proof (four_products_le Aw Az Ax Ay Bw Bz Bx By ltac:(lra) ltac:(lra)). lra. }
+  fold v0 V0 in E0, M0. fold v1 V1 in E1, M1. fold v2 V2 in E2, M2.
+  (* the vector: |V| <= |v| + |V - v| *)
+  pose proof (norm_of_bounded (V0 - v0) (V1 - v1) (V2 - v2) (1132 / 100 * u)
+                ltac:(rewrite Rabs_minus_sym; exact E0) ltac:(rewrite Rabs_minus_sym; exact E1)
+                ltac:(rewrite Rabs_minus_sym; exact E2)) as Ed.
+  pose proof (minkowski3 v0 v1 v2 (V0 - v0) (V1 - v1) (V2 - v2)) as Mk.
+  replace (v0 + (V0 - v0)) with V0 in Mk by ring. replace (v1 + (V1 - v1)) with V1 in Mk by ring.
+  replace (v2 + (V2 - v2)) with V2 in Mk by ring.
+  pose proof (norm_c_lower v0 v1 v2) as Nl.
+  (* the computed norm is at most 2 *)
+  assert (Vb : forall v V, Rabs (v - V) <= 1132 / 100 * u -> Rabs V <= 1 -> v * v <= 11 / 10).
+  { intros v V G1 G2. assert (Rabs v <= 1 + 1132 / 100 * u).
+    { replace v with (V + (v - V)) by ring. pose proof (Rabs_triang V (v - V)). lra. }
+    rewrite <- abs_sq. pose proof (Rabs_pos v).
+    apply Rle_trans with ((1 + 1132 / 100 * u) * (1 + 1132 / 100 * u)); [apply Rmult_le_compat; lra | nra]. }
+  pose proof (Vb v0 V0 E0 M0). pose proof (Vb v1 V1 E1 M1). pose proof (Vb v2 V2 E2 M2).
+  pose proof (sumsq_upper v0 v1 v2) as Su.
+  assert (Hn2 : norm_c v0 v1 v2 <= 2).
+  { unfold norm_c. replace 2 with (bpow radix2 1) by (simpl; lra).
+    apply fl_le_F; [apply generic_format_bpow; unfold FLT_exp; lia|].
+    replace (bpow radix2 1) with 2 by (simpl; lra).
+    rewrite <- (sqrt_square 2) by lra. apply sqrt_le_1_alt.
+    assert ((1 + 4 * u) * (v0 * v0 + v1 * v1 + v2 * v2) <= (1 + 4 * u) * (33 / 10)) by (apply mul_le_l; lra).
+    lra. }
+  assert (Hn0 : 0 <= norm_c v0 v1 v2) by (unfold norm_c; apply fl_nonneg, sqrt_pos).
+  assert (304 / 100 * u * norm_c v0 v1 v2 <= 304 / 100 * u * 2) by (apply mul_le_l; lra).
+  assert (Hb : bpow radix2 (-501) <= / 1000000 * u).
+  { rewrite bpow_m53. apply Rle_trans with (bpow radix2 (-20) * bpow radix2 (-53)).
+    - rewrite <- bpow_plus. apply bpow_le. lia.
+    - apply Rmult_le_compat_r; [apply bpow_ge_0 | simpl; lra]. }
+  (* the code's bound *)
+  pose proof kQuaternionTurnRounding_ge as K.
+  assert (U1 : 2 * norm_c v0 v1 v2 <= next_up (fl (2 * norm_c v0 v1 v2))) by (apply up_ge; lra).
+  assert (U2 : next_up (fl (2 * norm_c v0 v1 v2)) + kQuaternionTurnRounding
+               <= next_up (fl (next_up (fl (2 * norm_c v0 v1 v2)) + kQuaternionTurnRounding))) by (apply up_ge; lra).
+  lra.
+Qed.
+Print Assumptions quaternion_turn_rounding.

@@ -69,12 +69,9 @@ constexpr double kAxisVelocityRounding = 1e-14;
 // sites): within 309 u (|p|_inf + rho) of the exact p + R(q) r_B, |r_B|_inf <= rho.
 constexpr double kPoseRounding = 1e-13;
 
-// The turn between two double poses, 2 |vec(conj(qa) qb)| (Displacement),
-// absolute (every term is at most 1): the two normalisations put each
-// component within 4 u of the exact unit quaternion's; each component of the
-// product, four products whose magnitudes sum to at most 1 and three sums,
-// within 12 u; its norm within sqrt(3) 12 u + 2.6 u; twice that, under 48 u
-// (5.3e-15). 1e-14 covers it 1.9 times. Site: Displacement.
+// The turn between two double poses, 2 |vec(conj(qa) qb)| (Displacement):
+// proofs/PoseAllowances.v quaternion_turn_rounding, the computed 2 |v| within
+// 52 u (absolute) of the exact unit quaternions' turn.
 constexpr double kQuaternionTurnRounding = 1e-14;
 
 // The directional sweep of a god node's oriented box (SweptObbFrame::pose):
