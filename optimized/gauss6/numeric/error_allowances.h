@@ -64,23 +64,14 @@ constexpr double kAxisProductRounding = 1e-13;
 // site's guard norm_down(|a|) > 0 ensures).
 constexpr double kAxisVelocityRounding = 1e-14;
 
-// Posing a body point in doubles, X = R r_B + p (R = rotation_matrix(q): each
-// entry, a sum of four squares over |q|^2, within 9 u of the exact rotation
-// of q), and projecting it on a unit n: R r_B within (15.6 + 5.2) u rho per
-// coordinate (the entries' error on |r_B|_1 <= sqrt(3) rho, the products and
-// sums), + p within u (|p|_inf + rho), n.X within 3.01 u sqrt(3) of |X|_inf:
-// under 45 u (5e-15) of |p|_inf + rho, Euclidean. 1e-13 covers it 20 times.
-// Sites: StartFrame::set (static_error, with the stop pose's deviation) and
-// the contact step's test of the CCD's near pairs (sim_loop.cpp), which
-// argue the same posing.
+// Posing a body point in doubles, X = R r_B + p, R = rotation_matrix(q):
+// proofs/PoseAllowances.v pose_rounding (with _start_frame, _stand_at for the
+// sites): within 309 u (|p|_inf + rho) of the exact p + R(q) r_B, |r_B|_inf <= rho.
 constexpr double kPoseRounding = 1e-13;
 
-// The turn between two double poses, 2 |vec(conj(qa) qb)| (Displacement),
-// absolute (every term is at most 1): the two normalisations put each
-// component within 4 u of the exact unit quaternion's; each component of the
-// product, four products whose magnitudes sum to at most 1 and three sums,
-// within 12 u; its norm within sqrt(3) 12 u + 2.6 u; twice that, under 48 u
-// (5.3e-15). 1e-14 covers it 1.9 times. Site: Displacement.
+// The turn between two double poses, 2 |vec(conj(qa) qb)| (Displacement):
+// proofs/PoseAllowances.v quaternion_turn_rounding, the computed 2 |v| within
+// 52 u (absolute) of the exact unit quaternions' turn.
 constexpr double kQuaternionTurnRounding = 1e-14;
 
 // The directional sweep of a god node's oriented box (SweptObbFrame::pose):
