@@ -64,6 +64,106 @@ void mark_hull(const std::vector<Eigen::Vector2d>& plane, int* idx, int n, int* 
   for (int i = 0; i < std::max(h, 1); ++i) (*keep)[hull[i]] = 1;
 }
 
+// Calls on(face, corner) for each face around the vertex at corner c of face
+// f (f first), walking across the edges at the vertex in one direction (mesh m,
+// its faces' adjacency `neighbor`: bvh.h), until on returns false or the fan
+// closes. Returns true when it closed: every face around the vertex was
+// visited; false at a boundary edge, a face that lacks the vertex, more than
+// kMaxFan faces (a fan that is no disc), or when on stopped it.
+constexpr int kMaxFan = 64;
+template <class On>
+bool walk_fan(const TriangleMesh& m, const std::vector<int32_t>& neighbor, int f, int c, const On& on) {
+  const int v = m.F(f, c);
+  int face = f, corner = c;
+  for (int step = 0; step < kMaxFan; ++step) {
+    if (!on(face, corner)) return false;
+    // On around v: across v's other edge in this face (from corner + 2 to
+    // corner), to the face that shares it.
+    const int next = neighbor[3 * static_cast<size_t>(face) + (corner + 2) % 3];
+    if (next < 0) return false;
+    if (next == f) return true;
+    face = next;
+    corner = m.F(face, 0) == v ? 0 : m.F(face, 1) == v ? 1 : m.F(face, 2) == v ? 2 : -1;
+    if (corner < 0) return false;
+  }
+  return false;
+}
+
+// Whether the plane through the vertex at corner c of face f normal to `out`
+// leaves its neighbours on or behind it (out.(w - v) <= sine |w - v| for every
+// neighbour w; at(i): vertex i's position): `out` is then an outward normal of
+// the vertex's body at the vertex (in its normal cone, to the angle
+// asin(sine)). kUnknown when the fan around it does not close.
+enum class Support { kYes, kNo, kUnknown };
+template <class At>
+Support vertex_support(const TriangleMesh& m, const std::vector<int32_t>& neighbor, int f, int c, const Vec3& out,
+                       double sine, const At& at) {
+  const Vec3 p = at(m.F(f, c));
+  bool supports = true;
+  const bool closed = walk_fan(m, neighbor, f, c, [&](int face, int corner) {
+    for (int k = 1; k <= 2; ++k) {
+      const Vec3 e = at(m.F(face, (corner + k) % 3)) - p;
+      if (out.dot(e) > sine * e.norm()) supports = false;
+    }
+    return true;
+  });
+  return !closed ? Support::kUnknown : supports ? Support::kYes : Support::kNo;
+}
+
+// One side of a vertex/face pair: a mesh, its faces' adjacency, and its
+// vertices' positions in the world frame.
+template <class At>
+struct Side {
+  const TriangleMesh& mesh;
+  const std::vector<int32_t>& neighbor;
+  const At& at;
+  Vec3 corner(int f, int k) const { return at(mesh.F(f, k)); }
+};
+template <class At>
+Side(const TriangleMesh&, const std::vector<int32_t>&, const At&) -> Side<At>;
+
+// The vertex/face rule (contacts.h): whether the row of the vertex at corner
+// vc of face vf (p, on side V) against face `face` of side W (unit outward
+// normal nF: the row's normal is -nF seen from W, and the vertex's body must
+// have -nF as an outward normal at p) is left out: p lies beside the face,
+// beyond one edge or (beyond two) a corner, -nF does not support p's body,
+// and another face of W that shares a corner with that edge, or that corner,
+// holds p within d with a normal that does (p's closest point on the face
+// lies on that edge or corner; a vertex just beside a corner of a tool whose
+// bottom is two triangles lies within d of the one that does not share the
+// edge).
+template <class AtV, class AtW>
+bool held_beside(const Vec3& p, const Side<AtV>& V, int vf, int vc, const Side<AtW>& W, int face, const Vec3& nF,
+                 double d, double sine) {
+  const Vec3 P[3] = {W.corner(face, 0), W.corner(face, 1), W.corner(face, 2)};
+  bool beyond[3];
+  int count = 0;
+  for (int k = 0; k < 3; ++k) {
+    // nF x (P[k + 1] - P[k]) points into the face (counter-clockwise about nF).
+    beyond[k] = (p - P[k]).dot(nF.cross(P[(k + 1) % 3] - P[k])) < 0;
+    count += beyond[k];
+  }
+  if (count == 0 || count == 3) return false;  // over the face (or a degenerate one)
+  if (vertex_support(V.mesh, V.neighbor, vf, vc, Vec3(-nF), sine, V.at) != Support::kNo) return false;
+  const auto holds = [&](int g) {
+    if (g < 0 || g == face) return false;
+    const Vec3 q0 = W.corner(g, 0), q1 = W.corner(g, 1), q2 = W.corner(g, 2);
+    const Vec3 n2 = unit_normal(q0, q1, q2);
+    return n2 != Vec3::Zero() && (p - closest_point_on_triangle(p, q0, q1, q2)).norm() <= d &&
+           vertex_support(V.mesh, V.neighbor, vf, vc, Vec3(-n2), sine, V.at) == Support::kYes;
+  };
+  // The faces that share the edge's ends, or the corner: walked around each
+  // (in one direction: a fan cut by a boundary is walked in part).
+  const int k = count == 1 ? (beyond[0] ? 0 : beyond[1] ? 1 : 2) : (!beyond[2] ? 1 : !beyond[0] ? 2 : 0);
+  bool held = false;
+  for (int i = 0; i < (count == 1 ? 2 : 1) && !held; ++i)
+    walk_fan(W.mesh, W.neighbor, face, (k + i) % 3, [&](int g, int) {
+      held = holds(g);
+      return !held;
+    });
+  return held;
+}
+
 struct Collector {
   const ContactSettings& settings;
   double merge_distance, merge_cos;
@@ -134,6 +234,7 @@ ContactStatus generate_contacts(const CcdBody* obstacles, int num_obstacles, con
   set->num_contacts = 0;
   set->num_pairs_within = 0;
   set->num_reductions = 0;
+  set->num_beside = 0;
   if (!god.mesh || !god.bvh || !ws || !is_valid_pose(X_WB) || !(settings.distance > 0) ||
       !std::isfinite(settings.distance) || ws->god_world.size() != static_cast<size_t>(god.mesh->V.rows()) ||
       (num_obstacles > 0 && !obstacles) || (near.num_pairs > 0 && !near.pairs))
@@ -174,6 +275,7 @@ ContactStatus generate_contacts(const CcdBody* obstacles, int num_obstacles, con
   Collector col{settings, settings.merge_distance > 0 ? settings.merge_distance : 1e-3 * d,
                 std::cos(settings.merge_angle), set};
   const double par2 = settings.parallel_sine * settings.parallel_sine;
+  const double support_sine = std::sin(settings.merge_angle);
   ContactStatus status = ContactStatus::kOk;
   for (int o = 0; o < num_obstacles; ++o) {
     if (!obstacles[o].mesh || !obstacles[o].bvh) return ContactStatus::kInvalidInput;
@@ -181,6 +283,10 @@ ContactStatus generate_contacts(const CcdBody* obstacles, int num_obstacles, con
     const Bvh& ob = *obstacles[o].bvh;
     const auto ov = [&](int f, int k) -> Vec3 { return om.V.row(om.F(f, k)).transpose(); };
     const auto gv = [&](int f, int k) -> const Vec3& { return world(gm.F(f, k)); };
+    const auto god_at = [&](int v) -> Vec3 { return world(v); };
+    const auto obstacle_at = [&](int v) -> Vec3 { return om.V.row(v).transpose(); };
+    const Side god_side{gm, god.bvh->neighbor, god_at};
+    const Side obstacle_side{om, ob.neighbor, obstacle_at};
     const auto visit = [&](int gf, int of) {
       const uint8_t go = god.bvh->owned[gf], oo = ob.owned[of];
       const Vec3 oa = ov(of, 0), obb = ov(of, 1), oc = ov(of, 2);
@@ -195,15 +301,25 @@ ContactStatus generate_contacts(const CcdBody* obstacles, int num_obstacles, con
             const Vec3& x = gv(gf, k);
             const double sep = (x - closest_point_on_triangle(x, oa, obb, oc)).norm();
             const Vec3 n = unit_normal(oa, obb, oc);
-            if (sep <= d && n != Vec3::Zero()) col.add({x, n, sep, {kind, o, gf, k, of, -1}});
+            if (!(sep <= d && n != Vec3::Zero())) break;
+            if (held_beside(x, god_side, gf, k, obstacle_side, of, n, d, support_sine)) {
+              ++set->num_beside;
+              break;
+            }
+            col.add({x, n, sep, {kind, o, gf, k, of, -1}});
             break;
           }
           case PairKind::kObstacleVertexGodFace: {  // minus the god face's normal
             const Vec3 y = ov(of, j);
-            const Vec3 c = closest_point_on_triangle(y, gv(gf, 0), gv(gf, 1), gv(gf, 2));
+            const Vec3 c = closest_point_on_triangle(y, X[0], X[1], X[2]);
             const double sep = (y - c).norm();
-            const Vec3 n = -unit_normal(gv(gf, 0), gv(gf, 1), gv(gf, 2));
-            if (sep <= d && n != Vec3::Zero()) col.add({c, n, sep, {kind, o, gf, -1, of, j}});
+            const Vec3 n = -unit_normal(X[0], X[1], X[2]);
+            if (!(sep <= d && n != Vec3::Zero())) break;
+            if (held_beside(y, obstacle_side, of, j, god_side, gf, Vec3(-n), d, support_sine)) {
+              ++set->num_beside;
+              break;
+            }
+            col.add({c, n, sep, {kind, o, gf, -1, of, j}});
             break;
           }
           case PairKind::kEdgeEdge: {  // closest points inside both edges, edges not parallel
