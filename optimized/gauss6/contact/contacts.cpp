@@ -164,6 +164,15 @@ bool held_beside(const Vec3& p, const Side<AtV>& V, int vf, int vc, const Side<A
   return held;
 }
 
+// Whether the boxes [a_lo, a_hi] and [b_lo, b_hi] are more than `gap` apart
+// along some axis (compared without rounding: b_lo - a_hi > gap is taken as
+// b_lo > a_hi + gap rounded up).
+bool boxes_apart(const Vec3& a_lo, const Vec3& a_hi, const Vec3& b_lo, const Vec3& b_hi, double gap) {
+  for (int i = 0; i < 3; ++i)
+    if (b_lo[i] > (Upper{a_hi[i]} + Upper{gap}).v || a_lo[i] > (Upper{b_hi[i]} + Upper{gap}).v) return true;
+  return false;
+}
+
 struct Collector {
   const ContactSettings& settings;
   double merge_distance, merge_cos;
@@ -276,6 +285,14 @@ ContactStatus generate_contacts(const CcdBody* obstacles, int num_obstacles, con
                 std::cos(settings.merge_angle), set};
   const double par2 = settings.parallel_sine * settings.parallel_sine;
   const double support_sine = std::sin(settings.merge_angle);
+  // Features whose boxes are more than `apart` apart along an axis are more
+  // than 2 d apart, and their computed separation (its rounding below
+  // kBoxPoseRounding of the coordinates' magnitude `scale`) is above d: they
+  // need no test, and the set is the same with or without it.
+  double scale = std::abs(G.x()) + std::abs(G.y()) + std::abs(G.z()) + god.bvh->radius;
+  for (int o = 0; o < num_obstacles; ++o)
+    if (obstacles[o].bvh) scale = std::max(scale, obstacles[o].bvh->radius);
+  const double apart = (Upper{2 * d} + Upper{kBoxPoseRounding} * Upper{scale}).v;
   ContactStatus status = ContactStatus::kOk;
   for (int o = 0; o < num_obstacles; ++o) {
     if (!obstacles[o].mesh || !obstacles[o].bvh) return ContactStatus::kInvalidInput;
@@ -290,15 +307,22 @@ ContactStatus generate_contacts(const CcdBody* obstacles, int num_obstacles, con
     const auto visit = [&](int gf, int of) {
       const uint8_t go = god.bvh->owned[gf], oo = ob.owned[of];
       const Vec3 oa = ov(of, 0), obb = ov(of, 1), oc = ov(of, 2);
-      // Pairs proven farther apart than d by a separating axis have no pair within d.
       const Vec3 X[3] = {gv(gf, 0), gv(gf, 1), gv(gf, 2)}, Y[3] = {oa, obb, oc};
-      if (triangle_gap_lower_bound(X, Y, d) > d) return true;
+      // The features' boxes (their corners' bounds): a feature pair is tested
+      // only when its boxes come within `apart` of each other along every
+      // axis. A pair of coplanar triangles (a flat tool on a dense flat
+      // tessellation) is within d as a whole, so no bound on the triangle pair
+      // drops it, while most of its feature pairs lie far apart in the plane.
+      const Vec3 x_lo = X[0].cwiseMin(X[1]).cwiseMin(X[2]), x_hi = X[0].cwiseMax(X[1]).cwiseMax(X[2]);
+      const Vec3 y_lo = Y[0].cwiseMin(Y[1]).cwiseMin(Y[2]), y_hi = Y[0].cwiseMax(Y[1]).cwiseMax(Y[2]);
+      if (boxes_apart(x_lo, x_hi, y_lo, y_hi, apart)) return true;
       // One pass over the table of feature-pair kinds (feature_pair.h); k: the
       // god-object's corner (vertex k, or edge k -> k + 1), j: the obstacle's.
       for_each_feature_pair(go, oo, [&](PairKind kind, int k, int j) {
         switch (kind) {
           case PairKind::kGodVertexObstacleFace: {  // the obstacle face's normal
             const Vec3& x = gv(gf, k);
+            if (boxes_apart(x, x, y_lo, y_hi, apart)) break;
             const double sep = (x - closest_point_on_triangle(x, oa, obb, oc)).norm();
             const Vec3 n = unit_normal(oa, obb, oc);
             if (!(sep <= d && n != Vec3::Zero())) break;
@@ -310,7 +334,8 @@ ContactStatus generate_contacts(const CcdBody* obstacles, int num_obstacles, con
             break;
           }
           case PairKind::kObstacleVertexGodFace: {  // minus the god face's normal
-            const Vec3 y = ov(of, j);
+            const Vec3& y = Y[j];
+            if (boxes_apart(y, y, x_lo, x_hi, apart)) break;
             const Vec3 c = closest_point_on_triangle(y, X[0], X[1], X[2]);
             const double sep = (y - c).norm();
             const Vec3 n = -unit_normal(X[0], X[1], X[2]);
@@ -323,8 +348,9 @@ ContactStatus generate_contacts(const CcdBody* obstacles, int num_obstacles, con
             break;
           }
           case PairKind::kEdgeEdge: {  // closest points inside both edges, edges not parallel
-            const Vec3 &g0 = gv(gf, k), &g1 = gv(gf, (k + 1) % 3);
-            const Vec3 o0 = ov(of, j), o1 = ov(of, (j + 1) % 3);
+            const Vec3 &g0 = X[k], &g1 = X[(k + 1) % 3];
+            const Vec3 &o0 = Y[j], &o1 = Y[(j + 1) % 3];
+            if (boxes_apart(g0.cwiseMin(g1), g0.cwiseMax(g1), o0.cwiseMin(o1), o0.cwiseMax(o1), apart)) break;
             double s, t;
             closest_segment_parameters(g0, g1, o0, o1, &s, &t);
             if (!(s > 0 && s < 1 && t > 0 && t < 1)) break;
