@@ -1,7 +1,9 @@
 // Tests of contacts.h: a box resting on a box (four corner contacts, normals +z,
 // the Jacobian rows), duplicates merged, the edge/edge normal's sign, the
 // contact sets found from the CCD's near pairs against those of a full descent,
-// and a dense coplanar patch reduced to its support.
+// a dense coplanar patch reduced to its support, and the rows of a vertex
+// beside a face (a flat plate's vertex beside a tool's bottom edge, a sharp
+// vertex on a sharp edge).
 #include <catch2/catch.hpp>
 
 #include <cmath>
