@@ -304,25 +304,45 @@ ContactStatus generate_contacts(const CcdBody* obstacles, int num_obstacles, con
     const auto obstacle_at = [&](int v) -> Vec3 { return om.V.row(v).transpose(); };
     const Side god_side{gm, god.bvh->neighbor, god_at};
     const Side obstacle_side{om, ob.neighbor, obstacle_at};
+    int slab_face = -1;  // the god face of slab_n (its normal, not unit) and slab_l2 (|slab_n|^2 d^2)
+    Vec3 slab_n = Vec3::Zero();
+    double slab_l2 = 0;
     const auto visit = [&](int gf, int of) {
       const uint8_t go = god.bvh->owned[gf], oo = ob.owned[of];
       const Vec3 oa = ov(of, 0), obb = ov(of, 1), oc = ov(of, 2);
       const Vec3 X[3] = {gv(gf, 0), gv(gf, 1), gv(gf, 2)}, Y[3] = {oa, obb, oc};
-      // The features' boxes (their corners' bounds): a feature pair is tested
-      // only when its boxes come within `apart` of each other along every
-      // axis. A pair of coplanar triangles (a flat tool on a dense flat
-      // tessellation) is within d as a whole, so no bound on the triangle pair
-      // drops it, while most of its feature pairs lie far apart in the plane.
-      const Vec3 x_lo = X[0].cwiseMin(X[1]).cwiseMin(X[2]), x_hi = X[0].cwiseMax(X[1]).cwiseMax(X[2]);
-      const Vec3 y_lo = Y[0].cwiseMin(Y[1]).cwiseMin(Y[2]), y_hi = Y[0].cwiseMax(Y[1]).cwiseMax(Y[2]);
-      if (boxes_apart(x_lo, x_hi, y_lo, y_hi, apart)) return true;
+      // Pairs proven farther apart than d by a separating axis have no pair
+      // within d. But an obstacle triangle within d of the god face's plane (a
+      // flat tool on a dense flat tessellation: thousands of such pairs) is
+      // within d along the face normals and along the edges' cross products,
+      // all near that normal, so no axis drops it; its feature pairs, most of
+      // which lie far apart in the plane, are then sorted by their boxes (the
+      // bounds of their corners): one is tested only when its boxes come
+      // within `apart` of each other along every axis. Either way the set is
+      // the same: the axes and the boxes only save work.
+      if (gf != slab_face) {  // consecutive pairs often share their god face
+        slab_face = gf;
+        slab_n = (X[1] - X[0]).cross(X[2] - X[0]);
+        slab_l2 = slab_n.squaredNorm() * (d * d);
+      }
+      const auto within = [&](const Vec3& y) {
+        const double h = slab_n.dot(y - X[0]);
+        return h * h <= slab_l2;
+      };
+      const bool in_slab = within(Y[0]) && within(Y[1]) && within(Y[2]);
+      if (!in_slab && triangle_gap_lower_bound(X, Y, d) > d) return true;
+      Vec3 x_lo, x_hi, y_lo, y_hi;
+      if (in_slab) {
+        x_lo = X[0].cwiseMin(X[1]).cwiseMin(X[2]), x_hi = X[0].cwiseMax(X[1]).cwiseMax(X[2]);
+        y_lo = Y[0].cwiseMin(Y[1]).cwiseMin(Y[2]), y_hi = Y[0].cwiseMax(Y[1]).cwiseMax(Y[2]);
+      }
       // One pass over the table of feature-pair kinds (feature_pair.h); k: the
       // god-object's corner (vertex k, or edge k -> k + 1), j: the obstacle's.
       for_each_feature_pair(go, oo, [&](PairKind kind, int k, int j) {
         switch (kind) {
           case PairKind::kGodVertexObstacleFace: {  // the obstacle face's normal
             const Vec3& x = gv(gf, k);
-            if (boxes_apart(x, x, y_lo, y_hi, apart)) break;
+            if (in_slab && boxes_apart(x, x, y_lo, y_hi, apart)) break;
             const double sep = (x - closest_point_on_triangle(x, oa, obb, oc)).norm();
             const Vec3 n = unit_normal(oa, obb, oc);
             if (!(sep <= d && n != Vec3::Zero())) break;
@@ -335,7 +355,7 @@ ContactStatus generate_contacts(const CcdBody* obstacles, int num_obstacles, con
           }
           case PairKind::kObstacleVertexGodFace: {  // minus the god face's normal
             const Vec3& y = Y[j];
-            if (boxes_apart(y, y, x_lo, x_hi, apart)) break;
+            if (in_slab && boxes_apart(y, y, x_lo, x_hi, apart)) break;
             const Vec3 c = closest_point_on_triangle(y, X[0], X[1], X[2]);
             const double sep = (y - c).norm();
             const Vec3 n = -unit_normal(X[0], X[1], X[2]);
@@ -350,7 +370,8 @@ ContactStatus generate_contacts(const CcdBody* obstacles, int num_obstacles, con
           case PairKind::kEdgeEdge: {  // closest points inside both edges, edges not parallel
             const Vec3 &g0 = X[k], &g1 = X[(k + 1) % 3];
             const Vec3 &o0 = Y[j], &o1 = Y[(j + 1) % 3];
-            if (boxes_apart(g0.cwiseMin(g1), g0.cwiseMax(g1), o0.cwiseMin(o1), o0.cwiseMax(o1), apart)) break;
+            if (in_slab && boxes_apart(g0.cwiseMin(g1), g0.cwiseMax(g1), o0.cwiseMin(o1), o0.cwiseMax(o1), apart))
+              break;
             double s, t;
             closest_segment_parameters(g0, g1, o0, o1, &s, &t);
             if (!(s > 0 && s < 1 && t > 0 && t < 1)) break;
