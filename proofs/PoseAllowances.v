@@ -361,7 +361,8 @@ Print Assumptions pose_rounding_start_frame.
 (* pose_rounding_stand_at (runtime/sim_step4.cpp, stand_at): posing_error =
    round_up(deviation + kPoseRounding * (p_inf + god_radius)), the inner
    operations plain doubles: deviation + the posing error is at most it,
-   for rho >= 2^-1000 (a god-object radius above 1e-301). *)
+   for rho >= 2^-1000 (a god-object radius above 1e-301: kMinBodyRadius,
+   which RuntimeModel checks when it builds the model). *)
 (* covers optimized/gauss6/runtime/sim_step4.cpp "void stand_at(const RuntimeModel& model, LegEnd* leg)" sha256:81108f2f6f8aa92e *)
 Theorem pose_rounding_stand_at w x y z p0 p1 p2 r0 r1 r2 P rho dev :
   bpow radix2 (-802) <= w * w + x * x + y * y + z * z ->

@@ -592,6 +592,11 @@ TEST_CASE("faults: invalid handle poses give zero force and an event, invalid se
     far = make_scene();
     far.obstacles[0].pose.p.x() = 2e30;
     CHECK_THROWS_AS(RuntimeModel(far, RuntimeSettings{}), RuntimeError);
+    // A god-object below kMinBodyRadius (the hypothesis of PoseAllowances.v's
+    // pose_rounding_stand_at), refused by name.
+    Scene speck = make_scene();
+    speck.god_object.mesh.V *= 1e-302;
+    CHECK_THROWS_WITH(RuntimeModel(speck, RuntimeSettings{}), Catch::Contains("kMinBodyRadius"));
     // A delta the CCD cannot serve: denormal, below kMinDeltaPerExtent of the
     // scene's extent or above kMaxDeltaPerExtent of it.
     const double extent = scene_extent(make_scene());

@@ -68,6 +68,10 @@ constexpr double kAxisVelocityRounding = 1e-14;
 // proofs/PoseAllowances.v pose_rounding (with _start_frame, _stand_at for the
 // sites): within 309 u (|p|_inf + rho) of the exact p + R(q) r_B, |r_B|_inf <= rho.
 constexpr double kPoseRounding = 1e-13;
+// The least god-object radius (its body's bounding sphere about G) that
+// pose_rounding_stand_at covers: below 2^-1000 the posing error's underflow
+// terms are not within the allowance. RuntimeModel refuses a smaller body.
+constexpr double kMinBodyRadius = 0x1p-1000;
 
 // The turn between two double poses, 2 |vec(conj(qa) qb)| (Displacement):
 // proofs/PoseAllowances.v quaternion_turn_rounding, the computed 2 |v| within

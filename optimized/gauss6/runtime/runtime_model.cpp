@@ -5,6 +5,8 @@
 #include <cmath>
 #include <string>
 
+#include "gauss6/numeric/error_allowances.h"
+
 namespace gauss6 {
 
 namespace {
@@ -155,6 +157,9 @@ RuntimeModel::RuntimeModel(const Scene& scene, const RuntimeSettings& s) : setti
   god_bvh_B = build_bvh(god_mesh_B);
   god = {&god_mesh_B, &god_bvh_B};
   god_radius = god_bvh_B.radius;
+  if (!(god_radius >= kMinBodyRadius))
+    fail("the god-object's radius about G (" + std::to_string(god_radius) +
+         ") is below 2^-1000, the least the posing allowance covers (kMinBodyRadius)");
 
   // Inertia about G from the inertia about the centre of mass c (parallel axes).
   const MassProperties& mp = scene.god_mass.mass;
