@@ -30,7 +30,7 @@ struct ProximityCacheSettings {
                             // (0: every list's margin is `margin`; the runtime uses 256 delta)
   long fill_budget = 0;     // node pairs per step that fill the next list in the background while the
                             // one in use serves (0: no background fill; the runtime uses 300)
-  long fill_at_once = 200;   // node pairs an update's steps spend at most, together, on lists they need now
+  long fill_at_once = 1000;  // node pairs an update's steps spend at most, together, on lists they need now
                              // (the first list, or a new one while a list is kept): the rest goes on at the
                              // next steps, which descend the trees meanwhile (no update pays a whole fill:
                              // at a million triangles a list's fill costs several updates' time). An update
