@@ -257,15 +257,20 @@ TEST_CASE("ccd_step: steps served by the proximity cache find the first contact 
   // then take their pairs from a list that was completed steps after the pose
   // it holds), with margins that follow the speed (cache.margin_max), and with
   // fills a step needs cut to a few node pairs a step (cache.fill_at_once: the
-  // steps descend the trees until the list is complete, then take it).
+  // steps descend the trees until the list is complete, then take it; the
+  // first list too), and with margins capped at a fraction of the triangles'
+  // size (cache.triangle_margin: each list's margin is then that cap).
   const TriangleMesh god = make_icosphere(1, 0.5);
   const TriangleMesh slab = concatenate(make_box(3, 3, 1, Vec3(0, 0, -0.5)), make_box(0.4, 0.4, 0.6, Vec3(0.6, 0, 0.3)));
   const Bvh gb = build_bvh(god, 2), sb = build_bvh(slab, 2);
-  const long whole = ProximityCacheSettings{}.fill_at_once;
-  for (const auto [budget, margin_max, at_once] : {std::tuple{0L, 0.0, whole}, std::tuple{12L, 0.0, whole},
-                                                   std::tuple{12L, 0.06, whole}, std::tuple{12L, 0.06, 5L},
-                                                   std::tuple{0L, 0.0, 5L}}) {
-  INFO("cache_fill_budget " << budget << ", cache_margin_max " << margin_max << ", cache_fill_at_once " << at_once);
+  const long whole = std::numeric_limits<long>::max();  // every fill at once
+  const double uncapped = ProximityCacheSettings{}.triangle_margin;
+  for (const auto [budget, margin_max, at_once, triangle_margin] :
+       {std::tuple{0L, 0.0, whole, uncapped}, std::tuple{12L, 0.0, whole, uncapped},
+        std::tuple{12L, 0.06, whole, uncapped}, std::tuple{12L, 0.06, 5L, uncapped}, std::tuple{0L, 0.0, 5L, uncapped},
+        std::tuple{12L, 0.06, whole, 0.02}}) {
+  INFO("cache_fill_budget " << budget << ", cache_margin_max " << margin_max << ", cache_fill_at_once " << at_once
+                            << ", cache_triangle_margin " << triangle_margin);
   std::mt19937 rng(29);
   std::uniform_real_distribution<double> U(-1, 1);
   CcdStepSettings settings, plain;
@@ -274,6 +279,7 @@ TEST_CASE("ccd_step: steps served by the proximity cache find the first contact 
   settings.cache.fill_budget = budget;
   settings.cache.margin_max = margin_max;
   settings.cache.fill_at_once = at_once;
+  settings.cache.triangle_margin = triangle_margin;
   CcdStepWorkspace ws, ws_plain;
   const CcdBody obstacle{&slab, &sb};
   Pose x{Vec3(0.1, 0, 0.5 + 0.01), Quat{}};  // 1 cm above the slab
@@ -313,6 +319,12 @@ TEST_CASE("ccd_step: steps served by the proximity cache find the first contact 
     fills += r.cache_filled;
     refills += r.cache_refilled;
     hits += r.hit;
+    // The capped lists' margin: the cap (here below the smallest margin asked).
+    if (triangle_margin != uncapped && ws.cache.num_pairs >= 0) {
+      REQUIRE(ws.cache.triangle_size > 0);
+      REQUIRE(triangle_margin * ws.cache.triangle_size < settings.cache.margin);
+      CHECK(ws.cache.margin == triangle_margin * ws.cache.triangle_size);
+    }
     // The next step starts at this one's stop pose, lifted by 3 d (a motion
     // sliding at exactly d is undecidable at the default distance tolerance);
     // the pair that stopped it is its hint (the runtime passes the contacts there).
@@ -326,7 +338,9 @@ TEST_CASE("ccd_step: steps served by the proximity cache find the first contact 
               std::max(margin_max, settings.cache.margin), at_once, served, fills, refills, hits, gave_up);
   CHECK(gave_up <= 6);
   CHECK(hits >= 20);
-  if (at_once == whole) {
+  if (triangle_margin != uncapped) {
+    CHECK(served >= 10);
+  } else if (at_once == whole) {
     CHECK(served >= 30);
     CHECK(fills >= 3);
     if (budget == 0) CHECK(refills == 0);
@@ -354,6 +368,56 @@ static FeaturePair in_contact_hint() {
   hint.obstacle = 0;
   hint.god_face = hint.obstacle_face = 0;
   return hint;
+}
+
+TEST_CASE("ccd_step: the fills at once of one update share its fill_at_once, the first list's too", "[ccd_step]") {
+  // A ball resting 2e-4 above a slab (a hint given, as in contact), each
+  // update a jitter well within the margin: the first step needs a list and
+  // finds none. Each update is one call that opens it (fill_cache) and two
+  // that do not, all three needing the list until it is complete: together
+  // they fill at most fill_at_once node pairs of it (the first call all of
+  // them, the others none), without a background fill, until one puts it in
+  // use; meanwhile each step descends the trees and agrees with the brute force.
+  const TriangleMesh god = make_icosphere(1, 0.5);
+  double z_min = 1e300;
+  for (Eigen::Index v = 0; v < god.V.rows(); ++v) z_min = std::min(z_min, god.V(v, 2));
+  const TriangleMesh slab = make_box(3, 3, 1, Vec3(0, 0, -0.5));
+  const Bvh gb = build_bvh(god, 2), sb = build_bvh(slab, 2);
+  CcdStepSettings settings = background_fill_settings(0.03, 0, 0);
+  settings.cache.fill_at_once = 4;
+  CcdStepWorkspace ws;
+  const CcdBody obstacle{&slab, &sb};
+  const FeaturePair hint = in_contact_hint();
+  const Pose x{Vec3(0, 0, 2e-4 - z_min), Quat{}};
+  long filled = 0;
+  int updates = 0;
+  bool in_use = false;
+  for (; updates < 500 && !in_use; ++updates) {
+    INFO("update " << updates);
+    long this_update = 0;
+    for (int call = 0; call < 3 && !in_use; ++call) {
+      const Pose target{x.p + Vec3(1e-4 * (call + 1), 5e-5 * (updates % 3), 0), x.q};
+      CcdStepRequest request{x, target, &hint, 1};
+      request.fill_cache = call == 0;
+      CcdStepResult r;
+      ccd_step(&obstacle, 1, {&god, &gb}, request, settings, &ws, &r);
+      REQUIRE(r.status == CcdStatus::kOk);
+      CcdMotion m;
+      REQUIRE(make_ccd_motion(x, target, &m) == MotionStatus::kOk);
+      const BruteForce bf = brute_force(god, gb, slab, sb, m, settings.narrow);
+      CHECK(r.hit == bf.hit);
+      CHECK_FALSE(r.cache_filled);  // never whole at once
+      if (call > 0) CHECK(r.num_fill_node_pairs == 0);
+      this_update += r.num_fill_node_pairs;
+      in_use = r.cache_refilled;
+    }
+    CHECK(this_update <= settings.cache.fill_at_once);
+    filled += this_update;
+  }
+  CHECK(in_use);
+  CHECK(updates > 1);
+  CHECK(filled == ws.cache.fill_cost);
+  CHECK(ws.cache.num_pairs > 0);
 }
 
 TEST_CASE("ccd_step: a ball sliding on a slab into a wall, its cache refilled in the background", "[ccd_step]") {
@@ -776,6 +840,8 @@ TEST_CASE("ccd_step: a step told its first part is free searches only the rest",
   CcdStepSettings cached;
   cached.cache.margin = 1.0;  // the list covers the whole fall
   cached.cache.margin_max = 1.0;
+  cached.cache.fill_at_once = std::numeric_limits<long>::max();  // and is filled whole by the step at x0,
+  cached.cache.triangle_margin = 10;                              // its margin not capped by the box's size
   for (int way = 0; way < 4; ++way) {
     for (double u_star : {0.01, 0.2, 0.45, 0.8}) {
       for (double known : {0.0, 0.5 * u_star, 0.99 * u_star}) {

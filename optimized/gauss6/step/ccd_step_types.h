@@ -71,8 +71,9 @@ struct CcdStepRequest {
                                            // reach: a first contact met soon ends the search there (0: off)
   CcdQuestion question = CcdQuestion::kFirstContact;
   bool fill_cache = true;                  // go on with the proximity cache's background fill (cache.fill_budget
-                                           // node pairs); false for the later calls of one update, whose budget
-                                           // the first spent
+                                           // node pairs), and open an update: its calls share cache.fill_at_once
+                                           // node pairs of fills at once; false for the later calls of one
+                                           // update, whose budget the first spent
 };
 
 struct CcdStepResult {

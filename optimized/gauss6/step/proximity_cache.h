@@ -30,10 +30,12 @@ struct ProximityCacheSettings {
                             // (0: every list's margin is `margin`; the runtime uses 256 delta)
   long fill_budget = 0;     // node pairs per step that fill the next list in the background while the
                             // one in use serves (0: no background fill; the runtime uses 300)
-  long fill_at_once = 1000;  // node pairs a step spends at most on a list it needs now while a list for the
-                             // same meshes and settings is kept: the rest goes on at the next steps, which
-                             // descend the trees meanwhile (no step pays a whole fill: at a million
-                             // triangles a list's fill costs several updates' time)
+  long fill_at_once = 1000;  // node pairs an update's steps spend at most, together, on lists they need now
+                             // (the first list, or a new one while a list is kept): the rest goes on at the
+                             // next steps, which descend the trees meanwhile (no update pays a whole fill:
+                             // at a million triangles a list's fill costs several updates' time). An update
+                             // is the steps from one whose request opens it (CcdStepRequest::fill_cache)
+                             // to the next such
   // The policy, dimensionless (gauss6/step/proximity_stages.cpp states where each acts).
   double steps_per_list = 6;       // a new list's margin spans about this many steps like the last one
   double slow_fraction = 0.25;     // a step that moves at most this fraction of the margin refills at once;
@@ -44,11 +46,15 @@ struct ProximityCacheSettings {
   int skip_after_poor_fill = 8;    // ... makes the next this many chances to refill pass (plain descents)
   double fill_lead = 0.75;         // a background fill's pose lies this fraction of its margin past the pose
                                    // the god-object reaches when the fill is due
+  double triangle_margin = 0.25;   // a list's margin is at most this many times the bodies' triangle size
+                                   // (ProximityCache::triangle_size): its pairs then grow as the triangles
+                                   // near the contact, not as their square once the margin outgrows them
 };
 
 // The settings can be used: margins finite and >= 0, policy constants in range
 // (steps_per_list > 0, slow_fraction and fill_lead in (0, 1], max_probe_sub_intervals
-// in (0, 1], min_uses >= 1, skip_after_poor_fill >= 0, fill_budget >= 0, fill_at_once >= 1).
+// in (0, 1], min_uses >= 1, skip_after_poor_fill >= 0, fill_budget >= 0, fill_at_once >= 1,
+// triangle_margin > 0 and finite).
 bool valid_proximity_cache_settings(const ProximityCacheSettings& s);
 
 // The lists, allocated once (capacity: pairs a list holds; stack_capacity: the
@@ -103,13 +109,21 @@ struct ProximityCache {
   bool budget_cut = false;  // a fill a step needed was cut short (budget, or its bound): it goes on in the
                             // background, and no other starts at once, until it is put in use or dropped
                             // (the god-object went elsewhere)
+  long at_once_left = 0;    // node pairs this update's fills at once may still spend
+                            // (ProximityCacheSettings::fill_at_once)
+  // The keyed bodies' triangle size: the smallest over the bodies of the mean
+  // longest edge of kSizeSamples of its triangles, evenly spaced in index
+  // (0: none measured); measured when a fill sets the keys (no list in use).
+  static constexpr int kSizeSamples = 64;
+  double triangle_size = 0;
   CcdBody god;
   std::vector<CcdBody> obstacles;  // the keys; capacity obstacle_capacity, reserved here (never grows)
   // A fill in progress (ProximityCacheSettings::fill_budget): the same kind
   // of list for the pose `ref` (where the god-object is heading) and its own
   // margin, built a budget of node pairs per step in the background while the
-  // list above still serves, then swapped in; finished at once when a step
-  // needs it first. Same keys as the list above.
+  // list above still serves, then swapped in; finished, within the update's
+  // fill_at_once, when a step needs it first. Same keys as the list above
+  // (the keys above are the fill's when no list is in use: the first fill).
   struct Fill {
     Fill(int capacity, int stack_capacity) : pairs(static_cast<size_t>(capacity)), stack(stack_capacity) {}
     std::vector<Pair> pairs;

@@ -19,7 +19,8 @@ bool valid_proximity_cache_settings(const ProximityCacheSettings& s) {
   return s.margin >= 0 && std::isfinite(s.margin) && s.margin_max >= 0 && std::isfinite(s.margin_max) &&
          s.fill_budget >= 0 && s.steps_per_list > 0 && std::isfinite(s.steps_per_list) &&
          in_unit(s.slow_fraction) && in_unit(s.max_probe_sub_intervals) && in_unit(s.fill_lead) &&
-         s.min_uses >= 1 && s.skip_after_poor_fill >= 0 && s.fill_at_once >= 1;
+         s.min_uses >= 1 && s.skip_after_poor_fill >= 0 && s.fill_at_once >= 1 && s.triangle_margin > 0 &&
+         std::isfinite(s.triangle_margin);
 }
 
 namespace detail {
@@ -31,9 +32,14 @@ const ProximityCacheSettings& policy(const StepState& s) { return s.settings.cac
 
 // The margin of a list filled now: about steps_per_list steps like the last
 // one (v), within [margin, margin_max]: a wide one while the god-object slides
-// steadily (fewer fills), the narrow one at rest (a shorter list to scan).
+// steadily (fewer fills), the narrow one at rest (a shorter list to scan);
+// then at most triangle_margin triangle sizes (ProximityCache::triangle_size):
+// with triangles smaller than the margin a list's pairs grow as the square of
+// their density over the contact, with this cap as their number.
 double list_margin(const StepState& s, double v, double margin, double margin_max) {
-  return std::clamp(policy(s).steps_per_list * v, margin, margin_max);
+  const double m = std::clamp(policy(s).steps_per_list * v, margin, margin_max);
+  const double cap = policy(s).triangle_margin * s.ws->cache.triangle_size;
+  return cap > 0 ? std::min(m, cap) : m;
 }
 
 bool same_body(const CcdBody& a, const CcdBody& b) { return a.mesh == b.mesh && a.bvh == b.bvh; }
@@ -49,12 +55,43 @@ bool same_bodies(const ProximityCache& pc, const StepState& s) {
 double step_margin(const StepState& s) { return s.settings.cache.margin; }
 double step_margin_max(const StepState& s) { return std::max(s.settings.cache.margin_max, step_margin(s)); }
 
-// The list in use was filled for these meshes, trees, reach and margins.
-bool is_keyed(const StepState& s) {
+// The cache's keys are these meshes, trees, reach and margins (the list in
+// use's, or the first fill's while none is: set_keys).
+bool keys_match(const StepState& s) {
   const ProximityCache& pc = s.ws->cache;
-  return pc.num_pairs >= 0 && s.num_obstacles <= pc.obstacle_capacity && pc.reach == s.reach &&
-         pc.margin_min == step_margin(s) && pc.margin_max == step_margin_max(s) && same_bodies(pc, s);
+  return s.num_obstacles <= pc.obstacle_capacity && pc.reach == s.reach && pc.margin_min == step_margin(s) &&
+         pc.margin_max == step_margin_max(s) && same_bodies(pc, s);
 }
+// The mean longest edge of a sample of the mesh's triangles (ProximityCache::triangle_size).
+double sampled_triangle_size(const TriangleMesh& m) {
+  const Eigen::Index n = m.F.rows();
+  const Eigen::Index k = std::min<Eigen::Index>(n, ProximityCache::kSizeSamples);
+  double sum = 0;
+  for (Eigen::Index j = 0; j < k; ++j) {
+    const Eigen::Index f = j * n / k;
+    const Vec3 a = m.V.row(m.F(f, 0)), b = m.V.row(m.F(f, 1)), c = m.V.row(m.F(f, 2));
+    sum += std::max({(b - a).norm(), (c - b).norm(), (a - c).norm()});
+  }
+  return k > 0 ? sum / static_cast<double>(k) : 0.0;
+}
+
+double bodies_triangle_size(const StepState& s) {
+  double size = sampled_triangle_size(*s.god.mesh);
+  for (int o = 0; o < s.num_obstacles; ++o) size = std::min(size, sampled_triangle_size(*s.obstacles[o].mesh));
+  return std::isfinite(size) ? size : 0.0;
+}
+
+void set_keys(StepState* s) {
+  ProximityCache& pc = s->ws->cache;
+  pc.reach = s->reach;
+  pc.margin_min = step_margin(*s);
+  pc.margin_max = step_margin_max(*s);
+  pc.god = s->god;
+  pc.obstacles.assign(s->obstacles, s->obstacles + s->num_obstacles);
+}
+
+// The list in use was filled for these meshes, trees, reach and margins.
+bool is_keyed(const StepState& s) { return s.ws->cache.num_pairs >= 0 && keys_match(s); }
 
 // Fills: every pair not proven apart by reach + pf.margin with the god-object
 // at pf.ref (X0, or the pose a background fill is started at:
@@ -167,12 +204,8 @@ void put_fill(StepState* s) {
   std::swap(pc.pairs, pf.pairs);
   pc.num_pairs = pf.num_pairs;
   pc.ref = pf.ref;
-  pc.reach = s->reach;
   pc.margin = pf.margin;
-  pc.margin_min = step_margin(*s);
-  pc.margin_max = step_margin_max(*s);
-  pc.god = s->god;
-  pc.obstacles.assign(s->obstacles, s->obstacles + s->num_obstacles);
+  set_keys(s);
   pc.uses = 0;
   pc.budget_cut = false;
   pf.active = false;
@@ -224,11 +257,23 @@ struct CacheRanges {
   bool usable(double u) const { return window(u) > 0; }
 };
 
+// A fill a step needs now: at most the update's allowance left
+// (ProximityCache::at_once_left, ProximityCacheSettings::fill_at_once), charged
+// to it; true once complete.
+bool fill_at_once(StepState* s) {
+  ProximityCache& pc = s->ws->cache;
+  if (pc.fill.complete) return true;
+  const long cost = pc.fill.cost;
+  const bool complete = fill_within_budget(s, std::max(pc.at_once_left, 0L));
+  pc.at_once_left -= pc.fill.cost - cost;
+  return complete;
+}
+
 // The fill's pose is ahead of the god-object's path (fill_cache_in_background),
 // or at the start of a step that needed it (refill_if_worth): put it in use once
 // it leaves more of its margin than the list in use does, or, when that list
-// cannot serve this step, once complete (at most fill_at_once more node pairs
-// now: the step descends the trees meanwhile).
+// (or none: the first fill) cannot serve this step, once complete (within the
+// update's fill_at_once: the step descends the trees meanwhile).
 void take_background_fill(StepState* s, const CacheRanges& r, Displacement* since) {
   ProximityCache& pc = s->ws->cache;
   ProximityCache::Fill& pf = pc.fill;
@@ -238,7 +283,7 @@ void take_background_fill(StepState* s, const CacheRanges& r, Displacement* sinc
   const bool needed = !r.usable(s->u_cached) && r.usable(r.range(moved_ahead, pf.margin));
   if (!r.usable(s->u_cached) && !needed) {
     pf.active = false;  // the god-object went elsewhere
-  } else if ((better && pf.complete) || (needed && fill_within_budget(s, policy(*s).fill_at_once))) {
+  } else if ((better && pf.complete) || (needed && fill_at_once(s))) {
     put_fill(s);
     s->result->cache_refilled = true;
     *since = ahead;
@@ -257,18 +302,18 @@ void take_background_fill(StepState* s, const CacheRanges& r, Displacement* sinc
 // the one after that fills. A step that moves at most slow_fraction of the
 // margin fills regardless (the list then serves the next steps unless the
 // god-object speeds up).
-// The fill is at X0 (u = 0), at once but for its bound: while a list for
-// the same meshes and settings is kept (s->cache_keyed), it spends at most
-// fill_at_once node pairs now and goes on at the next steps (a list's pairs
-// grow faster than the meshes: at a million triangles a whole fill costs
-// several updates' time).
+// The fill is at X0 (u = 0), at once but for its bound: it spends at most what
+// is left of the update's fill_at_once node pairs now and goes on at the next
+// steps (a list's pairs grow faster than the meshes: at a million triangles a
+// whole fill costs several updates' time). A list for other meshes or
+// settings is dropped first: the cache's keys are then the fill's.
 void refill_if_worth(StepState* s, const CacheRanges& r, Displacement* since) {
   ProximityCache& pc = s->ws->cache;
   const double margin = step_margin(*s), rho = s->rho;
   const bool fresh = r.usable(s->u_cached);
   if (fresh) ++pc.uses;
-  const double fresh_margin =
-      list_margin(*s, pc.has_last ? Displacement(pc.last_x0, s->X0).bound(rho) : 0.0, margin, step_margin_max(*s));
+  const double v = pc.has_last ? Displacement(pc.last_x0, s->X0).bound(rho) : 0.0;
+  double fresh_margin = list_margin(*s, v, margin, step_margin_max(*s));
   bool fill = !fresh && r.usable(r.range(Displacement(s->X0, s->X0).bound(rho), fresh_margin));
   if (fill && pc.budget_cut && pc.fill.active) {
     fill = false;  // the fill cut short goes on (take_background_fill)
@@ -281,22 +326,24 @@ void refill_if_worth(StepState* s, const CacheRanges& r, Displacement* since) {
     fill = false;
   }
   if (!fill) return;
+  if (!s->cache_keyed) {  // the fill's keys, and its margin under these bodies' cap
+    pc.clear();
+    set_keys(s);
+    pc.triangle_size = bodies_triangle_size(*s);
+    fresh_margin = list_margin(*s, v, margin, step_margin_max(*s));
+  }
   start_fill(s, /*ahead=*/nullptr, fresh_margin);
-  const bool filled =
-      fill_within_budget(s, s->cache_keyed ? policy(*s).fill_at_once : std::numeric_limits<long>::max());
+  const bool filled = fill_at_once(s);
   // A fill cut short, by the update's budget or by fill_at_once, goes on at the
-  // next steps as a background fill (while the list in use keeps the keys:
-  // take_background_fill finishes it, within their budgets and fill_at_once, and
-  // puts it in use), and none starts at once meanwhile: no step spends its time
-  // on the same fill again. Without a list in use (the first fill) a fill the
-  // budget cut short is dropped.
-  if (!filled && (out_of_budget(*s) || s->cache_keyed) && pc.fill.active && pc.num_pairs >= 0) {
+  // next steps as a background fill (take_background_fill finishes it, within
+  // their budgets and fill_at_once, and puts it in use), and none starts at
+  // once meanwhile: no step spends its time on the same fill again.
+  s->u_cached = 0;
+  if (!filled && pc.fill.active) {
     pc.budget_cut = true;
-    s->u_cached = 0;
     return;
   }
   pc.clear();
-  s->u_cached = 0;
   s->cache_keyed = false;
   if (filled) {
     put_fill(s);
@@ -388,7 +435,7 @@ bool fill_within_budget(StepState* s, long max_node_pairs) {
 void serve_proximity_cache(StepState* s) {
   ProximityCache& pc = s->ws->cache;
   s->cache_keyed = is_keyed(*s);
-  if (!s->cache_keyed) pc.fill.active = false;  // a fill for other meshes or settings
+  if (!keys_match(*s)) pc.fill.active = false;  // a fill for other meshes or settings
   // More obstacles than the cache can be keyed by: no cache (its keys never grow).
   if (s->tester.done() || s->num_obstacles > pc.obstacle_capacity) return;
   const CcdStepResult& result = *s->result;
@@ -405,7 +452,7 @@ void serve_proximity_cache(StepState* s) {
   Displacement since(keyed ? pc.ref : s->X0, s->X0);
   s->cache_moved = keyed ? since.bound(s->rho) : std::numeric_limits<double>::infinity();
   s->u_cached = keyed ? r.range(s->cache_moved, pc.margin) : 0.0;
-  if (keyed && pc.fill.active) take_background_fill(s, r, &since);
+  if (pc.fill.active) take_background_fill(s, r, &since);  // (with a list in use or not)
   refill_if_worth(s, r, &since);
   s->u_cached = r.window(s->u_cached);
   s->result->u_cached = s->u_cached;
@@ -449,8 +496,8 @@ void fill_cache_in_background(StepState* s) {
   ProximityCache::Fill& pf = pc.fill;
   const CcdStepSettings& settings = s->settings;
   const Pose& X0 = s->X0;
-  if (settings.cache.fill_budget > 0 && s->cache_keyed) {
-    if (!pf.active && s->result->u_cached > 0 && pc.has_last) {
+  if (settings.cache.fill_budget > 0) {
+    if (s->cache_keyed && !pf.active && s->result->u_cached > 0 && pc.has_last) {
       const double v = Displacement(pc.last_x0, X0).bound(s->rho);
       const double j = std::ceil(static_cast<double>(std::max(pc.fill_cost, 1L)) /
                                  static_cast<double>(settings.cache.fill_budget));
