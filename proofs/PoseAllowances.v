@@ -9,6 +9,7 @@
 From Coq Require Import Reals Psatz.
 From Flocq Require Import Core.
 From Gauss6 Require Import Rounding Allowances.
+From Gauss6 Require ObbAllowances.  (* cauchy_schwarz3, used qualified *)
 Open Scope R_scope.
 
 (* ---- Error propagation, relative to a scale S ----
@@ -604,20 +605,7 @@ Qed.
 
 Lemma cs3 a0 a1 a2 w0 w1 w2 :
   a0 * w0 + a1 * w1 + a2 * w2 <= sqrt (a0 * a0 + a1 * a1 + a2 * a2) * sqrt (w0 * w0 + w1 * w1 + w2 * w2).
-Proof.
-  assert (0 <= a0 * a0 + a1 * a1 + a2 * a2) by nra.
-  assert (0 <= w0 * w0 + w1 * w1 + w2 * w2) by nra.
-  rewrite <- sqrt_mult by assumption.
-  destruct (Rle_or_lt (a0 * w0 + a1 * w1 + a2 * w2) 0) as [H1|H1].
-  - pose proof (sqrt_pos ((a0 * a0 + a1 * a1 + a2 * a2) * (w0 * w0 + w1 * w1 + w2 * w2))). lra.
-  - rewrite <- (sqrt_square (a0 * w0 + a1 * w1 + a2 * w2)) by lra. apply sqrt_le_1_alt.
-    assert (E : (a0 * a0 + a1 * a1 + a2 * a2) * (w0 * w0 + w1 * w1 + w2 * w2)
-                - (a0 * w0 + a1 * w1 + a2 * w2) * (a0 * w0 + a1 * w1 + a2 * w2)
-                = (a1 * w2 - a2 * w1) * (a1 * w2 - a2 * w1) + (a2 * w0 - a0 * w2) * (a2 * w0 - a0 * w2)
-                  + (a0 * w1 - a1 * w0) * (a0 * w1 - a1 * w0)) by ring.
-    pose proof (Rle_0_sqr (a1 * w2 - a2 * w1)). pose proof (Rle_0_sqr (a2 * w0 - a0 * w2)).
-    pose proof (Rle_0_sqr (a0 * w1 - a1 * w0)). unfold Rsqr in *. lra.
-Qed.
+Proof. exact (ObbAllowances.cauchy_schwarz3 a0 a1 a2 w0 w1 w2). Qed.
 
 (* The triangle inequality of the Euclidean norm of 3-vectors. *)
 Lemma minkowski3 x0 x1 x2 y0 y1 y2 :
