@@ -342,8 +342,10 @@ namespace detail {
 // bounds on how far the exactly moving point p(u) + R(u) r_B, for u in [u0, u1]
 // and |r_B| <= the god radius rho, can lie from the double X:
 //   - static_error: the stop pose's deviation (make_stop_pose: double pose vs
-//     exact motion) plus the double evaluation of R(q) r_B + p and of one
-//     projection n.X (|n| = 1 up to rounding): kPoseRounding (|p|_inf + rho);
+//     exact motion) plus the double evaluation of R(q) r_B + p: kPoseRounding
+//     (|p|_inf + rho) (proofs/PoseAllowances.v). The projections n.X of the
+//     double points on a separating axis round under kAxisProductRounding, at
+//     for_each_separating_axis (proofs/AxisAllowances.v axis_gap_rounding);
 //   - the motion: p(u) - p(u0) = (u - u0) dp, with dp within drift of its
 //     midpoint dp_mid, and R(u) R(u0)^T is the turn about g by 2 (atan(u |g|) -
 //     atan(u0 |g|)) <= 2 (u - u0) |g| (atan is 1-Lipschitz), so a body point r_B

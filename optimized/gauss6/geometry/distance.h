@@ -30,9 +30,12 @@ void closest_segment_parameters(const Vec3& p0, const Vec3& p1, const Vec3& q0, 
 // Separating axes of two triangles A and B given by their corners (one frame,
 // doubles): the two face normals and the nine edge cross products. Calls
 // on_axis(a, gap, side) for each axis a that proves a positive gap, with gap a
-// lower bound of the distance of the two triangles' projections on a / |a| and
-// side = +1 when B lies beyond A along a (-1 when before it); on_axis returns
-// true to stop.
+// lower bound of the distance of the two triangles' projections on a / |a|
+// (where that quotient is below 2^-600, gap may lie a little below 0, down to
+// -2^-600, next_down's absolute widening: still a lower bound, and the callers'
+// comparisons drop it) and side = +1 when B lies beyond A along a (-1 when
+// before it); on_axis returns true to stop. Machine-checked:
+// proofs/AxisAllowances.v axis_gap_distance.
 //
 // Proof. For convex sets and any vector a != 0, dist(A, B) >= (min_B a.y -
 // max_A a.x) / |a| (or the mirror). Whatever the rounded axis a is, the

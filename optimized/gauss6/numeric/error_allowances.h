@@ -54,7 +54,13 @@ constexpr double kNormFloor = 0x1p-500;
 // <= 2 |a|_1 |omega|_inf), the sums that join it to a.v by 8 u T: under 19 u
 // (2.1e-15) of T. 1e-13 covers the gap 89 times and the turn 47 times. Sites:
 // for_each_separating_axis (distance.h), triangle_time_lower_bound
-// (motion_bounds.h).
+// (motion_bounds.h). Machine-checked: proofs/AxisAllowances.v,
+// axis_gap_rounding (the gap on the side the code reports: 8.1 u |a|_1 s +
+// 10.1 2^-1075 proved, for |a|_1 >= kNormFloor, the site's guard; with
+// axis_gap_distance, the gap handed on is at most the features' distance) and
+// axis_turn_rounding (each corner's rate, velocity and turn together: 8 u
+// |a|_1 |v|_inf + 23 u T proved, the underflow under next_up's 2^-600, for
+// |r|_inf <= 2^400, which the coordinate limits ensure).
 constexpr double kAxisProductRounding = 1e-13;
 
 // The velocity term a.v of triangle_time_lower_bound and its share of the
@@ -81,8 +87,13 @@ constexpr double kQuaternionTurnRounding = 1e-14;
 // The directional sweep of a god node's oriented box (SweptObbFrame::pose):
 // the node's segment step + spin x c from the doubles c = R center (within
 // 3.01 u of |center|_1 <= sqrt(3) radius per coordinate), the cross product
-// (two products and a difference) and the sum: under 19 u (2.1e-15) of
-// |spin|_inf radius + |step|_inf. 1e-14 covers it 4.7 times.
+// (two products and a difference) and the sum: under 21 u of |spin|_inf
+// radius + |step|_inf per coordinate. The grow it joins is a ball's radius,
+// so the three coordinates count together: under 63.01 u |spin|_inf radius +
+// 3 u |step|_inf in the Euclidean norm, which 1e-14 (90 u) covers 1.43 times.
+// Machine-checked: proofs/AxisAllowances.v, spin_rounding (the underflow
+// under next_up's 2^-600; R's entries within 1.001, as rotation_matrix's
+// are: PoseAllowances.v).
 constexpr double kSpinRounding = 1e-14;
 
 // A god corner's offset from G in triangle_time_lower_bound, the subtraction
