@@ -512,10 +512,10 @@ Qed.
    kNormFloor (the axis passed for_each_separating_axis's guard); |v_i| <=
    v_inf, |omega_i| <= omega_inf, |r_k,i| <= r_inf (the code takes the
    maxima); 0 <= lag <= 1 (StartFrame::lag returns min(l, 1) of a sum of
-   products of nonnegative Uppers); r_inf <= 2^400 (the god corners and G
-   within kMaxCoordinate = 1e30 of the origin: make_ccd_motion refuses a
-   pose beyond it, RuntimeModel a god vertex beyond kMaxSceneCoordinate =
-   1e12, so r_inf < 2^103). *)
+   products of nonnegative Uppers); r_inf <= 2^400 (ccd_step's inputs_valid
+   refuses a god-object whose radius about G, which bounds every |r_B|, is
+   beyond kMaxCoordinate = 1e30, and make_ccd_motion a pose beyond it: the
+   posed corners' offsets from G stay below 2^103). *)
 Definition turn_h lag b := b + lag * Rmax 0 (- b).
 Definition turn_term side lag along_v (a w r : V3) :=
   fl (fl (along_v + fl (side * cdot r (ccross a w))) + fl (lag * Rmax 0 (- fl (side * cdot r (ccross a w))))).
@@ -707,6 +707,7 @@ Qed.
 (* covers optimized/gauss6/ccd/motion_bounds.h "inline double triangle_time_lower_bound(const SatSide& A, const Vec3 r[3]" sha256:e6fe43232891e550 *)
 (* covers optimized/gauss6/ccd/motion_bounds.h "GAUSS6_ALWAYS_INLINE double corner_offsets(const Vec3 A[3]" sha256:a6814e84c72b62d0 *)
 (* covers optimized/gauss6/ccd/motion_bounds.h "double lag(double tau_max) const" sha256:b83ba4ce01a1244a *)
+(* covers optimized/gauss6/step/ccd_step.cpp "bool inputs_valid(const CcdBody* obstacles" sha256:4e9f48e6837b3070 *)
 (* allowance kAxisVelocityRounding = 1e-14 *)
 Theorem axis_turn_rounding (a v w r0 r1 r2 : V3) side lag vinf winf rinf :
   dbl a -> (side = 1 \/ side = -1) -> 0 <= lag <= 1 ->

@@ -20,10 +20,13 @@
 #include <random>
 
 #include "gauss6/ccd/motion_bounds.h"
+#include "gauss6/geometry/bvh.h"
 #include "gauss6/geometry/distance.h"
 #include "gauss6/geometry/pose.h"
 #include "gauss6/numeric/error_allowances.h"
 #include "gauss6/numeric/rounding.h"
+#include "gauss6/step/ccd_step.h"
+#include "mesh_shapes.h"
 
 using namespace gauss6;
 
@@ -344,4 +347,31 @@ TEST_CASE("the node's sweep step within kSpinRounding (AxisAllowances.v spin_rou
   // The proof's bound, 63.01 u spin_inf radius + 3 u step_inf above the
   // underflow, is 0.70 of the allowance.
   CHECK(worst <= 0.70);
+}
+
+// axis_turn_rounding's hypothesis r_inf <= 2^400 on every path into
+// triangle_time_lower_bound: ccd_step refuses a god-object whose radius about
+// G exceeds kMaxCoordinate (make_ccd_motion refuses poses beyond it), so the
+// posed corners' offsets from G stay below 2^103. A god-object of radius 1e31
+// at poses the motion accepts is refused as invalid input; the control, of
+// radius 1e29, is served.
+TEST_CASE("ccd_step refuses a god-object beyond kMaxCoordinate (AxisAllowances.v axis_turn_rounding's hypothesis)",
+          "[proved]") {
+  const TriangleMesh slab = test::make_box(3, 3, 1, Vec3(0, 0, -0.5));
+  const Bvh sb = build_bvh(slab, 2);
+  const CcdBody obstacles[1] = {{&slab, &sb}};
+  const CcdStepSettings settings;
+  CcdStepWorkspace ws;
+  for (const double radius : {1e31, 1e29}) {
+    const TriangleMesh god = test::make_icosphere(1, radius);
+    const Bvh gb = build_bvh(god, 2);
+    REQUIRE(gb.radius >= 0.9 * radius);
+    // G within kMaxCoordinate (make_ccd_motion accepts the poses), moving up.
+    const Pose x0{Vec3(0, 0, 1e29), Quat{}};
+    const Pose x1{Vec3(0, 0, 2e29), Quat{}};
+    CcdStepResult r;
+    ccd_step(obstacles, 1, {&god, &gb}, {x0, x1}, settings, &ws, &r);
+    if (radius > kMaxCoordinate) CHECK(r.status == CcdStatus::kInvalidInput);
+    else CHECK(r.status != CcdStatus::kInvalidInput);
+  }
 }

@@ -60,7 +60,7 @@ constexpr double kNormFloor = 0x1p-500;
 // axis_gap_distance, the gap handed on is at most the features' distance) and
 // axis_turn_rounding (each corner's rate, velocity and turn together: 8 u
 // |a|_1 |v|_inf + 23 u T proved, the underflow under next_up's 2^-600, for
-// |r|_inf <= 2^400, which the coordinate limits ensure).
+// |r|_inf <= 2^400: ccd_step refuses a god radius beyond kMaxCoordinate).
 constexpr double kAxisProductRounding = 1e-13;
 
 // The velocity term a.v of triangle_time_lower_bound and its share of the

@@ -19,10 +19,15 @@ namespace detail {
 
 namespace {
 
-// Every pointer the step reads is set and the settings are usable.
+// Every pointer the step reads is set, the settings are usable, and the
+// god-object's radius (about G) is within kMaxCoordinate: with the poses'
+// positions within it too (make_ccd_motion), every posed corner's offset from
+// G stays below 2^103, which the turn's allowance at triangle_time_lower_bound
+// assumes (proofs/AxisAllowances.v axis_turn_rounding: r_inf <= 2^400).
 bool inputs_valid(const CcdBody* obstacles, int num_obstacles, const CcdBody& god, const CcdStepSettings& settings,
                   const CcdStepWorkspace* ws) {
-  bool ok = god.mesh && god.bvh && ws && (num_obstacles == 0 || obstacles) && !ccd_step_settings_problem(settings);
+  bool ok = god.mesh && god.bvh && ws && (num_obstacles == 0 || obstacles) && !ccd_step_settings_problem(settings) &&
+            god.bvh->radius <= kMaxCoordinate;  // false on NaN
   for (int o = 0; ok && o < num_obstacles; ++o) ok = obstacles[o].mesh && obstacles[o].bvh;
   return ok;
 }

@@ -41,8 +41,9 @@ const char* ccd_step_request_problem(const CcdStepRequest& request);
 // that cannot touch in time are dropped, the rest are tested earliest-first,
 // each only up to (best u so far) - time_tolerance, and the step reports the
 // best u less time_tolerance (so u* - u_hit grows by at most that tolerance).
-// Inputs: obstacles[0 .. num_obstacles) (world frame), god (body frame), the
-// request (the motion X0 -> X1, poses of G). Stop pose:
+// Inputs: obstacles[0 .. num_obstacles) (world frame), god (body frame; its
+// radius about G, god.bvh->radius, at most kMaxCoordinate, else kInvalidInput),
+// the request (the motion X0 -> X1, poses of G). Stop pose:
 // make_stop_pose(result.motion, result.u_hit, god.bvh->radius) when hit (u = 1 otherwise); with narrow.min_separation = d
 // its exact separation is >= d - deviation.
 //
