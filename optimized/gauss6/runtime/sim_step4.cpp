@@ -34,9 +34,16 @@ GodObjectStep::GodObjectStep(const RuntimeModel& model)
 }
 
 Pose split_step(const Pose& x0, const Pose& x1) {
-  // Half of the relative rotation vector (shortest way), applied to q0.
-  const Vec3 half = 0.5 * quat_log(x1.q * conjugate(x0.q));
-  return {0.5 * (x0.p + x1.p), normalized(quat_exp(half) * normalized(x0.q))};
+  // The bisector of the two unit quaternions, b taken on a's side (q and -q are
+  // the same rotation): the rotation halfway along the shortest way, which turns
+  // each half by half the relative angle. |a + b| >= sqrt(2), so the sum
+  // normalises without loss; a valid pose's components (is_valid_pose) keep the
+  // squares of a and b finite and non-zero.
+  using Vec4 = Eigen::Vector4d;
+  const Vec4 a = Vec4(x0.q.w, x0.q.x, x0.q.y, x0.q.z).normalized();
+  const Vec4 b = Vec4(x1.q.w, x1.q.x, x1.q.y, x1.q.z).normalized();
+  const Vec4 mid = (a.dot(b) < 0 ? Vec4(a - b) : Vec4(a + b)).normalized();
+  return {0.5 * (x0.p + x1.p), Quat{mid[0], mid[1], mid[2], mid[3]}};
 }
 
 namespace {
