@@ -159,7 +159,9 @@ bool motion_free(const RuntimeModel& model, const Pose& x0, const Pose& x1, cons
   CcdStepRequest request{x0, x1, g->hints.data(), g->num_hints};
   if (ref.one_piece && ref.ccd.status == CcdStatus::kOk) request.proven = {ref.from, &ref.ccd.motion, ref.u};
   request.question = CcdQuestion::kFreeOfContact;
+  const long before = g->budget.used();
   run_ccd(model, request, &g->check_ws, &g->check);
+  g->paths.check_units += g->budget.used() - before;
   return g->check.status == CcdStatus::kOk && !g->check.hit;
 }
 
@@ -277,7 +279,9 @@ bool first_leg(const RuntimeModel& model, const Pose& x_start, const Pose& targe
   if (u < 1) {
     serve_proven(model, u, g);
   } else {
+    const long before = g->budget.used();
     moved = ccd_leg(model, x_start, target, /*fill=*/k == 0, /*settling=*/false, g, &info->num_halves);
+    g->paths.first_leg_units += g->budget.used() - before;
     if (moved && k == 0 && !g->budget.exhausted() && grazed(model, contacts, *g)) {
       g->paths.grazed = true;
       g->paths.lifted = lift_out_of_graze(model, x_start, target, M, contacts, g, &info->num_halves);
@@ -403,6 +407,7 @@ void advance_god_object(const RuntimeModel& model, const Pose& x_start, const Po
   }
   info->xs = g.leg.xs;
   info->num_contacts = contacts->num_contacts;
+  g.paths.detour_units = g.budget.used() - g.paths.first_leg_units - g.paths.check_units;
   end_on_budget(model, x_target, *contacts, &g, info);
 }
 
