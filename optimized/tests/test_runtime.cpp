@@ -8,6 +8,7 @@
 
 #include <algorithm>
 #include <array>
+#include <climits>
 #include <atomic>
 #include <cmath>
 #include <cstdio>
@@ -634,6 +635,40 @@ TEST_CASE("runtime: step 4's paths: settle, refused settle, shortening, keep_a_c
     CHECK(height_over_crease(model, s.xs) >= kDelta * (1 - 1e-3));
     CHECK(info.num_contacts > 0);
     CHECK(lowest_over_crease_along(model, x0, s.xs) > 0.5 * kDelta);
+  }
+}
+
+TEST_CASE("runtime: step 4 splits an update's work units by path", "[runtime][budget]") {
+  // The settle of the paths test above under a count that never runs out: its
+  // units go to the first leg, the settling leg and the check of its direct
+  // motion (StepPaths), and add up to the update's; without a budget nothing
+  // is counted.
+  const Pose x0{Vec3(-kDelta, 0, kHalf + kDelta * (1 + RuntimeSettings{}.gap_factor)), Quat{}};
+  const Pose x1{x0.p + Vec3(4 * kDelta, 0, 0), Quat{}};
+  const Vec6 pressing = (Vec6() << 0, 0, -0.005, 0, 0, 0).finished();
+  for (const bool counted : {true, false}) {
+    RuntimeSettings settings;
+    if (counted) settings.budget.work_units = LONG_MAX / 4;
+    const RuntimeModel model(make_crease_scene(), settings);
+    SimState s(model);
+    SimStepInfo info;
+    step4_on(model, x0, x0, Vec6::Zero(), &s, &info);
+    REQUIRE(info.num_contacts > 0);
+    step4_on(model, x0, x1, pressing, &s, &info);
+    REQUIRE(s.step4.paths.settles == 1);
+    REQUIRE(s.step4.paths.refused == 0);
+    const StepPaths& p = s.step4.paths;
+    CHECK(p.first_leg_units + p.check_units + p.detour_units == info.work_units);
+    if (counted) {
+      CHECK(p.first_leg_units > 0);
+      CHECK(p.check_units > 0);
+      CHECK(p.detour_units > 0);
+    } else {
+      CHECK(info.work_units == 0);
+      CHECK(p.first_leg_units == 0);
+      CHECK(p.check_units == 0);
+      CHECK(p.detour_units == 0);
+    }
   }
 }
 

@@ -247,11 +247,14 @@ double motion_distance_bound(const Pose& a0, const CcdMotion& a, const Pose& b0,
 
 double proven_prefix(const Pose& a0, const CcdMotion& a, const Pose& b0, const CcdMotion& b, double ub,
                      double body_radius, double d) {
-  const double whole = motion_distance_bound(a0, a, b0, b, ub, body_radius);
-  if (whole < d) return 1;
-  const double ua = kPrefixShare * d / whole;
-  if (!(ua > 0 && ua < 1)) return 0;  // also NaN, an unbounded whole
-  return motion_distance_bound(a0, a, b0, b, ua * ub, body_radius, ua) < d ? ua : 0;
+  // The whole motion first; when it strays d or more, the share of it the bound allows.
+  for (double ua = 1;;) {
+    const double bound = motion_distance_bound(a0, a, b0, b, ua * ub, body_radius, ua);
+    if (bound < d) return ua;
+    if (ua < 1) return 0;
+    ua = kPrefixShare * d / bound;
+    if (!(ua > 0 && ua < 1)) return 0;  // also NaN, an unbounded whole
+  }
 }
 
 }  // namespace gauss6

@@ -34,9 +34,16 @@ GodObjectStep::GodObjectStep(const RuntimeModel& model)
 }
 
 Pose split_step(const Pose& x0, const Pose& x1) {
-  // Half of the relative rotation vector (shortest way), applied to q0.
-  const Vec3 half = 0.5 * quat_log(x1.q * conjugate(x0.q));
-  return {0.5 * (x0.p + x1.p), normalized(quat_exp(half) * normalized(x0.q))};
+  // The bisector of the two unit quaternions, b taken on a's side (q and -q are
+  // the same rotation): the rotation halfway along the shortest way, which turns
+  // each half by half the relative angle. |a + b| >= sqrt(2), so the sum
+  // normalises without loss; a valid pose's components (is_valid_pose) keep the
+  // squares of a and b finite and non-zero.
+  using Vec4 = Eigen::Vector4d;
+  const Vec4 a = Vec4(x0.q.w, x0.q.x, x0.q.y, x0.q.z).normalized();
+  const Vec4 b = Vec4(x1.q.w, x1.q.x, x1.q.y, x1.q.z).normalized();
+  const Vec4 mid = (a.dot(b) < 0 ? Vec4(a - b) : Vec4(a + b)).normalized();
+  return {0.5 * (x0.p + x1.p), Quat{mid[0], mid[1], mid[2], mid[3]}};
 }
 
 namespace {
@@ -152,7 +159,9 @@ bool motion_free(const RuntimeModel& model, const Pose& x0, const Pose& x1, cons
   CcdStepRequest request{x0, x1, g->hints.data(), g->num_hints};
   if (ref.one_piece && ref.ccd.status == CcdStatus::kOk) request.proven = {ref.from, &ref.ccd.motion, ref.u};
   request.question = CcdQuestion::kFreeOfContact;
+  const long before = g->budget.used();
   run_ccd(model, request, &g->check_ws, &g->check);
+  g->paths.check_units += g->budget.used() - before;
   return g->check.status == CcdStatus::kOk && !g->check.hit;
 }
 
@@ -270,7 +279,9 @@ bool first_leg(const RuntimeModel& model, const Pose& x_start, const Pose& targe
   if (u < 1) {
     serve_proven(model, u, g);
   } else {
+    const long before = g->budget.used();
     moved = ccd_leg(model, x_start, target, /*fill=*/k == 0, /*settling=*/false, g, &info->num_halves);
+    g->paths.first_leg_units += g->budget.used() - before;
     if (moved && k == 0 && !g->budget.exhausted() && grazed(model, contacts, *g)) {
       g->paths.grazed = true;
       g->paths.lifted = lift_out_of_graze(model, x_start, target, M, contacts, g, &info->num_halves);
@@ -396,6 +407,7 @@ void advance_god_object(const RuntimeModel& model, const Pose& x_start, const Po
   }
   info->xs = g.leg.xs;
   info->num_contacts = contacts->num_contacts;
+  g.paths.detour_units = g.budget.used() - g.paths.first_leg_units - g.paths.check_units;
   end_on_budget(model, x_target, *contacts, &g, info);
 }
 

@@ -61,6 +61,13 @@ struct StepPaths {
   int refused = 0;              // settled ends refused (the direct motion not proven free)
   int keep_halvings = 0;        // halvings after the last settle, to keep a contact
   bool stayed = false;          // the step ended at x_start (no halving kept a contact)
+  // Where an update's work units went (under a budget, RuntimeSettings::budget;
+  // 0 without one): the first legs' CCDs (the proximity list's fills of the
+  // update included), the checks of detours' direct motions (motion_free), and
+  // the detours' own legs (settling legs, a graze's lift leg).
+  long first_leg_units = 0;
+  long check_units = 0;
+  long detour_units = 0;
 };
 
 // Step 4's buffers, built once.
