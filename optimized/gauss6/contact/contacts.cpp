@@ -199,6 +199,130 @@ struct Collector {
   }
 };
 
+
+// The contacts within d of one (god triangle, obstacle triangle) pair of
+// obstacle o: one pass over the table of feature-pair kinds the two triangles
+// own (feature_pair.h), each feature pair's contact added to the set (its
+// normal: the face's for vertex/face, the edges' cross product for edge/edge)
+// unless the vertex/face rule leaves it out (held_beside). The corners come
+// from the two sides (the god-object's posed at X_WB, the obstacle's in the
+// world frame).
+template <class GodSide, class ObstacleSide>
+struct TrianglePairContacts {
+  const GodSide& god_side;
+  const ObstacleSide& obstacle_side;
+  const std::vector<uint8_t>& god_owned;
+  const std::vector<uint8_t>& obstacle_owned;
+  int o;                                   // the obstacle's index
+  double d, apart, par2, support_sine;     // settings.distance; feature boxes apart; parallel_sine^2; sin(merge_angle)
+  Collector* col;
+  ContactSet* set;
+  int slab_face = -1;  // the god face of slab_n (its normal, not unit) and slab_l2 (|slab_n|^2 d^2)
+  Vec3 slab_n = Vec3::Zero();
+  double slab_l2 = 0;
+
+  void test(int gf, int of) {
+    const uint8_t go = god_owned[gf], oo = obstacle_owned[of];
+    const Vec3 X[3] = {god_side.corner(gf, 0), god_side.corner(gf, 1), god_side.corner(gf, 2)};
+    const Vec3 Y[3] = {obstacle_side.corner(of, 0), obstacle_side.corner(of, 1), obstacle_side.corner(of, 2)};
+    // Pairs proven farther apart than d by a separating axis have no pair
+    // within d. But an obstacle triangle within d of the god face's plane (a
+    // flat tool on a dense flat tessellation: thousands of such pairs) is
+    // within d along the face normals and along the edges' cross products,
+    // all near that normal, so no axis drops it; its feature pairs, most of
+    // which lie far apart in the plane, are then sorted by their boxes (the
+    // bounds of their corners): one is tested only when its boxes come
+    // within `apart` of each other along every axis. Either way the set is
+    // the same: the axes and the boxes only save work.
+    if (gf != slab_face) {  // consecutive pairs often share their god face
+      slab_face = gf;
+      slab_n = (X[1] - X[0]).cross(X[2] - X[0]);
+      slab_l2 = slab_n.squaredNorm() * (d * d);
+    }
+    const auto within = [&](const Vec3& y) {
+      const double h = slab_n.dot(y - X[0]);
+      return h * h <= slab_l2;
+    };
+    const bool in_slab = within(Y[0]) && within(Y[1]) && within(Y[2]);
+    if (!in_slab && triangle_gap_lower_bound(X, Y, d) > d) return;
+    Box boxes;
+    if (in_slab) {
+      boxes.x_lo = X[0].cwiseMin(X[1]).cwiseMin(X[2]), boxes.x_hi = X[0].cwiseMax(X[1]).cwiseMax(X[2]);
+      boxes.y_lo = Y[0].cwiseMin(Y[1]).cwiseMin(Y[2]), boxes.y_hi = Y[0].cwiseMax(Y[1]).cwiseMax(Y[2]);
+    }
+    // k: the god-object's corner (vertex k, or edge k -> k + 1), j: the obstacle's.
+    for_each_feature_pair(go, oo, [&](PairKind kind, int k, int j) {
+      feature_pair(kind, k, j, gf, of, X, Y, in_slab ? &boxes : nullptr);
+      return true;
+    });
+  }
+
+  // The two triangles' corner boxes (in the slab only).
+  struct Box {
+    Vec3 x_lo, x_hi, y_lo, y_hi;
+  };
+
+  void feature_pair(PairKind kind, int k, int j, int gf, int of, const Vec3 (&X)[3], const Vec3 (&Y)[3],
+                    const Box* boxes) {
+    switch (kind) {
+      case PairKind::kGodVertexObstacleFace: {  // the obstacle face's normal
+        const Vec3& x = X[k];
+        if (boxes && boxes_apart(x, x, boxes->y_lo, boxes->y_hi, apart)) break;
+        const double sep = (x - closest_point_on_triangle(x, Y[0], Y[1], Y[2])).norm();
+        const Vec3 n = unit_normal(Y[0], Y[1], Y[2]);
+        if (!(sep <= d && n != Vec3::Zero())) break;
+        if (held_beside(x, god_side, gf, k, obstacle_side, of, n, d, support_sine)) {
+          ++set->num_beside;
+          break;
+        }
+        col->add({x, n, sep, {kind, o, gf, k, of, -1}});
+        break;
+      }
+      case PairKind::kObstacleVertexGodFace: {  // minus the god face's normal
+        const Vec3& y = Y[j];
+        if (boxes && boxes_apart(y, y, boxes->x_lo, boxes->x_hi, apart)) break;
+        const Vec3 c = closest_point_on_triangle(y, X[0], X[1], X[2]);
+        const double sep = (y - c).norm();
+        const Vec3 n = -unit_normal(X[0], X[1], X[2]);
+        if (!(sep <= d && n != Vec3::Zero())) break;
+        if (held_beside(y, obstacle_side, of, j, god_side, gf, Vec3(-n), d, support_sine)) {
+          ++set->num_beside;
+          break;
+        }
+        col->add({c, n, sep, {kind, o, gf, -1, of, j}});
+        break;
+      }
+      case PairKind::kEdgeEdge: {  // closest points inside both edges, edges not parallel
+        const Vec3 &g0 = X[k], &g1 = X[(k + 1) % 3];
+        const Vec3 &o0 = Y[j], &o1 = Y[(j + 1) % 3];
+        if (boxes && boxes_apart(g0.cwiseMin(g1), g0.cwiseMax(g1), o0.cwiseMin(o1), o0.cwiseMax(o1), apart)) break;
+        double s, t;
+        closest_segment_parameters(g0, g1, o0, o1, &s, &t);
+        if (!(s > 0 && s < 1 && t > 0 && t < 1)) break;
+        const Vec3 pg = g0 + s * (g1 - g0), po = o0 + t * (o1 - o0);
+        const double sep = (pg - po).norm();
+        if (!(sep <= d)) break;
+        Vec3 n = (g1 - g0).cross(o1 - o0);
+        if (n.squaredNorm() <= par2 * (g1 - g0).squaredNorm() * (o1 - o0).squaredNorm()) break;
+        n.normalize();
+        // Sign: from the obstacle's point to the god-object's; if they coincide,
+        // along the obstacle edge's outward direction (sum of its faces' normals).
+        double side = n.dot(pg - po);
+        if (side == 0) {
+          Vec3 out = unit_normal(Y[0], Y[1], Y[2]);
+          const int nb = obstacle_side.neighbor[3 * of + j];
+          if (nb >= 0) out += unit_normal(obstacle_side.corner(nb, 0), obstacle_side.corner(nb, 1),
+                                          obstacle_side.corner(nb, 2));
+          side = n.dot(out);
+        }
+        if (side < 0) n = -n;
+        col->add({pg, n, sep, {kind, o, gf, k, of, j}});
+        break;
+      }
+    }
+  }
+};
+
 }  // namespace
 
 int reduce_to_patch_supports(double patch_angle, ContactSet* set) noexcept {
@@ -298,105 +422,14 @@ ContactStatus generate_contacts(const CcdBody* obstacles, int num_obstacles, con
     if (!obstacles[o].mesh || !obstacles[o].bvh) return ContactStatus::kInvalidInput;
     const TriangleMesh& om = *obstacles[o].mesh;
     const Bvh& ob = *obstacles[o].bvh;
-    const auto ov = [&](int f, int k) -> Vec3 { return om.V.row(om.F(f, k)).transpose(); };
-    const auto gv = [&](int f, int k) -> const Vec3& { return world(gm.F(f, k)); };
     const auto god_at = [&](int v) -> Vec3 { return world(v); };
     const auto obstacle_at = [&](int v) -> Vec3 { return om.V.row(v).transpose(); };
     const Side god_side{gm, god.bvh->neighbor, god_at};
     const Side obstacle_side{om, ob.neighbor, obstacle_at};
-    int slab_face = -1;  // the god face of slab_n (its normal, not unit) and slab_l2 (|slab_n|^2 d^2)
-    Vec3 slab_n = Vec3::Zero();
-    double slab_l2 = 0;
+    TrianglePairContacts<decltype(god_side), decltype(obstacle_side)> pair{
+        god_side, obstacle_side, god.bvh->owned, ob.owned, o, d, apart, par2, support_sine, &col, set};
     const auto visit = [&](int gf, int of) {
-      const uint8_t go = god.bvh->owned[gf], oo = ob.owned[of];
-      const Vec3 oa = ov(of, 0), obb = ov(of, 1), oc = ov(of, 2);
-      const Vec3 X[3] = {gv(gf, 0), gv(gf, 1), gv(gf, 2)}, Y[3] = {oa, obb, oc};
-      // Pairs proven farther apart than d by a separating axis have no pair
-      // within d. But an obstacle triangle within d of the god face's plane (a
-      // flat tool on a dense flat tessellation: thousands of such pairs) is
-      // within d along the face normals and along the edges' cross products,
-      // all near that normal, so no axis drops it; its feature pairs, most of
-      // which lie far apart in the plane, are then sorted by their boxes (the
-      // bounds of their corners): one is tested only when its boxes come
-      // within `apart` of each other along every axis. Either way the set is
-      // the same: the axes and the boxes only save work.
-      if (gf != slab_face) {  // consecutive pairs often share their god face
-        slab_face = gf;
-        slab_n = (X[1] - X[0]).cross(X[2] - X[0]);
-        slab_l2 = slab_n.squaredNorm() * (d * d);
-      }
-      const auto within = [&](const Vec3& y) {
-        const double h = slab_n.dot(y - X[0]);
-        return h * h <= slab_l2;
-      };
-      const bool in_slab = within(Y[0]) && within(Y[1]) && within(Y[2]);
-      if (!in_slab && triangle_gap_lower_bound(X, Y, d) > d) return true;
-      Vec3 x_lo, x_hi, y_lo, y_hi;
-      if (in_slab) {
-        x_lo = X[0].cwiseMin(X[1]).cwiseMin(X[2]), x_hi = X[0].cwiseMax(X[1]).cwiseMax(X[2]);
-        y_lo = Y[0].cwiseMin(Y[1]).cwiseMin(Y[2]), y_hi = Y[0].cwiseMax(Y[1]).cwiseMax(Y[2]);
-      }
-      // One pass over the table of feature-pair kinds (feature_pair.h); k: the
-      // god-object's corner (vertex k, or edge k -> k + 1), j: the obstacle's.
-      for_each_feature_pair(go, oo, [&](PairKind kind, int k, int j) {
-        switch (kind) {
-          case PairKind::kGodVertexObstacleFace: {  // the obstacle face's normal
-            const Vec3& x = gv(gf, k);
-            if (in_slab && boxes_apart(x, x, y_lo, y_hi, apart)) break;
-            const double sep = (x - closest_point_on_triangle(x, oa, obb, oc)).norm();
-            const Vec3 n = unit_normal(oa, obb, oc);
-            if (!(sep <= d && n != Vec3::Zero())) break;
-            if (held_beside(x, god_side, gf, k, obstacle_side, of, n, d, support_sine)) {
-              ++set->num_beside;
-              break;
-            }
-            col.add({x, n, sep, {kind, o, gf, k, of, -1}});
-            break;
-          }
-          case PairKind::kObstacleVertexGodFace: {  // minus the god face's normal
-            const Vec3& y = Y[j];
-            if (in_slab && boxes_apart(y, y, x_lo, x_hi, apart)) break;
-            const Vec3 c = closest_point_on_triangle(y, X[0], X[1], X[2]);
-            const double sep = (y - c).norm();
-            const Vec3 n = -unit_normal(X[0], X[1], X[2]);
-            if (!(sep <= d && n != Vec3::Zero())) break;
-            if (held_beside(y, obstacle_side, of, j, god_side, gf, Vec3(-n), d, support_sine)) {
-              ++set->num_beside;
-              break;
-            }
-            col.add({c, n, sep, {kind, o, gf, -1, of, j}});
-            break;
-          }
-          case PairKind::kEdgeEdge: {  // closest points inside both edges, edges not parallel
-            const Vec3 &g0 = X[k], &g1 = X[(k + 1) % 3];
-            const Vec3 &o0 = Y[j], &o1 = Y[(j + 1) % 3];
-            if (in_slab && boxes_apart(g0.cwiseMin(g1), g0.cwiseMax(g1), o0.cwiseMin(o1), o0.cwiseMax(o1), apart))
-              break;
-            double s, t;
-            closest_segment_parameters(g0, g1, o0, o1, &s, &t);
-            if (!(s > 0 && s < 1 && t > 0 && t < 1)) break;
-            const Vec3 pg = g0 + s * (g1 - g0), po = o0 + t * (o1 - o0);
-            const double sep = (pg - po).norm();
-            if (!(sep <= d)) break;
-            Vec3 n = (g1 - g0).cross(o1 - o0);
-            if (n.squaredNorm() <= par2 * (g1 - g0).squaredNorm() * (o1 - o0).squaredNorm()) break;
-            n.normalize();
-            // Sign: from the obstacle's point to the god-object's; if they coincide,
-            // along the obstacle edge's outward direction (sum of its faces' normals).
-            double side = n.dot(pg - po);
-            if (side == 0) {
-              Vec3 out = unit_normal(oa, obb, oc);
-              const int nb = ob.neighbor[3 * of + j];
-              if (nb >= 0) out += unit_normal(ov(nb, 0), ov(nb, 1), ov(nb, 2));
-              side = n.dot(out);
-            }
-            if (side < 0) n = -n;
-            col.add({pg, n, sep, {kind, o, gf, k, of, j}});
-            break;
-          }
-        }
-        return true;
-      });
+      pair.test(gf, of);
       return true;
     };
     if (near.listed()) {  // the listed pairs of this obstacle (in range: ccd_step made them)
