@@ -3,7 +3,7 @@
 // contact sets found from the CCD's near pairs against those of a full descent,
 // a dense coplanar patch reduced to its support, and the rows of a vertex
 // beside a face (a flat plate's vertex beside a tool's bottom edge, a sharp
-// vertex on a sharp edge).
+// vertex on a sharp edge, a curved vertex beside a ridge at any distance).
 #include <catch2/catch.hpp>
 
 #include <cmath>
@@ -329,4 +329,51 @@ TEST_CASE("contacts: a sharp vertex on a sharp edge keeps both faces' rows", "[c
     if ((n - Vec3(0, -sy, cz)).norm() < 1e-12) flanks |= 2;
   }
   CHECK(flanks == 3);
+}
+
+TEST_CASE("contacts: a vertex whose body turns between two faces' normals keeps both rows, at every distance",
+          "[contacts]") {
+  // The octahedron's lowest vertex (its edges rise at 45 degrees: it supports
+  // every normal within 45 degrees of -z) half a delta from the ridge of an
+  // asymmetric prism, on the bisector of its flanks: flank g's normal is 20
+  // degrees from +z (the vertex supports it, and normals turned from it towards
+  // the other flank's), flank f's 60 degrees (it does not). The vertex's
+  // contact with the ridge pushes along a normal between the two, which g's
+  // row alone does not span: both rows stay. Nor does the set lose a row when
+  // the distance grows.
+  const double s = 0.2, a = 20 * M_PI / 180, b = 60 * M_PI / 180;
+  const TriangleMesh god = gauss6::test::make_mesh(
+      {{0, 0, 0}, {s, 0, s}, {0, s, s}, {-s, 0, s}, {0, -s, s}, {0, 0, 2 * s}},
+      {{0, 2, 1}, {0, 3, 2}, {0, 4, 3}, {0, 1, 4}, {5, 1, 2}, {5, 2, 3}, {5, 3, 4}, {5, 4, 1}}, "octahedron");
+  // The ridge along x at z = 0; flank g down to -y (normal (0, -sin a, cos a)),
+  // flank f down to +y (normal (0, sin b, cos b)), both to z = -1.
+  const double yg = -std::cos(a) / std::sin(a), yf = std::cos(b) / std::sin(b);
+  const TriangleMesh ridge = gauss6::test::make_mesh(
+      {{-1, 0, 0}, {-1, yg, -1}, {-1, yf, -1}, {1, 0, 0}, {1, yg, -1}, {1, yf, -1}},
+      {{0, 2, 1}, {3, 4, 5}, {0, 4, 3}, {0, 1, 4}, {0, 5, 2}, {0, 3, 5}, {1, 5, 4}, {1, 2, 5}}, "ridge");
+  const Vec3 ng(0, -std::sin(a), std::cos(a)), nf(0, std::sin(b), std::cos(b));
+  for (int f = 0; f < ridge.F.rows(); ++f) {  // outward: each face's normal points away from the prism's inside
+    const Vec3 p0 = ridge.V.row(ridge.F(f, 0)).transpose(), p1 = ridge.V.row(ridge.F(f, 1)).transpose(),
+               p2 = ridge.V.row(ridge.F(f, 2)).transpose();
+    REQUIRE((p1 - p0).cross(p2 - p0).dot((p0 + p1 + p2) / 3 - Vec3(0, (yg + yf) / 3, -2.0 / 3)) > 0);
+  }
+  const Bvh gb = build_bvh(god), rb = build_bvh(ridge);
+  const CcdBody obstacle{&ridge, &rb};
+  ContactWorkspace ws(god);
+  ContactSet set(16);
+  ContactSettings cs;
+  const Vec3 G = 0.5 * kDelta * (ng + nf).normalized() + Vec3(0.1, 0, 0);
+  for (const double distance : {1.5 * kDelta, 3 * kDelta, 30 * kDelta}) {
+    cs.distance = distance;
+    REQUIRE(generate_contacts(&obstacle, 1, {&god, &gb}, {G, Quat{}}, cs, &ws, &set) == ContactStatus::kOk);
+    INFO("distance " << distance / kDelta << " delta");
+    CHECK(set.num_beside == 0);
+    int flanks = 0;
+    for (int k = 0; k < set.num_contacts; ++k) {
+      const Vec3& n = set.contacts[k].normal;
+      if ((n - ng).norm() < 1e-12) flanks |= 1;
+      if ((n - nf).norm() < 1e-12) flanks |= 2;
+    }
+    CHECK(flanks == 3);
+  }
 }

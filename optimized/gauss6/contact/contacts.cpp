@@ -123,18 +123,27 @@ template <class At>
 Side(const TriangleMesh&, const std::vector<int32_t>&, const At&) -> Side<At>;
 
 // The vertex/face rule (contacts.h): whether the row of the vertex at corner
-// vc of face vf (p, on side V) against face `face` of side W (unit outward
-// normal nF: the row's normal is -nF seen from W, and the vertex's body must
-// have -nF as an outward normal at p) is left out: p lies beside the face,
-// beyond one edge or (beyond two) a corner, -nF does not support p's body,
-// and another face of W that shares a corner with that edge, or that corner,
-// holds p within d with a normal that does (p's closest point on the face
-// lies on that edge or corner; a vertex just beside a corner of a tool whose
-// bottom is two triangles lies within d of the one that does not share the
-// edge).
+// vc of face vf (p, on side V, at separation sep from the face) against face
+// `face` of side W (unit outward normal nF: the row's normal is -nF seen from
+// W, and the vertex's body must have -nF as an outward normal at p) is left
+// out: p lies beside the face, beyond one edge or (beyond two) a corner, -nF
+// does not support p's body, and another face g of W that shares a corner
+// with that edge, or that corner, holds p (p's closest point on the face lies
+// on that edge or corner; a vertex just beside a corner of a tool whose bottom
+// is two triangles is held by the one that does not share the edge):
+//  - g is as near p as the face is (to `tie`, the rounding of the two
+//    separations) and within d: g's row is in the set whenever the face's is,
+//    and whether the face's row is left out does not depend on d (a set at a
+//    larger distance holds every row of the set at a smaller one);
+//  - -n_g supports p's body, and no normal turned from it towards nF by more
+//    than `turn` does (p's body leaves no room between the two: a flat plate's
+//    vertex beside a tool's bottom edge). A curved body's vertex, which
+//    supports normals between n_g and nF, keeps the face's row: its contact
+//    with the edge pushes along a normal between the two, which n_g alone
+//    does not span.
 template <class AtV, class AtW>
 bool held_beside(const Vec3& p, const Side<AtV>& V, int vf, int vc, const Side<AtW>& W, int face, const Vec3& nF,
-                 double d, double sine) {
+                 double sep, double d, double tie, double sine, double turn) {
   const Vec3 P[3] = {W.corner(face, 0), W.corner(face, 1), W.corner(face, 2)};
   bool beyond[3];
   int count = 0;
@@ -145,12 +154,22 @@ bool held_beside(const Vec3& p, const Side<AtV>& V, int vf, int vc, const Side<A
   }
   if (count == 0 || count == 3) return false;  // over the face (or a degenerate one)
   if (vertex_support(V.mesh, V.neighbor, vf, vc, Vec3(-nF), sine, V.at) != Support::kNo) return false;
+  const double reach = std::min(d, sep + tie);
+  const double cos_turn = std::cos(turn), sin_turn = std::sin(turn);
   const auto holds = [&](int g) {
     if (g < 0 || g == face) return false;
     const Vec3 q0 = W.corner(g, 0), q1 = W.corner(g, 1), q2 = W.corner(g, 2);
     const Vec3 n2 = unit_normal(q0, q1, q2);
-    return n2 != Vec3::Zero() && (p - closest_point_on_triangle(p, q0, q1, q2)).norm() <= d &&
-           vertex_support(V.mesh, V.neighbor, vf, vc, Vec3(-n2), sine, V.at) == Support::kYes;
+    if (n2 == Vec3::Zero() || !((p - closest_point_on_triangle(p, q0, q1, q2)).norm() <= reach) ||
+        vertex_support(V.mesh, V.neighbor, vf, vc, Vec3(-n2), sine, V.at) != Support::kYes)
+      return false;
+    // n2 turned by `turn` towards nF (in their plane): it must not support p's
+    // body. Normals closer than `turn` leave no such room.
+    const Vec3 w = nF - nF.dot(n2) * n2;
+    const double wn = w.norm();
+    if (!(wn > sin_turn)) return true;
+    const Vec3 turned = cos_turn * n2 + (sin_turn / wn) * w;
+    return vertex_support(V.mesh, V.neighbor, vf, vc, Vec3(-turned), sine, V.at) == Support::kNo;
   };
   // The faces that share the edge's ends, or the corner: walked around each
   // (in one direction: a fan cut by a boundary is walked in part).
@@ -215,6 +234,7 @@ struct TrianglePairContacts {
   const std::vector<uint8_t>& obstacle_owned;
   int o;                                   // the obstacle's index
   double d, apart, par2, support_sine;     // settings.distance; feature boxes apart; parallel_sine^2; sin(merge_angle)
+  double tie, turn;                        // separations' rounding (held_beside); settings.patch_angle
   Collector* col;
   ContactSet* set;
   int slab_face = -1;  // the god face of slab_n (its normal, not unit) and slab_l2 (|slab_n|^2 d^2)
@@ -271,7 +291,7 @@ struct TrianglePairContacts {
         const double sep = (x - closest_point_on_triangle(x, Y[0], Y[1], Y[2])).norm();
         const Vec3 n = unit_normal(Y[0], Y[1], Y[2]);
         if (!(sep <= d && n != Vec3::Zero())) break;
-        if (held_beside(x, god_side, gf, k, obstacle_side, of, n, d, support_sine)) {
+        if (held_beside(x, god_side, gf, k, obstacle_side, of, n, sep, d, tie, support_sine, turn)) {
           ++set->num_beside;
           break;
         }
@@ -285,7 +305,7 @@ struct TrianglePairContacts {
         const double sep = (y - c).norm();
         const Vec3 n = -unit_normal(X[0], X[1], X[2]);
         if (!(sep <= d && n != Vec3::Zero())) break;
-        if (held_beside(y, obstacle_side, of, j, god_side, gf, Vec3(-n), d, support_sine)) {
+        if (held_beside(y, obstacle_side, of, j, god_side, gf, Vec3(-n), sep, d, tie, support_sine, turn)) {
           ++set->num_beside;
           break;
         }
@@ -417,6 +437,9 @@ ContactStatus generate_contacts(const CcdBody* obstacles, int num_obstacles, con
   for (int o = 0; o < num_obstacles; ++o)
     if (obstacles[o].bvh) scale = std::max(scale, obstacles[o].bvh->radius);
   const double apart = (Upper{2 * d} + Upper{kBoxPoseRounding} * Upper{scale}).v;
+  // Two separations of one vertex computed against two faces differ by their
+  // rounding, below kBoxPoseRounding of the coordinates' magnitude.
+  const double tie = (Upper{kBoxPoseRounding} * Upper{scale}).v;
   ContactStatus status = ContactStatus::kOk;
   for (int o = 0; o < num_obstacles; ++o) {
     if (!obstacles[o].mesh || !obstacles[o].bvh) return ContactStatus::kInvalidInput;
@@ -427,7 +450,8 @@ ContactStatus generate_contacts(const CcdBody* obstacles, int num_obstacles, con
     const Side god_side{gm, god.bvh->neighbor, god_at};
     const Side obstacle_side{om, ob.neighbor, obstacle_at};
     TrianglePairContacts<decltype(god_side), decltype(obstacle_side)> pair{
-        god_side, obstacle_side, god.bvh->owned, ob.owned, o, d, apart, par2, support_sine, &col, set};
+        god_side, obstacle_side, god.bvh->owned, ob.owned, o, d, apart, par2, support_sine, tie, settings.patch_angle,
+        &col, set};
     const auto visit = [&](int gf, int of) {
       pair.test(gf, of);
       return true;

@@ -20,11 +20,19 @@
 // plate's vertex just beside a tool's bottom edge is such a pair with the
 // tool's side face, whose horizontal normal the plate's vertex does not
 // support; the tool's bottom face across that edge gives the same vertex a
-// row that does (its plate's normal). Such a pair is left out when the face
-// across the edge gives the vertex a row within the distance whose normal
-// supports the vertex's body (counted in num_beside); when neither supports
-// (a sharp vertex on a sharp edge: a knife) or the other face is beyond the
-// distance, both rows are kept, and the vertex is held by both.
+// row that does (its plate's normal). Such a pair is left out (counted in
+// num_beside) when a face of the same body at that edge or corner gives the
+// vertex a row as near as the pair's (to rounding) and within the distance,
+// whose normal supports the vertex's body while no normal turned from it
+// towards the left-out one by more than patch_angle does: the vertex's body
+// leaves no room between the two (a flat plate). Otherwise both rows are
+// kept, and the vertex is held by both: a sharp vertex on a sharp edge (a
+// knife), where neither normal supports it; a curved body's vertex, which
+// supports normals between the two, along which its contact with the edge
+// pushes; a row nearer than every face that would hold it. Whether a row is
+// left out does not depend on the distance (but for a holding row within
+// rounding of it): a set within a larger distance holds every row of the set
+// within a smaller one.
 // Pairs with the same point (within merge_distance) and the same normal (within
 // merge_angle) are merged, keeping the smallest separation: a vertex on an edge
 // shared by two coplanar faces gives one contact, not two.
