@@ -1,7 +1,9 @@
 // Tests of contacts.h: a box resting on a box (four corner contacts, normals +z,
 // the Jacobian rows), duplicates merged, the edge/edge normal's sign, the
 // contact sets found from the CCD's near pairs against those of a full descent,
-// and a dense coplanar patch reduced to its support.
+// a dense coplanar patch reduced to its support, and the rows of a vertex
+// beside a face (a flat plate's vertex beside a tool's bottom edge, a sharp
+// vertex on a sharp edge, a curved vertex beside a ridge at any distance).
 #include <catch2/catch.hpp>
 
 #include <cmath>
@@ -232,5 +234,146 @@ TEST_CASE("contacts: a dense coplanar patch is reduced to its support, the same 
       const double min_small = (small.J.topRows(small.num_contacts) * a).minCoeff();
       CHECK(std::abs(min_all - min_small) <= 1e-12);
     }
+  }
+}
+
+namespace {
+// A flat sheet of kGrid x kGrid squares over [-2, 2]^2 at z = 0, two triangles
+// each, no jitter (vertices on the grid lines x, y = -2 + 4 i / kGrid).
+TriangleMesh flat_sheet(int grid) {
+  std::vector<Eigen::Vector3d> V;
+  std::vector<std::array<int, 3>> F;
+  for (int i = 0; i <= grid; ++i)
+    for (int j = 0; j <= grid; ++j) V.emplace_back(-2 + 4.0 * i / grid, -2 + 4.0 * j / grid, 0.0);
+  for (int i = 0; i < grid; ++i)
+    for (int j = 0; j < grid; ++j) {
+      const int a = i * (grid + 1) + j, b = a + grid + 1;
+      F.push_back({a, b, b + 1});
+      F.push_back({a, b + 1, a + 1});
+    }
+  return gauss6::test::make_mesh(V, F, "sheet");
+}
+}  // namespace
+
+TEST_CASE("contacts: a flat plate's vertices beside a tool's bottom edge hold it by its bottom, not its side",
+          "[contacts]") {
+  // A unit box flat on a sheet of 0.1 squares, half a delta above it, its +x
+  // bottom edge 0.3 delta short of the grid line x = 0.6: ten sheet vertices
+  // lie beside that edge, 0.58 delta from it, within the distance of both the
+  // box's bottom face and its +x side face. The side face's normal (-x for the
+  // row) is no contact normal of a flat sheet's vertex (its neighbours lie on
+  // both sides of the plane x = 0.6); the bottom face's (+z) is. Left with the
+  // side rows, a slide along +x was blocked (J a < 0 for a = +x).
+  const TriangleMesh sheet = flat_sheet(40), god = make_box(1, 1, 1);
+  const Bvh sb = build_bvh(sheet), gb = build_bvh(god);
+  const CcdBody obstacle{&sheet, &sb};
+  ContactWorkspace ws(god);
+  ContactSet set(4096);
+  ContactSettings cs;
+  cs.distance = 1.5 * kDelta;
+  for (const double turn : {0.0, 0.3}) {  // the box also turned about z: its edge then crosses the grid lines
+    const Quat q = quat_exp(Vec3(0, 0, turn));
+    // The +x bottom edge's midpoint 0.3 delta (along the box's +x) short of x = 0.6.
+    const Vec3 ex = rotation_matrix(q) * Vec3(1, 0, 0);
+    const Vec3 mid = Vec3(0.6, 0.0, 0.0) - 0.3 * kDelta * ex;
+    const Pose X{Vec3(mid.x() - 0.5 * ex.x(), mid.y() - 0.5 * ex.y(), 0.5 + 0.5 * kDelta), q};
+    REQUIRE(generate_contacts(&obstacle, 1, {&god, &gb}, X, cs, &ws, &set) == ContactStatus::kOk);
+    REQUIRE(set.num_reductions == 0);
+    if (turn == 0) CHECK(set.num_beside >= 10);
+    CHECK(set.num_beside > 0);
+    for (int k = 0; k < set.num_contacts; ++k) {
+      const Contact& c = set.contacts[k];
+      INFO("turn " << turn << ": " << static_cast<int>(c.features.kind) << " at " << c.point.transpose() << ", n "
+                   << c.normal.transpose());
+      CHECK((c.normal - Vec3(0, 0, 1)).norm() < 1e-12);
+    }
+    // Sliding along the box's +x, or any tangent motion, is not held back.
+    for (const Vec6& a : {(Vec6() << ex, 0, 0, 0).finished(), (Vec6() << -ex, 0, 0, 0).finished(),
+                          (Vec6() << 0, 0, 0, 0, 0, 1).finished()})
+      CHECK((set.J.topRows(set.num_contacts) * a).minCoeff() >= -1e-12);
+  }
+}
+
+TEST_CASE("contacts: a sharp vertex on a sharp edge keeps both faces' rows", "[contacts]") {
+  // An octahedron (the god-object, G at its lowest vertex) half a delta above
+  // the ridge of a triangular prism (ridge along x at z = r, flank normals
+  // (0, +-sin 60, cos 60)). Its vertex lies beside both flanks; neither flank's
+  // normal supports the octahedron at that vertex (its edges rise at 45 degrees
+  // on both sides), so neither row is left out: the vertex is held by both.
+  const double s = 0.2, r = 0.5;
+  const TriangleMesh god = gauss6::test::make_mesh(
+      {{0, 0, 0}, {s, 0, s}, {0, s, s}, {-s, 0, s}, {0, -s, s}, {0, 0, 2 * s}},
+      {{0, 2, 1}, {0, 3, 2}, {0, 4, 3}, {0, 1, 4}, {5, 1, 2}, {5, 2, 3}, {5, 3, 4}, {5, 4, 1}}, "octahedron");
+  TriangleMesh knife = gauss6::test::make_prism(3, r, 1);
+  // The prism's axis z to -x, its vertex on +x to +z: (x, y, z) -> (-z, y, x).
+  for (int v = 0; v < knife.V.rows(); ++v) {
+    const Vec3 p = knife.V.row(v).transpose();
+    knife.V.row(v) = Vec3(-p.z(), p.y(), p.x()).transpose();
+  }
+  const Bvh gb = build_bvh(god), kb = build_bvh(knife);
+  const CcdBody obstacle{&knife, &kb};
+  ContactWorkspace ws(god);
+  ContactSet set(16);
+  ContactSettings cs;
+  cs.distance = 1.5 * kDelta;
+  REQUIRE(generate_contacts(&obstacle, 1, {&god, &gb}, {Vec3(0.1, 0, r + 0.5 * kDelta), Quat{}}, cs, &ws, &set) ==
+          ContactStatus::kOk);
+  CHECK(set.num_beside == 0);
+  REQUIRE(set.num_contacts == 2);
+  const double sy = std::sin(M_PI / 3), cz = std::cos(M_PI / 3);
+  int flanks = 0;
+  for (int k = 0; k < set.num_contacts; ++k) {
+    const Vec3& n = set.contacts[k].normal;
+    CHECK(set.contacts[k].features.kind == PairKind::kGodVertexObstacleFace);
+    if ((n - Vec3(0, sy, cz)).norm() < 1e-12) flanks |= 1;
+    if ((n - Vec3(0, -sy, cz)).norm() < 1e-12) flanks |= 2;
+  }
+  CHECK(flanks == 3);
+}
+
+TEST_CASE("contacts: a vertex whose body turns between two faces' normals keeps both rows, at every distance",
+          "[contacts]") {
+  // The octahedron's lowest vertex (its edges rise at 45 degrees: it supports
+  // every normal within 45 degrees of -z) half a delta from the ridge of an
+  // asymmetric prism, on the bisector of its flanks: flank g's normal is 20
+  // degrees from +z (the vertex supports it, and normals turned from it towards
+  // the other flank's), flank f's 60 degrees (it does not). The vertex's
+  // contact with the ridge pushes along a normal between the two, which g's
+  // row alone does not span: both rows stay. Nor does the set lose a row when
+  // the distance grows.
+  const double s = 0.2, a = 20 * M_PI / 180, b = 60 * M_PI / 180;
+  const TriangleMesh god = gauss6::test::make_mesh(
+      {{0, 0, 0}, {s, 0, s}, {0, s, s}, {-s, 0, s}, {0, -s, s}, {0, 0, 2 * s}},
+      {{0, 2, 1}, {0, 3, 2}, {0, 4, 3}, {0, 1, 4}, {5, 1, 2}, {5, 2, 3}, {5, 3, 4}, {5, 4, 1}}, "octahedron");
+  // The ridge along x at z = 0; flank g down to -y (normal (0, -sin a, cos a)),
+  // flank f down to +y (normal (0, sin b, cos b)), both to z = -1.
+  const double yg = -std::cos(a) / std::sin(a), yf = std::cos(b) / std::sin(b);
+  const TriangleMesh ridge = gauss6::test::make_mesh(
+      {{-1, 0, 0}, {-1, yg, -1}, {-1, yf, -1}, {1, 0, 0}, {1, yg, -1}, {1, yf, -1}},
+      {{0, 2, 1}, {3, 4, 5}, {0, 4, 3}, {0, 1, 4}, {0, 5, 2}, {0, 3, 5}, {1, 5, 4}, {1, 2, 5}}, "ridge");
+  const Vec3 ng(0, -std::sin(a), std::cos(a)), nf(0, std::sin(b), std::cos(b));
+  for (int f = 0; f < ridge.F.rows(); ++f) {  // outward: each face's normal points away from the prism's inside
+    const Vec3 p0 = ridge.V.row(ridge.F(f, 0)).transpose(), p1 = ridge.V.row(ridge.F(f, 1)).transpose(),
+               p2 = ridge.V.row(ridge.F(f, 2)).transpose();
+    REQUIRE((p1 - p0).cross(p2 - p0).dot((p0 + p1 + p2) / 3 - Vec3(0, (yg + yf) / 3, -2.0 / 3)) > 0);
+  }
+  const Bvh gb = build_bvh(god), rb = build_bvh(ridge);
+  const CcdBody obstacle{&ridge, &rb};
+  ContactWorkspace ws(god);
+  ContactSet set(16);
+  ContactSettings cs;
+  const Vec3 G = 0.5 * kDelta * (ng + nf).normalized() + Vec3(0.1, 0, 0);
+  for (const double distance : {1.5 * kDelta, 3 * kDelta, 30 * kDelta}) {
+    cs.distance = distance;
+    REQUIRE(generate_contacts(&obstacle, 1, {&god, &gb}, {G, Quat{}}, cs, &ws, &set) == ContactStatus::kOk);
+    INFO("distance " << distance / kDelta << " delta");
+    CHECK(set.num_beside == 0);
+    int flanks = 0;
+    for (int k = 0; k < set.num_contacts; ++k) {
+      const Vec3& n = set.contacts[k].normal;
+      if ((n - ng).norm() < 1e-12) flanks |= 1;
+      if ((n - nf).norm() < 1e-12) flanks |= 2;
+    }
+    CHECK(flanks == 3);
   }
 }

@@ -64,6 +64,134 @@ void mark_hull(const std::vector<Eigen::Vector2d>& plane, int* idx, int n, int* 
   for (int i = 0; i < std::max(h, 1); ++i) (*keep)[hull[i]] = 1;
 }
 
+// Calls on(face, corner) for each face around the vertex at corner c of face
+// f (f first), walking across the edges at the vertex in one direction (mesh m,
+// its faces' adjacency `neighbor`: bvh.h), until on returns false or the fan
+// closes. Returns true when it closed: every face around the vertex was
+// visited; false at a boundary edge, a face that lacks the vertex, more than
+// kMaxFan faces (a fan that is no disc), or when on stopped it.
+constexpr int kMaxFan = 64;
+template <class On>
+bool walk_fan(const TriangleMesh& m, const std::vector<int32_t>& neighbor, int f, int c, const On& on) {
+  const int v = m.F(f, c);
+  int face = f, corner = c;
+  for (int step = 0; step < kMaxFan; ++step) {
+    if (!on(face, corner)) return false;
+    // On around v: across v's other edge in this face (from corner + 2 to
+    // corner), to the face that shares it.
+    const int next = neighbor[3 * static_cast<size_t>(face) + (corner + 2) % 3];
+    if (next < 0) return false;
+    if (next == f) return true;
+    face = next;
+    corner = m.F(face, 0) == v ? 0 : m.F(face, 1) == v ? 1 : m.F(face, 2) == v ? 2 : -1;
+    if (corner < 0) return false;
+  }
+  return false;
+}
+
+// Whether the plane through the vertex at corner c of face f normal to `out`
+// leaves its neighbours on or behind it (out.(w - v) <= sine |w - v| for every
+// neighbour w; at(i): vertex i's position): `out` is then an outward normal of
+// the vertex's body at the vertex (in its normal cone, to the angle
+// asin(sine)). kUnknown when the fan around it does not close.
+enum class Support { kYes, kNo, kUnknown };
+template <class At>
+Support vertex_support(const TriangleMesh& m, const std::vector<int32_t>& neighbor, int f, int c, const Vec3& out,
+                       double sine, const At& at) {
+  const Vec3 p = at(m.F(f, c));
+  bool supports = true;
+  const bool closed = walk_fan(m, neighbor, f, c, [&](int face, int corner) {
+    for (int k = 1; k <= 2; ++k) {
+      const Vec3 e = at(m.F(face, (corner + k) % 3)) - p;
+      if (out.dot(e) > sine * e.norm()) supports = false;
+    }
+    return true;
+  });
+  return !closed ? Support::kUnknown : supports ? Support::kYes : Support::kNo;
+}
+
+// One side of a vertex/face pair: a mesh, its faces' adjacency, and its
+// vertices' positions in the world frame.
+template <class At>
+struct Side {
+  const TriangleMesh& mesh;
+  const std::vector<int32_t>& neighbor;
+  const At& at;
+  Vec3 corner(int f, int k) const { return at(mesh.F(f, k)); }
+};
+template <class At>
+Side(const TriangleMesh&, const std::vector<int32_t>&, const At&) -> Side<At>;
+
+// The vertex/face rule (contacts.h): whether the row of the vertex at corner
+// vc of face vf (p, on side V, at separation sep from the face) against face
+// `face` of side W (unit outward normal nF: the row's normal is -nF seen from
+// W, and the vertex's body must have -nF as an outward normal at p) is left
+// out: p lies beside the face, beyond one edge or (beyond two) a corner, -nF
+// does not support p's body, and another face g of W that shares a corner
+// with that edge, or that corner, holds p (p's closest point on the face lies
+// on that edge or corner; a vertex just beside a corner of a tool whose bottom
+// is two triangles is held by the one that does not share the edge):
+//  - g is as near p as the face is (to `tie`, the rounding of the two
+//    separations) and within d: g's row is in the set whenever the face's is,
+//    and whether the face's row is left out does not depend on d (a set at a
+//    larger distance holds every row of the set at a smaller one);
+//  - -n_g supports p's body, and no normal turned from it towards nF by more
+//    than `turn` does (p's body leaves no room between the two: a flat plate's
+//    vertex beside a tool's bottom edge). A curved body's vertex, which
+//    supports normals between n_g and nF, keeps the face's row: its contact
+//    with the edge pushes along a normal between the two, which n_g alone
+//    does not span.
+template <class AtV, class AtW>
+bool held_beside(const Vec3& p, const Side<AtV>& V, int vf, int vc, const Side<AtW>& W, int face, const Vec3& nF,
+                 double sep, double d, double tie, double sine, double turn) {
+  const Vec3 P[3] = {W.corner(face, 0), W.corner(face, 1), W.corner(face, 2)};
+  bool beyond[3];
+  int count = 0;
+  for (int k = 0; k < 3; ++k) {
+    // nF x (P[k + 1] - P[k]) points into the face (counter-clockwise about nF).
+    beyond[k] = (p - P[k]).dot(nF.cross(P[(k + 1) % 3] - P[k])) < 0;
+    count += beyond[k];
+  }
+  if (count == 0 || count == 3) return false;  // over the face (or a degenerate one)
+  if (vertex_support(V.mesh, V.neighbor, vf, vc, Vec3(-nF), sine, V.at) != Support::kNo) return false;
+  const double reach = std::min(d, sep + tie);
+  const double cos_turn = std::cos(turn), sin_turn = std::sin(turn);
+  const auto holds = [&](int g) {
+    if (g < 0 || g == face) return false;
+    const Vec3 q0 = W.corner(g, 0), q1 = W.corner(g, 1), q2 = W.corner(g, 2);
+    const Vec3 n2 = unit_normal(q0, q1, q2);
+    if (n2 == Vec3::Zero() || !((p - closest_point_on_triangle(p, q0, q1, q2)).norm() <= reach) ||
+        vertex_support(V.mesh, V.neighbor, vf, vc, Vec3(-n2), sine, V.at) != Support::kYes)
+      return false;
+    // n2 turned by `turn` towards nF (in their plane): it must not support p's
+    // body. Normals closer than `turn` leave no such room.
+    const Vec3 w = nF - nF.dot(n2) * n2;
+    const double wn = w.norm();
+    if (!(wn > sin_turn)) return true;
+    const Vec3 turned = cos_turn * n2 + (sin_turn / wn) * w;
+    return vertex_support(V.mesh, V.neighbor, vf, vc, Vec3(-turned), sine, V.at) == Support::kNo;
+  };
+  // The faces that share the edge's ends, or the corner: walked around each
+  // (in one direction: a fan cut by a boundary is walked in part).
+  const int k = count == 1 ? (beyond[0] ? 0 : beyond[1] ? 1 : 2) : (!beyond[2] ? 1 : !beyond[0] ? 2 : 0);
+  bool held = false;
+  for (int i = 0; i < (count == 1 ? 2 : 1) && !held; ++i)
+    walk_fan(W.mesh, W.neighbor, face, (k + i) % 3, [&](int g, int) {
+      held = holds(g);
+      return !held;
+    });
+  return held;
+}
+
+// Whether the boxes [a_lo, a_hi] and [b_lo, b_hi] are more than `gap` apart
+// along some axis (compared without rounding: b_lo - a_hi > gap is taken as
+// b_lo > a_hi + gap rounded up).
+bool boxes_apart(const Vec3& a_lo, const Vec3& a_hi, const Vec3& b_lo, const Vec3& b_hi, double gap) {
+  for (int i = 0; i < 3; ++i)
+    if (b_lo[i] > (Upper{a_hi[i]} + Upper{gap}).v || a_lo[i] > (Upper{b_hi[i]} + Upper{gap}).v) return true;
+  return false;
+}
+
 struct Collector {
   const ContactSettings& settings;
   double merge_distance, merge_cos;
@@ -87,6 +215,131 @@ struct Collector {
       }
     }
     set->contacts[set->num_contacts++] = c;
+  }
+};
+
+
+// The contacts within d of one (god triangle, obstacle triangle) pair of
+// obstacle o: one pass over the table of feature-pair kinds the two triangles
+// own (feature_pair.h), each feature pair's contact added to the set (its
+// normal: the face's for vertex/face, the edges' cross product for edge/edge)
+// unless the vertex/face rule leaves it out (held_beside). The corners come
+// from the two sides (the god-object's posed at X_WB, the obstacle's in the
+// world frame).
+template <class GodSide, class ObstacleSide>
+struct TrianglePairContacts {
+  const GodSide& god_side;
+  const ObstacleSide& obstacle_side;
+  const std::vector<uint8_t>& god_owned;
+  const std::vector<uint8_t>& obstacle_owned;
+  int o;                                   // the obstacle's index
+  double d, apart, par2, support_sine;     // settings.distance; feature boxes apart; parallel_sine^2; sin(merge_angle)
+  double tie, turn;                        // separations' rounding (held_beside); settings.patch_angle
+  Collector* col;
+  ContactSet* set;
+  int slab_face = -1;  // the god face of slab_n (its normal, not unit) and slab_l2 (|slab_n|^2 d^2)
+  Vec3 slab_n = Vec3::Zero();
+  double slab_l2 = 0;
+
+  void test(int gf, int of) {
+    const uint8_t go = god_owned[gf], oo = obstacle_owned[of];
+    const Vec3 X[3] = {god_side.corner(gf, 0), god_side.corner(gf, 1), god_side.corner(gf, 2)};
+    const Vec3 Y[3] = {obstacle_side.corner(of, 0), obstacle_side.corner(of, 1), obstacle_side.corner(of, 2)};
+    // Pairs proven farther apart than d by a separating axis have no pair
+    // within d. But an obstacle triangle within d of the god face's plane (a
+    // flat tool on a dense flat tessellation: thousands of such pairs) is
+    // within d along the face normals and along the edges' cross products,
+    // all near that normal, so no axis drops it; its feature pairs, most of
+    // which lie far apart in the plane, are then sorted by their boxes (the
+    // bounds of their corners): one is tested only when its boxes come
+    // within `apart` of each other along every axis. Either way the set is
+    // the same: the axes and the boxes only save work.
+    if (gf != slab_face) {  // consecutive pairs often share their god face
+      slab_face = gf;
+      slab_n = (X[1] - X[0]).cross(X[2] - X[0]);
+      slab_l2 = slab_n.squaredNorm() * (d * d);
+    }
+    const auto within = [&](const Vec3& y) {
+      const double h = slab_n.dot(y - X[0]);
+      return h * h <= slab_l2;
+    };
+    const bool in_slab = within(Y[0]) && within(Y[1]) && within(Y[2]);
+    if (!in_slab && triangle_gap_lower_bound(X, Y, d) > d) return;
+    Box boxes;
+    if (in_slab) {
+      boxes.x_lo = X[0].cwiseMin(X[1]).cwiseMin(X[2]), boxes.x_hi = X[0].cwiseMax(X[1]).cwiseMax(X[2]);
+      boxes.y_lo = Y[0].cwiseMin(Y[1]).cwiseMin(Y[2]), boxes.y_hi = Y[0].cwiseMax(Y[1]).cwiseMax(Y[2]);
+    }
+    // k: the god-object's corner (vertex k, or edge k -> k + 1), j: the obstacle's.
+    for_each_feature_pair(go, oo, [&](PairKind kind, int k, int j) {
+      feature_pair(kind, k, j, gf, of, X, Y, in_slab ? &boxes : nullptr);
+      return true;
+    });
+  }
+
+  // The two triangles' corner boxes (in the slab only).
+  struct Box {
+    Vec3 x_lo, x_hi, y_lo, y_hi;
+  };
+
+  void feature_pair(PairKind kind, int k, int j, int gf, int of, const Vec3 (&X)[3], const Vec3 (&Y)[3],
+                    const Box* boxes) {
+    switch (kind) {
+      case PairKind::kGodVertexObstacleFace: {  // the obstacle face's normal
+        const Vec3& x = X[k];
+        if (boxes && boxes_apart(x, x, boxes->y_lo, boxes->y_hi, apart)) break;
+        const double sep = (x - closest_point_on_triangle(x, Y[0], Y[1], Y[2])).norm();
+        const Vec3 n = unit_normal(Y[0], Y[1], Y[2]);
+        if (!(sep <= d && n != Vec3::Zero())) break;
+        if (held_beside(x, god_side, gf, k, obstacle_side, of, n, sep, d, tie, support_sine, turn)) {
+          ++set->num_beside;
+          break;
+        }
+        col->add({x, n, sep, {kind, o, gf, k, of, -1}});
+        break;
+      }
+      case PairKind::kObstacleVertexGodFace: {  // minus the god face's normal
+        const Vec3& y = Y[j];
+        if (boxes && boxes_apart(y, y, boxes->x_lo, boxes->x_hi, apart)) break;
+        const Vec3 c = closest_point_on_triangle(y, X[0], X[1], X[2]);
+        const double sep = (y - c).norm();
+        const Vec3 n = -unit_normal(X[0], X[1], X[2]);
+        if (!(sep <= d && n != Vec3::Zero())) break;
+        if (held_beside(y, obstacle_side, of, j, god_side, gf, Vec3(-n), sep, d, tie, support_sine, turn)) {
+          ++set->num_beside;
+          break;
+        }
+        col->add({c, n, sep, {kind, o, gf, -1, of, j}});
+        break;
+      }
+      case PairKind::kEdgeEdge: {  // closest points inside both edges, edges not parallel
+        const Vec3 &g0 = X[k], &g1 = X[(k + 1) % 3];
+        const Vec3 &o0 = Y[j], &o1 = Y[(j + 1) % 3];
+        if (boxes && boxes_apart(g0.cwiseMin(g1), g0.cwiseMax(g1), o0.cwiseMin(o1), o0.cwiseMax(o1), apart)) break;
+        double s, t;
+        closest_segment_parameters(g0, g1, o0, o1, &s, &t);
+        if (!(s > 0 && s < 1 && t > 0 && t < 1)) break;
+        const Vec3 pg = g0 + s * (g1 - g0), po = o0 + t * (o1 - o0);
+        const double sep = (pg - po).norm();
+        if (!(sep <= d)) break;
+        Vec3 n = (g1 - g0).cross(o1 - o0);
+        if (n.squaredNorm() <= par2 * (g1 - g0).squaredNorm() * (o1 - o0).squaredNorm()) break;
+        n.normalize();
+        // Sign: from the obstacle's point to the god-object's; if they coincide,
+        // along the obstacle edge's outward direction (sum of its faces' normals).
+        double side = n.dot(pg - po);
+        if (side == 0) {
+          Vec3 out = unit_normal(Y[0], Y[1], Y[2]);
+          const int nb = obstacle_side.neighbor[3 * of + j];
+          if (nb >= 0) out += unit_normal(obstacle_side.corner(nb, 0), obstacle_side.corner(nb, 1),
+                                          obstacle_side.corner(nb, 2));
+          side = n.dot(out);
+        }
+        if (side < 0) n = -n;
+        col->add({pg, n, sep, {kind, o, gf, k, of, j}});
+        break;
+      }
+    }
   }
 };
 
@@ -134,6 +387,7 @@ ContactStatus generate_contacts(const CcdBody* obstacles, int num_obstacles, con
   set->num_contacts = 0;
   set->num_pairs_within = 0;
   set->num_reductions = 0;
+  set->num_beside = 0;
   if (!god.mesh || !god.bvh || !ws || !is_valid_pose(X_WB) || !(settings.distance > 0) ||
       !std::isfinite(settings.distance) || ws->god_world.size() != static_cast<size_t>(god.mesh->V.rows()) ||
       (num_obstacles > 0 && !obstacles) || (near.num_pairs > 0 && !near.pairs))
@@ -174,66 +428,32 @@ ContactStatus generate_contacts(const CcdBody* obstacles, int num_obstacles, con
   Collector col{settings, settings.merge_distance > 0 ? settings.merge_distance : 1e-3 * d,
                 std::cos(settings.merge_angle), set};
   const double par2 = settings.parallel_sine * settings.parallel_sine;
+  const double support_sine = std::sin(settings.merge_angle);
+  // Features whose boxes are more than `apart` apart along an axis are more
+  // than 2 d apart, and their computed separation (its rounding below
+  // kBoxPoseRounding of the coordinates' magnitude `scale`) is above d: they
+  // need no test, and the set is the same with or without it.
+  double scale = std::abs(G.x()) + std::abs(G.y()) + std::abs(G.z()) + god.bvh->radius;
+  for (int o = 0; o < num_obstacles; ++o)
+    if (obstacles[o].bvh) scale = std::max(scale, obstacles[o].bvh->radius);
+  const double apart = (Upper{2 * d} + Upper{kBoxPoseRounding} * Upper{scale}).v;
+  // Two separations of one vertex computed against two faces differ by their
+  // rounding, below kBoxPoseRounding of the coordinates' magnitude.
+  const double tie = (Upper{kBoxPoseRounding} * Upper{scale}).v;
   ContactStatus status = ContactStatus::kOk;
   for (int o = 0; o < num_obstacles; ++o) {
     if (!obstacles[o].mesh || !obstacles[o].bvh) return ContactStatus::kInvalidInput;
     const TriangleMesh& om = *obstacles[o].mesh;
     const Bvh& ob = *obstacles[o].bvh;
-    const auto ov = [&](int f, int k) -> Vec3 { return om.V.row(om.F(f, k)).transpose(); };
-    const auto gv = [&](int f, int k) -> const Vec3& { return world(gm.F(f, k)); };
+    const auto god_at = [&](int v) -> Vec3 { return world(v); };
+    const auto obstacle_at = [&](int v) -> Vec3 { return om.V.row(v).transpose(); };
+    const Side god_side{gm, god.bvh->neighbor, god_at};
+    const Side obstacle_side{om, ob.neighbor, obstacle_at};
+    TrianglePairContacts<decltype(god_side), decltype(obstacle_side)> pair{
+        god_side, obstacle_side, god.bvh->owned, ob.owned, o, d, apart, par2, support_sine, tie, settings.patch_angle,
+        &col, set};
     const auto visit = [&](int gf, int of) {
-      const uint8_t go = god.bvh->owned[gf], oo = ob.owned[of];
-      const Vec3 oa = ov(of, 0), obb = ov(of, 1), oc = ov(of, 2);
-      // Pairs proven farther apart than d by a separating axis have no pair within d.
-      const Vec3 X[3] = {gv(gf, 0), gv(gf, 1), gv(gf, 2)}, Y[3] = {oa, obb, oc};
-      if (triangle_gap_lower_bound(X, Y, d) > d) return true;
-      // One pass over the table of feature-pair kinds (feature_pair.h); k: the
-      // god-object's corner (vertex k, or edge k -> k + 1), j: the obstacle's.
-      for_each_feature_pair(go, oo, [&](PairKind kind, int k, int j) {
-        switch (kind) {
-          case PairKind::kGodVertexObstacleFace: {  // the obstacle face's normal
-            const Vec3& x = gv(gf, k);
-            const double sep = (x - closest_point_on_triangle(x, oa, obb, oc)).norm();
-            const Vec3 n = unit_normal(oa, obb, oc);
-            if (sep <= d && n != Vec3::Zero()) col.add({x, n, sep, {kind, o, gf, k, of, -1}});
-            break;
-          }
-          case PairKind::kObstacleVertexGodFace: {  // minus the god face's normal
-            const Vec3 y = ov(of, j);
-            const Vec3 c = closest_point_on_triangle(y, gv(gf, 0), gv(gf, 1), gv(gf, 2));
-            const double sep = (y - c).norm();
-            const Vec3 n = -unit_normal(gv(gf, 0), gv(gf, 1), gv(gf, 2));
-            if (sep <= d && n != Vec3::Zero()) col.add({c, n, sep, {kind, o, gf, -1, of, j}});
-            break;
-          }
-          case PairKind::kEdgeEdge: {  // closest points inside both edges, edges not parallel
-            const Vec3 &g0 = gv(gf, k), &g1 = gv(gf, (k + 1) % 3);
-            const Vec3 o0 = ov(of, j), o1 = ov(of, (j + 1) % 3);
-            double s, t;
-            closest_segment_parameters(g0, g1, o0, o1, &s, &t);
-            if (!(s > 0 && s < 1 && t > 0 && t < 1)) break;
-            const Vec3 pg = g0 + s * (g1 - g0), po = o0 + t * (o1 - o0);
-            const double sep = (pg - po).norm();
-            if (!(sep <= d)) break;
-            Vec3 n = (g1 - g0).cross(o1 - o0);
-            if (n.squaredNorm() <= par2 * (g1 - g0).squaredNorm() * (o1 - o0).squaredNorm()) break;
-            n.normalize();
-            // Sign: from the obstacle's point to the god-object's; if they coincide,
-            // along the obstacle edge's outward direction (sum of its faces' normals).
-            double side = n.dot(pg - po);
-            if (side == 0) {
-              Vec3 out = unit_normal(oa, obb, oc);
-              const int nb = ob.neighbor[3 * of + j];
-              if (nb >= 0) out += unit_normal(ov(nb, 0), ov(nb, 1), ov(nb, 2));
-              side = n.dot(out);
-            }
-            if (side < 0) n = -n;
-            col.add({pg, n, sep, {kind, o, gf, k, of, j}});
-            break;
-          }
-        }
-        return true;
-      });
+      pair.test(gf, of);
       return true;
     };
     if (near.listed()) {  // the listed pairs of this obstacle (in range: ccd_step made them)

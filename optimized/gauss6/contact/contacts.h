@@ -12,6 +12,27 @@
 // closest points are at an edge's end, or whose edges are parallel, are left
 // out: such a contact is a vertex near an edge, already in the set as the
 // vertex against the faces of that edge, with a well-defined face normal.
+// A vertex/face pair whose vertex lies beside the face (beyond one of its
+// edges, seen along the face's normal) is a vertex/edge contact, and the face's
+// normal is a contact normal of it only where it also supports the vertex's
+// own body: where the plane through the vertex normal to it leaves the
+// vertex's neighbours on the body's side (to the angle merge_angle). A flat
+// plate's vertex just beside a tool's bottom edge is such a pair with the
+// tool's side face, whose horizontal normal the plate's vertex does not
+// support; the tool's bottom face across that edge gives the same vertex a
+// row that does (its plate's normal). Such a pair is left out (counted in
+// num_beside) when a face of the same body at that edge or corner gives the
+// vertex a row as near as the pair's (to rounding) and within the distance,
+// whose normal supports the vertex's body while no normal turned from it
+// towards the left-out one by more than patch_angle does: the vertex's body
+// leaves no room between the two (a flat plate). Otherwise both rows are
+// kept, and the vertex is held by both: a sharp vertex on a sharp edge (a
+// knife), where neither normal supports it; a curved body's vertex, which
+// supports normals between the two, along which its contact with the edge
+// pushes; a row nearer than every face that would hold it. Whether a row is
+// left out does not depend on the distance (but for a holding row within
+// rounding of it): a set within a larger distance holds every row of the set
+// within a smaller one.
 // Pairs with the same point (within merge_distance) and the same normal (within
 // merge_angle) are merged, keeping the smallest separation: a vertex on an edge
 // shared by two coplanar faces gives one contact, not two.
@@ -28,7 +49,7 @@
 // merge_angle). A dense coplanar patch (a flat tool on a finely
 // tessellated plate: thousands of pairs) is then its corners, wherever the
 // search met them first. A set that fits is never reduced: every pair within
-// the distance is in it.
+// the distance is in it, but for the vertices beside an edge above.
 //
 // Real time: no allocation (ContactSet and ContactWorkspace are sized once), no
 // locks, no exceptions. When the reduced set still has no room (more distinct
@@ -80,6 +101,7 @@ struct ContactSet {
   int num_contacts = 0;
   int num_pairs_within = 0;       // pairs found within distance, before merging
   int num_reductions = 0;         // times the set was reduced to its patches' supports (0: every pair is in it)
+  int num_beside = 0;             // vertex/face pairs within distance left out: a vertex beside an edge (above)
   std::vector<Contact> contacts;
   Eigen::Matrix<double, Eigen::Dynamic, 6, Eigen::RowMajor> J;
   // Scratch of reduce_to_patch_supports (one entry a contact).
