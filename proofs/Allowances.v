@@ -457,7 +457,7 @@ Qed.
 (* The code's forms, at its sites. *)
 (* covers optimized/gauss6/numeric/rounding.h "GAUSS6_ALWAYS_INLINE Upper norm_up(double norm, double relative)" sha256:b4b3280a1e614758 *)
 (* covers optimized/gauss6/ccd/motion_bounds.cpp "void StartFrame::set(const CcdMotion& m, double u, double rho_in)" sha256:cfac9ee869768b2c *)
-(* covers optimized/gauss6/ccd/motion_bounds.h "PosedObb pose(const Obb& b) const" sha256:80435f8b04136e0b *)
+(* covers optimized/gauss6/ccd/motion_bounds.h "PosedObb pose(const Obb& b) const" sha256:dc4be357c933cab2 *)
 (* covers optimized/gauss6/ccd/motion_bounds.h "double radius(double r2) const" sha256:6689317b141e2024 *)
 Theorem norm_up_relative x y z :
   sqrt (x * x + y * y + z * z) <= Rmax (next_up (fl (norm_c x y z * fl (1 + kRelativeRounding)))) kNormFloor.

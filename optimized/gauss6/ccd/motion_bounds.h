@@ -205,7 +205,11 @@ struct SweptObbFrame {
     } else {
       out.half_step = 0.5 * step;
     }
-    if (!(out.grow < std::numeric_limits<double>::infinity())) out.grow = std::numeric_limits<double>::infinity();
+    // The 15-axis test holds for axes orthonormal to within kObbFrameTolerance
+    // (proofs/ObbSeparation.v); a posed box whose axes are not (R far from a
+    // rotation) gets an infinite grow, which no axis separates.
+    if (!(out.grow < std::numeric_limits<double>::infinity()) || !near_orthonormal(out.axes))
+      out.grow = std::numeric_limits<double>::infinity();
     out.still = (out.half_step.array() == 0).all();
     out.pays = obb_volume_ratio(b.half, out.axes.cwiseAbs() * b.half) < 0.5;
     return out;

@@ -32,7 +32,8 @@ Obb fit_obb(const Vec3* points, int num_points) {
   double best_size = std::numeric_limits<double>::infinity();
   const Mat3 frames[2] = {Mat3::Identity(), eig.eigenvectors()};
   for (const Mat3& axes : frames) {
-    if (!axes.allFinite()) continue;
+    // A frame not orthonormal to within kObbFrameTolerance is dropped (the identity always passes).
+    if (!axes.allFinite() || !near_orthonormal(axes)) continue;
     Vec3 lo = Vec3::Constant(std::numeric_limits<double>::infinity()), hi = -lo;
     double scale = 0;
     for (int i = 0; i < num_points; ++i) {
@@ -48,7 +49,10 @@ Obb fit_obb(const Vec3* points, int num_points) {
     b.half = 0.5 * (hi - lo) + Vec3::Constant(kObbFitRounding * scale + kUnderflowFloor);
     const Vec3 grown = b.half + Vec3::Constant(1e-3 * b.half.norm());
     const double size = grown.prod();
-    if (size < best_size) {
+    // The identity frame (the first) is kept whatever its size: where the
+    // volume overflows to inf (extents beyond ~1e102) no size compares below
+    // it, and the box must still hold the points.
+    if (size < best_size || &axes == &frames[0]) {
       best_size = size;
       best = b;
     }

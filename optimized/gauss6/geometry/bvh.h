@@ -15,6 +15,7 @@
 #pragma once
 
 #include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <limits>
 #include <utility>
@@ -23,6 +24,7 @@
 #include "gauss6/geometry/aabb.h"
 #include "gauss6/geometry/feature_pair.h"
 #include "gauss6/geometry/mesh.h"
+#include "gauss6/numeric/error_allowances.h"
 
 namespace gauss6 {
 
@@ -36,6 +38,21 @@ struct Obb {
   Mat3 axes = Mat3::Identity();
   Vec3 center = Vec3::Zero(), half = Vec3::Zero();
 };
+
+// True when the columns of m and its rows are orthonormal to within
+// kObbFrameTolerance: every entry of m^T m and of m m^T, computed in doubles,
+// within it of the identity's (false on NaN). The oriented boxes' tests rest
+// on it (error_allowances.h, proofs/ObbSeparation.v).
+inline bool near_orthonormal(const Mat3& m) {
+  const Mat3 g = m.transpose() * m, h = m * m.transpose();
+  for (int i = 0; i < 3; ++i) {
+    for (int j = 0; j < 3; ++j) {
+      const double id = i == j ? 1.0 : 0.0;
+      if (!(std::abs(g(i, j) - id) <= kObbFrameTolerance && std::abs(h(i, j) - id) <= kObbFrameTolerance)) return false;
+    }
+  }
+  return true;
+}
 
 struct BvhNode {
   Aabb box;            // the mesh's own frame

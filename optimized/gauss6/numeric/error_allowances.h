@@ -112,15 +112,35 @@ constexpr double kCornerOffsetRounding = 1e-12;
 // of an entry of |C| (<= 1 + 1e-15) and a number <= s (the largest
 // coordinate, extent or step involved), each within a few units of u of
 // itself, and the axes' error moves each by at most 1e-15 s: under 3e-14 s in
-// all. 1e-11 s covers it 300 times.
+// all. 1e-11 s covers it 300 times. Machine-checked (proofs/ObbSeparation.v),
+// for axes orthonormal to within 2^-46 (kObbFrameTolerance below) and s >=
+// 2^-1001 (every half extent is, by fit_obb's floor): obb_axis_rounding (|C| +
+// kObbAxisRounding bounds the exact |a_i . b_j|), obb_separation_face_a,
+// obb_separation_face_b (a test along a face axis that holds proves the swept
+// posed box and the obstacle's box, as sets over the reals with the double
+// axes, without a common point: roundings under 48 u s, the axes' defect
+// under 17 e s, 2.6e-13 s in all). Not yet proved: the nine cross axes.
 constexpr double kObbAxisRounding = 1e-15;
 constexpr double kObbSeparationRounding = 1e-11;
+// How far from orthonormal an oriented box's axes may be for the two tests
+// above to hold: every entry of A^T A and of A A^T, computed in doubles, within
+// 1e-14 of the identity's (near_orthonormal, bvh.h; fit_obb drops a frame that
+// fails it, SweptObbFrame::pose makes a posed box that fails it never separate).
+// Then both exact Gram matrices are within 2^-46 of the identity, the
+// hypothesis of proofs/ObbSeparation.v (machine-checked: frame_check_sound). Eigen's eigenvectors and their turn
+// by a double rotation stay near 1e-16 to 1e-15, so it never trips on a valid pose.
+constexpr double kObbFrameTolerance = 1e-14;
 
 // The half extents of a fitted oriented box (fit_obb), relative to the
 // largest coordinate of its points: each point's projection on the double
 // axes (three products and two sums) is within 3.01 u sqrt(3) of it (5.8e-16),
 // and the centre (the axes times the mid-projection) and (hi - lo) / 2 round
 // within a few units more: under 2e-15. 1e-13 covers it 50 times.
+// Machine-checked: proofs/ObbSeparation.v, obb_fit_rounding (every point p
+// within half_k of the centre along each double axis q_k, |q_k . (p - c)| <=
+// half_k exactly, for axes orthonormal to within 2^-46, whose defect moves the
+// centre's projection by up to 5.21 e scale = 7.4e-14 scale: the allowance
+// covers that and the roundings, under 40 u scale, 1.27 times).
 constexpr double kObbFitRounding = 1e-13;
 
 // The world box of a god node's body box at a double pose, c +- h with c =
@@ -154,7 +174,8 @@ constexpr double kBoxProductRounding = 2e-15;
 // dozen of them stay below 1e-306; 1e-300 covers them and is below any extent
 // that matters. Sites: fit_obb, generate_contacts, swept_box,
 // for_each_separating_axis. Machine-checked at swept_box: proofs/Allowances.v,
-// swept_box_rounding.
+// swept_box_rounding; at fit_obb: proofs/ObbSeparation.v, obb_fit_rounding
+// (the half extents' floor, >= 2^-1001, which obb_separated's theorems take).
 constexpr double kUnderflowFloor = 1e-300;
 
 // A corner value of F = (w + a ea) - b eb for linearly moving points (the
