@@ -932,7 +932,7 @@ Qed.
 
 Definition row (x y z : V) (m : nat) := mkV (comp x m) (comp y m) (comp z m).
 
-(* covers optimized/gauss6/geometry/bvh.h "inline bool near_orthonormal(const Mat3& m)" sha256:a5fd56fc86c8ed2a *)
+(* covers optimized/gauss6/geometry/bvh.h "inline bool near_orthonormal(const Mat3& m)" sha256:e1be52145f695303 *)
 (* covers optimized/gauss6/ccd/motion_bounds.h "PosedObb pose(const Obb& b) const" sha256:dc4be357c933cab2 *)
 (* covers optimized/gauss6/geometry/bvh.cpp "Obb fit_obb(const Vec3* points, int num_points)" sha256:e8643d5fb8f792eb *)
 Theorem frame_check_sound x y z :
