@@ -284,6 +284,14 @@ def winding_inside(P: np.ndarray, V: np.ndarray, F: np.ndarray) -> np.ndarray:
     return inside
 
 
+def deepest_inside(P: np.ndarray, V: np.ndarray, F: np.ndarray, lo: np.ndarray, hi: np.ndarray) -> float:
+    """The largest distance to a closed mesh's surface of the points (n, 3) inside it (0 if none);
+    lo, hi: the mesh's bounding box, which rules out most points at once (floating point)."""
+    cand = P[np.all((P > lo) & (P < hi), axis=1)]
+    inner = cand[winding_inside(cand, V, F)] if len(cand) else cand
+    return float(point_mesh_distance(inner, V, F).max()) if len(inner) else 0.0
+
+
 def friction_generators(r: np.ndarray, N: np.ndarray, mu: float, sides: int) -> np.ndarray:
     """The contact wrenches (k * sides, 6) spanning the Coulomb friction cones of contacts at r (from
     G, (k, 3)) with normals N (k, 3), coefficient mu: each cone by the pyramid of `sides` edges
@@ -500,7 +508,9 @@ def check_penetration(r: RunData, th: dict) -> Verdict:
     return Verdict(
         "penetration", "", len(ids) <= th["max_poses"], len(ids), float(P["depth"].max()) / r.delta if len(ids) else 0.0,
         "delta (depth estimate)", float(r.t[ticks[0]]) if len(ids) else None,
-        f"{len(r.first_tick)} distinct poses checked exactly; depth estimated on {len(P['sample'])}",
+        f"{len(r.first_tick)} distinct poses checked exactly; depth estimated on {len(P['sample'])}"
+        + (f" ({edges_only} of them cross by edges and faces only: no vertex of either body inside the other, "
+           "depth not estimated)" if (edges_only := int((P["depth"][P["sample"]] == 0).sum())) else ""),
         {"poses": len(r.first_tick), "penetrating_ticks": int(P["tick"].sum()),
          "max_intersecting_pairs": int(P["counts"].max()) if len(P["counts"]) else 0,
          "max_depth": float(P["depth"].max()) if len(P["depth"]) else 0.0},
@@ -1153,15 +1163,18 @@ class Oracle:
         return self.exact.intersecting_pairs(p, q)
 
     def depth_estimate(self, p, q) -> float:
-        """The deepest tool vertex inside an obstacle: its distance to that obstacle (floating point)."""
-        X = (rotation_matrices(np.asarray(q, float))[0] @ self.god_V.T).T + np.asarray(p, float)
+        """The deepest vertex of either body inside the other: its distance to the other's surface
+        (floating point). 0 when the bodies cross by edges and faces only (a blade through a thin
+        wall): no vertex of either is inside the other, and the depth is not estimated."""
+        R = rotation_matrices(np.asarray(q, float))[0]
+        p = np.asarray(p, float)
+        X = (R @ self.god_V.T).T + p
+        g_lo, g_hi = self.god_V.min(axis=0), self.god_V.max(axis=0)
         depth = 0.0
         for (_, V, F), (lo, hi) in zip(self.obstacles, self.boxes):
-            cand = X[np.all((X > lo) & (X < hi), axis=1)]
-            if len(cand):
-                inner = cand[winding_inside(cand, V, F)]
-                if len(inner):
-                    depth = max(depth, float(point_mesh_distance(inner, V, F).max()))
+            # The tool's vertices inside the obstacle; the obstacle's inside the tool, in its own frame.
+            depth = max(depth, deepest_inside(X, V, F, lo, hi),
+                        deepest_inside((V - p) @ R, self.god_V, self.god_F, g_lo, g_hi))
         return depth
 
     def mass_matrix(self, q) -> np.ndarray:

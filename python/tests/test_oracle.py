@@ -300,3 +300,28 @@ def test_the_hands_motion_explains_exactly_the_couplings_changes():
     f, tau = unexplained_per_tick(F, np.zeros((3, 6)), 0.1, np.repeat(np.eye(3)[None] * 1e-5, 3, 0), kh, ks)
     np.testing.assert_allclose(f, added_per_tick(F[:, :3]), atol=1e-15)
     np.testing.assert_allclose(tau, added_per_tick(F[:, 3:]), atol=1e-15)
+
+
+def test_the_depth_estimate_looks_from_both_bodies():
+    """The penetration depth estimate: the deepest vertex of either body inside the other. The thin
+    wall's probe (an octahedron of radius 5 mm, turned so that none of its vertices lies within the
+    0.2 mm wall) centred on the wall's top corner holds the corner's two vertices 0.1 mm from its
+    centre, about its inradius (2.9 mm) deep; centred between the wall's vertices it crosses the wall by
+    edges and faces only, which the estimate cannot measure (0) and the verdict's note names."""
+    o = Oracle(paths.DATASETS_DIR / "scenes" / "thin_wall.toml")
+    q = np.array([0.9, 0.3, 0.25, 0.2])
+    q /= np.linalg.norm(q)
+    (wall_lo, wall_hi), = o.boxes
+    corner = np.array([0.0, wall_hi[1], wall_hi[2]])
+    assert o.intersecting_pairs(corner, q) > 0
+    inradius = 0.005 / math.sqrt(3)
+    assert o.depth_estimate(corner, q) == pytest.approx(inradius, abs=2e-4)
+    middle = np.array([0.0, 0.0125, 0.03])  # 12.5 mm and more from the wall's vertices (a 25 x 20 mm grid)
+    assert o.intersecting_pairs(middle, q) > 0
+    assert o.depth_estimate(middle, q) == 0.0
+    x = _oscillation(50)
+    tr = synthetic(x, lambda k, x: np.zeros(3))
+    tr.ticks["xs_p"][:] = middle
+    tr.ticks["xs_q"][:] = q
+    verdict = o.judge(tr, checks=["penetration"], calibration={}).verdict("penetration")
+    assert not verdict.passed and "cross by edges and faces only" in verdict.note
