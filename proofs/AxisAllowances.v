@@ -92,31 +92,27 @@ Proof.
   lra.
 Qed.
 
+(* A selection of three values, the largest or the least (the two roles of
+   sel3_close and sel3_abs_le). *)
+Definition is_sel3 (sel : R -> R -> R -> R) := sel = max3 \/ sel = min3.
+Lemma max3_sel : is_sel3 max3. Proof. left; reflexivity. Qed.
+Lemma min3_sel : is_sel3 min3. Proof. right; reflexivity. Qed.
+
 (* The largest (least) of three values each within e of its exact one is
    within e of the exact largest (least). *)
-Lemma max3_close p0 p1 p2 P0 P1 P2 e :
+Lemma sel3_close sel p0 p1 p2 P0 P1 P2 e : is_sel3 sel ->
   Rabs (p0 - P0) <= e -> Rabs (p1 - P1) <= e -> Rabs (p2 - P2) <= e ->
-  Rabs (max3 p0 p1 p2 - max3 P0 P1 P2) <= e.
+  Rabs (sel p0 p1 p2 - sel P0 P1 P2) <= e.
 Proof.
-  intros H0 H1 H2. apply Rabs_le_inv in H0. apply Rabs_le_inv in H1. apply Rabs_le_inv in H2.
-  apply Rabs_le. unfold max3, Rmax. repeat destruct Rle_dec; lra.
+  intros Hs H0 H1 H2. apply Rabs_le_inv in H0. apply Rabs_le_inv in H1. apply Rabs_le_inv in H2.
+  apply Rabs_le. destruct Hs as [-> | ->]; unfold max3, min3, Rmax, Rmin; repeat destruct Rle_dec; lra.
 Qed.
-Lemma min3_close p0 p1 p2 P0 P1 P2 e :
-  Rabs (p0 - P0) <= e -> Rabs (p1 - P1) <= e -> Rabs (p2 - P2) <= e ->
-  Rabs (min3 p0 p1 p2 - min3 P0 P1 P2) <= e.
+(* The largest (least) of three values within m in magnitude is. *)
+Lemma sel3_abs_le sel P0 P1 P2 m : is_sel3 sel ->
+  Rabs P0 <= m -> Rabs P1 <= m -> Rabs P2 <= m -> Rabs (sel P0 P1 P2) <= m.
 Proof.
-  intros H0 H1 H2. apply Rabs_le_inv in H0. apply Rabs_le_inv in H1. apply Rabs_le_inv in H2.
-  apply Rabs_le. unfold min3, Rmin. repeat destruct Rle_dec; lra.
-Qed.
-Lemma max3_abs_le P0 P1 P2 m : Rabs P0 <= m -> Rabs P1 <= m -> Rabs P2 <= m -> Rabs (max3 P0 P1 P2) <= m.
-Proof.
-  intros H0 H1 H2. apply Rabs_le_inv in H0. apply Rabs_le_inv in H1. apply Rabs_le_inv in H2.
-  apply Rabs_le. unfold max3, Rmax. repeat destruct Rle_dec; lra.
-Qed.
-Lemma min3_abs_le P0 P1 P2 m : Rabs P0 <= m -> Rabs P1 <= m -> Rabs P2 <= m -> Rabs (min3 P0 P1 P2) <= m.
-Proof.
-  intros H0 H1 H2. apply Rabs_le_inv in H0. apply Rabs_le_inv in H1. apply Rabs_le_inv in H2.
-  apply Rabs_le. unfold min3, Rmin. repeat destruct Rle_dec; lra.
+  intros Hs H0 H1 H2. apply Rabs_le_inv in H0. apply Rabs_le_inv in H1. apply Rabs_le_inv in H2.
+  apply Rabs_le. destruct Hs as [-> | ->]; unfold max3, min3, Rmax, Rmin; repeat destruct Rle_dec; lra.
 Qed.
 Lemma F_max3 p q r : F p -> F q -> F r -> F (max3 p q r).
 Proof. intros. unfold max3, Rmax. repeat destruct Rle_dec; assumption. Qed.
@@ -245,17 +241,17 @@ Proof.
   assert (HA0 : 0 <= Aa) by (unfold Aa; apply Rmult_le_pos; lra).
   (* the computed extremes, within e of the exact ones, which are <= |a|_1 s *)
   assert (Ea_lo : Rabs (a_lo - min3 (edot a x0) (edot a x1) (edot a x2)) <= e)
-    by (apply min3_close; apply cdot_err; assumption).
+    by (apply (sel3_close min3); [exact min3_sel|..]; apply cdot_err; assumption).
   assert (Ea_hi : Rabs (a_hi - max3 (edot a x0) (edot a x1) (edot a x2)) <= e)
-    by (apply max3_close; apply cdot_err; assumption).
+    by (apply (sel3_close max3); [exact max3_sel|..]; apply cdot_err; assumption).
   assert (Eb_lo : Rabs (b_lo - min3 (edot a y0) (edot a y1) (edot a y2)) <= e)
-    by (apply min3_close; apply cdot_err; assumption).
+    by (apply (sel3_close min3); [exact min3_sel|..]; apply cdot_err; assumption).
   assert (Eb_hi : Rabs (b_hi - max3 (edot a y0) (edot a y1) (edot a y2)) <= e)
-    by (apply max3_close; apply cdot_err; assumption).
-  assert (Ma_lo : Rabs (min3 (edot a x0) (edot a x1) (edot a x2)) <= Aa) by (apply min3_abs_le; apply edot_le; assumption).
-  assert (Ma_hi : Rabs (max3 (edot a x0) (edot a x1) (edot a x2)) <= Aa) by (apply max3_abs_le; apply edot_le; assumption).
-  assert (Mb_lo : Rabs (min3 (edot a y0) (edot a y1) (edot a y2)) <= Aa) by (apply min3_abs_le; apply edot_le; assumption).
-  assert (Mb_hi : Rabs (max3 (edot a y0) (edot a y1) (edot a y2)) <= Aa) by (apply max3_abs_le; apply edot_le; assumption).
+    by (apply (sel3_close max3); [exact max3_sel|..]; apply cdot_err; assumption).
+  assert (Ma_lo : Rabs (min3 (edot a x0) (edot a x1) (edot a x2)) <= Aa) by (apply (sel3_abs_le min3); [exact min3_sel|..]; apply edot_le; assumption).
+  assert (Ma_hi : Rabs (max3 (edot a x0) (edot a x1) (edot a x2)) <= Aa) by (apply (sel3_abs_le max3); [exact max3_sel|..]; apply edot_le; assumption).
+  assert (Mb_lo : Rabs (min3 (edot a y0) (edot a y1) (edot a y2)) <= Aa) by (apply (sel3_abs_le min3); [exact min3_sel|..]; apply edot_le; assumption).
+  assert (Mb_hi : Rabs (max3 (edot a y0) (edot a y1) (edot a y2)) <= Aa) by (apply (sel3_abs_le max3); [exact max3_sel|..]; apply edot_le; assumption).
   set (XL := min3 (edot a x0) (edot a x1) (edot a x2)) in *.
   set (XH := max3 (edot a x0) (edot a x1) (edot a x2)) in *.
   set (YL := min3 (edot a y0) (edot a y1) (edot a y2)) in *.

@@ -10,11 +10,11 @@
      and every half extent is at least 2^-1001;
    - obb_axis_rounding: |C| + kObbAxisRounding, as obb_separated computes it,
      bounds the exact |a_i . b_j|;
-   - obb_separation_face_a, obb_separation_face_b: when obb_separated's test
-     along one of the six face axes holds, the swept posed box and the
+   - obb_separation_face: when obb_separated's test along one of the six
+     face axes holds, the swept posed box and the
      obstacle's box (as sets over the reals, with the double axes) have no
      common point (kObbSeparationRounding).
-   Not here: the nine cross axes a_i x b_j of obb_separated (see README). *)
+   The nine cross axes a_i x b_j of obb_separated: ObbCrossAxes.v. *)
 From Coq Require Import Reals Psatz List.
 Import ListNotations.
 From Flocq Require Import Core.
@@ -89,18 +89,25 @@ Qed.
 Lemma abs_of_sq x y : 0 <= y -> x * x <= y * y -> Rabs x <= y.
 Proof. intros. apply Rabs_le. split; nra. Qed.
 
-(* A near-unit axis a and a vector E with |E|^2 <= g^2: |a . E| <= (1 + e) g. *)
-Lemma unit_dot_ball e a E g : 0 <= e <= / 100 -> 0 <= g -> Rabs (vdot a a - 1) <= e -> vdot E E <= g * g ->
+Lemma vdot_self_pos a : 0 <= vdot a a.
+Proof. unfold vdot. pose proof (Rle_0_sqr (v0 a)). pose proof (Rle_0_sqr (v1 a)). pose proof (Rle_0_sqr (v2 a)). unfold Rsqr in *. lra. Qed.
+
+(* A vector a with |a|^2 <= 1 + e and a vector E with |E|^2 <= g^2: |a . E| <= (1 + e) g. *)
+Lemma ball_le e a E g : 0 <= e <= / 100 -> 0 <= g -> vdot a a <= 1 + e -> vdot E E <= g * g ->
   Rabs (vdot a E) <= (1 + e) * g.
 Proof.
   intros He Hg Ha HE. apply abs_of_sq; [nra|].
-  pose proof (cs_sq a E). assert (vdot a a <= 1 + e) by (unfold Rabs in Ha; destruct Rcase_abs; lra).
-  assert (0 <= vdot E E) by (unfold vdot; nra). assert (0 <= vdot a a) by (unfold vdot; nra).
+  pose proof (cs_sq a E). pose proof (vdot_self_pos E). pose proof (vdot_self_pos a).
   assert (vdot a a * vdot E E <= (1 + e) * (g * g)) by (apply Rmult_le_compat; lra).
   assert (0 <= e * (1 + e) * (g * g)) by (apply Rmult_le_pos; [nra | apply Rle_0_sqr]).
   assert ((1 + e) * (g * g) <= ((1 + e) * g) * ((1 + e) * g)) by nra.
   lra.
 Qed.
+
+(* A near-unit axis a and a vector E with |E|^2 <= g^2: |a . E| <= (1 + e) g. *)
+Lemma unit_dot_ball e a E g : 0 <= e <= / 100 -> 0 <= g -> Rabs (vdot a a - 1) <= e -> vdot E E <= g * g ->
+  Rabs (vdot a E) <= (1 + e) * g.
+Proof. intros He Hg Ha HE. apply ball_le; try assumption. unfold Rabs in Ha; destruct Rcase_abs; lra. Qed.
 
 (* Any vector w in a frame orthonormal to within e: w = sum_j (x_j . w) x_j + r,
    |r_m| <= e |w|_1 (the rows' Gram matrix). *)
@@ -151,11 +158,10 @@ Proof.
   assert (0 <= 302 / 100 * u) by lra. nra.
 Qed.
 
-(* |a|_1 <= sqrt 3 (1 + e) for a near-unit axis. *)
-Lemma norm1_unit e a : 0 <= e <= / 1000000000000 -> Rabs (vdot a a - 1) <= e -> vnorm1 a <= 1733 / 1000.
+(* |a|_1 <= sqrt 3 (1 + e) <= 1.733 for |a|^2 <= 1 + e. *)
+Lemma norm1_le e a : 0 <= e <= / 1000 -> vdot a a <= 1 + e -> vnorm1 a <= 1733 / 1000.
 Proof.
-  intros He Ha. unfold vnorm1, vdot in *.
-  assert (v0 a * v0 a + v1 a * v1 a + v2 a * v2 a <= 1 + e) by (unfold Rabs in Ha; destruct Rcase_abs; lra).
+  intros He H. unfold vnorm1, vdot in *.
   rewrite <- (abs_sq (v0 a)), <- (abs_sq (v1 a)), <- (abs_sq (v2 a)) in H.
   pose proof (Rabs_pos (v0 a)). pose proof (Rabs_pos (v1 a)). pose proof (Rabs_pos (v2 a)).
   set (x := Rabs (v0 a)) in *. set (y := Rabs (v1 a)) in *. set (z := Rabs (v2 a)) in *.
@@ -164,6 +170,10 @@ Proof.
   assert ((x + y + z) * (x + y + z) <= 1733 / 1000 * (1733 / 1000)) by lra.
   destruct (Rle_or_lt (x + y + z) (1733 / 1000)); [lra | nra].
 Qed.
+
+(* |a|_1 <= sqrt 3 (1 + e) for a near-unit axis. *)
+Lemma norm1_unit e a : 0 <= e <= / 1000000000000 -> Rabs (vdot a a - 1) <= e -> vnorm1 a <= 1733 / 1000.
+Proof. intros He Ha. apply (norm1_le e); [lra | unfold Rabs in Ha; destruct Rcase_abs; lra]. Qed.
 
 (* eta against kUnderflowFloor and 2^-1000. *)
 Lemma bpow_le_floor : bpow radix2 (-1000) <= / IZR (Z.pow 10 300).
@@ -500,6 +510,15 @@ Proof. unfold cdot, Allowances.dot3. rewrite (Rmult_comm (v0 a)), (Rmult_comm (v
 
 Lemma kSep_ge : 99 / 100 * / 100000000000 <= kObbSeparationRounding.
 Proof. unfold kObbSeparationRounding. pose proof (fl_lower (/ 100000000000) ltac:(lra)). pose proof eta_small. pose proof u_tiny. simpl in *. lra. Qed.
+Lemma kSep_scaled s : 0 <= s ->
+  kObbSeparationRounding <= / 10000000000 /\ 0 <= kObbSeparationRounding * s /\
+  kObbSeparationRounding * s <= / 10000000000 * s /\ 99 / 100 * / 100000000000 * s <= kObbSeparationRounding * s.
+Proof.
+  intros Hs. pose proof kSep_ge.
+  assert (K : kObbSeparationRounding <= / 10000000000).
+  { unfold kObbSeparationRounding. pose proof (fl_upper (/ 100000000000) ltac:(lra)). pose proof eta_small. pose proof u_tiny. simpl in *. lra. }
+  split; [exact K|]. split; [apply Rmult_le_pos; lra|]. split; apply Rmult_le_compat_r; lra.
+Qed.
 
 Lemma add_lin x y B : F x -> F y -> Rabs (x + y) <= B -> Rabs (fl (x + y) - (x + y)) <= u * B.
 Proof. intros. eapply Rle_trans; [apply add_rel; assumption|]. apply mul_le_l; [unfold u; lra | assumption]. Qed.
@@ -583,6 +602,43 @@ Proof.
   assert (0 <= e * s) by (apply Rmult_le_pos; lra). lra.
 Qed.
 
+(* t_w = cb - (ca + hs) per coordinate, projected on a near-unit axis and
+   computed: within 14 u s + 5.02 eta of the exact projection of cb - ca - hs. *)
+Lemma tw_err (L ca cb hs : V) s : vnorm1 L <= 1733 / 1000 -> FV ca -> FV cb -> FV hs ->
+  vinf_le ca s -> vinf_le cb s -> vinf_le hs s -> vinf_le (tw_c ca cb hs) s ->
+  Rabs (cdot L (tw_c ca cb hs) - vdot L (vsub (vsub cb ca) hs)) <= 14 * (u * s) + 502 / 100 * eta.
+Proof.
+  intros NL Fca Fcb Fhs Hca Hcb Hhs Htw.
+  pose proof u_tiny. pose proof eta_pos.
+  assert (Hs : 0 <= s) by (destruct Hca as (C0 & _); pose proof (Rabs_pos (v0 ca)); lra).
+  assert (Tm : forall c b d, F c -> F b -> F d -> Rabs c <= s -> Rabs b <= s -> Rabs d <= s ->
+            Rabs (fl (b - fl (c + d)) - (b - c - d)) <= 501 / 100 * (u * s)).
+  { intros c b d Fc Fb Fd Hc Hb Hd.
+    assert (S1 : Rabs (c + d) <= 2 * s) by (eapply Rle_trans; [apply Rabs_triang | lra]).
+    pose proof (add_lin c d (2 * s) Fc Fd S1) as E1.
+    assert (Rabs (fl (c + d)) <= 2 * s + u * (2 * s))
+      by (replace (fl (c + d)) with ((c + d) + (fl (c + d) - (c + d))) by ring; eapply Rle_trans; [apply Rabs_triang | lra]).
+    assert (S3 : Rabs (b - fl (c + d)) <= 3 * s + u * (2 * s))
+      by (eapply Rle_trans; [apply Rabs_triang|]; rewrite Rabs_Ropp; lra).
+    pose proof (sub_lin b (fl (c + d)) _ Fb (F_fl _) S3) as E2.
+    replace (fl (b - fl (c + d)) - (b - c - d)) with ((fl (b - fl (c + d)) - (b - fl (c + d))) - (fl (c + d) - (c + d))) by ring.
+    eapply Rle_trans; [apply Rabs_triang|]. rewrite Rabs_Ropp.
+    assert (0 <= u * s) by (apply Rmult_le_pos; lra).
+    assert (u * (3 * s + u * (2 * s)) <= 301 / 100 * (u * s)) by (unfold u in *; lra). lra. }
+  destruct Fca as (Fa0 & Fa1 & Fa2). destruct Fcb as (Fb0 & Fb1 & Fb2). destruct Fhs as (Fs0 & Fs1 & Fs2).
+  destruct Hca as (Ca0 & Ca1 & Ca2). destruct Hcb as (Cb0 & Cb1 & Cb2). destruct Hhs as (Hs0 & Hs1 & Hs2).
+  pose proof (Tm _ _ _ Fa0 Fb0 Fs0 Ca0 Cb0 Hs0) as T0. pose proof (Tm _ _ _ Fa1 Fb1 Fs1 Ca1 Cb1 Hs1) as T1.
+  pose proof (Tm _ _ _ Fa2 Fb2 Fs2 Ca2 Cb2 Hs2) as T2.
+  set (t := vsub (vsub cb ca) hs). set (tw := tw_c ca cb hs) in *.
+  assert (Dtw : Rabs (vdot L tw - vdot L t) <= 1733 / 1000 * (501 / 100 * (u * s))).
+  { replace (vdot L tw - vdot L t) with (vdot L (vsub tw t)) by (unfold vdot, vsub; simpl; ring).
+    apply dot_unit; [exact NL | repeat split; unfold tw, t, tw_c, vsub; simpl; assumption]. }
+  pose proof (cdot_unit L tw s NL Htw) as Dta.
+  replace (cdot L tw - vdot L t) with ((cdot L tw - vdot L tw) + (vdot L tw - vdot L t)) by ring.
+  assert (0 <= u * s) by (apply Rmult_le_pos; lra).
+  eapply Rle_trans; [apply Rabs_triang|]. lra.
+Qed.
+
 (* The rounding half of a face axis: the exact bound of |L . t| (h, the
    other box's sum, the axes' 16 e s, (1 + e) grow, |L . hs|) against the
    test the code computes. *)
@@ -606,30 +662,8 @@ Proof.
   fold (axis_entry L f0) in A0, A0'. fold (axis_entry L f1) in A1, A1'. fold (axis_entry L f2) in A2, A2'.
   set (a0 := axis_entry L f0) in *. set (a1 := axis_entry L f1) in *. set (a2 := axis_entry L f2) in *.
   (* t_w against the exact t *)
-  set (t := vsub (vsub cb ca) hs). set (tw := tw_c ca cb hs) in *.
-  assert (Tm : forall c b d, F c -> F b -> F d -> Rabs c <= s -> Rabs b <= s -> Rabs d <= s ->
-            Rabs (fl (b - fl (c + d)) - (b - c - d)) <= 501 / 100 * (u * s)).
-  { intros c b d Fc Fb Fd Hc Hb Hd.
-    assert (Rabs (c + d) <= 2 * s) by (eapply Rle_trans; [apply Rabs_triang | lra]).
-    pose proof (add_lin c d (2 * s) Fc Fd H2) as E1.
-    assert (Rabs (fl (c + d)) <= 2 * s + u * (2 * s))
-      by (replace (fl (c + d)) with ((c + d) + (fl (c + d) - (c + d))) by ring; eapply Rle_trans; [apply Rabs_triang | lra]).
-    assert (Rabs (b - fl (c + d)) <= 3 * s + u * (2 * s))
-      by (eapply Rle_trans; [apply Rabs_triang|]; rewrite Rabs_Ropp; lra).
-    pose proof (sub_lin b (fl (c + d)) _ Fb (F_fl _) H4) as E2.
-    replace (fl (b - fl (c + d)) - (b - c - d)) with ((fl (b - fl (c + d)) - (b - fl (c + d))) - (fl (c + d) - (c + d))) by ring.
-    eapply Rle_trans; [apply Rabs_triang|]. rewrite Rabs_Ropp.
-    assert (0 <= u * s) by (apply Rmult_le_pos; lra).
-    assert (u * (3 * s + u * (2 * s)) <= 301 / 100 * (u * s)) by (unfold u in *; lra). lra. }
-  destruct FL as (FL0 & FL1 & FL2). destruct Fca as (Fa0 & Fa1 & Fa2). destruct Fcb as (Fb0 & Fb1 & Fb2).
-  destruct Fhs as (Fs0 & Fs1 & Fs2). destruct Hca as (Ca0 & Ca1 & Ca2). destruct Hcb as (Cb0 & Cb1 & Cb2).
-  pose proof Hhs as Hhs'. destruct Hhs' as (Hs0 & Hs1' & Hs2).
-  pose proof (Tm _ _ _ Fa0 Fb0 Fs0 Ca0 Cb0 Hs0) as T0. pose proof (Tm _ _ _ Fa1 Fb1 Fs1 Ca1 Cb1 Hs1') as T1.
-  pose proof (Tm _ _ _ Fa2 Fb2 Fs2 Ca2 Cb2 Hs2) as T2.
-  assert (Dtw : Rabs (vdot L tw - vdot L t) <= 1733 / 1000 * (501 / 100 * (u * s))).
-  { replace (vdot L tw - vdot L t) with (vdot L (vsub tw t)) by (unfold vdot, vsub; simpl; ring).
-    apply dot_unit; [exact NL | repeat split; unfold tw, t, tw_c, vsub; simpl; assumption]. }
-  pose proof (cdot_unit L tw s NL Htw) as Dta.
+  pose proof (tw_err L ca cb hs s NL Fca Fcb Fhs Hca Hcb Hhs Htw) as Dt.
+  set (t := vsub (vsub cb ca) hs) in *. set (tw := tw_c ca cb hs) in *.
   (* the reach *)
   set (S := Allowances.dot3 a0 a1 a2 k0 k1 k2).
   pose proof (dot3_err a0 a1 a2 k0 k1 k2) as DS. fold S in DS.
@@ -671,11 +705,7 @@ Proof.
   set (reach := fl (r1 + d)) in *.
   (* the slack g *)
   pose proof kSep_ge as Ks.
-  assert (Ks' : kObbSeparationRounding <= / 10000000000).
-  { unfold kObbSeparationRounding. pose proof (fl_upper (/ 100000000000) ltac:(lra)). pose proof eta_small. simpl in *. lra. }
-  assert (0 <= kObbSeparationRounding * s) by (apply Rmult_le_pos; lra).
-  assert (Kss : kObbSeparationRounding * s <= / 10000000000 * s) by (apply Rmult_le_compat_r; lra).
-  assert (Ksl : 99 / 100 * / 100000000000 * s <= kObbSeparationRounding * s) by (apply Rmult_le_compat_r; lra).
+  destruct (kSep_scaled s ltac:(lra)) as (Ks' & Ks0 & Kss & Ksl).
   pose proof (fl_err (kObbSeparationRounding * s)) as E3. rewrite (Rabs_pos_eq (kObbSeparationRounding * s)) in E3 by lra.
   assert (u * (kObbSeparationRounding * s) <= u * s) by (apply mul_le_l; lra).
   set (ks := fl (kObbSeparationRounding * s)) in *.
@@ -692,9 +722,9 @@ Proof.
   assert (Heg : e * grow <= e * s) by (apply mul_le_l; lra).
   assert (0 <= e * grow) by (apply Rmult_le_pos; lra).
   (* |L . t| from |cdot L tw| *)
-  assert (Lt : Rabs (cdot L tw) <= Rabs (vdot L t) + 1733 / 1000 * (501 / 100 * (u * s)) + (524 / 100 * (u * s) + 502 / 100 * eta)).
-  { replace (cdot L tw) with (vdot L t + (vdot L tw - vdot L t) + (cdot L tw - vdot L tw)) by ring.
-    eapply Rle_trans; [apply Rabs_triang|]. eapply Rle_trans; [apply Rplus_le_compat_r, Rabs_triang|]. lra. }
+  assert (Lt : Rabs (cdot L tw) <= Rabs (vdot L t) + (14 * (u * s) + 502 / 100 * eta)).
+  { replace (cdot L tw) with (vdot L t + (cdot L tw - vdot L t)) by ring.
+    eapply Rle_trans; [apply Rabs_triang|]. lra. }
   destruct (abs_both _ _ E1). destruct (abs_both _ _ E2). destruct (abs_both _ _ E3). destruct (abs_both _ _ E4).
   destruct (abs_both _ _ E5). destruct (abs_both _ _ Dd'). assert (0 <= d) by apply Rabs_pos.
   unfold u in *; lra.
@@ -730,89 +760,97 @@ Definition obb_sizes (ca cb hs : V) ha0 ha1 ha2 hb0 hb1 hb2 grow s :=
   0 <= grow <= s /\ vinf_le ca s /\ vinf_le cb s /\ vinf_le hs s /\ vinf_le (tw_c ca cb hs) s /\
   bpow radix2 (-1001) <= s.
 
-(* covers optimized/gauss6/ccd/motion_bounds.h "GAUSS6_ALWAYS_INLINE bool obb_separated_as(const PosedObb& a, const Obb& b)" sha256:d562414b9fe2bde6 *)
-Theorem obb_separation_face_a e (a0 a1 a2 b0 b1 b2 ca cb hs L : V) ha0 ha1 ha2 hb0 hb1 hb2 hL grow s :
-  (forall v, In v [a0; a1; a2; b0; b1; b2; ca; cb; hs] -> FV v) ->
-  (forall x, In x [ha0; ha1; ha2; hb0; hb1; hb2; grow; s] -> F x) ->
-  ortho e a0 a1 a2 -> ortho e b0 b1 b2 -> 0 <= e <= bpow radix2 (-46) ->
-  obb_sizes ca cb hs ha0 ha1 ha2 hb0 hb1 hb2 grow s ->
-  (L = a0 /\ hL = ha0) \/ (L = a1 /\ hL = ha1) \/ (L = a2 /\ hL = ha2) ->
-  Rabs (cdot L (tw_c ca cb hs)) > fl (face_reach hL L b0 b1 b2 hb0 hb1 hb2 hs + sep_slack grow s) ->
-  forall X, ~ (in_swept a0 a1 a2 ca ha0 ha1 ha2 hs grow X /\ in_box b0 b1 b2 cb hb0 hb1 hb2 X).
+(* One face axis L of either box, the roles as parameters: L with its half
+   extent hL and the part wown of the common point in L's own box, the other
+   box's axes f_j with half extents k_j and the part woth in its box, and
+   the sweep's terms E, sigma (for either box's L, t = cb - ca - hs is
+   +-(wown - woth) + E + sigma hs). *)
+Lemma face_separates e (L f0 f1 f2 ca cb hs wown woth E : V) hL k0 k1 k2 grow s sigma :
+  FV L -> FV ca -> FV cb -> FV hs -> F hL -> F k0 -> F k1 -> F k2 -> F grow -> F s ->
+  ortho e f0 f1 f2 -> 0 <= e <= bpow radix2 (-46) -> Rabs (vdot L L - 1) <= e ->
+  0 <= hL <= s -> 0 <= k0 <= s -> 0 <= k1 <= s -> 0 <= k2 <= s -> 0 <= grow <= s ->
+  vinf_le ca s -> vinf_le cb s -> vinf_le hs s -> vinf_le (tw_c ca cb hs) s -> bpow radix2 (-1001) <= s ->
+  Rabs (cdot L (tw_c ca cb hs)) > fl (face_reach hL L f0 f1 f2 k0 k1 k2 hs + sep_slack grow s) ->
+  Rabs (vdot L wown) <= hL -> Rabs (vdot f0 woth) <= k0 -> Rabs (vdot f1 woth) <= k1 -> Rabs (vdot f2 woth) <= k2 ->
+  vdot E E <= grow * grow -> Rabs sigma <= 1 ->
+  Rabs (vdot L (vsub (vsub cb ca) hs)) <=
+    Rabs (vdot L wown) + Rabs (vdot L woth) + Rabs (vdot L E) + Rabs sigma * Rabs (vdot L hs) ->
+  False.
 Proof.
-  intros HV HF Hoa Hob He Hz HL T X [(sigma & E & Hsg & HE & Ha) Hb].
-  destruct Hz as (Z0 & Z1 & Z2 & Z3 & Z4 & Z5 & Zg & Zca & Zcb & Zhs & Ztw & Zs).
+  intros FL Fca Fcb Fhs Fh Fk0 Fk1 Fk2 Fg Fs Ho He HLu Hh Hk0 Hk1 Hk2 Hg Hca Hcb Hhs Htw Hs1 T Wown W0 W1 W2 HE Hsg Ht.
   pose proof (e_small e He) as He'.
-  assert (HLs : Rabs (vdot L L - 1) <= e /\ Rabs (vdot L (vsub (vsub (vsub X E) (vscale (1 + sigma) hs)) ca)) <= hL /\ FV L /\ 0 <= hL <= s).
-  { destruct Hoa as (_ & Ux & Uy & Uz & _). destruct Ha as (Ha0 & Ha1 & Ha2).
-    destruct HL as [[-> ->] | [[-> ->] | [-> ->]]]; repeat split; try assumption; try lra;
-      try (apply HV; simpl; tauto). }
-  destruct HLs as (HLu & HLw & FL & Hh).
   assert (NL : vnorm1 L <= 1733 / 1000) by (apply (norm1_unit e); assumption).
-  pose proof (face_round e L b0 b1 b2 ca cb hs hL hb0 hb1 hb2 grow s FL
-                (HV ca ltac:(simpl; tauto)) (HV cb ltac:(simpl; tauto)) (HV hs ltac:(simpl; tauto))
-                ltac:(destruct HL as [[_ ->] | [[_ ->] | [_ ->]]]; apply HF; simpl; tauto)
-                (HF hb0 ltac:(simpl; tauto)) (HF hb1 ltac:(simpl; tauto)) (HF hb2 ltac:(simpl; tauto))
-                (HF grow ltac:(simpl; tauto)) (HF s ltac:(simpl; tauto))
-                Hob He HLu Hh Z3 Z4 Z5 Zg Zca Zcb Zhs Ztw Zs T) as R.
-  destruct Hb as (Hb0 & Hb1 & Hb2).
-  set (t := vsub (vsub cb ca) hs) in *.
-  set (wown := vsub (vsub (vsub X E) (vscale (1 + sigma) hs)) ca) in *.
-  set (woth := vsub X cb) in *.
-  assert (Ht : vdot L t = vdot L wown - vdot L woth + vdot L E + sigma * vdot L hs)
-    by (unfold t, wown, woth, vdot, vsub, vscale; simpl; ring).
-  assert (Ht' : Rabs (vdot L t) <= Rabs (vdot L wown) + Rabs (vdot L woth) + Rabs (vdot L E) + Rabs sigma * Rabs (vdot L hs)).
-  { rewrite Ht. eapply Rle_trans; [apply abs4|]. rewrite Rabs_mult. lra. }
-  pose proof (face_exact e L b0 b1 b2 wown woth E hs t hL hb0 hb1 hb2 grow s sigma Hob He' HLu NL HLw Hb0 Hb1 Hb2
-                ltac:(lra) ltac:(lra) ltac:(lra) ltac:(lra) HE Hsg Ht').
+  pose proof (face_round e L f0 f1 f2 ca cb hs hL k0 k1 k2 grow s FL Fca Fcb Fhs Fh Fk0 Fk1 Fk2 Fg Fs
+                Ho He HLu Hh Hk0 Hk1 Hk2 Hg Hca Hcb Hhs Htw Hs1 T) as R.
+  pose proof (face_exact e L f0 f1 f2 wown woth E hs (vsub (vsub cb ca) hs) hL k0 k1 k2 grow s sigma Ho He' HLu NL
+                Wown W0 W1 W2 ltac:(lra) ltac:(lra) ltac:(lra) ltac:(lra) HE Hsg Ht).
   lra.
 Qed.
-Print Assumptions obb_separation_face_a.
 
+(* An axis L of a frame f (hL its half extent) and a point w of the box:
+   what face_separates asks of L. *)
+Lemma face_role e (L f0 f1 f2 w : V) hL h0 h1 h2 s : ortho e f0 f1 f2 -> FV f0 -> FV f1 -> FV f2 ->
+  F h0 -> F h1 -> F h2 -> 0 <= h0 <= s -> 0 <= h1 <= s -> 0 <= h2 <= s ->
+  Rabs (vdot f0 w) <= h0 -> Rabs (vdot f1 w) <= h1 -> Rabs (vdot f2 w) <= h2 ->
+  (L = f0 /\ hL = h0) \/ (L = f1 /\ hL = h1) \/ (L = f2 /\ hL = h2) ->
+  Rabs (vdot L L - 1) <= e /\ Rabs (vdot L w) <= hL /\ FV L /\ 0 <= hL <= s /\ F hL.
+Proof.
+  intros (_ & U0 & U1 & U2 & _) F0 F1 F2 G0 G1 G2 H0 H1 H2 W0 W1 W2 HL.
+  destruct HL as [[-> ->] | [[-> ->] | [-> ->]]]; tauto.
+Qed.
+
+(* The six face axes: L = a_i (hL = ha_i) with reach's row of A = |C| +
+   kObbAxisRounding, or L = b_j (hL = hb_j) with its column (A(i, j) computed
+   from C(i, j) = a_i . b_j). *)
 (* covers optimized/gauss6/ccd/motion_bounds.h "GAUSS6_ALWAYS_INLINE bool obb_separated_as(const PosedObb& a, const Obb& b)" sha256:d562414b9fe2bde6 *)
-Theorem obb_separation_face_b e (a0 a1 a2 b0 b1 b2 ca cb hs L : V) ha0 ha1 ha2 hb0 hb1 hb2 hL grow s :
+Theorem obb_separation_face e (a0 a1 a2 b0 b1 b2 ca cb hs L : V) ha0 ha1 ha2 hb0 hb1 hb2 hL grow s :
   (forall v, In v [a0; a1; a2; b0; b1; b2; ca; cb; hs] -> FV v) ->
   (forall x, In x [ha0; ha1; ha2; hb0; hb1; hb2; grow; s] -> F x) ->
   ortho e a0 a1 a2 -> ortho e b0 b1 b2 -> 0 <= e <= bpow radix2 (-46) ->
   obb_sizes ca cb hs ha0 ha1 ha2 hb0 hb1 hb2 grow s ->
-  (L = b0 /\ hL = hb0) \/ (L = b1 /\ hL = hb1) \/ (L = b2 /\ hL = hb2) ->
-  (* A(i, j) = |C(i, j)| + kObbAxisRounding with C = a^T b: the column of L *)
-  Rabs (cdot L (tw_c ca cb hs)) >
-    fl (fl (fl (hL + Allowances.dot3 (axis_entry a0 L) (axis_entry a1 L) (axis_entry a2 L) ha0 ha1 ha2)
-            + Rabs (cdot L hs)) + sep_slack grow s) ->
+  ((L = a0 /\ hL = ha0) \/ (L = a1 /\ hL = ha1) \/ (L = a2 /\ hL = ha2)) /\
+    Rabs (cdot L (tw_c ca cb hs)) > fl (face_reach hL L b0 b1 b2 hb0 hb1 hb2 hs + sep_slack grow s)
+  \/ ((L = b0 /\ hL = hb0) \/ (L = b1 /\ hL = hb1) \/ (L = b2 /\ hL = hb2)) /\
+    Rabs (cdot L (tw_c ca cb hs)) >
+      fl (fl (fl (hL + Allowances.dot3 (axis_entry a0 L) (axis_entry a1 L) (axis_entry a2 L) ha0 ha1 ha2)
+              + Rabs (cdot L hs)) + sep_slack grow s) ->
   forall X, ~ (in_swept a0 a1 a2 ca ha0 ha1 ha2 hs grow X /\ in_box b0 b1 b2 cb hb0 hb1 hb2 X).
 Proof.
-  intros HV HF Hoa Hob He Hz HL T X [(sigma & E & Hsg & HE & Ha) Hb].
+  intros HV HF Hoa Hob He Hz HLT X [(sigma & E & Hsg & HE & Ha) Hb].
   destruct Hz as (Z0 & Z1 & Z2 & Z3 & Z4 & Z5 & Zg & Zca & Zcb & Zhs & Ztw & Zs).
-  pose proof (e_small e He) as He'.
-  unfold axis_entry in T. rewrite (cdot_comm a0 L), (cdot_comm a1 L), (cdot_comm a2 L) in T.
-  fold (axis_entry L a0) (axis_entry L a1) (axis_entry L a2) in T.
-  fold (face_reach hL L a0 a1 a2 ha0 ha1 ha2 hs) in T.
-  assert (HLs : Rabs (vdot L L - 1) <= e /\ Rabs (vdot L (vsub X cb)) <= hL /\ FV L /\ 0 <= hL <= s).
-  { destruct Hob as (_ & Ux & Uy & Uz & _). destruct Hb as (Hb0 & Hb1 & Hb2).
-    destruct HL as [[-> ->] | [[-> ->] | [-> ->]]]; repeat split; try assumption; try lra;
-      try (apply HV; simpl; tauto). }
-  destruct HLs as (HLu & HLw & FL & Hh).
-  assert (NL : vnorm1 L <= 1733 / 1000) by (apply (norm1_unit e); assumption).
-  pose proof (face_round e L a0 a1 a2 ca cb hs hL ha0 ha1 ha2 grow s FL
-                (HV ca ltac:(simpl; tauto)) (HV cb ltac:(simpl; tauto)) (HV hs ltac:(simpl; tauto))
-                ltac:(destruct HL as [[_ ->] | [[_ ->] | [_ ->]]]; apply HF; simpl; tauto)
-                (HF ha0 ltac:(simpl; tauto)) (HF ha1 ltac:(simpl; tauto)) (HF ha2 ltac:(simpl; tauto))
-                (HF grow ltac:(simpl; tauto)) (HF s ltac:(simpl; tauto))
-                Hoa He HLu Hh Z0 Z1 Z2 Zg Zca Zcb Zhs Ztw Zs T) as R.
-  destruct Ha as (Ha0 & Ha1 & Ha2).
-  set (t := vsub (vsub cb ca) hs) in *.
-  set (woth := vsub (vsub (vsub X E) (vscale (1 + sigma) hs)) ca) in *.
-  set (wown := vsub X cb) in *.
-  assert (Ht : vdot L t = vdot L woth - vdot L wown + vdot L E + sigma * vdot L hs)
-    by (unfold t, wown, woth, vdot, vsub, vscale; simpl; ring).
-  assert (Ht' : Rabs (vdot L t) <= Rabs (vdot L wown) + Rabs (vdot L woth) + Rabs (vdot L E) + Rabs sigma * Rabs (vdot L hs)).
-  { rewrite Ht. eapply Rle_trans; [apply abs4|]. rewrite Rabs_mult. lra. }
-  pose proof (face_exact e L a0 a1 a2 wown woth E hs t hL ha0 ha1 ha2 grow s sigma Hoa He' HLu NL HLw Ha0 Ha1 Ha2
-                ltac:(lra) ltac:(lra) ltac:(lra) ltac:(lra) HE Hsg Ht').
-  lra.
+  assert (Fv : forall v, In v [a0; a1; a2; b0; b1; b2] -> FV v) by (intros v Hv; apply HV; simpl in *; tauto).
+  assert (G : forall x, In x [ha0; ha1; ha2; hb0; hb1; hb2] -> F x) by (intros x Hx; apply HF; simpl in *; tauto).
+  pose proof (G ha0 ltac:(simpl; tauto)) as G0. pose proof (G ha1 ltac:(simpl; tauto)) as G1.
+  pose proof (G ha2 ltac:(simpl; tauto)) as G2. pose proof (G hb0 ltac:(simpl; tauto)) as G3.
+  pose proof (G hb1 ltac:(simpl; tauto)) as G4. pose proof (G hb2 ltac:(simpl; tauto)) as G5.
+  set (t := vsub (vsub cb ca) hs).
+  set (wa := vsub (vsub (vsub X E) (vscale (1 + sigma) hs)) ca) in *.
+  set (wb := vsub X cb) in *.
+  assert (Ht : vdot L t = vdot L wa - vdot L wb + vdot L E + sigma * vdot L hs)
+    by (unfold t, wa, wb, vdot, vsub, vscale; simpl; ring).
+  assert (Ht' : forall p q, (p = wa /\ q = wb \/ p = wb /\ q = wa) ->
+            Rabs (vdot L t) <= Rabs (vdot L p) + Rabs (vdot L q) + Rabs (vdot L E) + Rabs sigma * Rabs (vdot L hs)).
+  { intros p q Hpq. rewrite Ht. eapply Rle_trans; [apply abs4|]. rewrite Rabs_mult.
+    destruct Hpq as [[-> ->] | [-> ->]]; lra. }
+  destruct Ha as (Ha0 & Ha1 & Ha2). destruct Hb as (Hb0 & Hb1 & Hb2).
+  destruct HLT as [[HL T] | [HL T]].
+  - (* L = a_i: L's own part wa, the other box b *)
+    destruct (face_role e L a0 a1 a2 wa hL ha0 ha1 ha2 s Hoa (Fv a0 ltac:(simpl; tauto)) (Fv a1 ltac:(simpl; tauto))
+                (Fv a2 ltac:(simpl; tauto)) G0 G1 G2 Z0 Z1 Z2 Ha0 Ha1 Ha2 HL) as (HLu & HLw & FL & Hh & Fh).
+    apply (face_separates e L b0 b1 b2 ca cb hs wa wb E hL hb0 hb1 hb2 grow s sigma); try assumption;
+      try (apply HV; simpl; tauto); try (apply HF; simpl; tauto).
+    apply Ht'; tauto.
+  - (* L = b_j: L's own part wb, the other box a; A's column, C(i, j) = a_i . L *)
+    unfold axis_entry in T. rewrite (cdot_comm a0 L), (cdot_comm a1 L), (cdot_comm a2 L) in T.
+    fold (axis_entry L a0) (axis_entry L a1) (axis_entry L a2) in T.
+    fold (face_reach hL L a0 a1 a2 ha0 ha1 ha2 hs) in T.
+    destruct (face_role e L b0 b1 b2 wb hL hb0 hb1 hb2 s Hob (Fv b0 ltac:(simpl; tauto)) (Fv b1 ltac:(simpl; tauto))
+                (Fv b2 ltac:(simpl; tauto)) G3 G4 G5 Z3 Z4 Z5 Hb0 Hb1 Hb2 HL) as (HLu & HLw & FL & Hh & Fh).
+    apply (face_separates e L a0 a1 a2 ca cb hs wb wa E hL ha0 ha1 ha2 grow s sigma); try assumption;
+      try (apply HV; simpl; tauto); try (apply HF; simpl; tauto).
+    apply Ht'; tauto.
 Qed.
-Print Assumptions obb_separation_face_b.
+Print Assumptions obb_separation_face.
 
 (* Every half extent fit_obb computes is at least 2^-1001 (kUnderflowFloor). *)
 Lemma fit_half_floor l h scale : F l -> F h -> l <= h -> 0 <= scale -> bpow radix2 (-1001) <= fit_half l h scale.

@@ -1,5 +1,5 @@
-// Tests of the theorems of proofs/ObbSeparation.v: the oriented boxes'
-// allowances (kObbAxisRounding, kObbFitRounding, kUnderflowFloor at fit_obb)
+// Tests of the theorems of proofs/ObbSeparation.v and proofs/ObbCrossAxes.v: the oriented boxes'
+// allowances (kObbAxisRounding, kObbSeparationRounding, kObbFitRounding, kUnderflowFloor at fit_obb)
 // and the frame check near_orthonormal (kObbFrameTolerance) they rest on,
 // computed by the code and checked against exact values in rationals (GMP) on
 // random and adversarial inputs: point sets of every scale from subnormal to
@@ -227,33 +227,65 @@ std::array<QV, 3> edge_vectors(const Mat3& m) {
   return g;
 }
 
-// Whether the swept posed box a (grow 0: the posed box plus the segment
-// [0, 2 half_step]) and the box b are disjoint, decided exactly: both are
+// Whether the exact projections on L of the swept posed box a (grow 0: the
+// posed box plus the segment [0, 2 half_step]; ga its edge half-vectors) and
+// of the box b (gb) are disjoint.
+bool separated_along(const QV& L, const PosedObb& a, const Obb& b, const std::array<QV, 3>& ga,
+                     const std::array<QV, 3>& gb) {
+  mpq_class ra = 0, rb = 0;
+  for (int k = 0; k < 3; ++k) {
+    ra += abs_q(qdot(L, ga[static_cast<size_t>(k)])) * Q(a.half[k]);
+    rb += abs_q(qdot(L, gb[static_cast<size_t>(k)])) * Q(b.half[k]);
+  }
+  const mpq_class s = qdot(L, qv(2 * a.half_step));
+  const QV ca = qv(a.center), cb = qv(b.center);
+  // a's projection: [L.ca + min(0, s) - ra, L.ca + max(0, s) + ra].
+  const mpq_class a_lo = qdot(L, ca) + (s < 0 ? s : mpq_class(0)) - ra, a_hi = qdot(L, ca) + (s > 0 ? s : mpq_class(0)) + ra;
+  const mpq_class b_lo = qdot(L, cb) - rb, b_hi = qdot(L, cb) + rb;
+  return b_lo > a_hi || a_lo > b_hi;
+}
+
+// Whether a (as above) and b are disjoint, decided exactly: both are
 // zonotopes (generators: each box's edge vectors, the step), so a separating
 // axis, if any, is among the cross products of two generators (and the
 // generators' own normals are among those), and a gap > 0 along one proves
 // them apart; none, and they meet.
 bool exactly_disjoint(const PosedObb& a, const Obb& b) {
   const std::array<QV, 3> ga = edge_vectors(a.axes), gb = edge_vectors(b.axes);
-  const QV step = qv(2 * a.half_step);
-  std::vector<QV> gens = {ga[0], ga[1], ga[2], gb[0], gb[1], gb[2], step};
-  const QV ca = qv(a.center), cb = qv(b.center);
+  const std::vector<QV> gens = {ga[0], ga[1], ga[2], gb[0], gb[1], gb[2], qv(2 * a.half_step)};
   for (size_t i = 0; i < gens.size(); ++i)
     for (size_t j = i + 1; j < gens.size(); ++j) {
       const QV L = qcross(gens[i], gens[j]);
       if (L[0] == 0 && L[1] == 0 && L[2] == 0) continue;
-      mpq_class ra = 0, rb = 0;
-      for (int k = 0; k < 3; ++k) {
-        ra += abs_q(qdot(L, ga[static_cast<size_t>(k)])) * Q(a.half[k]);
-        rb += abs_q(qdot(L, gb[static_cast<size_t>(k)])) * Q(b.half[k]);
-      }
-      const mpq_class s = qdot(L, step);
-      // a's projection: [L.ca + min(0, s) - ra, L.ca + max(0, s) + ra].
-      const mpq_class a_lo = qdot(L, ca) + (s < 0 ? s : mpq_class(0)) - ra, a_hi = qdot(L, ca) + (s > 0 ? s : mpq_class(0)) + ra;
-      const mpq_class b_lo = qdot(L, cb) - rb, b_hi = qdot(L, cb) + rb;
-      if (b_lo > a_hi || a_lo > b_hi) return true;
+      if (separated_along(L, a, b, ga, gb)) return true;
     }
   return false;
+}
+
+// Whether one of the six face axes (the boxes' double axes) separates their
+// exact projections: where none does, obb_separated's face tests cannot hold
+// (ObbSeparation.v obb_separation_face), so a "separated" is its cross axes'.
+bool face_axis_separates(const PosedObb& a, const Obb& b) {
+  const std::array<QV, 3> ga = edge_vectors(a.axes), gb = edge_vectors(b.axes);
+  for (int k = 0; k < 3; ++k)
+    if (separated_along(qv(a.axes.col(k)), a, b, ga, gb) || separated_along(qv(b.axes.col(k)), a, b, ga, gb)) return true;
+  return false;
+}
+
+// Moves b's centre from a's (plus the half step) along the unit dir to where
+// the two meet, found by `steps` bisections of [0, 8 S] in doubles, then by a
+// random relative amount from 2^-47 to 1, outwards or inwards.
+void place_at_edge(std::mt19937_64& rng, const PosedObb& a, Obb& b, const Vec3& dir, double S, int steps) {
+  std::uniform_real_distribution<double> pos(0, 1);
+  std::uniform_int_distribution<int> pick(0, 3), ex(-47, 0);
+  double lo = 0, hi = 8 * S;
+  for (int it = 0; it < steps; ++it) {
+    const double mid = 0.5 * (lo + hi);
+    b.center = a.center + a.half_step + mid * dir;
+    (exactly_disjoint(a, b) ? hi : lo) = mid;
+  }
+  const double d = hi * (1 + (pick(rng) < 2 ? 1 : -1) * std::ldexp(pos(rng), ex(rng)));
+  b.center = a.center + a.half_step + d * dir;
 }
 
 // A frame near_orthonormal accepts: a rotation, its entries moved by up to
@@ -270,17 +302,17 @@ Mat3 noisy_rotation(std::mt19937_64& rng, double noise) {
 
 }  // namespace
 
-// obb_separation_face_a / _b (and, not yet proved, the cross axes):
+// obb_separation_face and obb_separation_cross (ObbCrossAxes.v):
 // obb_separated never calls two boxes apart that meet, decided exactly in
 // rationals, for frames at the edge of near_orthonormal (entries moved by up
 // to 3e-15), boxes placed to touch or nearly (the obstacle's centre moved
 // along a random direction to the distance where they meet, found to 2^-45,
 // then by relative amounts from 2^-47 to 1), flat boxes (half extent at the floor) and
 // moving and still god boxes. Also: both answers occur.
-TEST_CASE("obb_separated never separates boxes that meet, decided exactly (ObbSeparation.v obb_separation_face_a, _b)", "[proved]") {
+TEST_CASE("obb_separated never separates boxes that meet, decided exactly (ObbSeparation.v obb_separation_face, ObbCrossAxes.v)", "[proved]") {
   std::mt19937_64 rng(45454);
   std::uniform_real_distribution<double> unit(-1, 1), pos(0, 1);
-  std::uniform_int_distribution<int> pick(0, 3), ex(-47, 0), scale(-300, 300);
+  std::uniform_int_distribution<int> pick(0, 3), scale(-300, 300);
   int separated = 0, met = 0;
   for (int n = 0; n < 300; ++n) {
     const double S = std::ldexp(1.0, scale(rng));
@@ -296,15 +328,7 @@ TEST_CASE("obb_separated never separates boxes that meet, decided exactly (ObbSe
     b.axes = noisy_rotation(rng, noise);
     for (int k = 0; k < 3; ++k) b.half[k] = pick(rng) == 0 ? 0x1p-996 : S * pos(rng);
     // Along a random direction, the distance at which the two meet, by bisection in doubles, then moved.
-    const Vec3 dir = Vec3(unit(rng), unit(rng), unit(rng)).normalized();
-    double lo = 0, hi = 8 * S;
-    for (int it = 0; it < 48; ++it) {
-      const double mid = 0.5 * (lo + hi);
-      b.center = a.center + a.half_step + mid * dir;
-      (exactly_disjoint(a, b) ? hi : lo) = mid;
-    }
-    const double d = hi * (1 + (pick(rng) < 2 ? 1 : -1) * std::ldexp(pos(rng), ex(rng)));
-    b.center = a.center + a.half_step + d * dir;
+    place_at_edge(rng, a, b, Vec3(unit(rng), unit(rng), unit(rng)).normalized(), S, 48);
     if (obb_separated(a, b)) {
       ++separated;
       REQUIRE(exactly_disjoint(a, b));
@@ -313,5 +337,45 @@ TEST_CASE("obb_separated never separates boxes that meet, decided exactly (ObbSe
     }
   }
   CHECK(separated > 50);
+  CHECK(met > 50);
+}
+
+// obb_separation_cross (ObbCrossAxes.v), the nine cross axes at their edge:
+// two rods (one long half extent each, a_i's and b_j's, the others thin or at
+// the floor) crossing, the obstacle's moved along a_i x b_j (in doubles) to
+// the distance where they meet (found to 2^-77 S by bisection in doubles, S
+// the scale), then by relative amounts from 2^-47 to 1; frames at the edge of
+// near_orthonormal, moving and still. Where obb_separated says apart, they are, decided exactly;
+// and in many of those no face axis separates them: a cross axis did.
+TEST_CASE("obb_separated's cross axes never separate boxes that meet, decided exactly (ObbCrossAxes.v obb_separation_cross)", "[proved]") {
+  std::mt19937_64 rng(4545);
+  std::uniform_real_distribution<double> unit(-1, 1), pos(0.5, 1);
+  std::uniform_int_distribution<int> pick(0, 3), axis(0, 2), scale(-300, 300);
+  int by_cross = 0, met = 0;
+  for (int n = 0; n < 400; ++n) {
+    const double S = std::ldexp(1.0, scale(rng));
+    const double noise = pick(rng) == 0 ? 0 : 3e-15;
+    const int i = axis(rng), j = axis(rng);
+    PosedObb a;
+    a.axes = noisy_rotation(rng, noise);
+    a.center = S * Vec3(unit(rng), unit(rng), unit(rng));
+    for (int k = 0; k < 3; ++k) a.half[k] = k == i ? S * pos(rng) : pick(rng) == 0 ? 0x1p-996 : S * 0x1p-20 * pos(rng);
+    a.half_step = pick(rng) < 2 ? Vec3(Vec3::Zero()) : Vec3(S * 0x1p-10 * Vec3(unit(rng), unit(rng), unit(rng)));
+    a.still = (a.half_step.array() == 0).all();
+    a.grow = 0;
+    Obb b;
+    b.axes = noisy_rotation(rng, noise);
+    for (int k = 0; k < 3; ++k) b.half[k] = k == j ? S * pos(rng) : pick(rng) == 0 ? 0x1p-996 : S * 0x1p-20 * pos(rng);
+    const Vec3 dir = a.axes.col(i).cross(b.axes.col(j)).normalized();
+    if (!std::isfinite(dir.x()) || dir.norm() < 0.5) continue;
+    place_at_edge(rng, a, b, dir, S, 80);
+    if (obb_separated(a, b)) {
+      REQUIRE(exactly_disjoint(a, b));
+      if (!face_axis_separates(a, b)) ++by_cross;
+    } else {
+      ++met;
+    }
+  }
+  CHECK(by_cross > 50);
   CHECK(met > 50);
 }
