@@ -148,7 +148,8 @@ void bind_quasistatics(py::module_& m) {
         "Returns a Projection with .ac, .lam, .active, .status, .iterations, the KKT residuals and kkt_relative\n"
         "(their scale-free form; 'optimal' only when it is within settings.certificate_tol). Input out of the\n"
         "solver's range (non-finite, M not SPD, a length |au|_M, |J_k|_{M^-1} or |b_k|/|J_k|_{M^-1} outside\n"
-        "[1e-100, 1e100], 0 allowed) is refused: status 'bad_input', .problem names it.");
+        "[1e-100, 1e100], 0 allowed, once au and b are scaled up by a power of two to bring lengths under\n"
+        "1e-100 into it) is refused: status 'bad_input', .problem names it.");
 
   py::class_<Projector>(m, "Projector", "A projection that keeps its workspace between calls (warm starts).")
       .def(py::init<const ProjectionSettings&>(), py::arg("settings") = ProjectionSettings{})

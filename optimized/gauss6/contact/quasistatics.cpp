@@ -112,6 +112,10 @@ constexpr double kSineRounding = 64 * std::numeric_limits<double>::epsilon();
 // 2.2e-308), so no test of the method loses its meaning (a norm |au|_M whose
 // square overflows made every row look met). Units and row scales move the
 // lengths by factors, not the answer: any sensible choice lies deep inside.
+// |au|_M and the offsets' distances are first scaled up together by 2^e when
+// one of them is under kMinLength (scale_exponent): the answer is homogeneous
+// in (au, b), and a god-object settling on a resting handle takes |au|_M
+// through every magnitude on its way to 0.
 constexpr double kMaxLength = 1e100;
 constexpr double kMinLength = 1e-100;
 static_assert(kMaxLength == 1e100 && kMinLength == 1e-100, "the refusals' messages state them");
@@ -723,6 +727,7 @@ ProjectionWorkspace::ProjectionWorkspace(int max_rows)
       row_norm(static_cast<size_t>(capacity)),
       inv_row_norm(static_cast<size_t>(capacity)),
       slack(static_cast<size_t>(capacity)),
+      scaled_b(static_cast<size_t>(capacity)),
       in_active(static_cast<size_t>(capacity)) {}
 
 void ProjectionWorkspace::reset() noexcept {
@@ -1020,6 +1025,47 @@ ProjectionStatus write_result(const ProjectionProblem& pb, const ProjectionSetti
 
 }  // namespace
 
+namespace {
+
+// The exponent e >= 0 of the scaling 2^e of (au, b) under which the problem's
+// smallest nonzero length (|au|_M, an offset's |b_k| / |J_k|_{M^-1}) is at
+// least kMinLength: 0 when it already is or when no length is nonzero (see
+// "Scale" in quasistatics.h). Estimated from logarithms, one more than needed
+// so that their rounding cannot leave it short; length_problem then judges the
+// scaled lengths (the largest may not exceed kMaxLength). Rows are validated
+// (update_cache) before this is called.
+int scale_exponent(const ProjectionProblem& pb, const ProjectionWorkspace& ws) noexcept {
+  double lowest = kInf;  // log2 of the smallest nonzero length
+  const double largest = pb.au.cwiseAbs().maxCoeff();
+  if (largest > 0) {
+    // |L^T au| on au scaled to a largest entry in [1, 2): exact when au is small,
+    // so that a subnormal au still gives its length's logarithm.
+    const int exponent = std::ilogb(largest);
+    Vec6 unit;
+    for (int i = 0; i < 6; ++i) unit[i] = std::ldexp(pb.au[i], -exponent);
+    const double norm = (ws.L.transpose() * unit).norm();
+    if (norm > 0 && norm < kInf) lowest = exponent + std::log2(norm);
+  }
+  for (int k = 0; pb.b != nullptr && k < pb.num_rows; ++k)
+    if (ws.row_norm[k] > 0 && pb.b[k] != 0)
+      lowest = std::min(lowest, std::log2(std::abs(pb.b[k])) - std::log2(ws.row_norm[k]));
+  const double floor = std::log2(kMinLength);
+  if (!(lowest < floor)) return 0;
+  return static_cast<int>(std::ceil(floor - lowest)) + 1;
+}
+
+// The answer of the problem scaled by 2^e, brought back: ac and lambda times
+// 2^-e (exact, short of results below 2^-1022), the KKT residuals measured
+// again on the data as given (kkt_relative and the status are scale-free).
+void unscale_result(const ProjectionProblem& pb, const ProjectionSettings& settings, int e,
+                    ProjectionResult* res) noexcept {
+  for (int i = 0; i < 6; ++i) res->ac[i] = std::ldexp(res->ac[i], -e);
+  for (int k = 0; k < pb.num_rows; ++k) res->lambda[k] = std::ldexp(res->lambda[k], -e);
+  if (settings.compute_residuals) compute_residuals(pb, res);
+}
+
+}  // namespace
+
 ProjectionStatus project(const ProjectionProblem& pb, const ProjectionSettings& settings,
                          ProjectionWorkspace* workspace, ProjectionResult* res) noexcept {
   if (res == nullptr) return ProjectionStatus::kBadInput;
@@ -1031,12 +1077,27 @@ ProjectionStatus project(const ProjectionProblem& pb, const ProjectionSettings& 
   }
   const int m = pb.num_rows;
 
+  // The problem solved: pb, or (au, b) scaled up by 2^e when a length is under
+  // kMinLength (see "Scale" in quasistatics.h; the answer is scaled back).
+  const int e = scale_exponent(pb, ws);
+  ProjectionProblem spb = pb;
+  if (e > 0) {
+    for (int i = 0; i < 6; ++i) spb.au[i] = std::ldexp(pb.au[i], e);
+    if (pb.b != nullptr) {
+      for (int k = 0; k < m; ++k) ws.scaled_b[k] = std::ldexp(pb.b[k], e);
+      spb.b = ws.scaled_b.data();
+    }
+  }
   // Target in Cholesky coordinates: y_u = L^T au.
-  const Vec6 yu = ws.L.transpose() * pb.au;
+  const Vec6 yu = ws.L.transpose() * spb.au;
   // The problem's lengths (y-space) within range (see kMaxLength): |y_u| and each
   // offset's distance |b_k| / |A_k| (an offset on a zero row is a bare sign test).
-  if (const char* problem = length_problem(yu, pb.b, ws, m)) return bad_input(pb, problem, res);
-  const LoopProblem lp{yu, yu.norm(), pb.b, m, settings.dependence_tol, settings.feasibility_tol,
+  // A refusal names the length as given when scaling did not help.
+  if (const char* problem = length_problem(yu, spb.b, ws, m)) {
+    const char* given = e > 0 ? length_problem(ws.L.transpose() * pb.au, pb.b, ws, m) : nullptr;
+    return bad_input(pb, given ? given : problem, res);
+  }
+  const LoopProblem lp{yu, yu.norm(), spb.b, m, settings.dependence_tol, settings.feasibility_tol,
                        settings.max_iterations};
 
   start_working_set(ws, settings.warm_start, m, lp.dep_tol);
@@ -1057,9 +1118,11 @@ ProjectionStatus project(const ProjectionProblem& pb, const ProjectionSettings& 
     ws.factor_matches_cache = false;
     return zero_force_result(pb, status, it.iterations, res);
   }
-  if (ws.num_active == 0) res->ac = pb.au;  // no active row: exactly no force
-  else final_point(pb, ws, lp, &it, res);
-  return write_result(pb, settings, ws, status, it.iterations, res);
+  if (ws.num_active == 0) res->ac = spb.au;  // no active row: exactly no force
+  else final_point(spb, ws, lp, &it, res);
+  status = write_result(spb, settings, ws, status, it.iterations, res);
+  if (e > 0) unscale_result(pb, settings, e, res);
+  return status;
 }
 
 }  // namespace gauss6

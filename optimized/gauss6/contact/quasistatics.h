@@ -25,6 +25,15 @@
 // ProjectionResult, sized for max_rows rows when they are built (any number;
 // kDefaultMaxContacts unless the model says otherwise). A problem with more
 // rows than either holds is refused (kBadInput), never truncated.
+//
+// Scale: the answer is positively homogeneous in (au, b): projecting
+// (2^e au, 2^e b) gives 2^e ac and 2^e lambda, exactly in floating point
+// (a power-of-two scaling is exact, short of overflow and of results below
+// 2^-1022). A problem with a length (below) under 1e-100 is solved so
+// scaled up, e one more than the least that lifts its smallest to 1e-100: a
+// god-object settling on a resting handle halves |au| every step, through
+// 1e-100, on its way to 0 (e = 0, the data as given, whenever they already lie
+// in the range).
 #pragma once
 
 #include <array>
@@ -89,7 +98,12 @@ enum class ProjectionStatus {
                        // workspace's and the result's max_rows],
                        // J null with rows, settings out of range, or a length
                        // out of [1e-100, 1e100] (|au|_M, a row's |J_k|_{M^-1},
-                       // an offset's |b_k| / |J_k|_{M^-1}; 0 is allowed):
+                       // an offset's |b_k| / |J_k|_{M^-1}; 0 is allowed) once
+                       // au and b are scaled up by 2^e (see "Scale" above:
+                       // lengths under 1e-100 are so brought into the range
+                       // when the largest allows it, so only lengths over
+                       // 1e100, a row's out of range, or lengths spanning more
+                       // than about 1e200 are refused):
                        // ProjectionResult::problem names it. ac as for
                        // kInfeasibleOffsets.
   kUncertified,        // the method ended but its answer fails the scale-free
@@ -182,6 +196,7 @@ struct ProjectionWorkspace {
   // Scratch.
   std::array<double, kMaxActive> lambda_active{};
   std::vector<double> slack;               // capacity
+  std::vector<double> scaled_b;            // capacity: b times 2^e (see project())
   std::vector<unsigned char> in_active;    // capacity
 };
 
