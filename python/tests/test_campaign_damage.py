@@ -131,8 +131,8 @@ def test_bad_counts_are_refused_at_parse_time(option, value, capsys):
 
 
 def test_killed_at_random_moments_and_damaged_between_kills_resumes_to_the_undamaged_summary(undamaged, tmp_path):
-    """The command killed (SIGKILL) KILLS times after seeded random delays (from before its first
-    chunk to after its last), a random chunk file damaged after each kill; then a run to the end:
+    """The command killed (SIGKILL) KILLS times at seeded moments (during its start-up, or after a
+    seeded number of its chunk writes), a random chunk file damaged after each kill; then a run to the end:
     its JSON summary is the undamaged one, and it names the damaged file it met."""
     rng = np.random.default_rng(2047)
     out = tmp_path / "run"
@@ -145,14 +145,28 @@ def test_killed_at_random_moments_and_damaged_between_kills_resumes_to_the_undam
                            check=True)
     span = time.monotonic() - t0  # a whole run's wall time, start-up included: kills fall inside it
     kills, written_at_kill, damaged = 0, [], []
+    def chunk_files():
+        return sorted(f for f in (out / "chunks").glob("0*.json")) if (out / "chunks").is_dir() else []
+
     for _ in range(KILLS):
+        # The moment: after a seeded number of chunk writes, fewer than the run has left to write (the
+        # chunks missing, and the one damaged last), so that it falls while the run still works
+        # whatever the machine's speed; 0 writes: during its start-up, after a seeded delay.
+        before = {f.name: f.stat().st_mtime_ns for f in chunk_files()}
+        left = NUM_CHUNKS - len(before) + (1 if damaged else 0)
+        writes = int(rng.integers(0, max(left, 1)))
         proc = subprocess.Popen(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
-        time.sleep(float(rng.uniform(0.2, 1.0)) * span)
+        deadline = time.monotonic() + (float(rng.uniform(0.0, 0.5)) * span if writes == 0 else 10 * span)
+        while proc.poll() is None and time.monotonic() < deadline:
+            written = sum(before.get(f.name) != f.stat().st_mtime_ns for f in chunk_files())
+            if writes and written >= writes:
+                break
+            time.sleep(0.002)
         if proc.poll() is None:
             proc.send_signal(signal.SIGKILL)
             kills += 1
         proc.wait()
-        files = sorted(f for f in (out / "chunks").glob("0*.json")) if (out / "chunks").is_dir() else []
+        files = chunk_files()
         written_at_kill.append(len(files))
         if files:
             victim = files[int(rng.integers(len(files)))]
