@@ -113,3 +113,30 @@ def output_file(text: str) -> str:
     """An argparse type: a file to write (an existing directory, a path under a file or an
     unwritable place is refused)."""
     return _writable(text, False, "output file")
+
+
+def add_budget_arguments(p: argparse.ArgumentParser) -> None:
+    """--budget-cpu [S] and --budget-units N (gauss6 run, gauss6 reproduce)."""
+    p.add_argument("--budget-cpu", type=_budget_seconds, nargs="?", const=RECOMMENDED_BUDGET_S, default=None,
+                   metavar="S", help="each god-object update's CPU budget in seconds (alone: the recommended "
+                   f"{RECOMMENDED_BUDGET_S * 1e3:g} ms; docs/sim-step.md, \"Budgeted updates\")")
+    p.add_argument("--budget-units", type=_budget_units, default=0, metavar="N",
+                   help="each god-object update's budget in work units (deterministic: repeats bit for bit)")
+
+
+# The recommended CPU budget of an update (update_budget.h kRecommendedUpdateCpuSeconds; a test keeps them equal).
+RECOMMENDED_BUDGET_S = 0.4e-3
+
+
+def _budget_seconds(text: str) -> float:
+    v = float(text)
+    if not (v > 0 and v < 1):
+        raise argparse.ArgumentTypeError(f"{text}: a CPU budget is in seconds, > 0 and < 1")
+    return v
+
+
+def _budget_units(text: str) -> int:
+    v = int(text)
+    if v < 1:
+        raise argparse.ArgumentTypeError(f"{text}: a budget in work units is >= 1")
+    return v

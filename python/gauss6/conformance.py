@@ -33,6 +33,8 @@ from pathlib import Path
 from . import paths
 from .campaign import Campaign, CampaignError, run_campaign
 from .datasets import BATTERY_SCENES
+from .engine_host import RUN_TIMEOUT, STEP_TIMEOUT
+from .validate import EXIT_CHECK_FAILED, EXIT_ENGINE_FAILED, EXIT_PASS, EXIT_USAGE, validate
 
 SUITES = {"conformance": BATTERY_SCENES}
 FORMAT_VERSION = 1
@@ -69,9 +71,6 @@ def make_chunks(engine: str, scenes, out: Path, config: str = "", script: str | 
 def run_chunk(chunk: dict) -> dict:
     """`gauss6 validate` on one scene (its outputs in OUT/<label>/); the run's row of the table,
     free of anything that depends on where or when it ran (paths, transport timings)."""
-    from .engine_host import RUN_TIMEOUT, STEP_TIMEOUT
-    from .validate import validate
-
     out = Path(chunk["out"]) / run_label(chunk)
     args = argparse.Namespace(
         engine=chunk["engine"], run=None, config=chunk["config"], scene=Path(chunk["scene_file"]),
@@ -100,8 +99,6 @@ def campaign(chunks: list[dict], parameters: dict | None = None) -> Campaign:
 
 
 def exit_status(runs: list[dict]) -> int:
-    from .validate import EXIT_CHECK_FAILED, EXIT_ENGINE_FAILED, EXIT_PASS
-
     if any(r["exit"] == EXIT_ENGINE_FAILED for r in runs):
         return EXIT_ENGINE_FAILED
     return EXIT_PASS if all(r["exit"] == EXIT_PASS for r in runs) else EXIT_CHECK_FAILED
@@ -209,8 +206,6 @@ def run_suite(engine: str, out: Path, scenes=None, config: str = "", script: str
 
 def cmd_suite(args) -> int:
     """`gauss6 validate --suite NAME`: the suite's scenes (or --scene's one) as a campaign."""
-    from .validate import EXIT_USAGE
-
     scenes = [str(args.scene)] if args.scene else SUITES[args.suite]
     try:
         runs, meta = run_suite(args.engine, args.out, scenes, args.config, args.script, args.duration,

@@ -48,12 +48,12 @@ class ExactScene:
     """A scene's obstacles (world frame) and god-object as the reference's exact mesh pairs."""
 
     def __init__(self, scene_path, thresholds: dict | None = None):
-        from . import oracle
         from ._gauss6 import ccd, runtime
+        from .thresholds import load_thresholds
 
         g = runtime.scene_geometry(str(scene_path))
         self.delta = float(g["delta"])
-        self.bound = float((thresholds or oracle.load_thresholds())["distance"]["bound"]) * self.delta
+        self.bound = float((thresholds or load_thresholds())["distance"]["bound"]) * self.delta
         god_V = np.asarray(g["god_V"], float)
         god_F = np.asarray(g["god_F"], np.int32)
         self.god_radius = float(np.linalg.norm(god_V, axis=1).max())

@@ -40,22 +40,15 @@ from __future__ import annotations
 
 import functools
 import math
-import tomllib
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Callable
 
 import numpy as np
 
-from . import paths
 from .crosscheck_ccd import point_triangle_distance
 from .exact_checks import ExactScene
-
-# The checkout's thresholds; an installed wheel carries a copy (python/CMakeLists.txt).
-THRESHOLDS = paths.REPO_ROOT / "harness" / "oracle.toml"
-if not THRESHOLDS.exists():
-    THRESHOLDS = Path(__file__).resolve().parent / "data" / "oracle.toml"
-
+from .thresholds import load_thresholds
 
 def added_per_tick(V: np.ndarray) -> np.ndarray:
     """What each tick adds to the vector of the tick before (force or torque rows of V, shape (n,
@@ -116,22 +109,6 @@ def unexplained_per_tick(W: np.ndarray, dx: np.ndarray, mass: float, inertia: np
             better = np.maximum(f / limits[0], tau / limits[1]) < np.maximum(best[0] / limits[0], best[1] / limits[1])
             best = (np.where(better, f, best[0]), np.where(better, tau, best[1]))
     return best
-
-
-def load_thresholds(path=None) -> dict:
-    """The thresholds file (default harness/oracle.toml): a regular file (paths.read_input_text),
-    valid TOML, not empty; ValueError naming the file otherwise."""
-    from .paths import read_input_text
-
-    path = Path(path or THRESHOLDS)
-    try:
-        thresholds = tomllib.loads(read_input_text(path, "thresholds file", 1 << 20))
-    except tomllib.TOMLDecodeError as e:
-        raise ValueError(f"{path}: not valid TOML: {e}") from None
-    if not thresholds:
-        raise ValueError(f"{path}: the thresholds file is empty (no setting): give the file to judge by, "
-                         "or none for the defaults")
-    return thresholds
 
 
 @dataclass

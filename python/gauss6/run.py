@@ -51,13 +51,10 @@ a lockstep run is not repeatable, and is run once (no least-of-repeats); a work-
 """
 from __future__ import annotations
 
-import argparse
 import json
 import os
 import platform
 import resource
-import sys
-import time
 import warnings
 from pathlib import Path
 
@@ -405,80 +402,3 @@ def failures(name: str, summary: dict, details: dict) -> list[str]:
     if c is not None and not c["certified"]:
         problems.append(f"{name}: not certified (certify_{name}.md: {c['first_violation']})")
     return problems
-
-
-def cmd_run(args: argparse.Namespace) -> int:
-    from . import LoadError
-
-    scene, out = Path(args.scene), Path(args.out)
-    start = time.monotonic()
-    try:
-        script = script_path(args.script) if args.script else None
-        if not scene.is_file():
-            raise ValueError(f"{scene}: no such scene file")
-        summary, details = run_scene(scene, out, name=args.name, script=script, threaded=args.threaded,
-                                     duration=args.duration, show_progress=not args.quiet,
-                                     check_poses=not args.no_certify, budget_seconds=args.budget_cpu or 0.0,
-                                     budget_units=args.budget_units)
-    except (LoadError, ValueError) as e:
-        print(f"gauss6 run: error: {e}", file=sys.stderr)
-        return 2
-    name = args.name or scene.stem
-    (out / "summary.json").write_text(json.dumps({name: summary}, indent=2) + "\n")
-    (out / "details.json").write_text(json.dumps({name: details}, indent=2) + "\n")
-    write_report(out, name, summary, details, time.monotonic() - start)
-    print(json.dumps(summary, indent=2))
-    problems = failures(name, summary, details)
-    for p in problems:
-        print(f"gauss6 run: error: {p}", file=sys.stderr)
-    print(f"written to {out}/ (report.md, summary.json, figure_{name}.png, view_{name}.html, certify_{name}.md, "
-          f"{name}.g6trace)")
-    return 1 if problems else 0
-
-
-def register(subparsers) -> None:
-    """Adds `run` to the gauss6 command's subparsers."""
-    from .cli_args import input_file, output_dir, run_seconds
-
-    p = subparsers.add_parser("run", help="run a scene with a hand script: trace, figure, certification, "
-                                          "viewer page and report (as `gauss6 reproduce` runs the paper's)")
-    p.add_argument("scene", type=input_file("scene"), help="the scene's TOML file (docs/scene-format.md)")
-    p.add_argument("--script", help="the hand script: a shipped one's name (bunny, peg_in_hole) or a JSON file "
-                                    "(default: the scene's [device] script)")
-    p.add_argument("--out", required=True, type=output_dir, help="output directory")
-    p.add_argument("--threaded", action="store_true", help="real threads and the wall clock (default: lockstep)")
-    p.add_argument("--duration", type=run_seconds, default=-1.0,
-                   help="run only the first S seconds of the script (default: all of it)")
-    p.add_argument("--name", help="the run's name in the output files (default: the scene file's stem)")
-    p.add_argument("--no-certify", action="store_true",
-                   help="skip the exact certification (slow on large scenes); the report says so")
-    add_budget_arguments(p)
-    p.add_argument("--quiet", action="store_true", help="no progress bars")
-    p.set_defaults(func=cmd_run)
-
-
-def add_budget_arguments(p: argparse.ArgumentParser) -> None:
-    """--budget-cpu [S] and --budget-units N (gauss6 run, gauss6 reproduce)."""
-    p.add_argument("--budget-cpu", type=_budget_seconds, nargs="?", const=RECOMMENDED_BUDGET_S, default=None,
-                   metavar="S", help="each god-object update's CPU budget in seconds (alone: the recommended "
-                   f"{RECOMMENDED_BUDGET_S * 1e3:g} ms; docs/sim-step.md, \"Budgeted updates\")")
-    p.add_argument("--budget-units", type=_budget_units, default=0, metavar="N",
-                   help="each god-object update's budget in work units (deterministic: repeats bit for bit)")
-
-
-# The recommended CPU budget of an update (update_budget.h kRecommendedUpdateCpuSeconds; a test keeps them equal).
-RECOMMENDED_BUDGET_S = 0.4e-3
-
-
-def _budget_seconds(text: str) -> float:
-    v = float(text)
-    if not (v > 0 and v < 1):
-        raise argparse.ArgumentTypeError(f"{text}: a CPU budget is in seconds, > 0 and < 1")
-    return v
-
-
-def _budget_units(text: str) -> int:
-    v = int(text)
-    if v < 1:
-        raise argparse.ArgumentTypeError(f"{text}: a budget in work units is >= 1")
-    return v

@@ -272,7 +272,7 @@ def test_a_log_line_longer_than_a_row_is_refused_before_it_is_read(tmp_path):
 
 
 def test_an_empty_thresholds_file_is_an_error(tmp_path):
-    from gauss6.oracle import load_thresholds
+    from gauss6.thresholds import load_thresholds
 
     for text in ("", "\n# nothing\n"):
         (tmp_path / "t.toml").write_text(text)

@@ -12,7 +12,8 @@ import numpy as np
 import pytest
 
 from gauss6 import paths
-from gauss6.oracle import CHECK_NAMES, CHECK_TABLE, Oracle, declarations, load_thresholds
+from gauss6.oracle import CHECK_NAMES, CHECK_TABLE, Oracle, declarations
+from gauss6.thresholds import load_thresholds
 from gauss6.trace import DTYPES, Trace, trace_metadata
 
 PEG = paths.DATASETS_DIR / "scenes" / "peg_in_hole.toml"

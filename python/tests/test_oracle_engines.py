@@ -143,7 +143,7 @@ def test_gauss6_passes_the_thin_walls_fast_hits(tmp_path):
     god-object between the fast hand's samples). The tool held on the near side while the hand,
     through the wall, backs off with no force (the offsets) is not judged by tracking: it must not
     follow there."""
-    from gauss6.oracle import load_thresholds
+    from gauss6.thresholds import load_thresholds
 
     th = load_thresholds()
     th["tracking"]["max_poses"] = 10 ** 6

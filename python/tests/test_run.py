@@ -12,7 +12,7 @@ import sys
 import numpy as np
 import pytest
 
-from gauss6 import run as run_mod
+from gauss6 import cli_args, run as run_mod
 from gauss6.trace import read_trace
 
 pytest.importorskip("gauss6._gauss6")
@@ -266,6 +266,6 @@ def test_the_recommended_budget_is_the_libraries(scene_dir, tmp_path):
 
     header = (paths.REPO_ROOT / "optimized/gauss6/step/update_budget.h").read_text()
     line = next(l for l in header.splitlines() if "kRecommendedUpdateCpuSeconds =" in l)
-    assert float(line.split("=")[1].strip().rstrip(";")) == run_mod.RECOMMENDED_BUDGET_S
+    assert float(line.split("=")[1].strip().rstrip(";")) == cli_args.RECOMMENDED_BUDGET_S
     r = run_cli("run", str(scene_dir / "scene.toml"), "--out", str(tmp_path), "--budget-cpu", "2")
     assert r.returncode == 2 and "a CPU budget is in seconds" in r.stderr

@@ -7,7 +7,7 @@ import argparse
 import json
 from pathlib import Path
 
-from ..cli_args import EXIT_FAILED, EXIT_OK, error, output_dir, run_seconds
+from ..cli_args import EXIT_FAILED, EXIT_OK, add_budget_arguments, error, output_dir, run_seconds
 
 
 def add_parser(subparsers) -> argparse.ArgumentParser:
@@ -18,8 +18,6 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
     rep.add_argument("--out", required=True, type=output_dir, help="output directory")
     rep.add_argument("--threaded", action="store_true", help="real threads and the wall clock (default: lockstep)")
     rep.add_argument("--quiet", action="store_true", help="no progress bars")
-    from ..run import add_budget_arguments
-
     add_budget_arguments(rep)  # (the paper's scenes; the surface scenes run unbudgeted)
     rep.add_argument("--slice", type=run_seconds, default=None,
                      help="engines: run only the first S seconds of each script (default: whole)")
