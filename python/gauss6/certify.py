@@ -35,8 +35,6 @@ from __future__ import annotations
 import functools
 import json
 import math
-import os
-import platform
 import time
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
@@ -44,6 +42,7 @@ from pathlib import Path
 import numpy as np
 
 from .exact_checks import ExactScene
+from .machine import machine
 from .trace import coverage_line
 
 FORMAT = "gauss6-certify"
@@ -250,11 +249,6 @@ def certify(scene_path, trace_path, chunk_ticks: int = 2000, tick_range: tuple[i
     return merge(results)
 
 
-def _machine() -> dict:
-    return {"platform": platform.platform(), "processor": platform.processor() or platform.machine(),
-            "cpus": os.cpu_count(), "python": platform.python_version()}
-
-
 def to_json(res: CertifyResult, scene_path, trace_path, coverage: dict | None = None) -> dict:
     """certify.json; coverage (trace.coverage of the whole trace) says what the run held: its ticks,
     time span, complete or cut, and its digest, beside the tick range certified ("ticks")."""
@@ -268,7 +262,7 @@ def to_json(res: CertifyResult, scene_path, trace_path, coverage: dict | None = 
             "bound_delta": bound / delta if delta else 0.0,
             "first_violation": asdict(first) if first else None,
             "violations": {"counts": dict(res.num_violations), "first_of_each": [asdict(v) for v in res.violations]},
-            "seconds": res.seconds, "machine": _machine()}
+            "seconds": res.seconds, "machine": machine()}
 
 
 def to_markdown(doc: dict) -> str:

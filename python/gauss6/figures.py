@@ -9,8 +9,6 @@ from __future__ import annotations
 
 from pathlib import Path
 
-import numpy as np
-
 
 def phase_spans(trace, end_time: float) -> list[tuple[str, float, float]]:
     """(name, start, end) of each phase from the trace's metadata (its phase events mark the same starts)."""

@@ -43,7 +43,7 @@ import sys
 import tarfile
 import tempfile
 import tomllib
-from dataclasses import asdict, dataclass, field
+from dataclasses import asdict, dataclass
 from pathlib import Path
 
 from . import bench, paths

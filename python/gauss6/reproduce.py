@@ -39,9 +39,9 @@ from pathlib import Path
 import numpy as np
 
 from . import paths
-# gauss6 run's path; LOCKSTEP_RUNS, least_update_times and machine are part of this module's interface too.
+# gauss6 run's path; LOCKSTEP_RUNS and least_update_times are part of this module's interface too.
 from .run import (COMMON_KEYS as RUN_KEYS, DEFINITIONS, LOCKSTEP_RUNS, _fmt, failures,  # noqa: F401
-                  least_update_times, machine, machine_line, report_footer, report_section,
+                  least_update_times, machine_line, report_footer, report_section,
                   run_scene, summarize as summarize_run)
 
 SCENES = {

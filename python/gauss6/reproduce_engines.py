@@ -283,7 +283,7 @@ def battery_lines(battery: dict) -> list[str]:
 
 def report(runs: list, sweeps: dict, missing: list, out: Path, slice_s, wall: float, sweep_slice: float,
            battery: dict | None = None) -> str:
-    from .validate import machine
+    from .machine import machine
 
     names = [c[0] for c in CHECKS]
     head = "| engine | script | " + " | ".join(names) + " |"

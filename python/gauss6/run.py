@@ -53,7 +53,6 @@ from __future__ import annotations
 
 import json
 import os
-import platform
 import resource
 import warnings
 from pathlib import Path
@@ -62,6 +61,7 @@ import numpy as np
 
 from . import paths
 from .exact_checks import distinct_poses, progress_bar
+from .machine import machine_line
 
 LOCKSTEP_RUNS = 5  # lockstep runs of a scene: the first is the trace; all give each step's least time
 UPDATE_BUDGET_MS = 1.0  # a 1 kHz sim loop's period: the report counts the updates over it
@@ -266,20 +266,6 @@ def run_scene(scene: Path, out: Path, name: str | None = None, title: str | None
     return summary, extra
 
 
-def machine() -> dict:
-    """CPU model and core count from /proc/cpuinfo (Linux), with the Python platform as fallback."""
-    model, cores = platform.processor() or platform.machine(), os.cpu_count()
-    try:
-        info = Path("/proc/cpuinfo").read_text()
-        models = [line.split(":", 1)[1].strip() for line in info.splitlines() if line.startswith("model name")]
-        if models:
-            model, cores = models[0], len(models)
-    except OSError:
-        pass
-    return {"cpu": model, "cores": cores, "system": f"{platform.system()} {platform.release()}",
-            "python": platform.python_version()}
-
-
 def _fmt(v) -> str:
     if v is None:
         return "-"
@@ -288,11 +274,6 @@ def _fmt(v) -> str:
     if isinstance(v, float):
         return f"{v:.3g}"
     return str(v)
-
-
-def machine_line() -> str:
-    m = machine()
-    return f"Machine: {m['cpu']}, {m['cores']} cores ({m['system']}, Python {m['python']})."
 
 
 def report_section(name: str, s: dict, d: dict, paper: dict | None = None) -> list[str]:

@@ -34,8 +34,6 @@ failed; 2 the engine failed (nothing else gives 0 or 1 then); 3 a usage error.
 from __future__ import annotations
 
 import json
-import os
-import platform
 import sys
 import time
 from pathlib import Path
@@ -45,6 +43,7 @@ import numpy as np
 from . import oracle as oracle_mod
 from .engine import EngineScene, check_spec
 from .engine_host import InlineHost, ProcessHost
+from .machine import machine
 from .thresholds import THRESHOLDS, load_thresholds
 from .trace import coverage_line
 
@@ -53,11 +52,6 @@ FORMAT_VERSION = 1
 EXIT_PASS, EXIT_CHECK_FAILED, EXIT_ENGINE_FAILED, EXIT_USAGE = 0, 1, 2, 3
 EXIT_CODES = {EXIT_PASS: "every check passed on a complete run", EXIT_CHECK_FAILED: "a check failed",
               EXIT_ENGINE_FAILED: "the engine failed", EXIT_USAGE: "usage error"}
-
-
-def machine() -> dict:
-    return {"platform": platform.platform(), "processor": platform.processor() or platform.machine(),
-            "cpus": os.cpu_count(), "python": platform.python_version()}
 
 
 def _progress(quiet: bool):

@@ -12,6 +12,7 @@ import numpy as np
 import pytest
 
 from gauss6 import cli, reproduce
+from gauss6.machine import machine
 from gauss6.trace import COLUMNS, DTYPES, Trace, read_trace
 
 runtime = pytest.importorskip("gauss6._gauss6").runtime
@@ -172,6 +173,6 @@ def test_report_states_the_machine_and_the_paper(peg_run, tmp_path):
     _, summary, extra = peg_run
     path = reproduce.write_report(tmp_path, {"peg": summary}, {"peg": extra}, wall=1.0)
     text = path.read_text()
-    assert "Machine:" in text and str(reproduce.machine()["cores"]) in text
+    assert "Machine:" in text and f"{machine()['cpus']} CPUs" in text
     assert "< 25.0" in text  # the paper's force time bound, beside ours
     assert "figure_peg.png" in text
