@@ -457,7 +457,7 @@ Qed.
 (* The code's forms, at its sites. *)
 (* covers optimized/gauss6/numeric/rounding.h "GAUSS6_ALWAYS_INLINE Upper norm_up(double norm, double relative)" sha256:b4b3280a1e614758 *)
 (* covers optimized/gauss6/ccd/motion_bounds.cpp "void StartFrame::set(const CcdMotion& m, double u, double rho_in)" sha256:cfac9ee869768b2c *)
-(* covers optimized/gauss6/ccd/motion_bounds.h "PosedObb pose(const Obb& b) const" sha256:dc4be357c933cab2 *)
+(* covers optimized/gauss6/ccd/motion_bounds.h "PosedObb pose_checked(const Obb& b, bool check_frame) const" sha256:3c631a4b53f4d403 *)
 (* covers optimized/gauss6/ccd/motion_bounds.h "double radius(double r2) const" sha256:6689317b141e2024 *)
 Theorem norm_up_relative x y z :
   sqrt (x * x + y * y + z * z) <= Rmax (next_up (fl (norm_c x y z * fl (1 + kRelativeRounding)))) kNormFloor.
@@ -547,7 +547,7 @@ Proof. apply fl_decimal_ge; pose proof bpow_m1000; unfold u; lra. Qed.
    computed coordinates' largest magnitude, exact): within it of the exact
    (u1 - u0) d, for every double input (the underflow of the product, eta,
    is covered by next_up's absolute 2^-600). *)
-(* covers optimized/gauss6/ccd/motion_bounds.cpp "SweptObbFrame StartFrame::obb_frame(double u1, double d) const" sha256:935ff5487d4e9f12 *)
+(* covers optimized/gauss6/ccd/motion_bounds.cpp "SweptObbFrame StartFrame::obb_frame(double u1, double d) const" sha256:1da7beb7e3e9eb96 *)
 Theorem step_rounding u0 u1 d m :
   F u0 -> F u1 -> F d -> Rabs (fl (fl (u1 - u0) * d)) <= m ->
   Rabs (fl (fl (u1 - u0) * d) - (u1 - u0) * d) <= next_up (fl (fl (kRelativeRounding * m) * 2)).

@@ -857,7 +857,7 @@ Proof.
   lra.
 Qed.
 
-(* covers optimized/gauss6/ccd/motion_bounds.h "PosedObb pose(const Obb& b) const" sha256:dc4be357c933cab2 *)
+(* covers optimized/gauss6/ccd/motion_bounds.h "PosedObb pose_checked(const Obb& b, bool check_frame) const" sha256:3c631a4b53f4d403 *)
 (* covers optimized/gauss6/numeric/rounding.h "GAUSS6_ALWAYS_INLINE Upper norm_up(double norm, double relative)" sha256:b4b3280a1e614758 *)
 Theorem spin_rounding (R0 R1 R2 m sp st : V3) sig tau radius S :
   bounded rho R0 -> bounded rho R1 -> bounded rho R2 ->

@@ -146,7 +146,7 @@ Print Assumptions shift_rounding.
 Definition norm_up_c x y z k := Rmax (next_up (fl (norm_c x y z * k))) kNormFloor.
 
 (* allowance kRelativeRoundingWide = 1e-12 *)
-(* covers optimized/gauss6/ccd/motion_bounds.h "PosedObb pose(const Obb& b) const" sha256:dc4be357c933cab2 *)
+(* covers optimized/gauss6/ccd/motion_bounds.h "PosedObb pose_checked(const Obb& b, bool check_frame) const" sha256:3c631a4b53f4d403 *)
 (* covers optimized/gauss6/numeric/rounding.h "GAUSS6_ALWAYS_INLINE Upper norm_up(double norm, double relative)" sha256:b4b3280a1e614758 *)
 Theorem obb_radius_rounding c0 c1 c2 h0 h1 h2 :
   let W := fl (1 + kRelativeRoundingWide) in

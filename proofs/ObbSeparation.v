@@ -970,8 +970,8 @@ Qed.
 
 Definition row (x y z : V) (m : nat) := mkV (comp x m) (comp y m) (comp z m).
 
-(* covers optimized/gauss6/geometry/bvh.h "inline bool near_orthonormal(const Mat3& m)" sha256:e1be52145f695303 *)
-(* covers optimized/gauss6/ccd/motion_bounds.h "PosedObb pose(const Obb& b) const" sha256:dc4be357c933cab2 *)
+(* covers optimized/gauss6/geometry/bvh.h "inline bool near_orthonormal(const Mat3& m, double tolerance = kObbFrameTolerance)" sha256:c6604e12f978af7d *)
+(* covers optimized/gauss6/ccd/motion_bounds.h "PosedObb pose_checked(const Obb& b, bool check_frame) const" sha256:3c631a4b53f4d403 *)
 (* covers optimized/gauss6/geometry/bvh.cpp "Obb fit_obb(const Vec3* points, int num_points)" sha256:e8643d5fb8f792eb *)
 Theorem frame_check_sound x y z :
   passes x x 1 -> passes y y 1 -> passes z z 1 -> passes x y 0 -> passes x z 0 -> passes y z 0 ->

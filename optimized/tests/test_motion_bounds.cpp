@@ -255,8 +255,8 @@ TEST_CASE("obb_separated: never separates a swept box from a box it reaches, sep
   for (int i = 0; i < 20000; ++i) {
     const double scale = std::pow(10.0, 4 * U(rng) - 2);
     SweptObbFrame f;
-    f.R = rotation_matrix(normalized(Quat{n(rng), n(rng), n(rng), n(rng)}));
-    if (i % 7 == 0) f.R = rotation_matrix(normalized(quat_exp(1e-3 * Vec3(n(rng), n(rng), n(rng)))));
+    f.set_rotation(rotation_matrix(normalized(Quat{n(rng), n(rng), n(rng), n(rng)})));
+    if (i % 7 == 0) f.set_rotation(rotation_matrix(normalized(quat_exp(1e-3 * Vec3(n(rng), n(rng), n(rng))))));
     f.p = scale * 10 * Vec3(n(rng), n(rng), n(rng));
     f.step = i % 3 == 0 ? Vec3::Zero() : Vec3(scale * std::pow(10.0, -4 * U(rng)) * Vec3(n(rng), n(rng), n(rng)));
     f.grow = i % 4 == 0 ? 0.0 : scale * std::pow(10.0, -8 * U(rng));
@@ -280,7 +280,7 @@ TEST_CASE("obb_separated: never separates a swept box from a box it reaches, sep
     for (int k = 0; k < 3; ++k) x_local[k] = (i % 2 ? 2 * U(rng) - 1 : (U(rng) < 0.5 ? -1 : 1)) * body.half[k];
     const Vec3 x_B = body.center + body.axes * x_local;
     const double reach = f.grow + f.turn * x_B.norm();
-    const Vec3 y = f.R * x_B + f.p + U(rng) * (f.step + f.spin.cross(f.R * x_B)) +
+    const Vec3 y = f.rotation() * x_B + f.p + U(rng) * (f.step + f.spin.cross(f.rotation() * x_B)) +
                    0.999 * reach * Vec3(n(rng), n(rng), n(rng)).normalized();
     REQUIRE(reach <= a.grow);
     // A world box with y inside or on its boundary.

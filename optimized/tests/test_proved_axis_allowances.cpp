@@ -310,7 +310,7 @@ TEST_CASE("the node's sweep step within kSpinRounding (AxisAllowances.v spin_rou
       if (finite && (q.w != 0 || q.x != 0 || q.y != 0 || q.z != 0)) break;
     }
     SweptObbFrame f;
-    f.R = rotation_matrix(q);
+    f.set_rotation(rotation_matrix(q));
     f.p = scaled_vec(rng, -1074, 40);
     f.step = bit(rng) ? Vec3::Zero() : scaled_vec(rng, -1074, 20);
     f.spin = scaled_vec(rng, -1074, 10);
@@ -323,10 +323,10 @@ TEST_CASE("the node's sweep step within kSpinRounding (AxisAllowances.v spin_rou
     b.half = scaled_vec(rng, -1074, 40).cwiseAbs();
     const PosedObb out = f.pose(b);
     // node_step as the code computes it (tied to the code by its half, bit for bit)
-    const Vec3 node_step = f.step + f.spin.cross(Vec3(f.R * b.center));
+    const Vec3 node_step = f.step + f.spin.cross(Vec3(f.rotation() * b.center));
     REQUIRE((out.half_step.array() == (0.5 * node_step).array()).all());
     QVec C;
-    for (int i = 0; i < 3; ++i) C[i] = dot(exact(f.R.row(i).transpose()), exact(b.center));
+    for (int i = 0; i < 3; ++i) C[i] = dot(exact(f.rotation().row(i).transpose()), exact(b.center));
     const QVec X = cross(exact(f.spin), C);
     mpq_class err2 = 0;
     for (int i = 0; i < 3; ++i) {

@@ -1,6 +1,6 @@
-// Tests of the theorems of proofs/ObbSeparation.v and proofs/ObbCrossAxes.v: the oriented boxes'
+// Tests of the theorems of proofs/ObbSeparation.v, proofs/ObbCrossAxes.v and proofs/ObbFrameProduct.v: the oriented boxes'
 // allowances (kObbAxisRounding, kObbSeparationRounding, kObbFitRounding, kUnderflowFloor at fit_obb)
-// and the frame check near_orthonormal (kObbFrameTolerance) they rest on,
+// and the frame check near_orthonormal (kObbFrameTolerance) they rest on, with the tight checks that let pose() skip it,
 // computed by the code and checked against exact values in rationals (GMP) on
 // random and adversarial inputs: point sets of every scale from subnormal to
 // 2^500, clusters far from the origin, thin arcs, rotated and sheared frames.
@@ -10,6 +10,7 @@
 
 #include <Eigen/Dense>
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <limits>
@@ -138,6 +139,100 @@ TEST_CASE("near_orthonormal accepts only frames within 2^-46 of orthonormal (Obb
   CHECK_FALSE(near_orthonormal(nan));
 }
 
+// The largest |entry - identity's| of m^T m and m m^T computed as near_orthonormal computes them.
+double computed_defect(const Mat3& m) {
+  double worst = 0;
+  for (int i = 0; i < 3; ++i)
+    for (int j = i; j < 3; ++j) {
+      const double id = i == j ? 1.0 : 0.0;
+      const double columns = m(0, i) * m(0, j) + m(1, i) * m(1, j) + m(2, i) * m(2, j);
+      const double rows = m(i, 0) * m(j, 0) + m(i, 1) * m(j, 1) + m(i, 2) * m(j, 2);
+      worst = std::max({worst, std::abs(columns - id), std::abs(rows - id)});
+    }
+  return worst;
+}
+
+// A rotation moved entrywise by up to `noise` until near_orthonormal accepts
+// it at `tolerance`.
+Mat3 rotation_within(std::mt19937_64& rng, double noise, double tolerance) {
+  std::uniform_real_distribution<double> unit(-1, 1);
+  for (;;) {
+    Mat3 m = random_rotation(rng);
+    for (int i = 0; i < 3; ++i)
+      for (int j = 0; j < 3; ++j) m(i, j) += noise * unit(rng);
+    if (near_orthonormal(m, tolerance)) return m;
+  }
+}
+
+// posed_frame_check (ObbFrameProduct.v): a rotation R that passes the frame
+// check at kObbRotationTight and axes A that pass it at kObbAxesTight give
+// posed axes R A, as pose() computes them, that pass it at
+// kObbFrameTolerance: their computed Gram entries within 81.8 u of the
+// identity's (the theorem's bound before the tolerance), their exact ones
+// within 2^-46 (posed_frame_ortho). Frames from rotations moved by up to
+// 6e-16 per entry, then pushed to the edge of their tolerance one ulp at a
+// time (a nudge kept when both still pass and the product's computed defect
+// grows). Through the code: pose(node), which skips the check, gives the
+// same box bit for bit as pose(obb), which makes it, and a shear R (not
+// tight) still gets the infinite grow with a tight node.
+TEST_CASE("tight frames' posed axes pass near_orthonormal (ObbFrameProduct.v posed_frame_check, posed_frame_ortho)", "[proved]") {
+  std::mt19937_64 rng(45456);
+  std::uniform_real_distribution<double> noise(0, 6e-16);
+  std::uniform_int_distribution<int> entry(0, 8), coin(0, 1);
+  const double bound = 81.8 * 0x1p-53;
+  int rotation_edge = 0, axes_edge = 0;
+  double worst = 0;
+  for (int n = 0; n < 3000; ++n) {
+    Mat3 R = rotation_within(rng, noise(rng), kObbRotationTight);
+    Mat3 A = rotation_within(rng, noise(rng), kObbAxesTight);
+    for (int it = 0; it < (n % 3 == 0 ? 300 : 0); ++it) {
+      Mat3 R2 = R, A2 = A;
+      Mat3& m = coin(rng) ? R2 : A2;
+      const int e = entry(rng);
+      m(e / 3, e % 3) = std::nextafter(m(e / 3, e % 3), coin(rng) ? 2.0 : -2.0);
+      if (near_orthonormal(R2, kObbRotationTight) && near_orthonormal(A2, kObbAxesTight) &&
+          computed_defect(R2 * A2) >= computed_defect(R * A)) {
+        R = R2;
+        A = A2;
+      }
+    }
+    REQUIRE(near_orthonormal(R, kObbRotationTight));
+    REQUIRE(near_orthonormal(A, kObbAxesTight));
+    if (!near_orthonormal(R, 0.5 * kObbRotationTight)) ++rotation_edge;
+    if (!near_orthonormal(A, 0.5 * kObbAxesTight)) ++axes_edge;
+    const Mat3 M = R * A;  // as SweptObbFrame::pose computes out.axes
+    worst = std::max(worst, computed_defect(M));
+    REQUIRE(computed_defect(M) <= bound);
+    REQUIRE(near_orthonormal(M));
+    REQUIRE(gram_defect(M) <= two_pow_m46());
+    // Through pose(): the skipped check and the made one agree bit for bit.
+    SweptObbFrame f;
+    f.set_rotation(R);
+    f.grow = 1e-3;
+    BvhNode node;
+    node.obb.axes = A;
+    node.obb.half = Vec3(0.1, 0.2, 0.3);
+    node.obb.center = Vec3(0.01, -0.02, 0.03);
+    node.obb_tight = near_orthonormal(A, kObbAxesTight);
+    const PosedObb skipped = f.pose(node), checked = f.pose(node.obb);
+    REQUIRE(skipped.grow == checked.grow);
+    REQUIRE((skipped.axes.array() == checked.axes.array()).all());
+  }
+  // Frames at the edge of their tolerances were reached.
+  CHECK(rotation_edge > 100);
+  CHECK(axes_edge > 100);
+  CHECK(worst > 0);
+  // A shear is not tight: pose(node) makes the check, and the box never separates.
+  Mat3 shear;
+  shear << 1, 0.5, 0, 0, 1, 0, 0, 0, 1;
+  SweptObbFrame g;
+  g.set_rotation(shear);
+  BvhNode node;
+  node.obb.half = Vec3::Ones();
+  node.obb_tight = true;
+  CHECK(g.pose(node).grow == std::numeric_limits<double>::infinity());
+}
+
 // obb_axis_rounding: |C| + kObbAxisRounding, computed as obb_separated
 // computes it, bounds the exact |a_i . b_j| for frames near_orthonormal
 // accepts, including axes that are almost parallel (C near 1) and almost
@@ -167,7 +262,9 @@ TEST_CASE("|C| + kObbAxisRounding bounds the exact axis products (ObbSeparation.
 // check the test calls the boxes apart.
 TEST_CASE("a posed box with axes far from orthonormal never separates (ObbSeparation.v, the frame hypothesis)", "[proved]") {
   SweptObbFrame f;
-  f.R << 1, 0.5, 0, 0, 1, 0, 0, 0, 1;
+  Mat3 shear;
+  shear << 1, 0.5, 0, 0, 1, 0, 0, 0, 1;
+  f.set_rotation(shear);
   Obb god;
   god.half = Vec3::Ones();
   const PosedObb a = f.pose(god);
@@ -178,11 +275,11 @@ TEST_CASE("a posed box with axes far from orthonormal never separates (ObbSepara
   // The same boxes with R a rotation about z by 0.5 rad: the test's answer
   // stands (the obstacle's centre is then outside the posed box along a_1).
   SweptObbFrame g;
-  g.R = Eigen::AngleAxisd(0.5, Vec3::UnitZ()).toRotationMatrix();
+  g.set_rotation(Eigen::AngleAxisd(0.5, Vec3::UnitZ()).toRotationMatrix());
   const PosedObb b = g.pose(god);
   REQUIRE(near_orthonormal(b.axes));
   Obb far;
-  far.center = g.R * Vec3(0, 1.5, 0);
+  far.center = g.rotation() * Vec3(0, 1.5, 0);
   far.half = Vec3::Constant(0.01);
   CHECK(obb_separated(b, far));
 }

@@ -77,7 +77,7 @@ void StartFrame::set(const CcdMotion& m, double u, double rho_in) {
 
 SweptObbFrame StartFrame::obb_frame(double u1, double d) const {
   SweptObbFrame f;
-  f.R = R;
+  f.set_rotation(R);
   f.p = p;
   const Upper span = Upper{u1} - Lower{u0};
   const Upper omega_n{omega_norm}, error{static_error};

@@ -177,18 +177,38 @@ struct PosedObb {
 // (the second order, the turn's lag behind spin and the enclosure's width:
 // StartFrame::obb_frame). A peg pivoting about its tip, G moving by -spin x
 // r_tip, then sweeps its tip's boxes by almost nothing.
-struct SweptObbFrame {
-  Mat3 R = Mat3::Identity();
+//
+// The rotation R is set with set_rotation, which checks it once at
+// kObbRotationTight: pose() then skips the frame check of R A for the nodes
+// whose axes passed at kObbAxesTight (BvhNode::obb_tight), since the product
+// passes it (proofs/ObbFrameProduct.v posed_frame_check).
+class SweptObbFrame {
+ public:
+  void set_rotation(const Mat3& rotation) {
+    R_ = rotation;
+    rotation_tight_ = near_orthonormal(R_, kObbRotationTight);
+  }
+  const Mat3& rotation() const { return R_; }
   Vec3 p = Vec3::Zero();
   Vec3 step = Vec3::Zero();  // world translation of G over the sub-interval (its midpoint)
   Vec3 spin = Vec3::Zero();  // directional: the turn's first order over the sub-interval (zero: isotropic)
   double grow = 0;           // static_error + d + (u1 - u0) |dp - dp_mid| (any point)
   double turn = 0;           // times |r_B| for a point's turn (isotropic) or its rest (directional)
   double spread = 0;         // directional: >= |spin| (times |half|)
-  PosedObb pose(const Obb& b) const {
+  // A BVH node's box: the frame check of R A is skipped when both R and the
+  // node's axes passed the tight checks.
+  PosedObb pose(const BvhNode& node) const { return pose_checked(node.obb, !(rotation_tight_ && node.obb_tight)); }
+  // Any box: R A is checked.
+  PosedObb pose(const Obb& b) const { return pose_checked(b, true); }
+
+ private:
+  Mat3 R_ = Mat3::Identity();
+  bool rotation_tight_ = true;  // R_ passes near_orthonormal at kObbRotationTight (the identity does)
+
+  PosedObb pose_checked(const Obb& b, bool check_frame) const {
     PosedObb out;
-    out.axes = R * b.axes;
-    const Vec3 c = R * b.center;
+    out.axes = R_ * b.axes;
+    const Vec3 c = R_ * b.center;
     out.center = c + p;
     out.half = b.half;
     // |r_B| <= |center| + |half| for every point of the box, each norm bounded
@@ -207,8 +227,10 @@ struct SweptObbFrame {
     }
     // The 15-axis test holds for axes orthonormal to within kObbFrameTolerance
     // (proofs/ObbSeparation.v); a posed box whose axes are not (R far from a
-    // rotation) gets an infinite grow, which no axis separates.
-    if (!(out.grow < std::numeric_limits<double>::infinity()) || !near_orthonormal(out.axes))
+    // rotation) gets an infinite grow, which no axis separates. Unchecked
+    // (check_frame false) only where R and b.axes passed the tight checks,
+    // which prove R A passes this one (ObbFrameProduct.v posed_frame_check).
+    if (!(out.grow < std::numeric_limits<double>::infinity()) || (check_frame && !near_orthonormal(out.axes)))
       out.grow = std::numeric_limits<double>::infinity();
     out.still = (out.half_step.array() == 0).all();
     out.pays = obb_volume_ratio(b.half, out.axes.cwiseAbs() * b.half) < 0.5;

@@ -422,7 +422,7 @@ ContactStatus generate_contacts(const CcdBody* obstacles, int num_obstacles, con
   // Node pairs whose boxes meet are then tested as oriented boxes (bvh.h), the
   // god node's posed at X_WB and grown by d: a fixed pose, no motion.
   SweptObbFrame obb_frame;
-  obb_frame.R = R;
+  obb_frame.set_rotation(R);
   obb_frame.p = G;
   obb_frame.grow = d;
   Collector col{settings, settings.merge_distance > 0 ? settings.merge_distance : 1e-3 * d,
@@ -473,7 +473,7 @@ ContactStatus generate_contacts(const CcdBody* obstacles, int num_obstacles, con
     };
     const auto separated = [&](int gi, int oi) {
       return node_pair_separated(
-          ws->boxes.get(ws->boxes.node_obbs, gi, [&] { return obb_frame.pose(god.bvh->nodes[gi].obb); }),
+          ws->boxes.get(ws->boxes.node_obbs, gi, [&] { return obb_frame.pose(god.bvh->nodes[gi]); }),
           ob.nodes[oi]);
     };
     if (for_each_candidate_pair_indexed(gm, *god.bvh, om, ob, node_box, face_box, d, &ws->stack, visit, &node_pairs,

@@ -137,6 +137,7 @@ struct Builder {
     BvhNode& node = bvh->nodes[index];
     node.obb = fit(begin, end);
     node.obb_pays = obb_volume_ratio(node.obb.half, 0.5 * (node.box.hi - node.box.lo)) < 0.5;
+    node.obb_tight = near_orthonormal(node.obb.axes, kObbAxesTight);
     if (end - begin <= leaf_size) {
       bvh->nodes[index].first = begin;
       bvh->nodes[index].count = end - begin;

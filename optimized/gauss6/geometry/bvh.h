@@ -40,19 +40,21 @@ struct Obb {
 };
 
 // True when the columns of m and its rows are orthonormal to within
-// kObbFrameTolerance: every entry of m^T m and of m m^T, computed in doubles,
-// within it of the identity's (false on NaN). The oriented boxes' tests rest
-// on it (error_allowances.h, proofs/ObbSeparation.v). Both Gram matrices are
-// symmetric bit for bit (a product commutes exactly), so only their six
-// distinct entries are computed, each dot in the order ((p0 + p1) + p2) that
-// frame_check_sound models: it runs on every posed node of a descent.
-inline bool near_orthonormal(const Mat3& m) {
+// `tolerance` (kObbFrameTolerance unless said): every entry of m^T m and of
+// m m^T, computed in doubles, within it of the identity's (false on NaN). The
+// oriented boxes' tests rest on it at kObbFrameTolerance (error_allowances.h,
+// proofs/ObbSeparation.v); at the tighter kObbAxesTight and kObbRotationTight
+// it tells SweptObbFrame::pose that the posed axes R A pass it too
+// (proofs/ObbFrameProduct.v). Both Gram matrices are symmetric bit for bit (a
+// product commutes exactly), so only their six distinct entries are computed,
+// each dot in the order ((p0 + p1) + p2) that frame_check_sound models.
+inline bool near_orthonormal(const Mat3& m, double tolerance = kObbFrameTolerance) {
   for (int i = 0; i < 3; ++i) {
     for (int j = i; j < 3; ++j) {
       const double id = i == j ? 1.0 : 0.0;
       const double columns = m(0, i) * m(0, j) + m(1, i) * m(1, j) + m(2, i) * m(2, j);
       const double rows = m(i, 0) * m(j, 0) + m(i, 1) * m(j, 1) + m(i, 2) * m(j, 2);
-      if (!(std::abs(columns - id) <= kObbFrameTolerance && std::abs(rows - id) <= kObbFrameTolerance)) return false;
+      if (!(std::abs(columns - id) <= tolerance && std::abs(rows - id) <= tolerance)) return false;
     }
   }
   return true;
@@ -62,6 +64,7 @@ struct BvhNode {
   Aabb box;            // the mesh's own frame
   Obb obb;             // the mesh's own frame; holds every vertex of the node's triangles
   bool obb_pays = false;  // the oriented box is less than half the axis-aligned one (obb_volume_ratio)
+  bool obb_tight = false; // obb.axes pass near_orthonormal at kObbAxesTight (SweptObbFrame::pose)
   int32_t first = 0;   // leaf: first slot in Bvh::triangles; inner: left child (right = first + 1)
   int32_t count = 0;   // leaf: number of triangles (> 0); inner: 0
 };

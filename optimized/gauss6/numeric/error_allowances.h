@@ -134,6 +134,19 @@ constexpr double kObbSeparationRounding = 1e-11;
 // hypothesis of proofs/ObbSeparation.v (machine-checked: frame_check_sound). Eigen's eigenvectors and their turn
 // by a double rotation stay near 1e-16 to 1e-15, so it never trips on a valid pose.
 constexpr double kObbFrameTolerance = 1e-14;
+// Tighter frame checks, made once per frame instead of once per posed box: a
+// node's fitted axes A within kObbAxesTight (2^-49, BvhNode::obb_tight, at
+// BVH build) and the pose's rotation R within kObbRotationTight (2^-50,
+// SweptObbFrame::set_rotation), both in near_orthonormal's sense, make the
+// posed axes R A, each entry a sum of three products rounded in any order,
+// pass near_orthonormal at kObbFrameTolerance (their exact Gram matrices
+// within 79 u of the identity, the computed ones within 82 u < 1e-14): then
+// SweptObbFrame::pose need not compute it. Machine-checked:
+// proofs/ObbFrameProduct.v, posed_frame_check. Eigen's eigenvectors sit
+// within 2^-49 and rotation_matrix's within 2^-50; a frame that is not falls
+// back to the check on the product.
+constexpr double kObbAxesTight = 0x1p-49;
+constexpr double kObbRotationTight = 0x1p-50;
 
 // The half extents of a fitted oriented box (fit_obb), relative to the
 // largest coordinate of its points: each point's projection on the double

@@ -113,7 +113,7 @@ TraversalStatus traverse(const StepState& s, const StartFrame& frame, const Moti
   const CcdBody& god = s.god;
   const SweptObbFrame obb_frame = frame.obb_frame(u_end, dist);
   const auto god_node_obb = [&](int node) -> const PosedObb& {
-    return swept.get(swept.node_obbs, node, [&] { return obb_frame.pose(god.bvh->nodes[node].obb); });
+    return swept.get(swept.node_obbs, node, [&] { return obb_frame.pose(god.bvh->nodes[node]); });
   };
   // God boxes grown by dist once here (outward rounded), so the traversal
   // compares them with the obstacles' exact boxes as they are (margin 0
