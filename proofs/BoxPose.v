@@ -4,7 +4,7 @@
    every double vertex of the body box posed as generate_contacts poses it
    (world(v) = G + R v in doubles). Same model as Rounding.v (binary64, round
    to nearest, gradual underflow, finite results, no fused multiply-add: the
-   build does not let the compiler contract). Per world coordinate: G the
+   build targets x86-64 without FMA, so nothing is contracted). Per world coordinate: G the
    pose's coordinate, R0, R1, R2 the row of the double rotation matrix. *)
 
 From Coq Require Import Reals Psatz List.
