@@ -41,6 +41,11 @@ Proof.
   assert (0 <= Rabs z) by apply Rabs_pos. nra.
 Qed.
 
+(* finite_of HF x as Fx: Fx : F x from HF : forall y, In y [...] -> F y, x one
+   of the list's values (the theorems take their doubles as one such list). *)
+Tactic Notation "finite_of" constr(HF) constr(x) "as" ident(H) :=
+  assert (H : F x) by (apply HF; simpl; tauto).
+
 (* One rounded step: an operand z within Ez of the exact Z, |Z| <= Bz. *)
 Lemma step z Z Bz Ez :
   Rabs Z <= Bz -> Rabs (z - Z) <= Ez -> Rabs (fl z - Z) <= Ez + u * (Bz + Ez) + eta.
@@ -965,12 +970,12 @@ Proof.
   assert (Hu : 0 < u < / 1000000) by (unfold u; lra). pose proof eta_pos. pose proof eta_small.
   assert (Hsmall : 5 * bpow radix2 (-1000) <= / IZR (Z.pow 10 300) * / 2) by (simpl; lra).
   assert (bpow radix2 (-1022) <= bpow radix2 (-1000)) by (apply bpow_le; lia).
-  assert (Fm0 : F m0) by (apply HF; simpl; tauto). assert (Fm1 : F m1) by (apply HF; simpl; tauto).
-  assert (Fm2 : F m2) by (apply HF; simpl; tauto). assert (Fq0 : F q0) by (apply HF; simpl; tauto).
-  assert (Fq1 : F q1) by (apply HF; simpl; tauto). assert (Fq2 : F q2) by (apply HF; simpl; tauto).
-  assert (Fc0 : F c0) by (apply HF; simpl; tauto). assert (Fc1 : F c1) by (apply HF; simpl; tauto).
-  assert (Fc2 : F c2) by (apply HF; simpl; tauto). assert (Fh0 : F h0) by (apply HF; simpl; tauto).
-  assert (Fh1 : F h1) by (apply HF; simpl; tauto). assert (Fh2 : F h2) by (apply HF; simpl; tauto).
+  finite_of HF m0 as Fm0. finite_of HF m1 as Fm1.
+  finite_of HF m2 as Fm2. finite_of HF q0 as Fq0.
+  finite_of HF q1 as Fq1. finite_of HF q2 as Fq2.
+  finite_of HF c0 as Fc0. finite_of HF c1 as Fc1.
+  finite_of HF c2 as Fc2. finite_of HF h0 as Fh0.
+  finite_of HF h1 as Fh1. finite_of HF h2 as Fh2.
   pose proof (Rabs_pos m0). pose proof (Rabs_pos m1). pose proof (Rabs_pos m2).
   pose proof (Rabs_pos c0). pose proof (Rabs_pos c1). pose proof (Rabs_pos c2).
   (* exact: within H of the exact R_mid c *)

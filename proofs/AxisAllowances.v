@@ -114,10 +114,9 @@ Proof.
   intros Hs H0 H1 H2. apply Rabs_le_inv in H0. apply Rabs_le_inv in H1. apply Rabs_le_inv in H2.
   apply Rabs_le. destruct Hs as [-> | ->]; unfold max3, min3, Rmax, Rmin; repeat destruct Rle_dec; lra.
 Qed.
-Lemma F_max3 p q r : F p -> F q -> F r -> F (max3 p q r).
-Proof. intros. unfold max3, Rmax. repeat destruct Rle_dec; assumption. Qed.
-Lemma F_min3 p q r : F p -> F q -> F r -> F (min3 p q r).
-Proof. intros. unfold min3, Rmin. repeat destruct Rle_dec; assumption. Qed.
+(* The largest or least of three doubles is a double. *)
+Lemma F_sel3 sel p q r : is_sel3 sel -> F p -> F q -> F r -> F (sel p q r).
+Proof. intros [-> | ->] **; unfold max3, min3, Rmax, Rmin; repeat destruct Rle_dec; assumption. Qed.
 
 (* kAxisProductRounding = fl(1e-13) >= 900 u. *)
 (* allowance kAxisProductRounding = 1e-13 *)
@@ -256,10 +255,10 @@ Proof.
   set (XH := max3 (edot a x0) (edot a x1) (edot a x2)) in *.
   set (YL := min3 (edot a y0) (edot a y1) (edot a y2)) in *.
   set (YH := max3 (edot a y0) (edot a y1) (edot a y2)) in *.
-  assert (Fa_lo : F a_lo) by (apply F_min3; apply F_fl).
-  assert (Fa_hi : F a_hi) by (apply F_max3; apply F_fl).
-  assert (Fb_lo : F b_lo) by (apply F_min3; apply F_fl).
-  assert (Fb_hi : F b_hi) by (apply F_max3; apply F_fl).
+  assert (Fa_lo : F a_lo) by (apply F_sel3; [apply min3_sel | apply F_fl ..]).
+  assert (Fa_hi : F a_hi) by (apply F_sel3; [apply max3_sel | apply F_fl ..]).
+  assert (Fb_lo : F b_lo) by (apply F_sel3; [apply min3_sel | apply F_fl ..]).
+  assert (Fb_hi : F b_hi) by (apply F_sel3; [apply max3_sel | apply F_fl ..]).
   (* each computed difference: at most the exact one plus 8.1 u |a|_1 s + 10.1 eta *)
   assert (Gen : forall p P q Q, F p -> F q -> Rabs (p - P) <= e -> Rabs (q - Q) <= e ->
                 Rabs P <= Aa -> Rabs Q <= Aa -> fl (p - q) <= (P - Q) + (81 / 10 * W + 101 / 10 * eta)).
@@ -742,7 +741,7 @@ Proof.
     assert (0 <= u * (norm1 a * vinf)) by (apply Rmult_le_pos; [lra | apply Rmult_le_pos; lra]).
     assert (0 <= u * (norm1 a * winf * rinf)) by (apply Rmult_le_pos; [lra | repeat apply Rmult_le_pos; lra]).
     lra. }
-  assert (Fap : F approach) by (apply F_max3; apply F_fl).
+  assert (Fap : F approach) by (apply F_sel3; [apply max3_sel | apply F_fl ..]).
   destruct (Rle_or_lt 0 approach) as [Hp|Hn].
   - pose proof (next_up_plus approach Hp) as N1.
     assert (N2 : next_up approach <= Rmax 0 (next_up approach)) by apply Rmax_r.

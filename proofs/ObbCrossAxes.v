@@ -472,10 +472,10 @@ Proof.
   assert (Fa0 : FV a0) by (apply HV; simpl; tauto). assert (Fa1 : FV a1) by (apply HV; simpl; tauto).
   assert (Fa2 : FV a2) by (apply HV; simpl; tauto). assert (Fca : FV ca) by (apply HV; simpl; tauto).
   assert (Fcb : FV cb) by (apply HV; simpl; tauto). assert (Fhs : FV hs) by (apply HV; simpl; tauto).
-  assert (G0 : F ha0) by (apply HF; simpl; tauto). assert (G1 : F ha1) by (apply HF; simpl; tauto).
-  assert (G2 : F ha2) by (apply HF; simpl; tauto). assert (G3 : F hb0) by (apply HF; simpl; tauto).
-  assert (G4 : F hb1) by (apply HF; simpl; tauto). assert (G5 : F hb2) by (apply HF; simpl; tauto).
-  assert (Gg : F grow) by (apply HF; simpl; tauto). assert (Gs : F s) by (apply HF; simpl; tauto).
+  finite_of HF ha0 as G0. finite_of HF ha1 as G1.
+  finite_of HF ha2 as G2. finite_of HF hb0 as G3.
+  finite_of HF hb1 as G4. finite_of HF hb2 as G5.
+  finite_of HF grow as Gg. finite_of HF s as Gs.
   pose proof (ortho_cycle _ _ _ _ Hoa) as Hoa1. pose proof (ortho_cycle _ _ _ _ Hoa1) as Hoa2.
   pose proof (ortho_cycle _ _ _ _ Hob) as Hob1. pose proof (ortho_cycle _ _ _ _ Hob1) as Hob2.
   apply (cross_core e x y z bj bj1 bj2 ca cb hs E X hx hy hbj hbj1 hbj2 grow s sigma); try assumption;

@@ -820,9 +820,9 @@ Proof.
   destruct Hz as (Z0 & Z1 & Z2 & Z3 & Z4 & Z5 & Zg & Zca & Zcb & Zhs & Ztw & Zs).
   assert (Fv : forall v, In v [a0; a1; a2; b0; b1; b2] -> FV v) by (intros v Hv; apply HV; simpl in *; tauto).
   assert (G : forall x, In x [ha0; ha1; ha2; hb0; hb1; hb2] -> F x) by (intros x Hx; apply HF; simpl in *; tauto).
-  pose proof (G ha0 ltac:(simpl; tauto)) as G0. pose proof (G ha1 ltac:(simpl; tauto)) as G1.
-  pose proof (G ha2 ltac:(simpl; tauto)) as G2. pose proof (G hb0 ltac:(simpl; tauto)) as G3.
-  pose proof (G hb1 ltac:(simpl; tauto)) as G4. pose proof (G hb2 ltac:(simpl; tauto)) as G5.
+  finite_of G ha0 as G0. finite_of G ha1 as G1.
+  finite_of G ha2 as G2. finite_of G hb0 as G3.
+  finite_of G hb1 as G4. finite_of G hb2 as G5.
   set (t := vsub (vsub cb ca) hs).
   set (wa := vsub (vsub (vsub X E) (vscale (1 + sigma) hs)) ca) in *.
   set (wb := vsub X cb) in *.

@@ -1,4 +1,5 @@
-// Tests of the theorems of proofs/Allowances.v: the rounding error of each
+// Tests of the theorems of proofs/Allowances.v (and BoxPose.v's
+// box_pose_encloses, the last case): the rounding error of each
 // proved allowance's expression, evaluated as its site evaluates it (the same
 // operations in the same order; the site's code is tied to the theorem by the
 // hash tools/check_proofs.sh compares), against the exact value in rationals
@@ -10,6 +11,7 @@
 
 #include <Eigen/Dense>
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <limits>
@@ -17,6 +19,8 @@
 
 #include "gauss6/numeric/error_allowances.h"
 #include "gauss6/ccd/motion_bounds.h"
+#include "gauss6/contact/contacts.h"
+#include "gauss6/geometry/pose.h"
 #include "gauss6/numeric/rounding.h"
 
 using namespace gauss6;
@@ -303,6 +307,66 @@ TEST_CASE("swept_box holds the exact products (Allowances.v swept_box_rounding)"
           REQUIRE(x <= Q(w.hi[i]));
         }
       }
+    }
+  }
+}
+
+// box_pose_encloses (BoxPose.v): posed_body_box, generate_contacts' world box
+// of a god body box, holds every double vertex of the body box posed as
+// generate_contacts poses it (G + R v in doubles). Adversarial: G and R mid
+// cancel (a body box at about -G in the body frame, turned by a small angle
+// about z), so |c| is tiny while the vertices round relative to |G|, and the
+// box is flat along one body axis and narrow along another, so h is tiny too:
+// a slack relative to |c| + h (the form before BoxPose.v) misses vertices
+// there by ~1e-16 |G|. Random poses and boxes of every scale besides.
+TEST_CASE("posed_body_box holds the posed vertices where G and R mid cancel (BoxPose.v box_pose_encloses)",
+          "[proved]") {
+  std::mt19937_64 rng(45450045);
+  std::uniform_real_distribution<double> unit(-1, 1), mant(0.5, 1);
+  std::uniform_int_distribution<int> ex_g(-20, 40), ex_t(-45, -5), ex_l(-40, 10), ex_any(-1074, 99), pick(0, 2);
+  const auto check = [](const Pose& X, const Aabb& box, const Vec3& v) {
+    const Mat3 R = rotation_matrix(X.q);
+    const Aabb w = posed_body_box(R, R.cwiseAbs(), X.p, box);
+    const Vec3 x = X.p + R * v;  // as generate_contacts' world(v)
+    for (int i = 0; i < 3; ++i) {
+      INFO("coordinate " << i << " x " << x[i] << " box [" << w.lo[i] << ", " << w.hi[i] << "]");
+      REQUIRE(w.lo[i] <= x[i]);
+      REQUIRE(x[i] <= w.hi[i]);
+    }
+  };
+  for (int n = 0; n < 20000; ++n) {
+    Pose X;
+    Aabb box;
+    if (n % 2 == 0) {  // cancelling: R m ~ -G along x, the box flat in body x and thin in body y
+      const double theta = std::ldexp(mant(rng), ex_t(rng)) * (unit(rng) < 0 ? -1 : 1);
+      X.q = Quat{std::cos(theta / 2), 0, 0, std::sin(theta / 2)};
+      X.p = Vec3(std::ldexp(unit(rng), ex_g(rng)), std::ldexp(unit(rng), ex_g(rng)), unit(rng));
+      const Mat3 R = rotation_matrix(X.q);
+      const double a = -X.p.x() / R(0, 0);
+      const double L = std::ldexp(mant(rng), ex_l(rng));
+      const double y0 = unit(rng) * L;
+      box.lo = Vec3(a, y0 - L, -1);
+      box.hi = Vec3(pick(rng) == 0 ? std::nextafter(a, 2 * std::abs(a) + 1) : a, y0 + L, 1);
+    } else {  // any pose and box, coordinates of every scale
+      X.q = Quat{unit(rng), unit(rng), unit(rng), unit(rng)};
+      if (X.q.norm2() == 0) X.q = Quat{};
+      X.p = Vec3(std::ldexp(unit(rng), ex_g(rng)), std::ldexp(unit(rng), ex_any(rng)), coordinate(rng) * 1e-18);
+      for (int i = 0; i < 3; ++i) {
+        double lo = std::ldexp(unit(rng), pick(rng) == 0 ? ex_any(rng) : ex_g(rng)), hi = lo + std::ldexp(mant(rng), ex_l(rng));
+        box.lo[i] = lo;
+        box.hi[i] = hi;
+      }
+    }
+    for (int corner = 0; corner < 8; ++corner)
+      check(X, box, Vec3((corner & 1) ? box.hi.x() : box.lo.x(), (corner & 2) ? box.hi.y() : box.lo.y(),
+                         (corner & 4) ? box.hi.z() : box.lo.z()));
+    for (int k = 0; k < 8; ++k) {
+      Vec3 v;
+      for (int i = 0; i < 3; ++i) {
+        const double t = 0.5 * (unit(rng) + 1);
+        v[i] = std::clamp(box.lo[i] + t * (box.hi[i] - box.lo[i]), box.lo[i], box.hi[i]);
+      }
+      check(X, box, v);
     }
   }
 }

@@ -381,6 +381,19 @@ int reduce_to_patch_supports(double patch_angle, ContactSet* set) noexcept {
   return m - kept;
 }
 
+Aabb posed_body_box(const Mat3& R, const Mat3& absR, const Vec3& G, const Aabb& box) noexcept {
+  // Centre and half extents through |R|, grown by kBoxPoseRounding relative to
+  // |G| + |R| |mid| + h: the magnitudes before G and R mid cancel, to which
+  // the posed vertices' rounding is relative (not to |c|, which cancelling
+  // makes small), and kUnderflowFloor.
+  const Vec3 mid = 0.5 * (box.lo + box.hi);
+  const Vec3 c = G + R * mid;
+  const Vec3 h = absR * (0.5 * (box.hi - box.lo));
+  const Vec3 reach = G.cwiseAbs() + absR * mid.cwiseAbs() + h;
+  const Vec3 slack = kBoxPoseRounding * reach + Vec3::Constant(kUnderflowFloor);
+  return Aabb{c - h - slack, c + h + slack};
+}
+
 ContactStatus generate_contacts(const CcdBody* obstacles, int num_obstacles, const CcdBody& god, const Pose& X_WB,
                                 const ContactSettings& settings, ContactWorkspace* ws, ContactSet* set,
                                 const NearPairs& near) noexcept {
@@ -409,15 +422,8 @@ ContactStatus generate_contacts(const CcdBody* obstacles, int num_obstacles, con
     }
     return ws->god_world[v];
   };
-  // World box of a body box: centre and half extents through |R|, grown by a
-  // rounding allowance (kBoxPoseRounding: the double vertices above round too).
   const Mat3 absR = R.cwiseAbs();
-  const auto god_box = [&](const Aabb& b) {
-    const Vec3 c = G + R * (0.5 * (b.lo + b.hi));
-    const Vec3 h = absR * (0.5 * (b.hi - b.lo));
-    const Vec3 slack = kBoxPoseRounding * (c.cwiseAbs() + h) + Vec3::Constant(kUnderflowFloor);
-    return Aabb{c - h - slack, c + h + slack};
-  };
+  const auto god_box = [&](const Aabb& b) { return posed_body_box(R, absR, G, b); };
   const double d = settings.distance;
   // Node pairs whose boxes meet are then tested as oriented boxes (bvh.h), the
   // god node's posed at X_WB and grown by d: a fixed pose, no motion.
@@ -432,7 +438,8 @@ ContactStatus generate_contacts(const CcdBody* obstacles, int num_obstacles, con
   // Features whose boxes are more than `apart` apart along an axis are more
   // than 2 d apart, and their computed separation (its rounding below
   // kBoxPoseRounding of the coordinates' magnitude `scale`) is above d: they
-  // need no test, and the set is the same with or without it.
+  // need no test, and the set is the same with or without it. (This and `tie`
+  // below are argued, not machine-checked: proofs/README.md.)
   double scale = std::abs(G.x()) + std::abs(G.y()) + std::abs(G.z()) + god.bvh->radius;
   for (int o = 0; o < num_obstacles; ++o)
     if (obstacles[o].bvh) scale = std::max(scale, obstacles[o].bvh->radius);

@@ -132,6 +132,12 @@ struct ContactWorkspace {
   BvhStack stack;
 };
 
+// The world box of the body box `box` at the pose (R, G), R the double
+// rotation_matrix of the pose and absR = |R| entrywise: it holds G + R v,
+// computed in doubles as generate_contacts poses a vertex, for every double v
+// within box (proofs/BoxPose.v, box_pose_encloses).
+Aabb posed_body_box(const Mat3& R, const Mat3& absR, const Vec3& G, const Aabb& box) noexcept;
+
 // The contact set of the god-object at pose X_WB (G = X_WB.p) against the
 // obstacles (world frame). With near.listed(), the triangle pairs near[0 ..
 // near.num_pairs) are tested instead of a descent of the trees: a list that

@@ -160,15 +160,13 @@ constexpr double kObbRotationTight = 0x1p-50;
 // covers that and the roundings, under 40 u scale, 1.27 times).
 constexpr double kObbFitRounding = 1e-13;
 
-// The world box of a god node's body box at a double pose, c +- h with c =
-// G + R m, h = |R| half (generate_contacts), grown to hold the posed double
-// vertices G + R v: c, h and each vertex round within a few units of u (under
-// 20 u) of |c| + h, per coordinate, wherever G and R m do not cancel; 1e-12
-// covers that 450 times. Where they cancel (|c| much below |G|), the
-// roundings are relative to |G| + |R m| instead, and the allowance does not
-// cover them when h is tiny too (a node flat along a world axis near the
-// coordinate plane): such a box may miss a vertex by a rounding (~1e-17 of
-// |G|). Site: generate_contacts.
+// The world box of a god node's body box at a double pose, c +- (h + slack)
+// with c = G + R mid, h = |R| half and slack = kBoxPoseRounding (|G| + |R|
+// |mid| + h) + kUnderflowFloor (posed_body_box, contacts.cpp), holds every
+// vertex posed in doubles, G + R v: machine-checked, proofs/BoxPose.v,
+// box_pose_encloses (roundings under 23 u of the reach, 1e-12 covers them
+// 390 times). Its uses in generate_contacts' `apart` and `tie` are argued
+// there, not proved.
 constexpr double kBoxPoseRounding = 1e-12;
 
 // A body box c +- h mapped by an interval rotation in midpoint-radius form
@@ -191,7 +189,8 @@ constexpr double kBoxProductRounding = 2e-15;
 // dozen of them stay below 1e-306; 1e-300 covers them and is below any extent
 // that matters. Sites: fit_obb, generate_contacts, swept_box,
 // for_each_separating_axis. Machine-checked at swept_box: proofs/Allowances.v,
-// swept_box_rounding; at fit_obb: proofs/ObbSeparation.v, obb_fit_rounding
+// swept_box_rounding; at generate_contacts: proofs/BoxPose.v,
+// box_pose_encloses; at fit_obb: proofs/ObbSeparation.v, obb_fit_rounding
 // (the half extents' floor, >= 2^-1001, which obb_separated's theorems take).
 constexpr double kUnderflowFloor = 1e-300;
 
