@@ -60,7 +60,12 @@ def run_benchmarks(binary: Path, out_json: Path, filter_regex: str = "", repetit
                           timeout=timeout)
     if proc.returncode != 0:
         raise RuntimeError(f"{' '.join(cmd)} failed ({proc.returncode}):\n{proc.stderr[-4000:]}")
-    doc = json.loads(out_json.read_text())
+    # Google Benchmark exits 0 and writes an empty file when the filter matches no benchmark.
+    text = out_json.read_text() if out_json.exists() else ""
+    if not text.strip():
+        raise RuntimeError(f"{binary.name}: no benchmark matches the filter {filter_regex!r}"
+                           if filter_regex else f"{' '.join(cmd)} wrote no results:\n{proc.stderr[-4000:]}")
+    doc = json.loads(text)
     errors = [b["name"] for b in doc.get("benchmarks", []) if b.get("error_occurred")]
     if errors:
         doc.setdefault("errors", errors)

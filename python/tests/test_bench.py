@@ -73,3 +73,10 @@ def test_real_filtered_run_writes_json_table_and_plot(tmp_path):
     assert doc["benchmarks"]
     assert (tmp_path / "table.md").read_text().count("\n| ") >= 3
     assert (tmp_path / "latency.png").stat().st_size > 1000
+
+
+@pytest.mark.skipif(not _built(), reason="benchmarks not built (-DGAUSS6_BUILD_BENCHMARKS=ON)")
+def test_a_filter_that_matches_nothing_is_named(tmp_path):
+    # Google Benchmark exits 0 with an empty output file then: the runner says so, no traceback.
+    with pytest.raises(RuntimeError, match="no benchmark matches the filter 'NoSuchBenchmark'"):
+        bench.run_benchmarks(bench.bench_binary(), tmp_path / "out.json", "NoSuchBenchmark")
