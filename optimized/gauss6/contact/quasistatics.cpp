@@ -1077,25 +1077,27 @@ ProjectionStatus project(const ProjectionProblem& pb, const ProjectionSettings& 
   }
   const int m = pb.num_rows;
 
-  // The problem solved: pb, or (au, b) scaled up by 2^e when a length is under
-  // kMinLength (see "Scale" in quasistatics.h; the answer is scaled back).
-  const int e = scale_exponent(pb, ws);
-  ProjectionProblem spb = pb;
-  if (e > 0) {
-    for (int i = 0; i < 6; ++i) spb.au[i] = std::ldexp(pb.au[i], e);
-    if (pb.b != nullptr) {
-      for (int k = 0; k < m; ++k) ws.scaled_b[k] = std::ldexp(pb.b[k], e);
-      spb.b = ws.scaled_b.data();
-    }
-  }
   // Target in Cholesky coordinates: y_u = L^T au.
-  const Vec6 yu = ws.L.transpose() * spb.au;
+  Vec6 yu = ws.L.transpose() * pb.au;
   // The problem's lengths (y-space) within range (see kMaxLength): |y_u| and each
   // offset's distance |b_k| / |A_k| (an offset on a zero row is a bare sign test).
-  // A refusal names the length as given when scaling did not help.
-  if (const char* problem = length_problem(yu, spb.b, ws, m)) {
-    const char* given = e > 0 ? length_problem(ws.L.transpose() * pb.au, pb.b, ws, m) : nullptr;
-    return bad_input(pb, given ? given : problem, res);
+  // Where one is under kMinLength, the problem solved is (au, b) scaled up by
+  // 2^e (see "Scale" in quasistatics.h; the answer is scaled back), judged
+  // again; a refusal names the length as given. Lengths in range take no
+  // logarithm: the scale is sought only past the check every call makes.
+  ProjectionProblem spb = pb;
+  int e = 0;
+  if (const char* problem = length_problem(yu, pb.b, ws, m)) {
+    e = scale_exponent(pb, ws);
+    if (e > 0) {
+      for (int i = 0; i < 6; ++i) spb.au[i] = std::ldexp(pb.au[i], e);
+      if (pb.b != nullptr) {
+        for (int k = 0; k < m; ++k) ws.scaled_b[k] = std::ldexp(pb.b[k], e);
+        spb.b = ws.scaled_b.data();
+      }
+      yu = ws.L.transpose() * spb.au;
+    }
+    if (e == 0 || length_problem(yu, spb.b, ws, m) != nullptr) return bad_input(pb, problem, res);
   }
   const LoopProblem lp{yu, yu.norm(), spb.b, m, settings.dependence_tol, settings.feasibility_tol,
                        settings.max_iterations};
