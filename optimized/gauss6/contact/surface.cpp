@@ -299,12 +299,13 @@ double shade_contacts(const SurfaceModel& surface, const TriangleMesh* obstacles
   return g.norm();
 }
 
-double contact_travel(const ContactSet& set, int capacity, const Pose& x_start, const Pose& xs) noexcept {
-  const Mat3 R01 = rotation_matrix(x_start.q) * rotation_matrix(xs.q).transpose();
+double contact_travel(const ContactSet& set, int capacity, const Vec3& p_start, const Mat3& R_start, const Vec3& p,
+                      const Mat3& R) noexcept {
+  const Mat3 R01 = R_start * R.transpose();
   double travel = 0;
   for (int k = 0; k < std::min(set.num_contacts, capacity); ++k) {
     const Vec3& I = set.contacts[k].point;
-    const Vec3 before = x_start.p + R01 * (I - xs.p);  // the same body point at x_start
+    const Vec3 before = p_start + R01 * (I - p);  // the same body point at the start pose
     travel = std::max(travel, (I - before).norm());
   }
   return travel;

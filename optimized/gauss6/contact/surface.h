@@ -148,11 +148,13 @@ double texture_slope_per_amplitude(TextureKind kind, double wavelength, int widt
 // The texture's shortest wavelength (scene units): L for the sine and the
 // bumps, two pixels for a height map.
 double shortest_wavelength(const TextureField& t) noexcept;
-// The largest distance a contact point of `set` (at the pose xs, its first
-// `capacity` contacts) moved from the pose x_start: how far a textured contact
-// slid in one sim step (beyond half the shortest wavelength the texture is
-// undersampled at this speed, max_texture_speed).
-double contact_travel(const ContactSet& set, int capacity, const Pose& x_start, const Pose& xs) noexcept;
+// The largest distance a contact point of `set` (at the pose (p, R), its first
+// `capacity` contacts) moved from the pose (p_start, R_start), the rotations
+// rotation_matrix of the poses' q: how far a textured contact slid in one sim
+// step (beyond half the shortest wavelength the texture is undersampled at
+// this speed, max_texture_speed).
+double contact_travel(const ContactSet& set, int capacity, const Vec3& p_start, const Mat3& R_start, const Vec3& p,
+                      const Mat3& R) noexcept;
 // The sampling bound of the method (METHOD.md 6.2): a texture is felt only if
 // the contact point moves less than half its shortest wavelength per constraint
 // update (Nyquist). Fastest exploration speed v = L_min f / 2 at update rate f

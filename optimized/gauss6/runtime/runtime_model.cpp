@@ -183,8 +183,9 @@ RuntimeModel::RuntimeModel(const Scene& scene, const RuntimeSettings& s) : setti
   match_distance = settings.match_distance > 0 ? settings.match_distance : 1e-3 * god_radius;
 }
 
-Mat6 mass_matrix_at(const RuntimeModel& model, const Quat& q) {
-  const Mat3 R = rotation_matrix(normalized(q));
+Mat6 mass_matrix_at(const RuntimeModel& model, const Quat& q) { return mass_matrix(model, rotation_matrix(normalized(q))); }
+
+Mat6 mass_matrix(const RuntimeModel& model, const Mat3& R) {
   Mat6 M = Mat6::Zero();
   M.topLeftCorner<3, 3>() = model.mass * Mat3::Identity();
   M.bottomRightCorner<3, 3>() = R * model.inertia_G_B * R.transpose();

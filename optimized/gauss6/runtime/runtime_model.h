@@ -138,7 +138,9 @@ struct EffectiveSettings {
 };
 EffectiveSettings resolve_runtime_settings(const Scene& scene, const RuntimeSettings& settings);
 
-// M = diag(m I3, R I_G R^T) at orientation q: world frame, about G.
+// M = diag(m I3, R I_G R^T) for the rotation R: world frame, about G.
+Mat6 mass_matrix(const RuntimeModel& model, const Mat3& R);
+// The same at orientation q: R = rotation_matrix(normalized(q)).
 Mat6 mass_matrix_at(const RuntimeModel& model, const Quat& q);
 
 }  // namespace gauss6

@@ -28,7 +28,8 @@ SimState::SimState(const RuntimeModel& model)
       step4(model),
       snapshot(capacity) {
   xs = model.initial_pose;
-  M = mass_matrix_at(model, xs.q);
+  R = R_start = rotation_matrix(normalized(xs.q));
+  M = mass_matrix(model, R);
   contacts.num_contacts = 0;
 }
 
@@ -234,7 +235,15 @@ void advance_by(const RuntimeModel& model, SimState* s, SimStepInfo* info) {
   const Vec6 residual = s->contacts.num_contacts > 0 ? Vec6(info->au - info->ac) : Vec6::Zero();
   advance_god_object(model, s->xs, pose_update(s->xs, info->ac), residual, s->M, &s->contacts, &s->step4, info);
   s->xs = info->xs;
-  s->M = mass_matrix_at(model, s->xs.q);
+  // Out of budget: what of the command the update left for the next ones, the
+  // distance of xs from x_target (travel plus turn times the god-object's radius).
+  if (info->budget_exhausted) {
+    const Vec6 left = pose_difference(info->x_target, s->xs);
+    info->budget_deferred = left.head<3>().norm() + left.tail<3>().norm() * model.god_radius;
+  }
+  s->R_start = s->R;
+  s->R = rotation_matrix(normalized(s->xs.q));
+  s->M = mass_matrix(model, s->R);
   s->step_events |= s->step4.events;
 }
 
@@ -252,7 +261,7 @@ void shade_contact_set(const RuntimeModel& model, SimState* s, SimStepInfo* info
   shade_contacts(model.surface, model.obstacle_meshes_W.data(), s->contacts, s->xs.p, s->capacity,
                  s->shaded_J.data(), rows3(s->shaded_normal), model.surface.texture ? &weighting : nullptr);
   if (!model.surface.texture) return;
-  info->texture_step = contact_travel(s->contacts, s->capacity, info->x_start, s->xs);
+  info->texture_step = contact_travel(s->contacts, s->capacity, info->x_start.p, s->R_start, s->xs.p, s->R);
   if (info->texture_step > 0.5 * shortest_wavelength(model.surface.field))
     s->step_events |= event_bit(RuntimeEventKind::kTextureUndersampled);
 }

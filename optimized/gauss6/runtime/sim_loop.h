@@ -28,7 +28,9 @@ struct SimState {
   explicit SimState(const RuntimeModel& model);
   int capacity = 0;                    // contacts the buffers below hold
   Pose xs;                             // god-object pose
-  Mat6 M = Mat6::Identity();           // at xs's orientation
+  Mat3 R = Mat3::Identity();           // xs's rotation, rotation_matrix(normalized(xs.q)), once a step
+  Mat3 R_start = Mat3::Identity();     // the same at the step's x_start (textures: contact_travel)
+  Mat6 M = Mat6::Identity();           // at R (mass_matrix)
   ContactSet contacts;                 // the current set (capacity contacts)
   std::vector<double> gap_rhs;         // capacity: b_k = delta (1 + gap_factor) - separation_k
   ProjectionWorkspace projection_ws;

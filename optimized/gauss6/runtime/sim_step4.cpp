@@ -323,10 +323,9 @@ bool settle(const RuntimeModel& model, const Pose& x_start, const Vec6& residual
 // the end of what its CCD proved free (or the first leg's end, after a
 // refused settle), the contact set already taken there. A stop on the budget
 // is no contact: the step is kContact only when that set is not empty. The
-// update's work, and what of the command it left for the next ones (the
-// distance of xs from x_target: travel plus turn times the god-object's radius).
-void end_on_budget(const RuntimeModel& model, const Pose& x_target, const ContactSet& contacts, GodObjectStep* g,
-                   SimStepInfo* info) {
+// update's work; what of the command it left is the sim loop's to measure
+// (SimStepInfo::budget_deferred).
+void end_on_budget(const ContactSet& contacts, GodObjectStep* g, SimStepInfo* info) {
   info->work_units = g->budget.used();
   info->budget_exhausted = false;
   info->budget_deferred = 0;
@@ -335,8 +334,6 @@ void end_on_budget(const RuntimeModel& model, const Pose& x_target, const Contac
   info->budget_exhausted = true;
   if (g->leg.ccd.budget_exhausted)
     info->status = contacts.num_contacts > 0 ? SimStepStatus::kContact : SimStepStatus::kFree;
-  const Vec6 left = pose_difference(x_target, info->xs);
-  info->budget_deferred = left.head<3>().norm() + left.tail<3>().norm() * model.god_radius;
   g->events |= event_bit(RuntimeEventKind::kUpdateBudgetExhausted);
 }
 
@@ -408,7 +405,7 @@ void advance_god_object(const RuntimeModel& model, const Pose& x_start, const Po
   info->xs = g.leg.xs;
   info->num_contacts = contacts->num_contacts;
   g.paths.detour_units = g.budget.used() - g.paths.first_leg_units - g.paths.check_units;
-  end_on_budget(model, x_target, *contacts, &g, info);
+  end_on_budget(*contacts, &g, info);
 }
 
 }  // namespace gauss6

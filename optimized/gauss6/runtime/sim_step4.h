@@ -115,7 +115,8 @@ Pose split_step(const Pose& x0, const Pose& x1);
 // at a half turn, and one check) over 1 + kMaxSettleShortenings tries, and 3
 // more out of a graze. Under a budget (RuntimeSettings::budget) the update
 // ends when it runs out, at the end of what its CCDs proved free, with the
-// contact set there (info's budget_exhausted, work_units, budget_deferred).
+// contact set there (info's budget_exhausted and work_units; the sim loop
+// measures budget_deferred).
 void advance_god_object(const RuntimeModel& model, const Pose& x_start, const Pose& x_target, const Vec6& residual,
                         const Mat6& M, ContactSet* contacts, GodObjectStep* g, SimStepInfo* info) noexcept;
 
