@@ -132,10 +132,20 @@ def test_a_users_scene_runs_to_a_certified_report(table_run):
     poses = len(np.unique(np.hstack([tr.ticks["xs_p"], tr.ticks["xs_q"]]), axis=0))
     assert details["certify"]["poses"] == details["distinct_poses"] == poses > 300
     assert details["certify"]["motions"] == poses - 1
-    # The cube touched the plate (pressed 6 mm past its crest at z = 0.011 for 0.5 s) and was pushed up.
+    # The cube touched the plate (pressed 6 mm past its crest at z = 0.011 for 0.5 s) and was pushed up:
+    # never pulled down (every contact normal of the plate's top points up), 0.26 N at rest on the
+    # crest; over the slide the force is off for the few ticks in which the command leaves the contacts
+    # to first order (down a crest's far side, levelling the cube), so its mean is lower (0.15 N).
     pressed = (tr.ticks["t"] > 0.35) & (tr.ticks["t"] < 0.8)
     assert np.all(tr.ticks["num_contacts"][pressed] > 0)
-    assert np.all(tr.ticks["wrench"][pressed, 2] > 0.1)
+    assert np.all(tr.ticks["wrench"][pressed, 2] >= 0)
+    assert tr.ticks["wrench"][pressed, 2].mean() > 0.1
+    # The cube slid after the hand over the waves (the hand 4 cm along x in 0.5 s): each leg of the
+    # slide starts in contact, and a leg the CCD stops at its start is a graze lifted out of, not a
+    # stop for the rest of the slide.
+    x = tr.ticks["xs_p"][:, 0]
+    at = lambda t: int(np.argmin(np.abs(tr.ticks["t"] - t)))
+    assert x[at(0.3)] < -0.019 and x[at(0.55)] > x[at(0.3)] + 0.01 and x[at(0.8)] > 0.015
     assert np.all(tr.ticks["xs_p"][:, 2] - 0.01 > -0.001 - 1e-9)  # never below the lowest trough
     # The script's phases are the trace's, the lockstep repeats gave each step's least time.
     assert [p["name"] for p in tr.meta["phases"]] == ["press", "slide", "lift"]

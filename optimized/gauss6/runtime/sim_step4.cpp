@@ -193,15 +193,19 @@ DetourResult take_detour(const RuntimeModel& model, const Pose& x_start, const P
   return result;
 }
 
-// A graze: the leg just run was stopped by a pair of the last contact set (at
-// the leg's start) that had not come closer than where it started, by half the
-// CCD's distance tolerance. The CCD may stop wherever a pair is within
-// min_separation + distance_tolerance, so a contact the last step left in that
-// band stops the next leg at once even when it moves away from it.
+// A graze: the leg just run, from a pose in contact, was stopped by a pair
+// that had not come closer than where it started, by half the CCD's distance
+// tolerance. The CCD may stop wherever a pair is within min_separation +
+// distance_tolerance, so a contact the last step left in that band stops the
+// next leg at once even when it moves away from it. A leg stopped at its
+// start (u_hit = 0) came no closer to any pair, whichever stopped it: one the
+// set holds, or one it leaves out (an edge/edge pair beside the vertex/face
+// rows that span it, or one the set's reduction dropped).
 bool grazed(const RuntimeModel& model, const ContactSet& contacts, const GodObjectStep& g) {
   const CcdStepResult& r = g.leg.ccd;
   if (!r.hit || r.status != CcdStatus::kOk) return false;
   const int m = std::min(contacts.num_contacts, contacts.capacity());
+  if (m > 0 && r.u_hit == 0) return true;
   for (int k = 0; k < m; ++k) {
     const Contact& c = contacts.contacts[k];
     if (c.features == r.pair)
