@@ -122,6 +122,7 @@ inline IVec3 enclose_point(const MotionEnclosure& e, const IVec3& r) {
 // |(p + R(q) r_B) - (p(u) + R(u) r_B)| <= deviation. With a CCD run at
 // min_separation = d and u = u_hit, the stop pose's exact separation is at least
 // d - deviation (and the exact motion on [0, u_hit] keeps a distance >= d).
+// Machine-checked: proofs/StopPose.v, stop_pose_deviation, stop_pose_separation.
 struct StopPose {
   Pose pose;
   double deviation = 0;   // scene units

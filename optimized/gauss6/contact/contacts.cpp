@@ -435,17 +435,19 @@ ContactStatus generate_contacts(const CcdBody* obstacles, int num_obstacles, con
                 std::cos(settings.merge_angle), set};
   const double par2 = settings.parallel_sine * settings.parallel_sine;
   const double support_sine = std::sin(settings.merge_angle);
-  // Features whose boxes are more than `apart` apart along an axis are more
-  // than 2 d apart, and their computed separation (its rounding below
-  // kBoxPoseRounding of the coordinates' magnitude `scale`) is above d: they
-  // need no test, and the set is the same with or without it. (This and `tie`
-  // below are argued, not machine-checked: proofs/README.md.)
+  // Features whose boxes are more than `apart` apart along an axis have a
+  // computed separation above d (their closest points' rounding, under 40 u
+  // of the coordinates' magnitude, which `scale` bounds, is within
+  // kBoxPoseRounding scale): they need no test, and the set is the same with
+  // or without it. Machine-checked for d >= 2^-500 (check_delta_scale's
+  // kMinDelta): proofs/ContactApart.v, apart_vertex_face, apart_edge_edge.
   double scale = std::abs(G.x()) + std::abs(G.y()) + std::abs(G.z()) + god.bvh->radius;
   for (int o = 0; o < num_obstacles; ++o)
     if (obstacles[o].bvh) scale = std::max(scale, obstacles[o].bvh->radius);
   const double apart = (Upper{2 * d} + Upper{kBoxPoseRounding} * Upper{scale}).v;
   // Two separations of one vertex computed against two faces differ by their
-  // rounding, below kBoxPoseRounding of the coordinates' magnitude.
+  // rounding, below kBoxPoseRounding of the coordinates' magnitude (argued,
+  // not machine-checked: proofs/README.md).
   const double tie = (Upper{kBoxPoseRounding} * Upper{scale}).v;
   ContactStatus status = ContactStatus::kOk;
   for (int o = 0; o < num_obstacles; ++o) {

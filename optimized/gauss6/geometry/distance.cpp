@@ -6,7 +6,24 @@
 
 namespace gauss6 {
 
+namespace {
+
+// The point of segment [a, b] closest to p: its parameter clamped to [0, 1]
+// (a segment of zero length, whose parameter is NaN, gives a).
+Vec3 closest_point_on_segment(const Vec3& p, const Vec3& a, const Vec3& b) {
+  const Vec3 ab = b - a;
+  const double t = ab.dot(p - a) / ab.squaredNorm();
+  return a + (t > 0 ? (t < 1 ? t : 1.0) : 0.0) * ab;
+}
+
+}  // namespace
+
 // Ericson, Real-Time Collision Detection, 5.1.5: Voronoi regions of the triangle.
+// Every branch returns a corner, a point of an edge at a parameter in [0, 1],
+// or the interior's combination at weights >= 0 summing to at most 1 + 8 u,
+// so the point lies in the corners' box to 40 u of their magnitude:
+// proofs/ContactApart.v, closest_branches and closest_in_box (generate_contacts'
+// `apart` rests on it).
 Vec3 closest_point_on_triangle(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c) {
   const Vec3 ab = b - a, ac = c - a, ap = p - a;
   const double d1 = ab.dot(ap), d2 = ac.dot(ap);
@@ -23,8 +40,21 @@ Vec3 closest_point_on_triangle(const Vec3& p, const Vec3& a, const Vec3& b, cons
   if (vb <= 0 && d2 >= 0 && d6 <= 0) return a + (d2 / (d2 - d6)) * ac;
   const double va = d3 * d6 - d5 * d4;
   if (va <= 0 && (d4 - d3) >= 0 && (d5 - d6) >= 0) return b + ((d4 - d3) / ((d4 - d3) + (d5 - d6))) * (c - b);
-  const double denom = 1 / (va + vb + vc);
-  return a + ab * (vb * denom) + ac * (vc * denom);
+  // Inside the face: va, vb, vc > 0 in exact arithmetic, so the weights are
+  // >= 0 and sum to at most 1 (to 8 u: ContactApart.v, interior_weights).
+  // Rounding of the six dot products is not known to break these signs (no
+  // test has seen it), but nothing rules it out on a face whose area is at
+  // the level of its rounding; there a weight < 0 would put the point
+  // anywhere on the face's plane, so such a face gets the nearest of its
+  // edges' points instead.
+  if (va >= 0 && vb >= 0 && vc >= 0) {
+    const double denom = 1 / (va + vb + vc);
+    return a + ab * (vb * denom) + ac * (vc * denom);
+  }
+  const Vec3 e0 = closest_point_on_segment(p, a, b), e1 = closest_point_on_segment(p, b, c),
+             e2 = closest_point_on_segment(p, c, a);
+  const double s0 = (p - e0).squaredNorm(), s1 = (p - e1).squaredNorm(), s2 = (p - e2).squaredNorm();
+  return s0 <= s1 ? (s0 <= s2 ? e0 : e2) : (s1 <= s2 ? e1 : e2);
 }
 
 // Ericson 5.1.9, with degenerate segments handled.

@@ -45,7 +45,7 @@ const char* ccd_step_request_problem(const CcdStepRequest& request);
 // radius about G, god.bvh->radius, at most kMaxCoordinate, else kInvalidInput),
 // the request (the motion X0 -> X1, poses of G). Stop pose:
 // make_stop_pose(result.motion, result.u_hit, god.bvh->radius) when hit (u = 1 otherwise); with narrow.min_separation = d
-// its exact separation is >= d - deviation.
+// its exact separation is >= d - deviation (proofs/StopPose.v, stop_pose_separation).
 //
 // request.hints[0 .. num_hints): feature pairs likely to touch first (the runtime
 // passes the contacts at X0); their triangle pairs are tested over the whole
