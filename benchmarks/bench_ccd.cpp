@@ -3,7 +3,7 @@
 // (ccd_step) along the step's motion, the stop pose, then the contact set there
 // (generate_contacts), with the runtime's settings (bench_data.h scene_model:
 // min_separation = delta, distance_tolerance = 0.1 delta, contacts within
-// delta (1 + contact_factor)), on the peg-in-hole and bunnies scenes
+// delta (1 + contact_factor)), on the peg-in-hole and bunnies scenes and the battery's dense_plate
 // (datasets_generated/scenes/). Two kinds of step sets:
 //   - scenario: the steps of the scene's scripted scenario (what `gauss6
 //     reproduce` runs), recorded once in lockstep at setup (bench_data.h
@@ -385,6 +385,10 @@ void register_all() {
       register_latency(std::string("CcdStep/") + scene + "/scenario", BM_CcdStep, std::string(scene),
                        std::string("scenario"))
           ->Iterations(1);
+  // The conformance battery's dense coplanar contact (docs/conformance-battery.md, dense_plate): a puck
+  // of about 3,200 bottom triangles pressed, slid and twisted flat on a plate of 12,800 coplanar ones.
+  register_latency("CcdStep/dense_plate/scenario", BM_CcdStep, std::string("dense_plate"), std::string("scenario"))
+      ->Iterations(1);
   for (const char* scene : {"peg_in_hole", "bunnies", "bunnies_full", "bunnies_278k", "bunnies_1m"})
     for (const char* script : {"scenario_counted", "scenario_cpu_budget", "scenario_unit_budget"})
       if (scene_meshes_present(scene))
