@@ -183,35 +183,13 @@ bool held_beside(const Vec3& p, const Side<AtV>& V, int vf, int vc, const Side<A
   return held;
 }
 
-// A point grown by `gap`, each coordinate rounded up: c + gap <= the result.
-Vec3 grown(const Vec3& c, double gap) {
-  return {(Upper{c.x()} + Upper{gap}).v, (Upper{c.y()} + Upper{gap}).v, (Upper{c.z()} + Upper{gap}).v};
-}
-
 // Whether the boxes [a_lo, a_hi] and [b_lo, b_hi] are more than `gap` apart
 // along some axis (compared without rounding: b_lo - a_hi > gap is taken as
-// b_lo > a_hi + gap rounded up), given a_up = grown(a_hi, gap) and b_up =
-// grown(b_hi, gap).
-bool boxes_apart(const Vec3& a_lo, const Vec3& a_up, const Vec3& b_lo, const Vec3& b_up) {
+// b_lo > a_hi + gap rounded up).
+bool boxes_apart(const Vec3& a_lo, const Vec3& a_hi, const Vec3& b_lo, const Vec3& b_hi, double gap) {
   for (int i = 0; i < 3; ++i)
-    if (b_lo[i] > a_up[i] || a_lo[i] > b_up[i]) return true;
+    if (b_lo[i] > (Upper{a_hi[i]} + Upper{gap}).v || a_lo[i] > (Upper{b_hi[i]} + Upper{gap}).v) return true;
   return false;
-}
-// grown(hi, gap) of the box of corners P[k] and P[l] from their own grown
-// corners G: per axis the grown coordinate of the corner that is the larger
-// there (the same double: the rounding is a function of the coordinate).
-Vec3 grown_hi(const Vec3 (&P)[3], const Vec3 (&G)[3], int k, int l) {
-  Vec3 up;
-  for (int i = 0; i < 3; ++i) up[i] = P[k][i] >= P[l][i] ? G[k][i] : G[l][i];
-  return up;
-}
-Vec3 grown_hi(const Vec3 (&P)[3], const Vec3 (&G)[3]) {
-  Vec3 up;
-  for (int i = 0; i < 3; ++i) {
-    const int k = P[0][i] >= P[1][i] ? 0 : 1;
-    up[i] = P[k][i] >= P[2][i] ? G[k][i] : G[2][i];
-  }
-  return up;
 }
 
 struct Collector {
@@ -289,18 +267,8 @@ struct TrianglePairContacts {
     if (!in_slab && triangle_gap_lower_bound(X, Y, d) > d) return;
     Box boxes;
     if (in_slab) {
-      // Each corner grown by `apart` once (a feature's box grows by that of
-      // its corner largest along each axis: grown_hi), and the triangles'
-      // boxes. When the triangles' boxes are apart along an axis by the
-      // largest grown corner of a side, every feature box (inside its
-      // triangle's, grown by one of those corners) is apart from every other
-      // side's feature box along it too: no feature pair is tested.
-      for (int k = 0; k < 3; ++k) boxes.x_up[k] = grown(X[k], apart), boxes.y_up[k] = grown(Y[k], apart);
-      boxes.x_lo = X[0].cwiseMin(X[1]).cwiseMin(X[2]), boxes.x_hi_up = grown_hi(X, boxes.x_up);
-      boxes.y_lo = Y[0].cwiseMin(Y[1]).cwiseMin(Y[2]), boxes.y_hi_up = grown_hi(Y, boxes.y_up);
-      const Vec3 x_max_up = boxes.x_up[0].cwiseMax(boxes.x_up[1]).cwiseMax(boxes.x_up[2]);
-      const Vec3 y_max_up = boxes.y_up[0].cwiseMax(boxes.y_up[1]).cwiseMax(boxes.y_up[2]);
-      if (boxes_apart(boxes.x_lo, x_max_up, boxes.y_lo, y_max_up)) return;
+      boxes.x_lo = X[0].cwiseMin(X[1]).cwiseMin(X[2]), boxes.x_hi = X[0].cwiseMax(X[1]).cwiseMax(X[2]);
+      boxes.y_lo = Y[0].cwiseMin(Y[1]).cwiseMin(Y[2]), boxes.y_hi = Y[0].cwiseMax(Y[1]).cwiseMax(Y[2]);
     }
     // k: the god-object's corner (vertex k, or edge k -> k + 1), j: the obstacle's.
     for_each_feature_pair(go, oo, [&](PairKind kind, int k, int j) {
@@ -309,11 +277,9 @@ struct TrianglePairContacts {
     });
   }
 
-  // The two triangles' corners grown by `apart` (grown) and their boxes: the
-  // lower corner, the upper one grown (in the slab only).
+  // The two triangles' corner boxes (in the slab only).
   struct Box {
-    Vec3 x_up[3], y_up[3];
-    Vec3 x_lo, x_hi_up, y_lo, y_hi_up;
+    Vec3 x_lo, x_hi, y_lo, y_hi;
   };
 
   void feature_pair(PairKind kind, int k, int j, int gf, int of, const Vec3 (&X)[3], const Vec3 (&Y)[3],
@@ -321,7 +287,7 @@ struct TrianglePairContacts {
     switch (kind) {
       case PairKind::kGodVertexObstacleFace: {  // the obstacle face's normal
         const Vec3& x = X[k];
-        if (boxes && boxes_apart(x, boxes->x_up[k], boxes->y_lo, boxes->y_hi_up)) break;
+        if (boxes && boxes_apart(x, x, boxes->y_lo, boxes->y_hi, apart)) break;
         const double sep = (x - closest_point_on_triangle(x, Y[0], Y[1], Y[2])).norm();
         const Vec3 n = unit_normal(Y[0], Y[1], Y[2]);
         if (!(sep <= d && n != Vec3::Zero())) break;
@@ -334,7 +300,7 @@ struct TrianglePairContacts {
       }
       case PairKind::kObstacleVertexGodFace: {  // minus the god face's normal
         const Vec3& y = Y[j];
-        if (boxes && boxes_apart(y, boxes->y_up[j], boxes->x_lo, boxes->x_hi_up)) break;
+        if (boxes && boxes_apart(y, y, boxes->x_lo, boxes->x_hi, apart)) break;
         const Vec3 c = closest_point_on_triangle(y, X[0], X[1], X[2]);
         const double sep = (y - c).norm();
         const Vec3 n = -unit_normal(X[0], X[1], X[2]);
@@ -347,12 +313,9 @@ struct TrianglePairContacts {
         break;
       }
       case PairKind::kEdgeEdge: {  // closest points inside both edges, edges not parallel
-        const int k1 = (k + 1) % 3, j1 = (j + 1) % 3;
-        const Vec3 &g0 = X[k], &g1 = X[k1];
-        const Vec3 &o0 = Y[j], &o1 = Y[j1];
-        if (boxes && boxes_apart(g0.cwiseMin(g1), grown_hi(X, boxes->x_up, k, k1), o0.cwiseMin(o1),
-                                 grown_hi(Y, boxes->y_up, j, j1)))
-          break;
+        const Vec3 &g0 = X[k], &g1 = X[(k + 1) % 3];
+        const Vec3 &o0 = Y[j], &o1 = Y[(j + 1) % 3];
+        if (boxes && boxes_apart(g0.cwiseMin(g1), g0.cwiseMax(g1), o0.cwiseMin(o1), o0.cwiseMax(o1), apart)) break;
         double s, t;
         closest_segment_parameters(g0, g1, o0, o1, &s, &t);
         if (!(s > 0 && s < 1 && t > 0 && t < 1)) break;
