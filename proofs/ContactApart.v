@@ -362,6 +362,26 @@ Proof.
 Qed.
 Print Assumptions apart_separation.
 
+(* The box test either way round: P within its box [alo, ahi] and Q within
+   [blo, bhi], each to 40 u M + 5 eta, and the boxes more than `apart` apart
+   one way or the other: the computed |P - Q| is above d (apart_separation
+   with the roles of the two boxes as the test found them). *)
+Lemma apart_either d scale M alo ahi blo bhi P Q y z : F d -> F P -> F Q ->
+  bpow radix2 (-500) <= d -> 0 <= scale -> 0 <= M -> M <= 4 * scale + bpow radix2 (-490) ->
+  alo - (40 * u * M + 5 * eta) <= P <= ahi + (40 * u * M + 5 * eta) ->
+  blo - (40 * u * M + 5 * eta) <= Q <= bhi + (40 * u * M + 5 * eta) ->
+  next_up (fl (ahi + apart d scale)) < blo \/ next_up (fl (bhi + apart d scale)) < alo ->
+  let w := fl (P - Q) in
+  d < norm_c w y z /\ d < norm_c y w z /\ d < norm_c y z w.
+Proof.
+  intros Fd FP FQ Hd Hs HM HMs HP HQ Hbox w.
+  destruct Hbox as [Hbox|Hbox].
+  - destruct (apart_separation d scale M ahi blo P Q y z Fd FP FQ Hd Hs HM HMs Hbox ltac:(lra) ltac:(lra))
+      as (? & ? & ? & _). tauto.
+  - destruct (apart_separation d scale M bhi alo Q P y z Fd FQ FP Hd Hs HM HMs Hbox ltac:(lra) ltac:(lra))
+      as (_ & _ & _ & ? & ? & ?). tauto.
+Qed.
+
 (* ---- closest_point_on_triangle's branches are closest_coord ---- *)
 
 (* The code's branches, per coordinate (a, b, c the corners' coordinates):
@@ -423,11 +443,7 @@ Proof.
   assert (0 <= u * M) by (apply Rmult_le_pos; lra).
   pose proof (closest_in_box a b c q lo hi M Fa Fb Fc Ha Hb Hc Ma Mb Mc Hq) as Hin.
   pose proof (closest_format a b c q Fa Fb Fc Hq) as Fq.
-  destruct Hbox as [Hbox|Hbox].
-  - destruct (apart_separation d scale M x lo x q y z Fd Fx Fq Hd Hs HM HMs Hbox ltac:(lra) ltac:(lra))
-      as (? & ? & ? & _). tauto.
-  - destruct (apart_separation d scale M hi x q x y z Fd Fq Fx Hd Hs HM HMs Hbox ltac:(lra) ltac:(lra))
-      as (_ & _ & _ & ? & ? & ?). tauto.
+  exact (apart_either d scale M x x lo hi x q y z Fd Fx Fq Hd Hs HM HMs ltac:(lra) ltac:(lra) Hbox).
 Qed.
 Print Assumptions apart_vertex_face.
 
@@ -452,10 +468,6 @@ Proof.
   pose proof (edge_in_box s g0 g1 alo ahi M Hs01 Hg0 Hg1 Mg0 Mg1) as HP.
   pose proof (edge_in_box t o0 o1 blo bhi M Ht01 Ho0 Ho1 Mo0 Mo1) as HQ.
   assert (FP : F (point_c s g0 g1)) by apply F_fl. assert (FQ : F (point_c t o0 o1)) by apply F_fl.
-  destruct Hbox as [Hbox|Hbox].
-  - destruct (apart_separation d scale M ahi blo _ _ y z Fd FP FQ Hd Hs HM HMs Hbox ltac:(lra) ltac:(lra))
-      as (? & ? & ? & _). tauto.
-  - destruct (apart_separation d scale M bhi alo _ _ y z Fd FQ FP Hd Hs HM HMs Hbox ltac:(lra) ltac:(lra))
-      as (_ & _ & _ & ? & ? & ?). tauto.
+  exact (apart_either d scale M alo ahi blo bhi _ _ y z Fd FP FQ Hd Hs HM HMs ltac:(lra) ltac:(lra) Hbox).
 Qed.
 Print Assumptions apart_edge_edge.
