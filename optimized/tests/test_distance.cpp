@@ -56,6 +56,41 @@ TEST_CASE("triangle_gap_lower_bound: never above the distance, and useful", "[di
   CHECK(triangle_gap_lower_bound(T, N, 0) == 0);
 }
 
+TEST_CASE("triangle_gap_lower_bound: parallel triangles side by side are apart by their in-plane gap",
+          "[distance]") {
+  // A flat tool's face over a dense flat tessellation: two triangles in
+  // parallel planes (a height h apart, h from 0 to far below their gap in the
+  // plane), tilted anyhow, B beyond A's edge in the plane. The eleven axes all
+  // lie along the common normal (gap h); the in-plane axes (distance.h) find
+  // the gap in the plane. Tolerance: the bound must reach half the distance
+  // (each in-plane axis is an edge's own normal: the closest corners may lie
+  // off it), and never exceed it (the reference's long double rounding).
+  std::mt19937 rng(47);
+  std::normal_distribution<double> n(0, 1);
+  std::uniform_real_distribution<double> U(0, 1);
+  int checked = 0, found = 0;
+  for (int i = 0; i < 5000; ++i) {
+    const Vec3 axis = Vec3(n(rng), n(rng), n(rng)).normalized();
+    const Vec3 t1 = axis.unitOrthogonal(), t2 = axis.cross(t1);
+    const auto in_plane = [&](double x, double y, double z) { return Vec3(x * t1 + y * t2 + z * axis); };
+    // A: a triangle with its edge 0-1 on the line y = 0, corner 2 at y < 0;
+    // B: every corner at y >= g, the planes h apart.
+    const double g = 0.01 + U(rng), h = (i % 3 == 0 ? 0.0 : 1e-6 * U(rng)) * g;
+    const auto x = [&] { return 2 * U(rng) - 1; };  // B's corners over A's edge, which spans [-1, 1] or more
+    const Vec3 A[3] = {in_plane(-1 - U(rng), 0, 0), in_plane(1 + U(rng), 0, 0), in_plane(n(rng), -0.1 - U(rng), 0)};
+    const Vec3 B[3] = {in_plane(x(), g, h), in_plane(x(), g + U(rng), h), in_plane(x(), g + 0.1 + U(rng), h)};
+    const long double exact = triangle_distance(A, B);
+    if (!(exact > 0)) continue;
+    ++checked;
+    const double bound = triangle_gap_lower_bound(A, B, std::numeric_limits<double>::infinity());
+    REQUIRE(static_cast<long double>(bound) <= exact + 1e-15L);
+    found += bound >= 0.5 * static_cast<double>(exact);
+  }
+  std::printf("in-plane axes: %d of %d parallel pairs bounded by half their distance or more\n", found, checked);
+  CHECK(checked > 4900);
+  CHECK(found > checked * 9 / 10);
+}
+
 TEST_CASE("contacts: closest points agree with dense sampling", "[contacts]") {
   std::mt19937 rng(8);
   std::normal_distribution<double> n(0, 1);

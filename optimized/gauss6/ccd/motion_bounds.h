@@ -68,7 +68,7 @@ struct TriangleMotion {
 // projection approaches B's at most at max(0, max over corners of side n.v + b
 // + lag max(0, -b)) + w (the corners' projections bound every point's: the
 // first-order motion is affine in x), and it needs (g - reach) / that;
-// the largest such time over the 11 axes (and `extra`:
+// the largest such time over the axes (and `extra`:
 // for_each_separating_axis), or 0 when none proves g > reach; +inf when an
 // axis proves a gap that the motion never closes. Returns as soon as one axis
 // proves more than `enough`. Rounding: a.v is within kAxisVelocityRounding

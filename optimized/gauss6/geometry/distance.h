@@ -28,7 +28,11 @@ void closest_segment_parameters(const Vec3& p0, const Vec3& p1, const Vec3& q0, 
                                 double* t);
 
 // Separating axes of two triangles A and B given by their corners (one frame,
-// doubles): the two face normals and the nine edge cross products. Calls
+// doubles): the two face normals and the nine edge cross products, then, for
+// two triangles whose planes lie within kInPlaneSine of parallel, each face's
+// normal crossed with its own edges (in-plane axes: two parallel triangles
+// side by side, a flat tool's face over a dense flat tessellation, have all
+// eleven axes along their common normal, and only these separate them). Calls
 // on_axis(a, gap, side) for each axis a that proves a positive gap, with gap a
 // lower bound of the distance of the two triangles' projections on a / |a|
 // (where that quotient is below 2^-600, gap may lie a little below 0, down to
@@ -61,6 +65,12 @@ void closest_segment_parameters(const Vec3& p0, const Vec3& p1, const Vec3& q0, 
 // formed (a vertex and a face: the face's normal; two edges: their cross
 // product), in the order of the 11, and the result is that of the 11.
 enum class Shape : int { kVertex = 1, kEdge = 2, kTriangle = 3 };
+
+// The sine of the angle between two triangles' planes below which
+// for_each_separating_axis tries their in-plane axes (a heuristic: any axis
+// is a sound bound; these cost six more projections, and only parallel
+// planes need them).
+inline constexpr double kInPlaneSine = 0.1;
 
 // One side of the test, prepared once where it meets several others (a god
 // face posed at a sub-interval's start: StartFrame::posed_face): its corners
@@ -120,6 +130,16 @@ GAUSS6_ALWAYS_INLINE void for_each_separating_axis(const SatSide& A, const SatSi
   for (int i = 0; i < edges_a; ++i)
     for (int j = 0; j < edges_b; ++j)
       if (along(A.e[i].cross(B.e[j]))) return;
+  if constexpr (na == 3 && nb == 3) {
+    // (Not for a degenerate triangle, whose zero normal gives no plane: a
+    // feature passed as one keeps the axes of its Shape.)
+    const double aa = A.n.squaredNorm(), bb = B.n.squaredNorm();
+    if (!(aa > 0 && bb > 0 && A.n.cross(B.n).squaredNorm() <= kInPlaneSine * kInPlaneSine * aa * bb)) return;
+    for (int i = 0; i < 3; ++i)
+      if (along(A.n.cross(A.e[i]))) return;
+    for (int j = 0; j < 3; ++j)
+      if (along(B.n.cross(B.e[j]))) return;
+  }
 }
 template <Shape ShapeA = Shape::kTriangle, Shape ShapeB = Shape::kTriangle, class OnAxis>
 GAUSS6_ALWAYS_INLINE void for_each_separating_axis(const Vec3 A[3], const Vec3 B[3], OnAxis&& on_axis,

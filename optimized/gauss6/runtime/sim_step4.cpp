@@ -172,7 +172,10 @@ bool motion_free(const RuntimeModel& model, const Pose& x0, const Pose& x1, cons
 // min_separation of each other (proven_prefix: the detour's own leg for a
 // graze's lift, the first leg for a settle), by the CCD past that. Otherwise
 // the god-object is back where it stood (that leg's near pairs lost with
-// legs_ws). *halves: the detour leg's halves.
+// legs_ws). A detour leg stopped at its start (u = 0) ends at its waypoint,
+// whose separation no CCD proved (a graze's lift pose, lifted to first order
+// off the set's rows only, may lie nearer than delta to a pair the set left
+// out): refused. *halves: the detour leg's halves.
 enum class Detour { kKept, kRefused, kNotRun };
 struct DetourResult {
   Detour outcome;
@@ -185,7 +188,7 @@ DetourResult take_detour(const RuntimeModel& model, const Pose& x_start, const P
   *halves = 1;
   const bool ran = ccd_leg(model, from, to, /*fill=*/false, settling, g, halves);
   const LegEnd& ref = settling ? back : g->leg;
-  if (ran && motion_free(model, x_start, g->leg.xs, ref, g))
+  if (ran && g->leg.u > 0 && motion_free(model, x_start, g->leg.xs, ref, g))
     return {Detour::kKept, g->leg.ccd.status, g->leg.ccd.u_hit};
   const DetourResult result{ran ? Detour::kRefused : Detour::kNotRun, g->leg.ccd.status, g->leg.ccd.u_hit};
   g->leg = back;

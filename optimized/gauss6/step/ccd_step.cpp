@@ -250,17 +250,15 @@ bool search_sub_intervals(StepState* s) {
       const CcdBody& ob = s->obstacles[o];
       ++result->num_triangle_pairs;
       if (charge(s, Work::kTrianglePair, 1)) return false;
-      const double t = s->start.earliest(s->start.posed_face(*god.mesh, gf, &s->ws->swept), *ob.mesh, of, s->reach,
-                                         tester.end());
-      if (t > tester.end()) {
-        ++result->num_axis_culls;
-        return true;
-      }
+      const double t = candidate_time(s, s->start.posed_face(*god.mesh, gf, &s->ws->swept), *ob.mesh, of);
+      if (t == kNearOnly || t == kDropped) ++result->num_axis_culls;  // no pair test
+      if (t == kDropped) return true;
       if (num_cand < cand_capacity) {
         cand[num_cand++] = {{gf, of, o}, t};
         return true;
       }
       listed = false;
+      if (t == kNearOnly) return true;  // nothing to test
       const long boxes = result->num_box_iterations;
       if (!searched(*s, gf, of, o)) tester.test(*god.mesh, *god.bvh, gf, *ob.mesh, *ob.bvh, of, o);
       // A hit at the sub-interval's start cannot be bettered: stop. So does the budget's end.
@@ -344,12 +342,23 @@ bool answered(const StepState& s) { return s.any_hit && s.result->hit; }
 
 // Earliest-first: each hit shortens the windows of the pairs after it, and
 // once a pair's bound passes the best u so far, so do all the rest.
+double candidate_time(const StepState* s, const SweptBoxCache::PosedFace& g, const TriangleMesh& om, int of) {
+  const double end = s->tester.end();
+  const double t = s->start.earliest(g, om, of, s->settings.narrow.min_separation, end);
+  if (t <= end) return t;
+  return s->reach > s->settings.narrow.min_separation ? kNearOnly : kDropped;
+}
+
 bool test_candidates(StepState* s, int num_cand) {
   CcdStepWorkspace::Candidate* const cand = s->ws->candidates.data();
   PairTester& tester = s->tester;
   const CcdBody& god = s->god;
-  std::sort(cand, cand + num_cand, [](const auto& a, const auto& b) { return a.earliest < b.earliest; });
-  for (int c = 0; c < num_cand; ++c) {
+  // The near pairs only (kNearOnly) last, unsorted: a dense contact lists
+  // thousands of them and tests none.
+  const int num_tested = static_cast<int>(
+      std::partition(cand, cand + num_cand, [](const auto& c) { return c.earliest != kNearOnly; }) - cand);
+  std::sort(cand, cand + num_tested, [](const auto& a, const auto& b) { return a.earliest < b.earliest; });
+  for (int c = 0; c < num_tested; ++c) {
     if (cand[c].earliest > tester.end() || tester.done() || answered(*s)) break;
     const TrianglePair& p = cand[c].pair;
     if (searched(*s, p.god_face, p.obstacle_face, p.obstacle)) continue;
@@ -359,7 +368,7 @@ bool test_candidates(StepState* s, int num_cand) {
     if (charge_test(s, boxes)) {
       // The rest cannot come within the reach before the next one's bound
       // (sorted), nor past the range the candidates were listed for.
-      const double next = c + 1 < num_cand ? cand[c + 1].earliest : tester.u1;
+      const double next = c + 1 < num_tested ? cand[c + 1].earliest : tester.u1;
       stop_on_budget(s, std::max(tester.u0, std::min(next, tester.u1)));
       return false;
     }

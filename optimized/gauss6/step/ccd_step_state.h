@@ -66,6 +66,18 @@ struct StepState {
 bool searched(const StepState& s, int gf, int of, int o);
 // A check (CcdQuestion::kFreeOfContact) has its answer: a hit.
 bool answered(const StepState& s);
+// The time a triangle pair within the reach (its boxes are: the descent's, or
+// the proximity list's gap bound) is listed with in ws->candidates: a lower
+// bound of the first u at which it can come within min_separation
+// (StartFrame::earliest at min_separation: the narrow phase's question, so
+// that a pair resting between min_separation and the reach, a flat tool on a
+// dense plate, is cleared by one axis instead of bounded at the reach over all
+// eleven). A pair that cannot before the window's end is a near pair only
+// (kNearOnly: listed for the contact set at the stop pose, never tested) when
+// the step keeps near pairs beyond min_separation, else dropped (kDropped).
+inline constexpr double kNearOnly = std::numeric_limits<double>::infinity();
+inline constexpr double kDropped = -std::numeric_limits<double>::infinity();
+double candidate_time(const StepState* s, const SweptBoxCache::PosedFace& g, const TriangleMesh& om, int of);
 // Tests cand[0 .. num_cand) earliest-first (ws->candidates), skipping the
 // pairs searched with the hints. False when the update's budget ran out
 // first: the step then stopped where the untested candidates' time bounds
