@@ -370,54 +370,82 @@ static FeaturePair in_contact_hint() {
   return hint;
 }
 
-TEST_CASE("ccd_step: the fills at once of one update share its fill_at_once, the first list's too", "[ccd_step]") {
+// The most triangles a leaf of the tree holds.
+static long largest_leaf(const Bvh& bvh) {
+  long most = 0;
+  for (const BvhNode& n : bvh.nodes) most = std::max(most, static_cast<long>(n.count));
+  return most;
+}
+
+TEST_CASE("ccd_step: the fills at once of one update share its fill_at_once work units, the first list's too",
+          "[ccd_step][budget]") {
   // A ball resting 2e-4 above a slab (a hint given, as in contact), each
   // update a jitter well within the margin: the first step needs a list and
   // finds none. Each update is one call that opens it (fill_cache) and two
   // that do not, all three needing the list until it is complete: together
-  // they fill at most fill_at_once node pairs of it (the first call all of
-  // them, the others none), without a background fill, until one puts it in
-  // use; meanwhile each step descends the trees and agrees with the brute force.
+  // they fill at most fill_at_once work units of it, node pairs and their
+  // triangle pairs' gap bounds at update_budget.h's weights (the first call
+  // all of them, the others none), and at most one leaf pair's triangle pairs
+  // beyond (a node pair's visit is not split), without a background fill,
+  // until one puts it in use; meanwhile each step descends the trees and
+  // agrees with the brute force. At 4 units the fill's first node pairs are
+  // inner ones; at 40 it reaches leaf pairs, whose triangle pairs a bound of
+  // node pairs would leave uncounted (40 node pairs spend more than 40 + the
+  // overrun units here). Without an update budget (one call) and under one
+  // that never runs out (the fill in chunks, each charged to it).
   const TriangleMesh god = make_icosphere(1, 0.5);
   double z_min = 1e300;
   for (Eigen::Index v = 0; v < god.V.rows(); ++v) z_min = std::min(z_min, god.V(v, 2));
   const TriangleMesh slab = make_box(3, 3, 1, Vec3(0, 0, -0.5));
   const Bvh gb = build_bvh(god, 2), sb = build_bvh(slab, 2);
-  CcdStepSettings settings = background_fill_settings(0.03, 0, 0);
-  settings.cache.fill_at_once = 4;
-  CcdStepWorkspace ws;
+  const long overrun = work_units(Work::kTrianglePair, largest_leaf(gb) * largest_leaf(sb));
   const CcdBody obstacle{&slab, &sb};
   const FeaturePair hint = in_contact_hint();
   const Pose x{Vec3(0, 0, 2e-4 - z_min), Quat{}};
-  long filled = 0;
-  int updates = 0;
-  bool in_use = false;
-  for (; updates < 500 && !in_use; ++updates) {
-    INFO("update " << updates);
-    long this_update = 0;
-    for (int call = 0; call < 3 && !in_use; ++call) {
-      const Pose target{x.p + Vec3(1e-4 * (call + 1), 5e-5 * (updates % 3), 0), x.q};
-      CcdStepRequest request{x, target, &hint, 1};
-      request.fill_cache = call == 0;
-      CcdStepResult r;
-      ccd_step(&obstacle, 1, {&god, &gb}, request, settings, &ws, &r);
-      REQUIRE(r.status == CcdStatus::kOk);
-      CcdMotion m;
-      REQUIRE(make_ccd_motion(x, target, &m) == MotionStatus::kOk);
-      const BruteForce bf = brute_force(god, gb, slab, sb, m, settings.narrow);
-      CHECK(r.hit == bf.hit);
-      CHECK_FALSE(r.cache_filled);  // never whole at once
-      if (call > 0) CHECK(r.num_fill_node_pairs == 0);
-      this_update += r.num_fill_node_pairs;
-      in_use = r.cache_refilled;
+  for (const auto [at_once, budgeted] : {std::pair{4L, false}, std::pair{40L, false}, std::pair{40L, true}}) {
+    INFO("fill_at_once " << at_once << (budgeted ? ", under a budget that never runs out" : ""));
+    CcdStepSettings settings = background_fill_settings(0.03, 0, 0);
+    settings.cache.fill_at_once = at_once;
+    CcdStepWorkspace ws;
+    UpdateBudget never_out;
+    if (budgeted) ws.budget = &never_out;
+    long filled = 0, largest = 0;
+    int updates = 0, with_triangle_pairs = 0;
+    bool in_use = false;
+    for (; updates < 2000 && !in_use; ++updates) {
+      INFO("update " << updates);
+      never_out.start({0, std::numeric_limits<long>::max() / 4, kDefaultBudgetCheckInterval});
+      long node_pairs = 0, units = 0;
+      for (int call = 0; call < 3 && !in_use; ++call) {
+        const Pose target{x.p + Vec3(1e-4 * (call + 1), 5e-5 * (updates % 3), 0), x.q};
+        CcdStepRequest request{x, target, &hint, 1};
+        request.fill_cache = call == 0;
+        CcdStepResult r;
+        ccd_step(&obstacle, 1, {&god, &gb}, request, settings, &ws, &r);
+        REQUIRE(r.status == CcdStatus::kOk);
+        CcdMotion m;
+        REQUIRE(make_ccd_motion(x, target, &m) == MotionStatus::kOk);
+        const BruteForce bf = brute_force(god, gb, slab, sb, m, settings.narrow);
+        CHECK(r.hit == bf.hit);
+        CHECK_FALSE(r.cache_filled);  // never whole at once
+        if (call > 0) CHECK(r.num_fill_node_pairs == 0);
+        node_pairs += r.num_fill_node_pairs;
+        units += work_units(Work::kNodePair, r.num_fill_node_pairs) +
+                 work_units(Work::kTrianglePair, r.num_fill_triangle_pairs);
+        with_triangle_pairs += r.num_fill_triangle_pairs > 0;
+        in_use = r.cache_refilled;
+      }
+      CHECK(units <= at_once + overrun);
+      largest = std::max(largest, units);
+      filled += node_pairs;
     }
-    CHECK(this_update <= settings.cache.fill_at_once);
-    filled += this_update;
+    CHECK(in_use);
+    CHECK(updates > 1);
+    CHECK(filled == ws.cache.fill_cost);
+    CHECK(ws.cache.num_pairs > 0);
+    CHECK(largest >= at_once);  // each update spends its allowance until the fill completes
+    if (at_once > overrun) CHECK(with_triangle_pairs > 0);
   }
-  CHECK(in_use);
-  CHECK(updates > 1);
-  CHECK(filled == ws.cache.fill_cost);
-  CHECK(ws.cache.num_pairs > 0);
 }
 
 TEST_CASE("ccd_step: a ball sliding on a slab into a wall, its cache refilled in the background", "[ccd_step]") {

@@ -146,7 +146,12 @@ enum class TraversalStatus { kDone = 0, kStopped, kStackFull, kPaused };
 // at most `budget` node pairs, and returns kPaused with the rest pending there
 // when the budget runs out: a traversal spread over several calls (the
 // proximity cache's background fill, ccd_step). On kStopped the pairs of the
-// leaf pair being visited are not all visited.
+// leaf pair being visited are not all visited. The budget is a count of node
+// pairs (take_node_pair below), or a caller's own allowance with its own
+// take_node_pair (found by argument-dependent lookup), which visit may also
+// draw on: the proximity cache's fills count a node pair's triangle pairs
+// too (proximity_stages.cpp), so a traversal pauses before the node pair that
+// follows the one whose triangle pairs spent the allowance.
 //
 // cut(god_node, obstacle_node), when given, gets every node pair the traversal
 // stops at: those found apart and the leaf pairs (before their triangles are
@@ -158,11 +163,13 @@ enum class TraversalStatus { kDone = 0, kStopped, kStackFull, kPaused };
 struct NoCut {
   void operator()(int, int) const {}
 };
-template <class GodNodeBox, class GodFaceBox, class Visit, class Separated, class Cut = NoCut>
+// A budget of node pairs: true when it allows one more (and counts it).
+inline bool take_node_pair(long& budget) { return budget-- > 0; }
+template <class GodNodeBox, class GodFaceBox, class Budget, class Visit, class Separated, class Cut = NoCut>
 TraversalStatus resume_candidate_pairs([[maybe_unused]] const TriangleMesh& god_mesh, const Bvh& god,
                                        const TriangleMesh& obs_mesh, const Bvh& obs, const GodNodeBox& god_node_box,
                                        const GodFaceBox& god_face_box, double margin, BvhStack* stack, int* pending,
-                                       long budget, Visit&& visit, int* num_node_pairs, const Separated& separated,
+                                       Budget budget, Visit&& visit, int* num_node_pairs, const Separated& separated,
                                        const Cut& cut = Cut{}) {
   const int capacity = static_cast<int>(stack->items.size());
   auto* items = stack->items.data();
@@ -172,7 +179,7 @@ TraversalStatus resume_candidate_pairs([[maybe_unused]] const TriangleMesh& god_
     return status;
   };
   while (size > 0) {
-    if (budget-- <= 0) return leave(TraversalStatus::kPaused);
+    if (!take_node_pair(budget)) return leave(TraversalStatus::kPaused);
     const auto [gi, oi] = items[--size];
     const BvhNode& gn = god.nodes[gi];
     const BvhNode& on = obs.nodes[oi];

@@ -448,7 +448,7 @@ void ccd_step(const CcdBody* obstacles, int num_obstacles, const CcdBody& god, c
     result->status = CcdStatus::kInvalidInput;
     return;
   }
-  // A call that opens an update renews its fills' allowance (ProximityCacheSettings::fill_at_once).
+  // A call that opens an update renews its fills' allowance of work units (ProximityCacheSettings::fill_at_once).
   if (request.fill_cache) ws->cache.at_once_left = settings.cache.fill_at_once;
   const MotionStatus ms = make_ccd_motion(request.X0, request.X1, &result->motion);
   if (ms != MotionStatus::kOk) {

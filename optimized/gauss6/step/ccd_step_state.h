@@ -101,10 +101,26 @@ inline bool charge_test(StepState* s, long boxes_before) {
 // the first contact found is no later than u (then that hit is the step's
 // answer). Either way the result says so (CcdStepResult::budget_exhausted).
 void stop_on_budget(StepState* s, double u);
-// A fill of the proximity cache of at most max_node_pairs node pairs, spread
-// over chunks charged to the budget (proximity_stages.cpp fill_some: true once
-// complete); without a budget one call.
-bool fill_within_budget(StepState* s, long max_node_pairs);
+// What a fill of the proximity cache may still spend: node pairs (the
+// background fill's, ProximityCacheSettings::fill_budget) and work units, its
+// node pairs and the gap bounds of the triangle pairs they reach at the
+// weights of update_budget.h (the update's fills at once,
+// ProximityCacheSettings::fill_at_once). The fill's traversal takes no node
+// pair once either is spent (take_node_pair), so it ends at most one node
+// pair's triangle pairs (a leaf pair's) beyond its units.
+struct FillAllowance {
+  long node_pairs, units;
+};
+inline bool take_node_pair(FillAllowance* left) {
+  if (left->node_pairs <= 0 || left->units <= 0) return false;
+  --left->node_pairs;
+  left->units -= work_units(Work::kNodePair, 1);
+  return true;
+}
+// A fill of the proximity cache within *left (drawn on as it goes), spread
+// over chunks charged to the update's budget (proximity_stages.cpp fill_some:
+// true once complete); without a budget one call.
+bool fill_within_budget(StepState* s, FillAllowance* left);
 // Records cand[0 .. num_cand) as the near pairs for [u0, u_hit] (-1: none).
 void set_near_pairs(StepState* s, int num_cand, double u0);
 
@@ -114,13 +130,13 @@ void set_near_pairs(StepState* s, int num_cand, double u0);
 // oriented boxes (bvh.h: the god node's posed at u0, swept along the
 // translation up to u_end, grown by what else its points may move, plus dist),
 // and visit(gf, of, o) gets the rest (false: stop). It runs from the node pairs
-// pending on `stack` (resume_candidate_pairs) for at most `budget` node pairs,
-// counted in *num_node_pairs. The god-object's boxes are cached in `swept`
-// (the step's, ws->swept, or a fill's own): call swept.next_interval() first
-// whenever the enclosure or dist changed.
-template <class Visit, class Cut = NoCut>
+// pending on `stack` (resume_candidate_pairs) for at most `budget` node pairs
+// (a count, or a fill's FillAllowance*), counted in *num_node_pairs. The
+// god-object's boxes are cached in `swept` (the step's, ws->swept, or a fill's
+// own): call swept.next_interval() first whenever the enclosure or dist changed.
+template <class Budget, class Visit, class Cut = NoCut>
 TraversalStatus traverse(const StepState& s, const StartFrame& frame, const MotionEnclosure& enc, SweptBoxCache& swept,
-                         double u_end, double dist, int o, BvhStack* stack, int* pending, long budget,
+                         double u_end, double dist, int o, BvhStack* stack, int* pending, Budget budget,
                          int* num_node_pairs, const Visit& visit, const Cut& cut = Cut{}) {
   const CcdBody& god = s.god;
   const SweptObbFrame obb_frame = frame.obb_frame(u_end, dist);

@@ -72,7 +72,7 @@ struct CcdStepRequest {
   CcdQuestion question = CcdQuestion::kFirstContact;
   bool fill_cache = true;                  // go on with the proximity cache's background fill (cache.fill_budget
                                            // node pairs), and open an update: its calls share cache.fill_at_once
-                                           // node pairs of fills at once; false for the later calls of one
+                                           // work units of fills at once; false for the later calls of one
                                            // update, whose budget the first spent
 };
 
@@ -103,6 +103,7 @@ struct CcdStepResult {
   bool cache_filled = false;               // the proximity cache was (re)filled at X0 (CcdStepWorkspace)
   bool cache_refilled = false;             // a background fill of the cache was completed and put in use
   int num_fill_node_pairs = 0;             // node pairs that the cache's fills (at once or in the background) tested
+  int num_fill_triangle_pairs = 0;         // triangle pairs whose gap those fills bounded
   double u_cached = 0;                     // [0, u_cached] searched from the proximity cache (0: not used)
   // The update's budget (CcdStepWorkspace::budget) ran out in this step or before it: the step stopped
   // at the end of what it had proven, a conservative hit at u_hit with no pair (pair FeaturePair{},

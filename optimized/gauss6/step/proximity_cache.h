@@ -30,12 +30,13 @@ struct ProximityCacheSettings {
                             // (0: every list's margin is `margin`; the runtime uses 256 delta)
   long fill_budget = 0;     // node pairs per step that fill the next list in the background while the
                             // one in use serves (0: no background fill; the runtime uses 300)
-  long fill_at_once = 1000;  // node pairs an update's steps spend at most, together, on lists they need now
-                             // (the first list, or a new one while a list is kept): the rest goes on at the
-                             // next steps, which descend the trees meanwhile (no update pays a whole fill:
-                             // at a million triangles a list's fill costs several updates' time). An update
-                             // is the steps from one whose request opens it (CcdStepRequest::fill_cache)
-                             // to the next such
+  long fill_at_once = 2000;  // work units (update_budget.h: the node pairs and the triangle pairs' gap
+                             // bounds) an update's steps spend at most, together, on lists they need now
+                             // (the first list, or a new one while a list is kept), and one leaf pair's
+                             // triangle pairs beyond: the rest goes on at the next steps, which descend the
+                             // trees meanwhile (no update pays a whole fill: at a million triangles a list's
+                             // fill costs several updates' time). An update is the steps from one whose
+                             // request opens it (CcdStepRequest::fill_cache) to the next such
   // The policy, dimensionless (gauss6/step/proximity_stages.cpp states where each acts).
   double steps_per_list = 6;       // a new list's margin spans about this many steps like the last one
   double slow_fraction = 0.25;     // a step that moves at most this fraction of the margin refills at once;
@@ -109,8 +110,8 @@ struct ProximityCache {
   bool budget_cut = false;  // a fill a step needed was cut short (budget, or its bound): it goes on in the
                             // background, and no other starts at once, until it is put in use or dropped
                             // (the god-object went elsewhere)
-  long at_once_left = 0;    // node pairs this update's fills at once may still spend
-                            // (ProximityCacheSettings::fill_at_once)
+  long at_once_left = 0;    // work units this update's fills at once may still spend (< 0: spent, and
+                            // overrun by that much; ProximityCacheSettings::fill_at_once)
   // The keyed bodies' triangle size: the smallest over the bodies of the mean
   // longest edge of kSizeSamples of its triangles, evenly spaced in index
   // (0: none measured); measured when a fill sets the keys (no list in use).

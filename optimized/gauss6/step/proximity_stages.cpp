@@ -96,7 +96,7 @@ bool is_keyed(const StepState& s) { return s.ws->cache.num_pairs >= 0 && keys_ma
 // Fills: every pair not proven apart by reach + pf.margin with the god-object
 // at pf.ref (X0, or the pose a background fill is started at:
 // fill_cache_in_background), descended into pf.pairs obstacle by obstacle, a
-// budget of node pairs at a time (fill_some: true once complete; a fill that
+// FillAllowance at a time (fill_some: true once complete; a fill that
 // does not fit, in pf.pairs or on pf.stack, is dropped), then swapped in
 // (put_fill).
 void start_obstacle(StepState* s) {
@@ -129,7 +129,7 @@ void start_fill(StepState* s, const Pose* ahead, double m) {
   start_obstacle(s);
 }
 
-bool fill_some(StepState* s, long budget) {
+bool fill_some(StepState* s, FillAllowance* left) {
   ProximityCache& pc = s->ws->cache;
   ProximityCache::Fill& pf = pc.fill;
   if (!pf.active) return false;
@@ -147,9 +147,11 @@ bool fill_some(StepState* s, long budget) {
   while (pf.obstacle < s->num_obstacles) {
     int used = 0;
     const TraversalStatus ts = traverse(*s, frame, enc, pf.swept, 0.0, fill_dist, pf.obstacle, &pf.stack, &pf.pending,
-                                        budget, &used, [&](int gf, int of, int o) {
+                                        left, &used, [&](int gf, int of, int o) {
       double radius = 0;
       charge(s, Work::kTrianglePair, 1);  // (the chunks' ends check: fill_within_budget)
+      left->units -= work_units(Work::kTrianglePair, 1);  // (the next node pair checks: take_node_pair)
+      ++s->result->num_fill_triangle_pairs;
       const double gap = frame.gap(frame.posed_face(*god.mesh, gf, &pf.swept), *s->obstacles[o].mesh, of, fill_dist,
                                    &radius);
       if (gap > fill_dist) return true;
@@ -159,7 +161,6 @@ bool fill_some(StepState* s, long budget) {
     });
     s->result->num_fill_node_pairs += used;
     pf.cost += used;
-    budget -= used;
     if (ts == TraversalStatus::kPaused) return false;
     if (ts != TraversalStatus::kDone) {
       pf.active = false;
@@ -268,15 +269,15 @@ struct CacheRanges {
   bool usable(double u) const { return window(u) > 0; }
 };
 
-// A fill a step needs now: at most the update's allowance left
-// (ProximityCache::at_once_left, ProximityCacheSettings::fill_at_once), charged
-// to it; true once complete.
+// A fill a step needs now: at most the update's work units left
+// (ProximityCache::at_once_left, ProximityCacheSettings::fill_at_once), its
+// node pairs' and triangle pairs' units charged to it; true once complete.
 bool fill_at_once(StepState* s) {
   ProximityCache& pc = s->ws->cache;
   if (pc.fill.complete) return true;
-  const long cost = pc.fill.cost;
-  const bool complete = fill_within_budget(s, std::max(pc.at_once_left, 0L));
-  pc.at_once_left -= pc.fill.cost - cost;
+  FillAllowance left{std::numeric_limits<long>::max(), pc.at_once_left};
+  const bool complete = fill_within_budget(s, &left);
+  pc.at_once_left = left.units;
   return complete;
 }
 
@@ -412,13 +413,15 @@ void search_cached_pairs(StepState* s, const ProximityCache& pc, const Displacem
 
 // Node pairs a fill descends between two charges to the update's budget.
 constexpr long kFillChunk = 64;
-bool fill_within_budget(StepState* s, long max_node_pairs) {
-  if (s->ws->budget == nullptr) return fill_some(s, max_node_pairs);
+bool fill_within_budget(StepState* s, FillAllowance* left) {
+  if (s->ws->budget == nullptr) return fill_some(s, left);
   const ProximityCache::Fill& pf = s->ws->cache.fill;
-  for (long left = max_node_pairs; left > 0 && !out_of_budget(*s);) {
+  while (left->node_pairs > 0 && left->units > 0 && !out_of_budget(*s)) {
     const long cost = pf.cost;
-    const bool complete = fill_some(s, std::min(left, kFillChunk));
-    left -= pf.cost - cost;
+    FillAllowance chunk{std::min(left->node_pairs, kFillChunk), left->units};
+    const bool complete = fill_some(s, &chunk);
+    left->node_pairs -= pf.cost - cost;
+    left->units = chunk.units;
     charge(s, Work::kNodePair, pf.cost - cost);
     if (complete || !pf.active) return complete;  // done, or dropped (does not fit)
   }
@@ -518,7 +521,8 @@ void fill_cache_in_background(StepState* s) {
         start_fill(s, &ahead, m);
       }
     }
-    if (pf.active && !pf.complete) fill_within_budget(s, settings.cache.fill_budget);
+    FillAllowance step{settings.cache.fill_budget, std::numeric_limits<long>::max()};
+    if (pf.active && !pf.complete) fill_within_budget(s, &step);
   }
   // The next step's background fill and list margin follow this step's motion.
   pc.budget_cut = pc.budget_cut && pc.fill.active;  // the fill cut short goes on (put in use: false)

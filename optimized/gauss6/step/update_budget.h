@@ -33,6 +33,8 @@ inline constexpr long kWorkWeight[kNumWorkKinds] = {
     2,   // kBox: a narrow-phase box (one bisection of a feature pair)
 };
 inline constexpr long kInstructionsPerUnit = 650;    // about, per unit (the calibration's ratio)
+// The work units of `count` pieces of one kind (every count of units is made here).
+inline constexpr long work_units(Work kind, long count) { return kWorkWeight[static_cast<int>(kind)] * count; }
 
 // CPU time that a 1 kHz sim loop can give a god-object update on every update:
 // the period (1 ms) less the rest of the sim step (the projection, publishing:
@@ -69,7 +71,7 @@ class UpdateBudget {
   // Charges `count` pieces of work of one kind; true when the budget has run out (by now or before).
   bool spend(Work kind, long count) noexcept {
     pieces_[static_cast<int>(kind)] += count;
-    used_ += kWorkWeight[static_cast<int>(kind)] * count;
+    used_ += work_units(kind, count);
     if (used_ >= next_check_) check();
     return exhausted_;
   }
