@@ -104,6 +104,19 @@ Proof.
   apply abs_bounds in HE. lra.
 Qed.
 
+(* Weights s = v + w in (1, 1 + 8 u] on a corner z above m: (1 - s) (a - m) +
+   s (z - m) = (z - m) + (s - 1) (z - a) >= -16 u M. *)
+Lemma comb_side a z s m M : 1 < s -> s <= 1 + 8 * u -> m <= z -> Rabs (z - a) <= 2 * M ->
+  - (16 * u * M) <= (1 - s) * (a - m) + s * (z - m).
+Proof.
+  intros H1 Hs Hz Hd.
+  assert (E : (1 - s) * (a - m) + s * (z - m) = (z - m) + (s - 1) * (z - a)) by ring.
+  assert (- (2 * M) <= z - a) by (apply abs_bounds in Hd; lra).
+  assert ((s - 1) * (- (2 * M)) <= (s - 1) * (z - a)) by (apply Rmult_le_compat_l; lra).
+  assert ((s - 1) * (2 * M) <= (8 * u) * (2 * M)) by (apply Rmult_le_compat_r; [pose proof (Rabs_pos (z - a)) |]; lra).
+  lra.
+Qed.
+
 (* The combination a + v (b - a) + w (c - a) of three reals above m, v, w >= 0,
    v + w <= 1 + 8 u: at least m - 16 u M (a convex combination but for the
    8 u excess of v + w). *)
@@ -120,19 +133,13 @@ Proof.
     assert (0 <= v * (b - m)) by (apply Rmult_le_pos; lra).
     assert (0 <= w * (c - m)) by (apply Rmult_le_pos; lra).
     assert (0 <= u * M) by (apply Rmult_le_pos; [lra | pose proof (Rabs_pos a); lra]). lra.
-  - destruct (Rle_lt_dec b c) as [Hbc|Hbc].
+  - (* v + w > 1: the combination is at least (1 - s) (a - m) + s (z - m), z the
+       lesser of b and c, s = v + w: one lemma for either *)
+    destruct (Rle_lt_dec b c) as [Hbc|Hbc].
     + assert (w * (b - m) <= w * (c - m)) by (apply Rmult_le_compat_l; lra).
-      assert (E2 : (1 - (v + w)) * (a - m) + v * (b - m) + w * (b - m) = (b - m) + (v + w - 1) * (b - a)) by ring.
-      assert (- (2 * M) <= b - a) by (apply abs_bounds in Dba; lra).
-      assert ((v + w - 1) * (- (2 * M)) <= (v + w - 1) * (b - a)) by (apply Rmult_le_compat_l; lra).
-      assert ((v + w - 1) * (2 * M) <= (8 * u) * (2 * M)) by (apply Rmult_le_compat_r; [pose proof (Rabs_pos a) |]; lra).
-      lra.
+      pose proof (comb_side a b (v + w) m M ltac:(lra) Hs Hb Dba). lra.
     + assert (v * (c - m) <= v * (b - m)) by (apply Rmult_le_compat_l; lra).
-      assert (E2 : (1 - (v + w)) * (a - m) + v * (c - m) + w * (c - m) = (c - m) + (v + w - 1) * (c - a)) by ring.
-      assert (- (2 * M) <= c - a) by (apply abs_bounds in Dca; lra).
-      assert ((v + w - 1) * (- (2 * M)) <= (v + w - 1) * (c - a)) by (apply Rmult_le_compat_l; lra).
-      assert ((v + w - 1) * (2 * M) <= (8 * u) * (2 * M)) by (apply Rmult_le_compat_r; [pose proof (Rabs_pos a) |]; lra).
-      lra.
+      pose proof (comb_side a c (v + w) m M ltac:(lra) Hs Hc Dca). lra.
 Qed.
 
 (* The interior branch's point a + (b - a) v + (c - a) w, computed as the
