@@ -27,8 +27,8 @@ Proof. unfold Rabs; destruct (Rcase_abs x); lra. Qed.
 
 (* The parameter of an edge branch: fl(x / fl(x + y)) for doubles x, y >= 0
    (closest_point_on_triangle: d1 / (d1 - d3) with d1 >= 0 >= d3, d2 / (d2 -
-   d6) with d2 >= 0 >= d6, (d4 - d3) / ((d4 - d3) + (d5 - d6)) with both
-   differences >= 0 as computed) lies in [0, 1]. (A zero divisor, x = y = 0,
+   d6) with d2 >= 0 >= d6, eb / (eb - ec) with eb >= 0 >= ec, as computed)
+   lies in [0, 1]. (A zero divisor, x = y = 0,
    gives NaN in IEEE, and a NaN point, whose separation fails `sep <= d`; the
    model's x / 0 = 0 stays in [0, 1] too.) *)
 Definition ratio x y := fl (x / fl (x + y)).
@@ -104,6 +104,19 @@ Proof.
   apply abs_bounds in HE. lra.
 Qed.
 
+(* Weights s = v + w in (1, 1 + 8 u] on a corner z above m: (1 - s) (a - m) +
+   s (z - m) = (z - m) + (s - 1) (z - a) >= -16 u M. *)
+Lemma comb_side a z s m M : 1 < s -> s <= 1 + 8 * u -> m <= z -> Rabs (z - a) <= 2 * M ->
+  - (16 * u * M) <= (1 - s) * (a - m) + s * (z - m).
+Proof.
+  intros H1 Hs Hz Hd.
+  assert (E : (1 - s) * (a - m) + s * (z - m) = (z - m) + (s - 1) * (z - a)) by ring.
+  assert (- (2 * M) <= z - a) by (apply abs_bounds in Hd; lra).
+  assert ((s - 1) * (- (2 * M)) <= (s - 1) * (z - a)) by (apply Rmult_le_compat_l; lra).
+  assert ((s - 1) * (2 * M) <= (8 * u) * (2 * M)) by (apply Rmult_le_compat_r; [pose proof (Rabs_pos (z - a)) |]; lra).
+  lra.
+Qed.
+
 (* The combination a + v (b - a) + w (c - a) of three reals above m, v, w >= 0,
    v + w <= 1 + 8 u: at least m - 16 u M (a convex combination but for the
    8 u excess of v + w). *)
@@ -120,19 +133,13 @@ Proof.
     assert (0 <= v * (b - m)) by (apply Rmult_le_pos; lra).
     assert (0 <= w * (c - m)) by (apply Rmult_le_pos; lra).
     assert (0 <= u * M) by (apply Rmult_le_pos; [lra | pose proof (Rabs_pos a); lra]). lra.
-  - destruct (Rle_lt_dec b c) as [Hbc|Hbc].
+  - (* v + w > 1: the combination is at least (1 - s) (a - m) + s (z - m), z the
+       lesser of b and c, s = v + w: one lemma for either *)
+    destruct (Rle_lt_dec b c) as [Hbc|Hbc].
     + assert (w * (b - m) <= w * (c - m)) by (apply Rmult_le_compat_l; lra).
-      assert (E2 : (1 - (v + w)) * (a - m) + v * (b - m) + w * (b - m) = (b - m) + (v + w - 1) * (b - a)) by ring.
-      assert (- (2 * M) <= b - a) by (apply abs_bounds in Dba; lra).
-      assert ((v + w - 1) * (- (2 * M)) <= (v + w - 1) * (b - a)) by (apply Rmult_le_compat_l; lra).
-      assert ((v + w - 1) * (2 * M) <= (8 * u) * (2 * M)) by (apply Rmult_le_compat_r; [pose proof (Rabs_pos a) |]; lra).
-      lra.
+      pose proof (comb_side a b (v + w) m M ltac:(lra) Hs Hb Dba). lra.
     + assert (v * (c - m) <= v * (b - m)) by (apply Rmult_le_compat_l; lra).
-      assert (E2 : (1 - (v + w)) * (a - m) + v * (c - m) + w * (c - m) = (c - m) + (v + w - 1) * (c - a)) by ring.
-      assert (- (2 * M) <= c - a) by (apply abs_bounds in Dca; lra).
-      assert ((v + w - 1) * (- (2 * M)) <= (v + w - 1) * (c - a)) by (apply Rmult_le_compat_l; lra).
-      assert ((v + w - 1) * (2 * M) <= (8 * u) * (2 * M)) by (apply Rmult_le_compat_r; [pose proof (Rabs_pos a) |]; lra).
-      lra.
+      pose proof (comb_side a c (v + w) m M ltac:(lra) Hs Hc Dca). lra.
 Qed.
 
 (* The interior branch's point a + (b - a) v + (c - a) w, computed as the
@@ -314,7 +321,7 @@ Qed.
    separation, the norm of the rounded difference (whichever coordinate the
    axis is, whichever order the sum takes), is above d. *)
 (* covers optimized/gauss6/contact/contacts.cpp "bool boxes_apart(const Vec3& a_lo, const Vec3& a_hi, const Vec3& b_lo, const Vec3& b_hi, double gap)" sha256:f61afe30bf87fbb8 *)
-(* covers optimized/gauss6/contact/contacts.cpp "ContactStatus generate_contacts(const CcdBody* obstacles, int num_obstacles, const CcdBody& god, const Pose& X_WB," sha256:648942469fa8ccd6 *)
+(* covers optimized/gauss6/contact/contacts.cpp "ContactStatus generate_contacts(const CcdBody* obstacles, int num_obstacles, const CcdBody& god, const Pose& X_WB," sha256:2ff787cd3dd142c4 *)
 (* allowance kBoxPoseRounding = 1e-12 *)
 Theorem apart_separation d scale M ahi blo P Q y z : F d -> F P -> F Q ->
   bpow radix2 (-500) <= d -> 0 <= scale -> 0 <= M -> M <= 4 * scale + bpow radix2 (-490) ->
@@ -387,12 +394,12 @@ Qed.
 (* The code's branches, per coordinate (a, b, c the corners' coordinates):
    the corners (regions of a, b, c); a + t ab with t = d1 / (d1 - d3), d1 >=
    0 >= d3 (edge ab: ratio d1 (-d3)); a + t ac with t = d2 / (d2 - d6), d2 >=
-   0 >= d6 (edge ac); b + t (c - b) with t = (d4 - d3) / ((d4 - d3) + (d5 -
-   d6)), both differences >= 0 (edge bc); the interior a + ab v + ac w when
+   0 >= d6 (edge ac); b + t (c - b) with t = eb / (eb - ec), eb = bc . bp >=
+   0 >= ec = bc . cp (edge bc); the interior a + ab v + ac w when
    va, vb, vc >= 0 (interior_weights); otherwise the nearest of the three
    edges' points at clamped parameters (closest_point_on_segment: t in [0, 1]
    or 0 for NaN). Each is closest_coord. *)
-(* covers optimized/gauss6/geometry/distance.cpp "Vec3 closest_point_on_triangle(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c)" sha256:0ee81f43bbc4c4e4 *)
+(* covers optimized/gauss6/geometry/distance.cpp "Vec3 closest_point_on_triangle(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c)" sha256:8dfabb2ddc3007f1 *)
 (* covers optimized/gauss6/geometry/distance.cpp "Vec3 closest_point_on_segment(const Vec3& p, const Vec3& a, const Vec3& b)" sha256:b5dc81da5de5cba4 *)
 Theorem closest_branches a b c :
   (forall x y e0 e1, F x -> F y -> 0 <= x -> 0 <= y -> (e0 = a \/ e0 = b \/ e0 = c) -> (e1 = a \/ e1 = b \/ e1 = c) ->

@@ -451,10 +451,13 @@ ContactStatus generate_contacts(const CcdBody* obstacles, int num_obstacles, con
   for (int o = 0; o < num_obstacles; ++o)
     if (obstacles[o].bvh) scale = std::max(scale, obstacles[o].bvh->radius);
   const double apart = (Upper{2 * d} + Upper{kBoxPoseRounding} * Upper{scale}).v;
-  // Two separations of one vertex computed against two faces differ by their
-  // rounding, below kBoxPoseRounding of the coordinates' magnitude (argued,
-  // not machine-checked: proofs/README.md).
-  const double tie = (Upper{kBoxPoseRounding} * Upper{scale}).v;
+  // Two faces that share an edge compute one vertex's separations within `tie`
+  // when both take that edge's branch or its ends' (each point within 200 u of
+  // the coordinates' magnitude of the edge's exact closest point, the
+  // separations within 460 u of it and 2^-530: proofs/ContactTie.v,
+  // tie_shared_edge). The floor kNormFloor covers the squares' underflow in
+  // the norms; it matters only in a scene smaller than about 2^-450.
+  const double tie = std::max((Upper{kBoxPoseRounding} * Upper{scale}).v, kNormFloor);
   ContactStatus status = ContactStatus::kOk;
   for (int o = 0; o < num_obstacles; ++o) {
     if (!obstacles[o].mesh || !obstacles[o].bvh) return ContactStatus::kInvalidInput;

@@ -24,22 +24,29 @@ Vec3 closest_point_on_segment(const Vec3& p, const Vec3& a, const Vec3& b) {
 // so the point lies in the corners' box to 40 u of their magnitude:
 // proofs/ContactApart.v, closest_branches and closest_in_box (generate_contacts'
 // `apart` rests on it).
+// Each corner and edge branch is decided and computed from the dot products
+// of its own edges, (end - start) . (p - start) and (end - start) . (p - end)
+// (edge bc's, eb and ec, from bc itself, not as differences of ab's and ac's, whose
+// rounding grows as |ab| |bp| / |bc|): the point is then within a few u of the
+// coordinates' magnitude of the exact closest point of that edge, whichever
+// face computes it (proofs/ContactTie.v, edge_rule_point; generate_contacts'
+// `tie` rests on it: tie_shared_edge).
 Vec3 closest_point_on_triangle(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c) {
   const Vec3 ab = b - a, ac = c - a, ap = p - a;
   const double d1 = ab.dot(ap), d2 = ac.dot(ap);
   if (d1 <= 0 && d2 <= 0) return a;
-  const Vec3 bp = p - b;
-  const double d3 = ab.dot(bp), d4 = ac.dot(bp);
-  if (d3 >= 0 && d4 <= d3) return b;
+  const Vec3 bp = p - b, bc = c - b;
+  const double d3 = ab.dot(bp), d4 = ac.dot(bp), eb = bc.dot(bp);
+  if (d3 >= 0 && eb <= 0) return b;
   const double vc = d1 * d4 - d3 * d2;
   if (vc <= 0 && d1 >= 0 && d3 <= 0) return a + (d1 / (d1 - d3)) * ab;
   const Vec3 cp = p - c;
-  const double d5 = ab.dot(cp), d6 = ac.dot(cp);
-  if (d6 >= 0 && d5 <= d6) return c;
+  const double d5 = ab.dot(cp), d6 = ac.dot(cp), ec = bc.dot(cp);
+  if (d6 >= 0 && ec >= 0) return c;
   const double vb = d5 * d2 - d1 * d6;
   if (vb <= 0 && d2 >= 0 && d6 <= 0) return a + (d2 / (d2 - d6)) * ac;
   const double va = d3 * d6 - d5 * d4;
-  if (va <= 0 && (d4 - d3) >= 0 && (d5 - d6) >= 0) return b + ((d4 - d3) / ((d4 - d3) + (d5 - d6))) * (c - b);
+  if (va <= 0 && eb >= 0 && ec <= 0) return b + (eb / (eb - ec)) * bc;
   // Inside the face: va, vb, vc > 0 in exact arithmetic, so the weights are
   // >= 0 and sum to at most 1 (to 8 u: ContactApart.v, interior_weights).
   // Rounding of the six dot products is not known to break these signs (no
