@@ -28,11 +28,14 @@ void closest_segment_parameters(const Vec3& p0, const Vec3& p1, const Vec3& q0, 
                                 double* t);
 
 // Separating axes of two triangles A and B given by their corners (one frame,
-// doubles): the two face normals and the nine edge cross products, then, for
-// two triangles whose planes lie within kInPlaneSine of parallel, each face's
-// normal crossed with its own edges (in-plane axes: two parallel triangles
-// side by side, a flat tool's face over a dense flat tessellation, have all
-// eleven axes along their common normal, and only these separate them). Calls
+// doubles): the two face normals and the nine edge cross products, then, when
+// InPlane is set and the two triangles' planes lie within kInPlaneSine of
+// parallel, each face's normal crossed with its own edges (in-plane axes: two
+// parallel triangles side by side, a flat tool's face over a dense flat
+// tessellation, have all eleven axes along their common normal, and only
+// these separate them; the distance bounds that list pairs, the proximity
+// list's fill and the contact generation, set it; the time bounds, whose pairs
+// are already listed as near, need not pay for them). Calls
 // on_axis(a, gap, side) for each axis a that proves a positive gap, with gap a
 // lower bound of the distance of the two triangles' projections on a / |a|
 // (where that quotient is below 2^-600, gap may lie a little below 0, down to
@@ -94,7 +97,7 @@ GAUSS6_ALWAYS_INLINE SatSide sat_side(const Vec3 P[3]) {
   return t;
 }
 
-template <Shape ShapeA = Shape::kTriangle, Shape ShapeB = Shape::kTriangle, class OnAxis>
+template <Shape ShapeA = Shape::kTriangle, Shape ShapeB = Shape::kTriangle, bool InPlane = false, class OnAxis>
 GAUSS6_ALWAYS_INLINE void for_each_separating_axis(const SatSide& A, const SatSide& B, OnAxis&& on_axis,
                                                    const Vec3* extra = nullptr) {
   constexpr int na = static_cast<int>(ShapeA), nb = static_cast<int>(ShapeB);
@@ -130,7 +133,7 @@ GAUSS6_ALWAYS_INLINE void for_each_separating_axis(const SatSide& A, const SatSi
   for (int i = 0; i < edges_a; ++i)
     for (int j = 0; j < edges_b; ++j)
       if (along(A.e[i].cross(B.e[j]))) return;
-  if constexpr (na == 3 && nb == 3) {
+  if constexpr (InPlane && na == 3 && nb == 3) {
     // (Not for a degenerate triangle, whose zero normal gives no plane: a
     // feature passed as one keeps the axes of its Shape.)
     const double aa = A.n.squaredNorm(), bb = B.n.squaredNorm();
@@ -148,16 +151,17 @@ GAUSS6_ALWAYS_INLINE void for_each_separating_axis(const Vec3 A[3], const Vec3 B
 }
 
 // Separating-axis bound of the distance of two triangles: the largest gap
-// proven along the 11 axes (for_each_separating_axis), rounding included (0
+// proven along the 11 axes and the in-plane ones (for_each_separating_axis), rounding included (0
 // when none proves a positive gap), returned as soon as one axis proves more
 // than `enough`. Inline: the contact generation calls it for every candidate
 // triangle pair.
 inline double triangle_gap_lower_bound(const SatSide& A, const SatSide& B, double enough) {
   double best = 0;
-  for_each_separating_axis(A, B, [&](const Vec3&, double g, double) GAUSS6_ALWAYS_INLINE_LAMBDA {
-    best = std::max(best, g);
-    return best > enough;
-  });
+  for_each_separating_axis<Shape::kTriangle, Shape::kTriangle, /*InPlane=*/true>(
+      A, B, [&](const Vec3&, double g, double) GAUSS6_ALWAYS_INLINE_LAMBDA {
+        best = std::max(best, g);
+        return best > enough;
+      });
   return best;
 }
 inline double triangle_gap_lower_bound(const Vec3 A[3], const Vec3 B[3], double enough) {
