@@ -251,6 +251,16 @@ struct TrianglePairContacts {
     const uint8_t go = god_owned[gf], oo = obstacle_owned[of];
     const Vec3 X[3] = {god_side.corner(gf, 0), god_side.corner(gf, 1), god_side.corner(gf, 2)};
     const Vec3 Y[3] = {obstacle_side.corner(of, 0), obstacle_side.corner(of, 1), obstacle_side.corner(of, 2)};
+    // Two triangles whose corner boxes lie more than `apart` apart along an
+    // axis have no feature pair within d: each feature's box lies inside its
+    // triangle's, so each feature pair's boxes are apart too (the rounded
+    // differences are monotone), and ContactApart.v's theorems hold for them.
+    // The cheapest test first: most pairs of a near list that are not in
+    // contact are dropped here.
+    Box boxes;
+    boxes.x_lo = X[0].cwiseMin(X[1]).cwiseMin(X[2]), boxes.x_hi = X[0].cwiseMax(X[1]).cwiseMax(X[2]);
+    boxes.y_lo = Y[0].cwiseMin(Y[1]).cwiseMin(Y[2]), boxes.y_hi = Y[0].cwiseMax(Y[1]).cwiseMax(Y[2]);
+    if (boxes_apart(boxes.x_lo, boxes.x_hi, boxes.y_lo, boxes.y_hi, apart)) return;
     // Pairs proven farther apart than d by a separating axis have no pair
     // within d. But an obstacle triangle within d of the god face's plane (a
     // flat tool on a dense flat tessellation: thousands of such pairs) is
@@ -271,11 +281,6 @@ struct TrianglePairContacts {
     };
     const bool in_slab = within(Y[0]) && within(Y[1]) && within(Y[2]);
     if (!in_slab && triangle_gap_lower_bound(X, Y, d) > d) return;
-    Box boxes;
-    if (in_slab) {
-      boxes.x_lo = X[0].cwiseMin(X[1]).cwiseMin(X[2]), boxes.x_hi = X[0].cwiseMax(X[1]).cwiseMax(X[2]);
-      boxes.y_lo = Y[0].cwiseMin(Y[1]).cwiseMin(Y[2]), boxes.y_hi = Y[0].cwiseMax(Y[1]).cwiseMax(Y[2]);
-    }
     // k: the god-object's corner (vertex k, or edge k -> k + 1), j: the obstacle's.
     for_each_feature_pair(go, oo, [&](PairKind kind, int k, int j) {
       feature_pair(kind, k, j, gf, of, X, Y, in_slab ? &boxes : nullptr);
@@ -283,7 +288,7 @@ struct TrianglePairContacts {
     });
   }
 
-  // The two triangles' corner boxes (in the slab only).
+  // The two triangles' corner boxes (their features' boxes are tested against them in the slab only).
   struct Box {
     Vec3 x_lo, x_hi, y_lo, y_hi;
   };
