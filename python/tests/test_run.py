@@ -142,10 +142,12 @@ def test_a_users_scene_runs_to_a_certified_report(table_run):
     assert tr.ticks["wrench"][pressed, 2].mean() > 0.1
     # The cube slid after the hand over the waves (the hand 4 cm along x in 0.5 s): each leg of the
     # slide starts in contact, and a leg the CCD stops at its start is a graze lifted out of, not a
-    # stop for the rest of the slide.
+    # stop for the rest of the slide: the cube covers at least 3 of the hand's 4 cm. (A lift whose own
+    # leg stops at once is refused, its lift pose a waypoint no CCD proved separated: the cube lags a
+    # few millimetres there rather than standing on an unproven pose.)
     x = tr.ticks["xs_p"][:, 0]
     at = lambda t: int(np.argmin(np.abs(tr.ticks["t"] - t)))
-    assert x[at(0.3)] < -0.019 and x[at(0.55)] > x[at(0.3)] + 0.01 and x[at(0.8)] > 0.015
+    assert x[at(0.3)] < -0.019 and x[at(0.55)] > x[at(0.3)] + 0.01 and x[at(0.8)] > x[at(0.3)] + 0.03
     assert np.all(tr.ticks["xs_p"][:, 2] - 0.01 > -0.001 - 1e-9)  # never below the lowest trough
     # The script's phases are the trace's, the lockstep repeats gave each step's least time.
     assert [p["name"] for p in tr.meta["phases"]] == ["press", "slide", "lift"]
