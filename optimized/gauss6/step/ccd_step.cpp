@@ -251,7 +251,6 @@ bool search_sub_intervals(StepState* s) {
       ++result->num_triangle_pairs;
       if (charge(s, Work::kTrianglePair, 1)) return false;
       const double t = candidate_time(s, s->start.posed_face(*god.mesh, gf, &s->ws->swept), *ob.mesh, of);
-      if (t == kNearOnly || t == kDropped) ++result->num_axis_culls;  // no pair test
       if (t == kDropped) return true;
       if (num_cand < cand_capacity) {
         cand[num_cand++] = {{gf, of, o}, t};
@@ -340,15 +339,16 @@ bool searched(const StepState& s, int gf, int of, int o) { return among(s.hints,
 
 bool answered(const StepState& s) { return s.any_hit && s.result->hit; }
 
-// Earliest-first: each hit shortens the windows of the pairs after it, and
-// once a pair's bound passes the best u so far, so do all the rest.
-double candidate_time(const StepState* s, const SweptBoxCache::PosedFace& g, const TriangleMesh& om, int of) {
+double candidate_time(StepState* s, const SweptBoxCache::PosedFace& g, const TriangleMesh& om, int of) {
   const double end = s->tester.end();
   const double t = s->start.earliest(g, om, of, s->settings.narrow.min_separation, end);
   if (t <= end) return t;
+  ++s->result->num_axis_culls;  // no pair test
   return s->reach > s->settings.narrow.min_separation ? kNearOnly : kDropped;
 }
 
+// Earliest-first: each hit shortens the windows of the pairs after it, and
+// once a pair's bound passes the best u so far, so do all the rest.
 bool test_candidates(StepState* s, int num_cand) {
   CcdStepWorkspace::Candidate* const cand = s->ws->candidates.data();
   PairTester& tester = s->tester;
@@ -366,7 +366,7 @@ bool test_candidates(StepState* s, int num_cand) {
     const long boxes = s->result->num_box_iterations;
     tester.test(*god.mesh, *god.bvh, p.god_face, *ob.mesh, *ob.bvh, p.obstacle_face, p.obstacle);
     if (charge_test(s, boxes)) {
-      // The rest cannot come within the reach before the next one's bound
+      // The rest cannot come within min_separation before the next one's bound
       // (sorted), nor past the range the candidates were listed for.
       const double next = c + 1 < num_tested ? cand[c + 1].earliest : tester.u1;
       stop_on_budget(s, std::max(tester.u0, std::min(next, tester.u1)));

@@ -74,10 +74,11 @@ bool answered(const StepState& s);
 // dense plate, is cleared by one axis instead of bounded at the reach over all
 // eleven). A pair that cannot before the window's end is a near pair only
 // (kNearOnly: listed for the contact set at the stop pose, never tested) when
-// the step keeps near pairs beyond min_separation, else dropped (kDropped).
+// the step keeps near pairs beyond min_separation, else dropped (kDropped);
+// either is counted as an axis cull (no pair test).
 inline constexpr double kNearOnly = std::numeric_limits<double>::infinity();
 inline constexpr double kDropped = -std::numeric_limits<double>::infinity();
-double candidate_time(const StepState* s, const SweptBoxCache::PosedFace& g, const TriangleMesh& om, int of);
+double candidate_time(StepState* s, const SweptBoxCache::PosedFace& g, const TriangleMesh& om, int of);
 // Tests cand[0 .. num_cand) earliest-first (ws->candidates), skipping the
 // pairs searched with the hints. False when the update's budget ran out
 // first: the step then stopped where the untested candidates' time bounds

@@ -401,7 +401,6 @@ void search_cached_pairs(StepState* s, const ProximityCache& pc, const Displacem
     }
     const double t = candidate_time(s, s->start.posed_face(*s->god.mesh, c.god_face, &s->ws->swept),
                                     *s->obstacles[c.obstacle].mesh, c.obstacle_face);
-    if (t == kNearOnly || t == kDropped) ++result->num_axis_culls;  // no pair test
     if (t == kDropped) continue;
     cand[num_cand++] = {{c.god_face, c.obstacle_face, c.obstacle}, t};  // fits: the cache has cand's capacity
   }
