@@ -469,7 +469,7 @@ Theorem norm_up_relative x y z :
 Proof. apply norm_upper_bound, one_plus_relative. Qed.
 
 (* covers optimized/gauss6/numeric/rounding.h "GAUSS6_ALWAYS_INLINE Upper norm_up(double norm, double relative)" sha256:b4b3280a1e614758 *)
-(* covers optimized/gauss6/geometry/distance.h "GAUSS6_ALWAYS_INLINE void for_each_separating_axis(const SatSide& A" sha256:3258a47a8b50fd57 *)
+(* covers optimized/gauss6/geometry/distance.h "GAUSS6_ALWAYS_INLINE void for_each_separating_axis(const SatSide& A" sha256:f9abadb85b78baa3 *)
 Theorem norm_up_wide x y z :
   sqrt (x * x + y * y + z * z) <= Rmax (next_up (fl (norm_c x y z * fl (1 + kRelativeRoundingWide)))) kNormFloor.
 Proof. apply norm_upper_bound, one_plus_wide. Qed.

@@ -214,7 +214,7 @@ Proof.
   unfold axis_slack in T1; fold K in T1. lra.
 Qed.
 
-(* covers optimized/gauss6/geometry/distance.h "GAUSS6_ALWAYS_INLINE void for_each_separating_axis(const SatSide& A" sha256:3258a47a8b50fd57 *)
+(* covers optimized/gauss6/geometry/distance.h "GAUSS6_ALWAYS_INLINE void for_each_separating_axis(const SatSide& A" sha256:f9abadb85b78baa3 *)
 (* covers optimized/gauss6/geometry/distance.h "GAUSS6_ALWAYS_INLINE SatSide sat_side(const Vec3 P[3])" sha256:3a6fbe04d8d11102 *)
 Theorem axis_gap_rounding (a x0 x1 x2 y0 y1 y2 : V3) s :
   dbl a -> bounded s x0 -> bounded s x1 -> bounded s x2 ->
@@ -327,7 +327,7 @@ Proof.
   apply ObbAllowances.projection_convex; assumption.
 Qed.
 
-(* covers optimized/gauss6/geometry/distance.h "GAUSS6_ALWAYS_INLINE void for_each_separating_axis(const SatSide& A" sha256:3258a47a8b50fd57 *)
+(* covers optimized/gauss6/geometry/distance.h "GAUSS6_ALWAYS_INLINE void for_each_separating_axis(const SatSide& A" sha256:f9abadb85b78baa3 *)
 Theorem axis_gap_distance (a x0 x1 x2 y0 y1 y2 : V3) s t0 t1 t2 w0 w1 w2 :
   dbl a -> bounded s x0 -> bounded s x1 -> bounded s x2 ->
   bounded s y0 -> bounded s y1 -> bounded s y2 -> kNormFloor <= abs1 a ->

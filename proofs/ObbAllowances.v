@@ -274,7 +274,7 @@ Proof.
   split; nra.
 Qed.
 
-(* covers optimized/gauss6/geometry/distance.h "GAUSS6_ALWAYS_INLINE void for_each_separating_axis(const SatSide& A" sha256:3258a47a8b50fd57 *)
+(* covers optimized/gauss6/geometry/distance.h "GAUSS6_ALWAYS_INLINE void for_each_separating_axis(const SatSide& A" sha256:f9abadb85b78baa3 *)
 Theorem separating_axis_gap a0 a1 a2 x0 x1 x2 y0 y1 y2 a_hi b_lo p :
   dot3 a0 a1 a2 x0 x1 x2 <= a_hi -> b_lo <= dot3 a0 a1 a2 y0 y1 y2 ->
   0 < p -> p <= b_lo - a_hi ->
