@@ -203,7 +203,7 @@ Qed.
 
 (* closest_point_on_triangle's coordinate, one of its branches (the corners;
    an edge's point at a parameter in [0, 1]: the branches of edges ab, ac, bc
-   by ratio_unit, the fallback's segment points by their clamp; the interior
+   by ratio_unit (edge_point, the edge rule); the interior
    at weights of interior_weights), lies in [lo, hi] of the corners, to
    40 u M + 5 eta. *)
 Definition closest_coord (a b c q : R) : Prop :=
@@ -396,11 +396,12 @@ Qed.
    0 >= d3 (edge ab: ratio d1 (-d3)); a + t ac with t = d2 / (d2 - d6), d2 >=
    0 >= d6 (edge ac); b + t (c - b) with t = eb / (eb - ec), eb = bc . bp >=
    0 >= ec = bc . cp (edge bc); the interior a + ab v + ac w when
-   va, vb, vc >= 0 (interior_weights); otherwise the nearest of the three
-   edges' points at clamped parameters (closest_point_on_segment: t in [0, 1]
-   or 0 for NaN). Each is closest_coord. *)
-(* covers optimized/gauss6/geometry/distance.cpp "Vec3 closest_point_on_triangle(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c)" sha256:8dfabb2ddc3007f1 *)
-(* covers optimized/gauss6/geometry/distance.cpp "Vec3 closest_point_on_segment(const Vec3& p, const Vec3& a, const Vec3& b)" sha256:b5dc81da5de5cba4 *)
+   va, vb, vc >= 0 (interior_weights). The code computes every edge's point
+   this way (edge_point, the edge rule, also at the ends: a corner) and keeps
+   the nearest of them and the interior's (ClosestPoint.v closest_c). Each is
+   closest_coord. *)
+(* covers optimized/gauss6/geometry/distance.cpp "Vec3 closest_point_on_triangle(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c)" sha256:fdad0635e55c0607 *)
+(* covers optimized/gauss6/geometry/distance.cpp "Vec3 edge_point(const Vec3& s, const Vec3& t, const Vec3& st, double e, double f)" sha256:d2f624d780071625 *)
 Theorem closest_branches a b c :
   (forall x y e0 e1, F x -> F y -> 0 <= x -> 0 <= y -> (e0 = a \/ e0 = b \/ e0 = c) -> (e1 = a \/ e1 = b \/ e1 = c) ->
      closest_coord a b c (point_c (ratio x y) e0 e1)) /\
