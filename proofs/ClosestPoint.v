@@ -307,56 +307,6 @@ Qed.
 
 (* ---- The interior's point ---- *)
 
-(* Its coordinate within 24 u M + 5 eta of a + v (b - a) + w (c - a) (the
-   steps of ContactApart.v interior_in_box). *)
-Lemma interior_err a b c v w M : F a -> F b -> F c ->
-  0 <= v -> 0 <= w -> v + w <= 1 + 8 * u -> Rabs a <= M -> Rabs b <= M -> Rabs c <= M ->
-  Rabs (interior_c a b c v w - (a + v * (b - a) + w * (c - a))) <= 24 * u * M + 5 * eta.
-Proof.
-  intros Fa Fb Fc Hv Hw Hs Ma Mb Mc. pose proof u_small as Hu. pose proof eta_pos.
-  assert (HM : 0 <= M) by (pose proof (Rabs_pos a); lra).
-  assert (Hv1 : v <= 1 + 8 * u) by lra. assert (Hw1 : w <= 1 + 8 * u) by lra.
-  set (X := a + v * (b - a) + w * (c - a)).
-  pose proof (sub_rel b a Fb Fa) as E1. pose proof (sub_rel c a Fc Fa) as E2.
-  assert (Dba : Rabs (b - a) <= 2 * M) by (apply Rle_trans with (M + M); [apply abs_diff_le | ]; lra).
-  assert (Dca : Rabs (c - a) <= 2 * M) by (apply Rle_trans with (M + M); [apply abs_diff_le | ]; lra).
-  assert (A1 : u * Rabs (b - a) <= u * (2 * M)) by (apply Rmult_le_compat_l; lra).
-  assert (A2 : u * Rabs (c - a) <= u * (2 * M)) by (apply Rmult_le_compat_l; lra).
-  assert (Q1 : Rabs (fl (b - a) * v - v * (b - a)) <= (1 + 8 * u) * (2 * u * M)).
-  { replace (fl (b - a) * v - v * (b - a)) with (v * (fl (b - a) - (b - a))) by ring.
-    rewrite Rabs_mult, Rabs_pos_eq by lra.
-    apply Rmult_le_compat; [lra | apply Rabs_pos | lra | lra]. }
-  assert (Q2 : Rabs (fl (c - a) * w - w * (c - a)) <= (1 + 8 * u) * (2 * u * M)).
-  { replace (fl (c - a) * w - w * (c - a)) with (w * (fl (c - a) - (c - a))) by ring.
-    rewrite Rabs_mult, Rabs_pos_eq by lra.
-    apply Rmult_le_compat; [lra | apply Rabs_pos | lra | lra]. }
-  assert (B1 : Rabs (v * (b - a)) <= (1 + 8 * u) * (2 * M))
-    by (rewrite Rabs_mult, Rabs_pos_eq by lra; apply Rmult_le_compat; [lra | apply Rabs_pos | lra | lra]).
-  assert (B2 : Rabs (w * (c - a)) <= (1 + 8 * u) * (2 * M))
-    by (rewrite Rabs_mult, Rabs_pos_eq by lra; apply Rmult_le_compat; [lra | apply Rabs_pos | lra | lra]).
-  pose proof (step _ _ _ _ B1 Q1) as P1. pose proof (step _ _ _ _ B2 Q2) as P2.
-  set (p1 := fl (fl (b - a) * v)) in *. set (p2 := fl (fl (c - a) * w)) in *.
-  set (e1 := (1 + 8 * u) * (2 * u * M) + u * ((1 + 8 * u) * (2 * M) + (1 + 8 * u) * (2 * u * M)) + eta) in *.
-  assert (S1 : Rabs ((a + p1) - (a + v * (b - a))) <= e1)
-    by (replace ((a + p1) - (a + v * (b - a))) with (p1 - v * (b - a)) by ring; exact P1).
-  assert (BS1 : Rabs (a + v * (b - a)) <= M + (1 + 8 * u) * (2 * M))
-    by (eapply Rle_trans; [apply Rabs_triang | lra]).
-  pose proof (step _ _ _ _ BS1 S1) as P3. set (s1 := fl (a + p1)) in *.
-  assert (S2 : Rabs ((s1 + p2) - X) <= (e1 + u * (M + (1 + 8 * u) * (2 * M) + e1) + eta) + e1).
-  { unfold X. replace (s1 + p2 - (a + v * (b - a) + w * (c - a)))
-      with ((s1 - (a + v * (b - a))) + (p2 - w * (c - a))) by ring.
-    eapply Rle_trans; [apply Rabs_triang | lra]. }
-  assert (BX : Rabs X <= M + 2 * ((1 + 8 * u) * (2 * M))).
-  { unfold X. eapply Rle_trans; [apply Rabs_triang|].
-    pose proof (Rabs_triang a (v * (b - a))). lra. }
-  pose proof (step _ _ _ _ BX S2) as P4.
-  unfold interior_c. fold p1 p2 s1.
-  set (E := e1 + u * (M + (1 + 8 * u) * (2 * M) + e1) + eta + e1) in *.
-  assert (HE : E + u * (M + 2 * ((1 + 8 * u) * (2 * M)) + E) + eta <= 24 * u * M + 5 * eta)
-    by (unfold E, e1, u in *; lra).
-  lra.
-Qed.
-
 (* The weights' combination at v + w <= 1 + 8 u is within 16 u M of the face's
    point at the weights scaled to sum at most 1. *)
 Lemma scaled_comb a b c v w M : 0 <= v -> 0 <= w -> 1 < v + w -> v + w <= 1 + 8 * u ->
