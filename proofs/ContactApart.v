@@ -145,22 +145,16 @@ Qed.
 (* The interior branch's point a + (b - a) v + (c - a) w, computed as the
    code computes it, v, w >= 0, v + w <= 1 + 8 u. *)
 Definition interior_c a b c v w := fl (fl (a + fl (fl (b - a) * v)) + fl (fl (c - a) * w)).
-Lemma interior_in_box a b c v w lo hi M : F a -> F b -> F c ->
-  0 <= v -> 0 <= w -> v + w <= 1 + 8 * u ->
-  lo <= a <= hi -> lo <= b <= hi -> lo <= c <= hi -> Rabs a <= M -> Rabs b <= M -> Rabs c <= M ->
-  lo - (40 * u * M + 5 * eta) <= interior_c a b c v w <= hi + (40 * u * M + 5 * eta).
+(* The interior's coordinate within 24 u M + 5 eta of the exact
+   a + v (b - a) + w (c - a). *)
+Lemma interior_err a b c v w M : F a -> F b -> F c ->
+  0 <= v -> 0 <= w -> v + w <= 1 + 8 * u -> Rabs a <= M -> Rabs b <= M -> Rabs c <= M ->
+  Rabs (interior_c a b c v w - (a + v * (b - a) + w * (c - a))) <= 24 * u * M + 5 * eta.
 Proof.
-  intros Fa Fb Fc Hv Hw Hs Ha Hb Hc Ma Mb Mc. pose proof u_small as Hu. pose proof eta_pos.
+  intros Fa Fb Fc Hv Hw Hs Ma Mb Mc. pose proof u_small as Hu. pose proof eta_pos.
   assert (HM : 0 <= M) by (pose proof (Rabs_pos a); lra).
   assert (Hv1 : v <= 1 + 8 * u) by lra. assert (Hw1 : w <= 1 + 8 * u) by lra.
-  (* the exact point X lies within 16 u M of [lo, hi] *)
   set (X := a + v * (b - a) + w * (c - a)).
-  assert (HX : lo - 16 * u * M <= X <= hi + 16 * u * M).
-  { pose proof (comb_lower a b c v w lo M Hv Hw Hs ltac:(lra) ltac:(lra) ltac:(lra) Ma Mb Mc).
-    pose proof (comb_lower (- a) (- b) (- c) v w (- hi) M Hv Hw Hs ltac:(lra) ltac:(lra) ltac:(lra)
-      ltac:(rewrite Rabs_Ropp; exact Ma) ltac:(rewrite Rabs_Ropp; exact Mb) ltac:(rewrite Rabs_Ropp; exact Mc)).
-    unfold X. split; lra. }
-  (* the differences, the products, the two sums *)
   pose proof (sub_rel b a Fb Fa) as E1. pose proof (sub_rel c a Fc Fa) as E2.
   assert (Dba : Rabs (b - a) <= 2 * M) by (apply Rle_trans with (M + M); [apply abs_diff_le | ]; lra).
   assert (Dca : Rabs (c - a) <= 2 * M) by (apply Rle_trans with (M + M); [apply abs_diff_le | ]; lra).
@@ -193,17 +187,35 @@ Proof.
   assert (BX : Rabs X <= M + 2 * ((1 + 8 * u) * (2 * M))).
   { unfold X. eapply Rle_trans; [apply Rabs_triang|].
     pose proof (Rabs_triang a (v * (b - a))). lra. }
-  pose proof (step _ _ _ _ BX S2) as P4. apply abs_bounds in P4.
+  pose proof (step _ _ _ _ BX S2) as P4.
   unfold interior_c. fold p1 p2 s1.
   set (E := e1 + u * (M + (1 + 8 * u) * (2 * M) + e1) + eta + e1) in *.
   assert (HE : E + u * (M + 2 * ((1 + 8 * u) * (2 * M)) + E) + eta <= 24 * u * M + 5 * eta)
     by (unfold E, e1, u in *; lra).
-  unfold u in *; lra.
+  lra.
+Qed.
+
+Lemma interior_in_box a b c v w lo hi M : F a -> F b -> F c ->
+  0 <= v -> 0 <= w -> v + w <= 1 + 8 * u ->
+  lo <= a <= hi -> lo <= b <= hi -> lo <= c <= hi -> Rabs a <= M -> Rabs b <= M -> Rabs c <= M ->
+  lo - (40 * u * M + 5 * eta) <= interior_c a b c v w <= hi + (40 * u * M + 5 * eta).
+Proof.
+  intros Fa Fb Fc Hv Hw Hs Ha Hb Hc Ma Mb Mc. pose proof u_small as Hu. pose proof eta_pos.
+  assert (HM : 0 <= M) by (pose proof (Rabs_pos a); lra).
+  (* the exact point X lies within 16 u M of [lo, hi] *)
+  set (X := a + v * (b - a) + w * (c - a)).
+  assert (HX : lo - 16 * u * M <= X <= hi + 16 * u * M).
+  { pose proof (comb_lower a b c v w lo M Hv Hw Hs ltac:(lra) ltac:(lra) ltac:(lra) Ma Mb Mc).
+    pose proof (comb_lower (- a) (- b) (- c) v w (- hi) M Hv Hw Hs ltac:(lra) ltac:(lra) ltac:(lra)
+      ltac:(rewrite Rabs_Ropp; exact Ma) ltac:(rewrite Rabs_Ropp; exact Mb) ltac:(rewrite Rabs_Ropp; exact Mc)).
+    unfold X. split; lra. }
+  pose proof (interior_err a b c v w M Fa Fb Fc Hv Hw Hs Ma Mb Mc) as E. fold X in E. apply abs_bounds in E.
+  assert (0 <= u * M) by nra. lra.
 Qed.
 
 (* closest_point_on_triangle's coordinate, one of its branches (the corners;
    an edge's point at a parameter in [0, 1]: the branches of edges ab, ac, bc
-   by ratio_unit, the fallback's segment points by their clamp; the interior
+   by ratio_unit (edge_point, the edge rule); the interior
    at weights of interior_weights), lies in [lo, hi] of the corners, to
    40 u M + 5 eta. *)
 Definition closest_coord (a b c q : R) : Prop :=
@@ -396,11 +408,12 @@ Qed.
    0 >= d3 (edge ab: ratio d1 (-d3)); a + t ac with t = d2 / (d2 - d6), d2 >=
    0 >= d6 (edge ac); b + t (c - b) with t = eb / (eb - ec), eb = bc . bp >=
    0 >= ec = bc . cp (edge bc); the interior a + ab v + ac w when
-   va, vb, vc >= 0 (interior_weights); otherwise the nearest of the three
-   edges' points at clamped parameters (closest_point_on_segment: t in [0, 1]
-   or 0 for NaN). Each is closest_coord. *)
-(* covers optimized/gauss6/geometry/distance.cpp "Vec3 closest_point_on_triangle(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c)" sha256:8dfabb2ddc3007f1 *)
-(* covers optimized/gauss6/geometry/distance.cpp "Vec3 closest_point_on_segment(const Vec3& p, const Vec3& a, const Vec3& b)" sha256:b5dc81da5de5cba4 *)
+   va, vb, vc >= 0 (interior_weights). The code computes every edge's point
+   this way (edge_point, the edge rule, also at the ends: a corner) and keeps
+   the nearest of them and the interior's (ClosestPoint.v closest_c). Each is
+   closest_coord. *)
+(* covers optimized/gauss6/geometry/distance.cpp "Vec3 closest_point_on_triangle(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c)" sha256:fdad0635e55c0607 *)
+(* covers optimized/gauss6/geometry/distance.cpp "Vec3 edge_point(const Vec3& s, const Vec3& t, const Vec3& st, double e, double f)" sha256:d2f624d780071625 *)
 Theorem closest_branches a b c :
   (forall x y e0 e1, F x -> F y -> 0 <= x -> 0 <= y -> (e0 = a \/ e0 = b \/ e0 = c) -> (e1 = a \/ e1 = b \/ e1 = c) ->
      closest_coord a b c (point_c (ratio x y) e0 e1)) /\

@@ -13,7 +13,8 @@
    the edge, is within 200 u M + 2^-533 (Euclidean) of the exact closest point
    of the segment to p, and so that two such separations are within `tie`.
    The premise that each face takes that edge's branch or its ends' (the
-   region tests' selection) is not proved here (proofs/README.md). The
+   region tests' selection) is not needed since closest_point_on_triangle
+   keeps the nearest of the three edges' points: ClosestPoint.v tie_closest. The
    model's x / 0 = 0 where IEEE gives NaN: e = f = 0 computed (a degenerate
    edge, whose face generate_contacts drops) is outside the statements.
    Same model as Rounding.v (binary64, round to nearest, gradual underflow,
@@ -304,7 +305,8 @@ Proof.
   unfold eta. pose proof (bpow_gt_0 radix2 (-1075)). simpl (bpow radix2 7). lra.
 Qed.
 
-(* covers optimized/gauss6/geometry/distance.cpp "Vec3 closest_point_on_triangle(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c)" sha256:8dfabb2ddc3007f1 *)
+(* covers optimized/gauss6/geometry/distance.cpp "Vec3 edge_point(const Vec3& s, const Vec3& t, const Vec3& st, double e, double f)" sha256:d2f624d780071625 *)
+(* covers optimized/gauss6/geometry/distance.cpp "Vec3 closest_point_on_segment(const Vec3& p, const Vec3& a, const Vec3& b)" sha256:d103371e3f2661db *)
 Theorem edge_rule_point a0 a1 a2 b0 b1 b2 p0 p1 p2 q0 q1 q2 M :
   (forall v, In v [a0; a1; a2; b0; b1; b2; p0; p1; p2] -> F v) ->
   (forall v, In v [a0; a1; a2; b0; b1; b2; p0; p1; p2] -> Rabs v <= M) ->

@@ -1,14 +1,16 @@
-// Tests of the theorems of proofs/ContactTie.v: closest_point_on_triangle's
-// corner and edge branches, decided and computed from each edge's own dot
-// products, return a point within 200 u M + 2^-533 (Euclidean) of the exact
-// closest point of that edge (edge_rule_point), whichever face computes it and
+// Tests of the theorems of proofs/ContactTie.v: the edge rule (distance.cpp
+// edge_point, public as closest_point_on_segment), decided and computed from
+// an edge's own dot products, returns a point within 200 u M + 2^-533
+// (Euclidean) of the exact closest point of that edge (edge_rule_point),
 // whichever way round it sees the edge; so two faces that share the edge
 // compute one vertex's separations within generate_contacts' `tie` of each
-// other (tie_shared_edge). Random and adversarial inputs: a shared edge many
-// orders of magnitude shorter than the faces' other edges (where the old bc
-// branch, which took its parameter from differences of the other edges' dot
-// products, erred by up to the edge's length), subnormal and huge
-// coordinates, folded and nearly flat face pairs.
+// other (tie_shared_edge, and ClosestPoint.v tie_closest for the faces'
+// closest_point_on_triangle, tested in test_proved_closest_point.cpp too).
+// Random and adversarial inputs: a shared edge many orders of magnitude
+// shorter than the faces' other edges (where the old bc branch, which took its
+// parameter from differences of the other edges' dot products, erred by up to
+// the edge's length), subnormal and huge coordinates, folded and nearly flat
+// face pairs.
 #include <catch2/catch.hpp>
 
 #include <gmpxx.h>
@@ -73,10 +75,9 @@ struct SharedEdge {
 };
 SharedEdge make_shared_edge(std::mt19937_64& rng) {
   std::uniform_real_distribution<double> unit(-1, 1), half(0, 1);
-  // Scales down to 2^-200: below about 2^-256 the region tests' products of
-  // two dot products (vc, vb, va: degree 4 in the coordinates) underflow to 0
-  // and the branch is not the shared edge's, outside the theorem's premise.
-  std::uniform_int_distribution<int> scale_exp(-200, 40), short_exp(0, 70), kind(0, 3);
+  // Scales down to 2^-330, where the old region tests' products of two dot
+  // products (degree 4 in the coordinates) underflowed to 0.
+  std::uniform_int_distribution<int> scale_exp(-330, 40), short_exp(0, 70), kind(0, 3);
   const double s = std::min(std::ldexp(1.0, scale_exp(rng)), 1e12);
   SharedEdge k;
   k.b = Vec3(unit(rng), unit(rng), unit(rng)) * s;
@@ -91,15 +92,10 @@ SharedEdge make_shared_edge(std::mt19937_64& rng) {
   k.a = k.b + 0.5 * len * e + s * (0.5 + half(rng)) * w1;
   k.d = k.b + 0.5 * len * e + s * (0.5 + half(rng)) * w2;
   const Vec3 out = -(w1 + w2).normalized();
-  // p near the edge (within its length), or far (within the faces' size). Far
-  // from an edge shorter than about 2^-26 of the faces, the region tests va,
-  // vb, vc (differences of products of ab's and ac's dot products, whose
-  // rounding is u (|ab| |bp|)^2 against an exact value of |ab| |bp| |bc|^2)
-  // lose their sign and the face takes its interior branch at weights that
-  // are mostly rounding: outside the theorem's premise (the branch of the
-  // shared edge or of its ends), and its separation is not the edge's (a
-  // known gap: proofs/README.md, "Not yet proved from issue 45").
-  const bool far = kind(rng) != 2 && short_exp(rng) <= 20 && len >= s * 0x1p-20;
+  // p near the edge (within its length), or far (within the faces' size; on
+  // a sliver, an edge shorter than about 2^-26 of the faces, Ericson's region
+  // tests lost their sign there: ClosestPoint.v's rule does not use them).
+  const bool far = kind(rng) != 2;
   const double h = far ? s * half(rng) : len * half(rng);
   k.p = k.b + half(rng) * len * e + h * out;
   k.M = 0;
@@ -114,8 +110,8 @@ mpq_class distance_sq(const Vec3& q, const Q3& Q) {
 
 }  // namespace
 
-TEST_CASE("closest_point_on_triangle's point on a short shared edge is the edge's closest point (ContactTie.v "
-          "edge_rule_point)",
+TEST_CASE("the edge rule's point on a short shared edge is the edge's closest point, either way round "
+          "(ContactTie.v edge_rule_point)",
           "[proved]") {
   std::mt19937_64 rng(45046);
   int checked = 0;
@@ -124,9 +120,9 @@ TEST_CASE("closest_point_on_triangle's point on a short shared edge is the edge'
     if (k.c == k.b) continue;  // a degenerate face (generate_contacts drops it: zero normal)
     const Q3 exact_point = closest_on_segment(k.p, k.b, k.c);
     const mpq_class bound = point_bound_sq(k.M);
-    // F sees the edge as its bc, G as its ab (from c to b): both within the bound.
-    const Vec3 qf = closest_point_on_triangle(k.p, k.a, k.b, k.c);
-    const Vec3 qg = closest_point_on_triangle(k.p, k.c, k.b, k.d);
+    // F sees the edge from b to c, G from c to b: both within the bound.
+    const Vec3 qf = closest_point_on_segment(k.p, k.b, k.c);
+    const Vec3 qg = closest_point_on_segment(k.p, k.c, k.b);
     INFO("case " << i << " M " << k.M << " |bc| " << (k.c - k.b).norm());
     REQUIRE(distance_sq(qf, exact_point) <= bound);
     REQUIRE(distance_sq(qg, exact_point) <= bound);
@@ -135,19 +131,22 @@ TEST_CASE("closest_point_on_triangle's point on a short shared edge is the edge'
   CHECK(checked > 15000);  // most cases are not degenerate
 }
 
-TEST_CASE("a face with an edge 2^-30 of its others: the bc branch's point is the edge's (ContactTie.v "
+TEST_CASE("a face with an edge 2^-30 of its others: the edge rule's point on bc is the edge's (ContactTie.v "
           "edge_rule_point)",
           "[proved]") {
   // A tall thin face over a short base bc, p beyond bc at unit distance: the
   // differences d4 - d3 and d5 - d6 of the old region and parameter tests of
   // bc cancel to their rounding (u |ab| |bp| against |bc|^2 = 2^-60): the old
   // code returned the corner b, up to |bc| = 2^-30 from the exact point, 2^15
-  // times the bound.
+  // times the bound. The edge rule computes bc's point from bc's own dot
+  // products. (closest_point_on_triangle may return b here: its distance from
+  // p is the exact point's to rounding, which is what it promises:
+  // ClosestPoint.v closest_upper, tested in test_proved_closest_point.cpp.)
   const double eps = 0x1p-30;
   const Vec3 a(0.5 * eps, 1, 0), b(0, 0, 0), c(eps, 0, 0);
   for (const double s : {0.1, 0.25, 1.0 / 3, 0.5, 0.7, 0.9}) {
     const Vec3 p(s * eps, -1, 0.25);
-    const Vec3 q = closest_point_on_triangle(p, a, b, c);
+    const Vec3 q = closest_point_on_segment(p, b, c);
     INFO("s = " << s << ": q.x = " << q.x() << ", exact " << s * eps);
     REQUIRE(distance_sq(q, closest_on_segment(p, b, c)) <= point_bound_sq(1.0));
   }
@@ -169,7 +168,8 @@ TEST_CASE("two faces sharing an edge compute one vertex's separations within `ti
                        << k.d.transpose() << " p " << k.p.transpose());
     REQUIRE(sg <= sf + tie);  // held_beside's reach, min(d, sep + tie), rounded as the code rounds it
     REQUIRE(sf <= sg + tie);
-    // The separations differ by at most 460 u M + 2^-530 (the theorem's bound, under tie).
-    REQUIRE(std::abs(sf - sg) <= 460 * kU * k.M + 0x1p-530);
+    // The separations differ by at most 480 u M + 2^-528 (ClosestPoint.v
+    // tie_closest's bound, under tie).
+    REQUIRE(std::abs(sf - sg) <= 480 * kU * k.M + 0x1p-528);
   }
 }

@@ -8,60 +8,79 @@ namespace gauss6 {
 
 namespace {
 
-// The point of segment [a, b] closest to p: its parameter clamped to [0, 1]
-// (a segment of zero length, whose parameter is NaN, gives a).
-Vec3 closest_point_on_segment(const Vec3& p, const Vec3& a, const Vec3& b) {
-  const Vec3 ab = b - a;
-  const double t = ab.dot(p - a) / ab.squaredNorm();
-  return a + (t > 0 ? (t < 1 ? t : 1.0) : 0.0) * ab;
+// The edge rule (proofs/ContactTie.v edge_rule): the point of the edge from s
+// to t nearest p, decided and computed from that edge's own dot products
+// e = (t - s) . (p - s) and f = (t - s) . (p - t): s when e <= 0, t when
+// f >= 0, else s + (e / (e - f)) (t - s) (e > 0 > f: no division by zero).
+// Within 200 u M + 2^-533 of the exact closest point of the segment, M the
+// coordinates' magnitude: ContactTie.v edge_rule_point.
+Vec3 edge_point(const Vec3& s, const Vec3& t, const Vec3& st, double e, double f) {
+  if (e <= 0) return s;
+  if (f >= 0) return t;
+  return s + (e / (e - f)) * st;
 }
 
 }  // namespace
 
-// Ericson, Real-Time Collision Detection, 5.1.5: Voronoi regions of the triangle.
-// Every branch returns a corner, a point of an edge at a parameter in [0, 1],
-// or the interior's combination at weights >= 0 summing to at most 1 + 8 u,
-// so the point lies in the corners' box to 40 u of their magnitude:
-// proofs/ContactApart.v, closest_branches and closest_in_box (generate_contacts'
-// `apart` rests on it).
-// Each corner and edge branch is decided and computed from the dot products
-// of its own edges, (end - start) . (p - start) and (end - start) . (p - end)
-// (edge bc's, eb and ec, from bc itself, not as differences of ab's and ac's, whose
-// rounding grows as |ab| |bp| / |bc|): the point is then within a few u of the
-// coordinates' magnitude of the exact closest point of that edge, whichever
-// face computes it (proofs/ContactTie.v, edge_rule_point; generate_contacts'
-// `tie` rests on it: tie_shared_edge).
+Vec3 closest_point_on_segment(const Vec3& p, const Vec3& a, const Vec3& b) {
+  const Vec3 ab = b - a;
+  return edge_point(a, b, ab, ab.dot(p - a), ab.dot(p - b));
+}
+
+// Corners first (Ericson, Real-Time Collision Detection, 5.1.5): a corner both
+// of whose edges' computed dot products point away from p is returned; it is
+// as near p as any point of the face, to 63 u M + 2^-530 (proofs/ClosestPoint.v
+// corner_nearest: exact algebra, |p - x|^2 = |p - a|^2 - 2 (s D1 + t D2) +
+// |s ab + t ac|^2, with D1, D2 within their rounding of <= 0). Otherwise the
+// candidates whose rounding is bounded whatever the face's shape: the three
+// edges' points by the edge rule, and the interior's combination a + ab v +
+// ac w when its computed weights va, vb, vc are >= 0 (v, w >= 0, v + w <=
+// 1 + 8 u: ContactApart.v interior_weights); the nearest of them by the
+// computed (p - q).squaredNorm(), the separation the callers compute as
+// (p - q).norm(). Ericson's region tests, products of two dot products,
+// choose the interior on a sliver (an edge shorter than about 2^-26 of the
+// others) where their rounding passes their value, and an edge whose region
+// p is not in where the products underflow (coordinates below about 2^-256):
+// there the point was up to the face's size from the exact closest point.
+// Every branch returns a corner, an edge's point at a parameter in [0, 1] or
+// the interior's combination, within the corners' box to 40 u M
+// (ContactApart.v closest_branches, closest_in_box: generate_contacts'
+// `apart`). The computed separation is at most the exact distance of p from
+// each edge plus 240 u M + 2^-529 and at least p's exact distance from the
+// face less 240 u M + 2^-529 (ClosestPoint.v closest_upper, closest_lower), so
+// two faces whose exact closest points of p are one point of an edge they
+// share compute separations within generate_contacts' `tie` of each other
+// (ClosestPoint.v tie_closest).
 Vec3 closest_point_on_triangle(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c) {
   const Vec3 ab = b - a, ac = c - a, ap = p - a;
   const double d1 = ab.dot(ap), d2 = ac.dot(ap);
   if (d1 <= 0 && d2 <= 0) return a;
   const Vec3 bp = p - b, bc = c - b;
-  const double d3 = ab.dot(bp), d4 = ac.dot(bp), eb = bc.dot(bp);
+  const double d3 = ab.dot(bp), eb = bc.dot(bp);
   if (d3 >= 0 && eb <= 0) return b;
-  const double vc = d1 * d4 - d3 * d2;
-  if (vc <= 0 && d1 >= 0 && d3 <= 0) return a + (d1 / (d1 - d3)) * ab;
   const Vec3 cp = p - c;
-  const double d5 = ab.dot(cp), d6 = ac.dot(cp), ec = bc.dot(cp);
+  const double d6 = ac.dot(cp), ec = bc.dot(cp);
   if (d6 >= 0 && ec >= 0) return c;
-  const double vb = d5 * d2 - d1 * d6;
-  if (vb <= 0 && d2 >= 0 && d6 <= 0) return a + (d2 / (d2 - d6)) * ac;
-  const double va = d3 * d6 - d5 * d4;
-  if (va <= 0 && eb >= 0 && ec <= 0) return b + (eb / (eb - ec)) * bc;
-  // Inside the face: va, vb, vc > 0 in exact arithmetic, so the weights are
-  // >= 0 and sum to at most 1 (to 8 u: ContactApart.v, interior_weights).
-  // Rounding of the six dot products is not known to break these signs (no
-  // test has seen it), but nothing rules it out on a face whose area is at
-  // the level of its rounding; there a weight < 0 would put the point
-  // anywhere on the face's plane, so such a face gets the nearest of its
-  // edges' points instead.
+  // The edges' points, the nearest kept (ties to the first).
+  Vec3 best = edge_point(a, b, ab, d1, d3);
+  double best_sq = (p - best).squaredNorm();
+  const Vec3 q_ac = edge_point(a, c, ac, d2, d6);
+  const double s_ac = (p - q_ac).squaredNorm();
+  if (s_ac < best_sq) best = q_ac, best_sq = s_ac;
+  const Vec3 q_bc = edge_point(b, c, bc, eb, ec);
+  const double s_bc = (p - q_bc).squaredNorm();
+  if (s_bc < best_sq) best = q_bc, best_sq = s_bc;
+  // The interior's point, when its weights are >= 0 as computed (in exact
+  // arithmetic va, vb, vc > 0 inside the face); taken when nearer. A zero sum
+  // gives a NaN point, whose comparison fails.
+  const double d4 = ac.dot(bp), d5 = ab.dot(cp);
+  const double va = d3 * d6 - d5 * d4, vb = d5 * d2 - d1 * d6, vc = d1 * d4 - d3 * d2;
   if (va >= 0 && vb >= 0 && vc >= 0) {
     const double denom = 1 / (va + vb + vc);
-    return a + ab * (vb * denom) + ac * (vc * denom);
+    const Vec3 q = a + ab * (vb * denom) + ac * (vc * denom);
+    if ((p - q).squaredNorm() < best_sq) return q;
   }
-  const Vec3 e0 = closest_point_on_segment(p, a, b), e1 = closest_point_on_segment(p, b, c),
-             e2 = closest_point_on_segment(p, c, a);
-  const double s0 = (p - e0).squaredNorm(), s1 = (p - e1).squaredNorm(), s2 = (p - e2).squaredNorm();
-  return s0 <= s1 ? (s0 <= s2 ? e0 : e2) : (s1 <= s2 ? e1 : e2);
+  return best;
 }
 
 // Ericson 5.1.9, with degenerate segments handled.
