@@ -84,6 +84,18 @@ double magnitude(std::initializer_list<Vec3> vs) {
 // distances' conversion to double (8 u M, see the file's comment).
 double bound(double M) { return 248 * kU * M + 0x1p-529; }
 
+// closest_point_on_triangle's separation of p from (a, b, c) lies between the
+// exact distance of p from the face and from its nearest edge, to bound(M).
+void check_separation(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c) {
+  const double M = magnitude({p, a, b, c});
+  const Exact x = exact_distances(p, a, b, c);
+  const double sep = (p - closest_point_on_triangle(p, a, b, c)).norm();
+  INFO(std::hexfloat << " p " << p.transpose() << " a " << a.transpose() << " b " << b.transpose() << " c "
+                     << c.transpose());
+  REQUIRE(sep <= root(x.edges_sq) + bound(M));
+  REQUIRE(sep >= root(x.face_sq) - bound(M));
+}
+
 // A sliver: edge bc of length 2^-k (k in [26, 60]) of the face's size s, a
 // far from it, p beyond bc at up to the face's size (in its plane or off it).
 struct Face {
@@ -125,11 +137,8 @@ TEST_CASE("closest_point_on_triangle on slivers with p far beyond the short edge
     for (int k = 0; k < 3; ++k) {  // every way round: the short edge as bc, ca, ab
       const Vec3 A = k == 0 ? f.a : k == 1 ? f.b : f.c, B = k == 0 ? f.b : k == 1 ? f.c : f.a,
                  C = k == 0 ? f.c : k == 1 ? f.a : f.b;
-      const double sep = (f.p - closest_point_on_triangle(f.p, A, B, C)).norm();
-      INFO("case " << i << " way " << k << std::hexfloat << " p " << f.p.transpose() << " a " << A.transpose()
-                   << " b " << B.transpose() << " c " << C.transpose());
-      REQUIRE(sep <= root(x.edges_sq) + bound(M));
-      REQUIRE(sep >= root(x.face_sq) - bound(M));
+      INFO("case " << i << " way " << k);
+      check_separation(f.p, A, B, C);
     }
     far_off_before += root(x.edges_sq) > 1e-3 * M;
   }
@@ -150,13 +159,8 @@ TEST_CASE("closest_point_on_triangle with coordinates below 2^-256: separation w
     const double s = std::ldexp(1.0, exp(rng));
     const Vec3 a = Vec3(unit(rng), unit(rng), unit(rng)) * s, b = Vec3(unit(rng), unit(rng), unit(rng)) * s,
                c = Vec3(unit(rng), unit(rng), unit(rng)) * s, p = Vec3(unit(rng), unit(rng), unit(rng)) * 2 * s;
-    const double M = magnitude({p, a, b, c});
-    const Exact x = exact_distances(p, a, b, c);
-    const double sep = (p - closest_point_on_triangle(p, a, b, c)).norm();
-    INFO("case " << i << std::hexfloat << " p " << p.transpose() << " a " << a.transpose() << " b "
-                 << b.transpose() << " c " << c.transpose());
-    REQUIRE(sep <= root(x.edges_sq) + bound(M));
-    REQUIRE(sep >= root(x.face_sq) - bound(M));
+    INFO("case " << i);
+    check_separation(p, a, b, c);
     const Vec3 ab = b - a;
     ab_region_before += ab.dot(p - a) >= 0 && ab.dot(p - b) <= 0;
   }
@@ -179,13 +183,8 @@ TEST_CASE("closest_point_on_triangle on ordinary and near-degenerate faces: sepa
     const Vec3 foot = a + 0.4 * (b - a) + 0.3 * (c - a);
     const Vec3 p = kind(rng) == 2 ? Vec3(foot + std::ldexp(s, -30) * Vec3(unit(rng), unit(rng), unit(rng)))
                                   : Vec3(Vec3(unit(rng), unit(rng), unit(rng)) * 2 * s);
-    const double M = magnitude({p, a, b, c});
-    const Exact x = exact_distances(p, a, b, c);
-    const double sep = (p - closest_point_on_triangle(p, a, b, c)).norm();
-    INFO("case " << i << std::hexfloat << " p " << p.transpose() << " a " << a.transpose() << " b "
-                 << b.transpose() << " c " << c.transpose());
-    REQUIRE(sep <= root(x.edges_sq) + bound(M));
-    REQUIRE(sep >= root(x.face_sq) - bound(M));
+    INFO("case " << i);
+    check_separation(p, a, b, c);
   }
   // A point above a well-shaped face's interior gets the foot of p, not an
   // edge's point: separation its height (to rounding), not its distance from
