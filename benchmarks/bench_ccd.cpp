@@ -250,7 +250,8 @@ void time_steps(benchmark::State& state, const RuntimeModel& model, const std::v
   // cache at once and put a background fill in use, the work units, whether
   // the budget ran out, the contacts, and the update's pieces of work of each
   // kind: node pairs, triangle pairs, pair tests, boxes, then its units by
-  // path: first legs, checks, detour legs: StepPaths) for profiles.
+  // path: first legs, checks, detour legs: StepPaths, then its feature pairs'
+  // time bounds and rigid queries) for profiles.
   double slowest_ns = -1, over_1ms = 0, over_100us = 0;
   std::FILE* log = std::getenv("GAUSS6_BENCH_STEP_LOG") ? std::fopen(std::getenv("GAUSS6_BENCH_STEP_LOG"), "w") : nullptr;
   size_t i = 0;
@@ -301,7 +302,7 @@ void time_steps(benchmark::State& state, const RuntimeModel& model, const std::v
         state.counters["slowest_settled"] = info.settled;
       }
       if (log != nullptr)
-        std::fprintf(log, "%zu %.0f %d %ld %d %d %d %d %d %d %d %d %d %ld %d %d %ld %ld %ld %ld %ld %ld %ld\n", index, cpu_ns,
+        std::fprintf(log, "%zu %.0f %d %ld %d %d %d %d %d %d %d %d %d %ld %d %d %ld %ld %ld %ld %ld %ld %ld %ld %ld\n", index, cpu_ns,
                      r.num_pair_tests,
                      r.num_box_iterations, r.num_node_pairs, r.num_fill_node_pairs, r.num_triangle_pairs,
                      static_cast<int>(info.settled), static_cast<int>(info.status == SimStepStatus::kContact),
@@ -309,7 +310,8 @@ void time_steps(benchmark::State& state, const RuntimeModel& model, const std::v
                      info.work_units, int(info.budget_exhausted), info.num_contacts,
                      sim.step4.budget.pieces(Work::kNodePair), sim.step4.budget.pieces(Work::kTrianglePair),
                      sim.step4.budget.pieces(Work::kPairTest), sim.step4.budget.pieces(Work::kBox),
-                     sim.step4.paths.first_leg_units, sim.step4.paths.check_units, sim.step4.paths.detour_units);
+                     sim.step4.paths.first_leg_units, sim.step4.paths.check_units, sim.step4.paths.detour_units,
+                     sim.step4.budget.pieces(Work::kFeatureBound), sim.step4.budget.pieces(Work::kFeatureQuery));
       counters.add("hits", info.status == SimStepStatus::kContact);
       counters.add("settling_legs", info.settled);
       // Step 4's paths (docs/sim-step.md's table: these means times `steps`).

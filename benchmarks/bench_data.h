@@ -160,7 +160,7 @@ void for_each_set_step(const CcdSet& set, Visit&& visit) {
 // none, the recommended CPU time per update, a count of work units, or a
 // count that never runs out (the unbudgeted run, bit for bit, its work counted).
 enum class Budget { kNone, kCpu, kUnits, kCounted };
-inline constexpr long kBenchWorkUnits = 2000;  // about 1.3 M instructions (update_budget.h's ratio)
+inline constexpr long kBenchWorkUnits = 2000;  // about 1.5 M instructions (update_budget.h's ratio)
 inline RuntimeSettings budget_settings(Budget b) {
   RuntimeSettings s;
   if (b == Budget::kCpu) s.budget.cpu_seconds = kRecommendedUpdateCpuSeconds;

@@ -106,8 +106,8 @@ TEST_CASE("budget: a budget that never runs out changes nothing, bit for bit", "
 }
 
 TEST_CASE("budget: an update out of budget ends on what is proven, and the next ones go on", "[runtime][budget]") {
-  // The most work units an update of this run takes without a budget (149); three quarters of it
-  // runs out on the landing and on the twisting slide, where the updates cost more than at rest (84).
+  // The most work units an update of this run takes without a budget; three quarters of it runs
+  // out on the landing and on the twisting slide, where the updates cost more than at rest.
   // (Below what an update at rest costs, no update could prove any motion: the god-object would
   // stay put, docs/sim-step.md "Limit".)
   ScriptedDevice d0(press_slide_twist);

@@ -136,10 +136,10 @@ void search_hints(StepState* s) {
                        f.obstacle_face < s->obstacles[f.obstacle].mesh->F.rows();
     if (!valid || among(hints, h, f.god_face, f.obstacle_face, f.obstacle)) continue;  // each distinct pair once
     const CcdBody& ob = s->obstacles[f.obstacle];
-    const long boxes = s->result->num_box_iterations;
+    const TestCounts before = test_counts(*s);
     tester.test(*god.mesh, *god.bvh, f.god_face, *ob.mesh, *ob.bvh, f.obstacle_face, f.obstacle);
     if (k > 0 || lead == 0) s->num_searched = h + 1;  // (the lead alone is not hints[0 .. lead])
-    if (charge_test(s, boxes)) return;  // the step stops at s->searched (ccd_step)
+    if (charge_test(s, before)) return;  // the step stops at s->searched (ccd_step)
   }
 }
 
@@ -258,10 +258,10 @@ bool search_sub_intervals(StepState* s) {
       }
       listed = false;
       if (t == kNearOnly) return true;  // nothing to test
-      const long boxes = result->num_box_iterations;
+      const TestCounts before = test_counts(*s);
       if (!searched(*s, gf, of, o)) tester.test(*god.mesh, *god.bvh, gf, *ob.mesh, *ob.bvh, of, o);
       // A hit at the sub-interval's start cannot be bettered: stop. So does the budget's end.
-      return !charge_test(s, boxes) && !tester.done() && !answered(*s);
+      return !charge_test(s, before) && !tester.done() && !answered(*s);
     });
     if (ts == TraversalStatus::kStackFull) {
       // Unknown beyond here: stop conservatively at the sub-interval's start.
@@ -363,9 +363,9 @@ bool test_candidates(StepState* s, int num_cand) {
     const TrianglePair& p = cand[c].pair;
     if (searched(*s, p.god_face, p.obstacle_face, p.obstacle)) continue;
     const CcdBody& ob = s->obstacles[p.obstacle];
-    const long boxes = s->result->num_box_iterations;
+    const TestCounts before = test_counts(*s);
     tester.test(*god.mesh, *god.bvh, p.god_face, *ob.mesh, *ob.bvh, p.obstacle_face, p.obstacle);
-    if (charge_test(s, boxes)) {
+    if (charge_test(s, before)) {
       // The rest cannot come within min_separation before the next one's bound
       // (sorted), nor past the range the candidates were listed for.
       const double next = c + 1 < num_tested ? cand[c + 1].earliest : tester.u1;

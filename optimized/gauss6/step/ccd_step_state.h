@@ -91,10 +91,24 @@ inline bool charge(StepState* s, Work kind, long count) {
   return s->ws->budget != nullptr && s->ws->budget->spend(kind, count);
 }
 inline bool out_of_budget(const StepState& s) { return s.ws->budget != nullptr && s.ws->budget->exhausted(); }
-// A narrow-phase test just run, begun with `boxes_before` boxes counted: its set-up and boxes.
-inline bool charge_test(StepState* s, long boxes_before) {
+// The result's counts of a triangle pair's narrow-phase work (PairTester),
+// taken before its test so that the test is charged by what it did.
+struct TestCounts {
+  long boxes;
+  int bounds, queries;
+};
+inline TestCounts test_counts(const StepState& s) {
+  const CcdStepResult& r = *s.result;
+  return {r.num_box_iterations, r.num_feature_culls + r.num_pair_tests, r.num_pair_tests};
+}
+// A triangle pair's narrow-phase test just run, begun at `before`: its
+// set-up, its feature pairs' time bounds, their rigid queries and boxes.
+inline bool charge_test(StepState* s, const TestCounts& before) {
+  const TestCounts now = test_counts(*s);
   charge(s, Work::kPairTest, 1);
-  return charge(s, Work::kBox, s->result->num_box_iterations - boxes_before);
+  charge(s, Work::kFeatureBound, now.bounds - before.bounds);
+  charge(s, Work::kFeatureQuery, now.queries - before.queries);
+  return charge(s, Work::kBox, now.boxes - before.boxes);
 }
 // The budget ran out with the motion proven free of every pair not yet
 // tested up to u (at the step's reach), every pair tested searched to the

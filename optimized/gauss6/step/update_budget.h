@@ -24,15 +24,17 @@ namespace gauss6 {
 // The pieces of work the CCD charges, and their weights in work units
 // (instructions per piece, divided by kInstructionsPerUnit and rounded;
 // docs/benchmarks.md gives the fit).
-enum class Work { kNodePair = 0, kTrianglePair, kPairTest, kBox };
-inline constexpr int kNumWorkKinds = 4;
+enum class Work { kNodePair = 0, kTrianglePair, kPairTest, kFeatureBound, kFeatureQuery, kBox };
+inline constexpr int kNumWorkKinds = 6;
 inline constexpr long kWorkWeight[kNumWorkKinds] = {
     1,   // kNodePair: a node pair of a tree descent or fill (boxes tested)
     2,   // kTrianglePair: a candidate triangle pair's time or gap bound
-    4,   // kPairTest: a narrow-phase test's set-up (a triangle pair)
+    4,   // kPairTest: a narrow-phase test's set-up (a triangle pair: its swept and posed corners)
+    2,   // kFeatureBound: a feature pair's own time bound (past its box filter)
+    16,  // kFeatureQuery: a rigid narrow-phase query (its u-filter; boxes apart), a feature pair past its bound
     2,   // kBox: a narrow-phase box (one bisection of a feature pair)
 };
-inline constexpr long kInstructionsPerUnit = 650;    // about, per unit (the calibration's ratio)
+inline constexpr long kInstructionsPerUnit = 730;    // about, per unit (the calibration's ratio)
 // The work units of `count` pieces of one kind (every count of units is made here).
 inline constexpr long work_units(Work kind, long count) { return kWorkWeight[static_cast<int>(kind)] * count; }
 
@@ -49,7 +51,7 @@ inline constexpr double kRecommendedUpdateCpuSeconds = 0.4e-3;
 // replays (docs/benchmarks.md), which count the steps beyond it.
 inline constexpr double kUpdateOverrunBound = 0.25e-3;
 // Work units between two reads of the CPU clock (a read costs about a
-// microsecond on a VM; 64 units, about 40,000 instructions, 10-20 us here).
+// microsecond on a VM; 64 units, about 47,000 instructions, 10-20 us here).
 inline constexpr long kDefaultBudgetCheckInterval = 64;
 
 struct UpdateBudgetSettings {
