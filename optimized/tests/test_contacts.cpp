@@ -3,10 +3,15 @@
 // contact sets found from the CCD's near pairs against those of a full descent,
 // a dense coplanar patch reduced to its support, and the rows of a vertex
 // beside a face (a flat plate's vertex beside a tool's bottom edge, a sharp
-// vertex on a sharp edge, a curved vertex beside a ridge at any distance).
+// vertex on a sharp edge, a curved vertex beside a ridge at any distance), and
+// the merge cells of ContactCollector against comparing every contact (the
+// merging as it was before the cells, kept here).
 #include <catch2/catch.hpp>
 
+#include <algorithm>
+#include <array>
 #include <cmath>
+#include <limits>
 #include <random>
 
 #include "gauss6/step/ccd_step.h"
@@ -178,6 +183,78 @@ TEST_CASE("contacts: the CCD's near pairs give the same set as the descent", "[c
   CHECK(with_contacts > 100);
 }
 
+namespace {
+// A sheet of grid x grid squares over [-2, 2]^2 at z = 0, two triangles each:
+// without rng its vertices on the grid lines x, y = -2 + 4 i / grid; with it,
+// the interior ones moved in the plane by up to a quarter square (seeded by
+// rng): a dense coplanar tessellation.
+TriangleMesh grid_sheet(int grid, std::mt19937* rng) {
+  std::uniform_real_distribution<double> U(-1, 1);
+  std::vector<Eigen::Vector3d> V;
+  std::vector<std::array<int, 3>> F;
+  for (int i = 0; i <= grid; ++i)
+    for (int j = 0; j <= grid; ++j) {
+      if (!rng) {
+        V.emplace_back(-2 + 4.0 * i / grid, -2 + 4.0 * j / grid, 0.0);
+        continue;
+      }
+      const bool edge = i == 0 || j == 0 || i == grid || j == grid;
+      const double h = 4.0 / grid, jx = edge ? 0 : 0.25 * h * U(*rng), jy = edge ? 0 : 0.25 * h * U(*rng);
+      V.emplace_back(-2 + i * h + jx, -2 + j * h + jy, 0.0);
+    }
+  for (int i = 0; i < grid; ++i)
+    for (int j = 0; j < grid; ++j) {
+      const int a = i * (grid + 1) + j, b = a + grid + 1;
+      F.push_back({a, b, b + 1});
+      F.push_back({a, b + 1, a + 1});
+    }
+  return gauss6::test::make_mesh(V, F, "sheet");
+}
+}  // namespace
+
+namespace {
+// The merging as it was before the merge cells: every contact of the set
+// compared in order (the reduction is reduce_to_patch_supports). The
+// reference the cells must reproduce bit for bit.
+namespace before_cells {
+// Returns false when the contact was left out for want of room (overflow).
+bool add(const Contact& c, const ContactSettings& s, ContactSet* set) {
+  ++set->num_pairs_within;
+  const double md = s.merge_distance > 0 ? s.merge_distance : 1e-3 * s.distance, mc = std::cos(s.merge_angle);
+  const double reject = md * (1 + 8 * std::numeric_limits<double>::epsilon());
+  for (int i = 0; i < set->num_contacts; ++i) {
+    Contact& o = set->contacts[i];
+    if (std::abs(o.point.x() - c.point.x()) > reject || std::abs(o.point.y() - c.point.y()) > reject) continue;
+    if ((o.point - c.point).norm() <= md && o.normal.dot(c.normal) >= mc) {
+      if (c.separation < o.separation) o = c;
+      return true;
+    }
+  }
+  if (set->num_contacts == set->capacity()) {
+    ++set->num_reductions;
+    if (reduce_to_patch_supports(s.patch_angle, set) == 0) return false;
+  }
+  set->contacts[set->num_contacts++] = c;
+  return true;
+}
+}  // namespace before_cells
+
+// The two sets hold the same contacts, bit for bit, in the same order.
+void require_same_set(const ContactSet& a, const ContactSet& b) {
+  REQUIRE(a.num_contacts == b.num_contacts);
+  REQUIRE(a.num_pairs_within == b.num_pairs_within);
+  REQUIRE(a.num_reductions == b.num_reductions);
+  for (int k = 0; k < a.num_contacts; ++k) {
+    INFO("contact " << k);
+    const Contact &x = a.contacts[k], &y = b.contacts[k];
+    REQUIRE(x.point == y.point);
+    REQUIRE(x.normal == y.normal);
+    REQUIRE(x.separation == y.separation);
+    REQUIRE(x.features == y.features);
+  }
+}
+}  // namespace
+
 TEST_CASE("contacts: a dense coplanar patch is reduced to its support, the same cone", "[contacts]") {
   // A unit box laid flat on a 40 x 40 grid sheet (3,200 coplanar triangles, the
   // interior vertices jittered in the plane), turned about z and moved by seeded
@@ -188,28 +265,16 @@ TEST_CASE("contacts: a dense coplanar patch is reduced to its support, the same 
   // reduced set agree for any motion a, since each row is affine in its point
   // and the least of an affine function over a patch is at a hull vertex.
   // 1e-12: rounding of rows of norm ~1 (points within 2 of G) and of |a| = 1.
+  // A set merged through the cells and one that compares every contact are
+  // equal, bit for bit.
   std::mt19937 rng(43);
   std::uniform_real_distribution<double> U(-1, 1);
-  constexpr int kGrid = 40;
-  std::vector<Eigen::Vector3d> V;
-  std::vector<std::array<int, 3>> F;
-  for (int i = 0; i <= kGrid; ++i)
-    for (int j = 0; j <= kGrid; ++j) {
-      const bool edge = i == 0 || j == 0 || i == kGrid || j == kGrid;
-      const double h = 4.0 / kGrid, jx = edge ? 0 : 0.25 * h * U(rng), jy = edge ? 0 : 0.25 * h * U(rng);
-      V.emplace_back(-2 + i * h + jx, -2 + j * h + jy, 0.0);
-    }
-  for (int i = 0; i < kGrid; ++i)
-    for (int j = 0; j < kGrid; ++j) {
-      const int a = i * (kGrid + 1) + j, b = a + kGrid + 1;
-      F.push_back({a, b, b + 1});
-      F.push_back({a, b + 1, a + 1});
-    }
-  const TriangleMesh sheet = gauss6::test::make_mesh(V, F, "sheet"), god = make_box(1, 1, 1);
+  const TriangleMesh sheet = grid_sheet(40, &rng), god = make_box(1, 1, 1);
   const Bvh sb = build_bvh(sheet), gb = build_bvh(god);
   const CcdBody obstacle{&sheet, &sb};
   ContactWorkspace ws(god);
-  ContactSet small(16), all(4096);
+  ContactSet small(16), all(4096), every(16);
+  every.merge_head.clear();  // no merge buckets: every contact is compared, as before the cells
   ContactSettings cs;
   cs.distance = 1.5 * kDelta;
   for (int trial = 0; trial < 20; ++trial) {
@@ -221,6 +286,8 @@ TEST_CASE("contacts: a dense coplanar patch is reduced to its support, the same 
     CHECK(small.num_reductions > 0);
     CHECK(small.num_contacts <= 16);
     CHECK(small.num_pairs_within == all.num_pairs_within);
+    REQUIRE(generate_contacts(&obstacle, 1, {&god, &gb}, X, cs, &ws, &every) == ContactStatus::kOk);
+    require_same_set(small, every);
     // The smallest separation is kept.
     double least_all = 1e300, least_small = 1e300;
     for (int k = 0; k < all.num_contacts; ++k) least_all = std::min(least_all, all.contacts[k].separation);
@@ -238,21 +305,8 @@ TEST_CASE("contacts: a dense coplanar patch is reduced to its support, the same 
 }
 
 namespace {
-// A flat sheet of kGrid x kGrid squares over [-2, 2]^2 at z = 0, two triangles
-// each, no jitter (vertices on the grid lines x, y = -2 + 4 i / kGrid).
-TriangleMesh flat_sheet(int grid) {
-  std::vector<Eigen::Vector3d> V;
-  std::vector<std::array<int, 3>> F;
-  for (int i = 0; i <= grid; ++i)
-    for (int j = 0; j <= grid; ++j) V.emplace_back(-2 + 4.0 * i / grid, -2 + 4.0 * j / grid, 0.0);
-  for (int i = 0; i < grid; ++i)
-    for (int j = 0; j < grid; ++j) {
-      const int a = i * (grid + 1) + j, b = a + grid + 1;
-      F.push_back({a, b, b + 1});
-      F.push_back({a, b + 1, a + 1});
-    }
-  return gauss6::test::make_mesh(V, F, "sheet");
-}
+// A flat sheet of grid x grid squares (grid_sheet without jitter).
+TriangleMesh flat_sheet(int grid) { return grid_sheet(grid, nullptr); }
 }  // namespace
 
 TEST_CASE("contacts: a flat plate's vertices beside a tool's bottom edge hold it by its bottom, not its side",
@@ -375,5 +429,69 @@ TEST_CASE("contacts: a vertex whose body turns between two faces' normals keeps 
       if ((n - nf).norm() < 1e-12) flanks |= 2;
     }
     CHECK(flanks == 3);
+  }
+}
+
+TEST_CASE("contacts: the merge cells give the set that comparing every contact gives, on dense coplanar patches",
+          "[contacts]") {
+  // Streams of contacts as a dense coplanar patch gives them (a jittered grid
+  // of points in a plane of any orientation, one normal to rounding), with a
+  // second patch tilted beyond patch_angle, separations drawn from a few
+  // values (ties decide the patch's closest), and near-duplicates of earlier
+  // points at 0 to 2 merge distances (some merge, some not), some of them
+  // placed on the cells' boundaries. Each is added to sets of several
+  // capacities by ContactCollector and by the rule of comparing every contact:
+  // the sets must be equal, bit for bit and in order, after every contact. A
+  // merge the cells miss leaves a duplicate or a larger separation, or shifts
+  // a reduction: the comparison fails.
+  std::mt19937 rng(58);
+  std::uniform_real_distribution<double> U(-1, 1), U01(0, 1);
+  const double seps[4] = {0.3e-6, 0.7e-6, 1e-6 / 3, 1e-6};
+  for (int trial = 0; trial < 60; ++trial) {
+    ContactSettings cs;
+    cs.distance = 1.1e-6;
+    const double md = 1e-3 * cs.distance;
+    const int capacity = trial % 3 == 0 ? 8 : trial % 3 == 1 ? 16 : 64;
+    ContactSet cells(capacity), every(capacity);
+    ContactCollector col(cs, &cells);
+    REQUIRE(col.indexed);
+    // The plate: normal n (near +z in half the trials, any in the others), in-plane axes u, v.
+    Vec3 n = trial % 2 == 0 ? Vec3(0.01 * U(rng), 0.01 * U(rng), 1) : Vec3(U(rng), U(rng), U(rng));
+    n.normalize();
+    const Vec3 u = n.unitOrthogonal(), v = n.cross(u), origin(0.05 * U(rng), 0.05 * U(rng), 0.01 * U(rng));
+    const Vec3 tilted = (n + 2e-3 * u).normalized();  // another patch
+    const double spacing = 1e-3;
+    const int grid = 20 + trial % 20;
+    std::vector<Contact> made;
+    bool overflow = false;
+    for (int k = 0; k < grid * grid + 200; ++k) {
+      Contact c;
+      const double r = U01(rng);
+      if (r < 0.25 && !made.empty()) {  // a near-duplicate of an earlier contact
+        const Contact& o = made[static_cast<size_t>(U01(rng) * static_cast<double>(made.size())) % made.size()];
+        c = o;
+        Vec3 off(U(rng), U(rng), U(rng));
+        c.point = o.point + (2 * md * U01(rng)) * off.normalized();
+        if (U01(rng) < 0.3) {  // on a cell boundary of x (the cells' side is 4 reject)
+          const double side = 4 * col.reject;
+          c.point.x() = std::round(c.point.x() / side) * side;
+        }
+        c.normal = (o.normal + 1e-9 * Vec3(U(rng), U(rng), U(rng))).normalized();
+      } else {
+        const int i = k % grid, j = (k / grid) % grid;
+        const Vec3 p = origin + ((i - grid / 2) + 0.25 * U(rng)) * spacing * u + ((j - grid / 2) + 0.25 * U(rng)) * spacing * v;
+        c.point = p;
+        c.normal = (r < 0.9 ? n : tilted) + 1e-12 * Vec3(U(rng), U(rng), U(rng));
+        c.normal.normalize();
+      }
+      c.separation = seps[static_cast<int>(U01(rng) * 4) % 4];
+      c.features = {PairKind::kObstacleVertexGodFace, 0, k % 7, -1, k, k % 3};
+      made.push_back(c);
+      col.add(c);
+      overflow = !before_cells::add(c, cs, &every) || overflow;
+      REQUIRE(col.overflow == overflow);
+      require_same_set(cells, every);
+    }
+    REQUIRE(cells.num_reductions > 0);
   }
 }

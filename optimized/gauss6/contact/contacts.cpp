@@ -41,7 +41,9 @@ Vec3 unit_normal(const Vec3& a, const Vec3& b, const Vec3& c) {
 constexpr double kCollinearSine = 1e-12;
 bool turns_left(const Eigen::Vector2d& a, const Eigen::Vector2d& b, const Eigen::Vector2d& c) {
   const Eigen::Vector2d u = b - a, w = c - a;
-  return u.x() * w.y() - u.y() * w.x() > kCollinearSine * u.norm() * w.norm();
+  const double area = u.x() * w.y() - u.y() * w.x();
+  // The bound is >= 0 (or NaN): a turn that is not left needs no norms.
+  return area > 0 && area > kCollinearSine * u.norm() * w.norm();
 }
 
 // Marks keep[] for the vertices of the convex hull of plane[idx[0 .. n))
@@ -193,38 +195,6 @@ bool boxes_apart(const Vec3& a_lo, const Vec3& a_hi, const Vec3& b_lo, const Vec
   return false;
 }
 
-struct Collector {
-  const ContactSettings& settings;
-  double merge_distance, merge_cos;
-  ContactSet* set;
-  bool overflow = false;
-
-  void add(const Contact& c) {
-    ++set->num_pairs_within;
-    // A contact whose point lies farther than merge_distance along an axis is
-    // not merged, whatever the rounding of the norm (which errs by under 4 u):
-    // the set's contacts are mostly such, and the norm is left for the rest.
-    const double reject = merge_distance * (1 + 8 * std::numeric_limits<double>::epsilon());
-    for (int i = 0; i < set->num_contacts; ++i) {
-      Contact& o = set->contacts[i];
-      if (std::abs(o.point.x() - c.point.x()) > reject || std::abs(o.point.y() - c.point.y()) > reject) continue;
-      if ((o.point - c.point).norm() <= merge_distance && o.normal.dot(c.normal) >= merge_cos) {
-        if (c.separation < o.separation) o = c;
-        return;
-      }
-    }
-    if (set->num_contacts == set->capacity()) {
-      ++set->num_reductions;
-      if (reduce_to_patch_supports(settings.patch_angle, set) == 0) {
-        overflow = true;
-        return;
-      }
-    }
-    set->contacts[set->num_contacts++] = c;
-  }
-};
-
-
 // The contacts within d of one (god triangle, obstacle triangle) pair of
 // obstacle o: one pass over the table of feature-pair kinds the two triangles
 // own (feature_pair.h), each feature pair's contact added to the set (its
@@ -241,7 +211,7 @@ struct TrianglePairContacts {
   int o;                                   // the obstacle's index
   double d, apart, par2, support_sine;     // settings.distance; feature boxes apart; parallel_sine^2; sin(merge_angle)
   double tie, turn;                        // separations' rounding (held_beside); settings.patch_angle
-  Collector* col;
+  ContactCollector* col;
   ContactSet* set;
   int slab_face = -1;  // the god face of slab_n (its normal, not unit) and slab_l2 (|slab_n|^2 d^2)
   Vec3 slab_n = Vec3::Zero();
@@ -265,11 +235,13 @@ struct TrianglePairContacts {
     // within d. But an obstacle triangle within d of the god face's plane (a
     // flat tool on a dense flat tessellation: thousands of such pairs) is
     // within d along the face normals and along the edges' cross products,
-    // all near that normal, so no axis drops it; its feature pairs, most of
-    // which lie far apart in the plane, are then sorted by their boxes (the
-    // bounds of their corners): one is tested only when its boxes come
-    // within `apart` of each other along every axis. Either way the set is
-    // the same: the axes and the boxes only save work.
+    // all near that normal, so no axis drops it, and the axes are not tried.
+    // The feature pairs of a pair the axes keep (a tool's side face over the
+    // plate's triangles along its bottom edge) or do not try, most of which
+    // lie far apart, are then sorted by their boxes (the bounds of their
+    // corners): one is tested only when its boxes come within `apart` of each
+    // other along every axis. Either way the set is the same: the axes and
+    // the boxes only save work.
     if (gf != slab_face) {  // consecutive pairs often share their god face
       slab_face = gf;
       slab_n = (X[1] - X[0]).cross(X[2] - X[0]);
@@ -281,24 +253,37 @@ struct TrianglePairContacts {
     };
     const bool in_slab = within(Y[0]) && within(Y[1]) && within(Y[2]);
     if (!in_slab && triangle_gap_lower_bound(X, Y, d) > d) return;
+    for (int i = 0; i < 3; ++i) {
+      boxes.x_reach[i] = (Upper{boxes.x_hi[i]} + Upper{apart}).v;
+      boxes.y_reach[i] = (Upper{boxes.y_hi[i]} + Upper{apart}).v;
+    }
     // k: the god-object's corner (vertex k, or edge k -> k + 1), j: the obstacle's.
     for_each_feature_pair(go, oo, [&](PairKind kind, int k, int j) {
-      feature_pair(kind, k, j, gf, of, X, Y, in_slab ? &boxes : nullptr);
+      feature_pair(kind, k, j, gf, of, X, Y, boxes);
       return true;
     });
   }
 
-  // The two triangles' corner boxes (their features' boxes are tested against them in the slab only).
+  // The two triangles' corner boxes, and their upper bounds grown by `apart`
+  // (rounded up, as boxes_apart rounds them: computed once for the pair's
+  // feature pairs).
   struct Box {
     Vec3 x_lo, x_hi, y_lo, y_hi;
+    double x_reach[3], y_reach[3];
   };
+  // boxes_apart(v, v, lo, hi, apart), hi + apart given as reach.
+  bool vertex_apart(const Vec3& v, const Vec3& lo, const double (&reach)[3]) const {
+    for (int i = 0; i < 3; ++i)
+      if (lo[i] > (Upper{v[i]} + Upper{apart}).v || v[i] > reach[i]) return true;
+    return false;
+  }
 
   void feature_pair(PairKind kind, int k, int j, int gf, int of, const Vec3 (&X)[3], const Vec3 (&Y)[3],
-                    const Box* boxes) {
+                    const Box& boxes) {
     switch (kind) {
       case PairKind::kGodVertexObstacleFace: {  // the obstacle face's normal
         const Vec3& x = X[k];
-        if (boxes && boxes_apart(x, x, boxes->y_lo, boxes->y_hi, apart)) break;
+        if (vertex_apart(x, boxes.y_lo, boxes.y_reach)) break;
         const double sep = (x - closest_point_on_triangle(x, Y[0], Y[1], Y[2])).norm();
         const Vec3 n = unit_normal(Y[0], Y[1], Y[2]);
         if (!(sep <= d && n != Vec3::Zero())) break;
@@ -311,7 +296,7 @@ struct TrianglePairContacts {
       }
       case PairKind::kObstacleVertexGodFace: {  // minus the god face's normal
         const Vec3& y = Y[j];
-        if (boxes && boxes_apart(y, y, boxes->x_lo, boxes->x_hi, apart)) break;
+        if (vertex_apart(y, boxes.x_lo, boxes.x_reach)) break;
         const Vec3 c = closest_point_on_triangle(y, X[0], X[1], X[2]);
         const double sep = (y - c).norm();
         const Vec3 n = -unit_normal(X[0], X[1], X[2]);
@@ -326,7 +311,7 @@ struct TrianglePairContacts {
       case PairKind::kEdgeEdge: {  // closest points inside both edges, edges not parallel
         const Vec3 &g0 = X[k], &g1 = X[(k + 1) % 3];
         const Vec3 &o0 = Y[j], &o1 = Y[(j + 1) % 3];
-        if (boxes && boxes_apart(g0.cwiseMin(g1), g0.cwiseMax(g1), o0.cwiseMin(o1), o0.cwiseMax(o1), apart)) break;
+        if (boxes_apart(g0.cwiseMin(g1), g0.cwiseMax(g1), o0.cwiseMin(o1), o0.cwiseMax(o1), apart)) break;
         double s, t;
         closest_segment_parameters(g0, g1, o0, o1, &s, &t);
         if (!(s > 0 && s < 1 && t > 0 && t < 1)) break;
@@ -392,6 +377,96 @@ int reduce_to_patch_supports(double patch_angle, ContactSet* set) noexcept {
   return m - kept;
 }
 
+ContactCollector::ContactCollector(const ContactSettings& settings, ContactSet* set) noexcept
+    : settings(settings),
+      merge_distance(settings.merge_distance > 0 ? settings.merge_distance : 1e-3 * settings.distance),
+      merge_cos(std::cos(settings.merge_angle)),
+      set(set) {
+  // A contact whose point lies farther than merge_distance along an axis is
+  // not merged, whatever the rounding of the norm (which errs by under 4 u):
+  // the set's contacts are mostly such, and the norm is left for the rest.
+  reject = merge_distance * (1 + 8 * std::numeric_limits<double>::epsilon());
+  inv_cell = 1 / (4 * reject);
+  const size_t buckets = set->merge_head.size();
+  indexed = inv_cell > 0 && std::isfinite(inv_cell) && buckets > 0 && (buckets & (buckets - 1)) == 0 &&
+            set->merge_next.size() >= set->contacts.size();
+  if (indexed) rebuild();
+}
+
+bool ContactCollector::cell_of(const Vec3& p, int64_t* ix, int64_t* iy) const {
+  const double x = std::floor(p.x() * inv_cell), y = std::floor(p.y() * inv_cell);
+  if (!(std::abs(x) < kMaxCell && std::abs(y) < kMaxCell)) return false;  // NaN too
+  *ix = static_cast<int64_t>(x);
+  *iy = static_cast<int64_t>(y);
+  return true;
+}
+
+size_t ContactCollector::bucket(int64_t ix, int64_t iy) const {
+  uint64_t h = static_cast<uint64_t>(ix) * 0x9E3779B97F4A7C15ull ^ static_cast<uint64_t>(iy) * 0xC2B2AE3D27D4EB4Full;
+  h ^= h >> 29;
+  return static_cast<size_t>(h) & (set->merge_head.size() - 1);
+}
+
+void ContactCollector::insert(int i, int64_t ix, int64_t iy) {
+  const size_t b = bucket(ix, iy);
+  set->merge_next[i] = set->merge_head[b];
+  set->merge_head[b] = i;
+}
+
+void ContactCollector::rebuild() {
+  std::fill(set->merge_head.begin(), set->merge_head.end(), -1);
+  int64_t ix = 0, iy = 0;
+  for (int i = 0; i < set->num_contacts; ++i) {
+    if (!cell_of(set->contacts[i].point, &ix, &iy)) {
+      indexed = false;
+      return;
+    }
+    insert(i, ix, iy);
+  }
+}
+
+bool ContactCollector::merges(const Contact& o, const Contact& c) const {
+  if (std::abs(o.point.x() - c.point.x()) > reject || std::abs(o.point.y() - c.point.y()) > reject) return false;
+  return (o.point - c.point).norm() <= merge_distance && o.normal.dot(c.normal) >= merge_cos;
+}
+
+void ContactCollector::add(const Contact& c) noexcept {
+  ++set->num_pairs_within;
+  int64_t ix = 0, iy = 0;
+  if (indexed && !cell_of(c.point, &ix, &iy)) indexed = false;  // every contact is compared from now on
+  // The first contact of the set (in its order) that c merges with.
+  int first = -1;
+  if (indexed) {
+    for (int64_t dx = -1; dx <= 1; ++dx)
+      for (int64_t dy = -1; dy <= 1; ++dy)
+        for (int i = set->merge_head[bucket(ix + dx, iy + dy)]; i >= 0; i = set->merge_next[i])
+          if ((first < 0 || i < first) && merges(set->contacts[i], c)) first = i;
+  } else {
+    for (int i = 0; i < set->num_contacts && first < 0; ++i)
+      if (merges(set->contacts[i], c)) first = i;
+  }
+  if (first >= 0) {  // merged: the smaller separation stays
+    Contact& o = set->contacts[first];
+    if (c.separation < o.separation) {
+      int64_t ox = 0, oy = 0;
+      const bool moved = indexed && (!cell_of(o.point, &ox, &oy) || ox != ix || oy != iy);
+      o = c;
+      if (moved) rebuild();
+    }
+    return;
+  }
+  if (set->num_contacts == set->capacity()) {
+    ++set->num_reductions;
+    if (reduce_to_patch_supports(settings.patch_angle, set) == 0) {
+      overflow = true;
+      return;
+    }
+    if (indexed) rebuild();
+  }
+  if (indexed) insert(set->num_contacts, ix, iy);
+  set->contacts[set->num_contacts++] = c;
+}
+
 Aabb posed_body_box(const Mat3& R, const Mat3& absR, const Vec3& G, const Aabb& box) noexcept {
   // Centre and half extents through |R|, grown by kBoxPoseRounding relative to
   // |G| + |R| |mid| + h: the magnitudes before G and R mid cancel, to which
@@ -442,8 +517,7 @@ ContactStatus generate_contacts(const CcdBody* obstacles, int num_obstacles, con
   obb_frame.set_rotation(R);
   obb_frame.p = G;
   obb_frame.grow = d;
-  Collector col{settings, settings.merge_distance > 0 ? settings.merge_distance : 1e-3 * d,
-                std::cos(settings.merge_angle), set};
+  ContactCollector col(settings, set);
   const double par2 = settings.parallel_sine * settings.parallel_sine;
   const double support_sine = std::sin(settings.merge_angle);
   // Features whose boxes are more than `apart` apart along an axis have a

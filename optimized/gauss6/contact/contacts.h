@@ -96,7 +96,9 @@ struct ContactSet {
         order(contacts.size()),
         hull(contacts.size() + 1),
         keep(contacts.size()),
-        plane(contacts.size()) {}
+        plane(contacts.size()),
+        merge_head(merge_buckets(capacity), -1),
+        merge_next(contacts.size()) {}
   int capacity() const { return static_cast<int>(contacts.size()); }
   int num_contacts = 0;
   int num_pairs_within = 0;       // pairs found within distance, before merging
@@ -108,6 +110,18 @@ struct ContactSet {
   std::vector<int> patch, order, hull;
   std::vector<unsigned char> keep;
   std::vector<Eigen::Vector2d> plane;
+  // Scratch of generate_contacts' merging: the set's contacts hashed by the
+  // grid cell of their point's x and y (merge_head: a bucket's first contact,
+  // -1 for none; merge_next: the next contact of its bucket), so that a new
+  // contact is compared with the contacts of the nine cells around its own,
+  // not with every contact.
+  std::vector<int> merge_head, merge_next;
+  // The number of buckets for a set of `capacity`: a power of two, at least four times it.
+  static size_t merge_buckets(int capacity) {
+    size_t n = 16;
+    while (n < 4 * static_cast<size_t>(capacity > 0 ? capacity : 0)) n *= 2;
+    return n;
+  }
 };
 
 // Reduces contacts[0 .. num_contacts) to the support of each patch (above):
@@ -117,6 +131,43 @@ struct ContactSet {
 // Contacts of one patch: normals within patch_angle (radians) of its first
 // contact's. Rows J are not touched. Returns the number of contacts left out.
 int reduce_to_patch_supports(double patch_angle, ContactSet* set) noexcept;
+
+// Adds contacts to a set as generate_contacts adds each pair's contact: c is
+// merged with the first contact of the set (in the set's order) whose point is
+// within merge_distance of c's and whose normal is within merge_angle (the
+// smaller separation stays); otherwise appended, a full set first reduced
+// (reduce_to_patch_supports; overflow when that frees nothing, c then left
+// out). Counts num_pairs_within and num_reductions.
+// The set's contacts are indexed by grid cells of side 4 `reject` along x and
+// y (ContactSet::merge_head): a contact within `reject` of another along x and
+// along y lies in one of the nine cells around the other's, so the first of
+// the contacts of those cells that merges is the first of the whole set, and
+// the set is the same as when c is compared with every contact. Cells are
+// formed only while every point's scaled coordinates stay below kMaxCell (each
+// then rounds by at most 1/8, and two within `reject` differ by under 1/2
+// before flooring); past that, or for a point that is not finite, every
+// contact is compared for the rest of the collector's life.
+// The set is used as it is (contacts already in it are kept and merged with).
+struct ContactCollector {
+  ContactCollector(const ContactSettings& settings, ContactSet* set) noexcept;
+  void add(const Contact& c) noexcept;
+
+  const ContactSettings& settings;
+  double merge_distance, merge_cos;  // settings.merge_distance (or 1e-3 distance), cos(merge_angle)
+  ContactSet* set;
+  bool overflow = false;             // a contact was left out: the reduced set had no room
+  double reject = 0;                 // merge_distance and its norm's rounding: farther along x or y never merges
+  double inv_cell = 0;               // 1 / (4 reject)
+  bool indexed = false;              // whether the cells are in use
+
+ private:
+  static constexpr double kMaxCell = 0x1p50;
+  bool cell_of(const Vec3& p, int64_t* ix, int64_t* iy) const;
+  size_t bucket(int64_t ix, int64_t iy) const;
+  void insert(int i, int64_t ix, int64_t iy);
+  void rebuild();
+  bool merges(const Contact& o, const Contact& c) const;
+};
 
 // World positions of the god-object's vertices, posed on first use in each call
 // (a vertex is current when its stamp equals `stamp`), the god nodes' world
