@@ -16,7 +16,9 @@
 
 #include "gauss6/geometry/bvh.h"
 #include "gauss6/ccd/ccd.h"
+#include "gauss6/geometry/distance.h"
 #include "gauss6/step/ccd_step.h"
+#include "gauss6/step/update_budget.h"
 #include "mesh_shapes.h"
 
 using namespace gauss6;
@@ -1165,3 +1167,82 @@ TEST_CASE("ccd_step: a descent's cut serves only the trees it was made for", "[c
   }
   CHECK(hits >= 5);
 }
+
+namespace {
+
+// The distance between two triangles (doubles): the least of each corner's to
+// the other triangle and of the nine edge pairs'.
+double triangle_distance(const Vec3 A[3], const Vec3 B[3]) {
+  double d = std::numeric_limits<double>::infinity();
+  for (int k = 0; k < 3; ++k) {
+    d = std::min(d, (A[k] - closest_point_on_triangle(A[k], B[0], B[1], B[2])).norm());
+    d = std::min(d, (B[k] - closest_point_on_triangle(B[k], A[0], A[1], A[2])).norm());
+    for (int j = 0; j < 3; ++j) {
+      const Vec3 &a0 = A[k], &a1 = A[(k + 1) % 3], &b0 = B[j], &b1 = B[(j + 1) % 3];
+      double s = 0, t = 0;
+      closest_segment_parameters(a0, a1, b0, b1, &s, &t);
+      d = std::min(d, ((a0 + s * (a1 - a0)) - (b0 + t * (b1 - b0))).norm());
+    }
+  }
+  return d;
+}
+
+}  // namespace
+
+TEST_CASE("ccd_step: a budget stop inside a later piece's descent keeps the near pairs of the pieces before",
+          "[ccd_step][budget]") {
+  // A ball sliding down onto a slab, its motion searched in lead pieces, under
+  // work-unit budgets from a few units to more than the step takes. Where the
+  // budget runs out in the descent of a piece after the first, the step stops
+  // at that piece's start with the near pairs listed for the piece before
+  // (they hold up to there): the contact set at the stop pose is then taken
+  // from them, not from a descent of the trees. Whatever the stop, a listed
+  // set holds every triangle pair within near_reach at the stop pose (the
+  // pose of the nominal motion there; 1e-9 of slack for its rounding).
+  const TriangleMesh god = make_icosphere(2, 0.4), slab = make_box(3, 3, 1, Vec3(0, 0, -0.5));
+  const Bvh gb = build_bvh(god, 2), sb = build_bvh(slab, 2);
+  const CcdBody obstacle{&slab, &sb};
+  CcdStepSettings settings;
+  settings.near_distance = 0.02;
+  const Pose x0{Vec3(0, 0, 0.55), Quat{}}, x1{Vec3(0.3, 0.1, 0.38), normalized(quat_exp(Vec3(0.2, 0.1, 0.3)))};
+  CcdStepRequest request{x0, x1};
+  request.lead_sweep = 16;
+  int stops = 0, kept = 0;
+  for (long units = 1; units <= 3000; units = units < 40 ? units + 1 : units * 11 / 10) {
+    INFO("work units " << units);
+    CcdStepWorkspace ws;
+    UpdateBudget budget;
+    budget.start({0, units, kDefaultBudgetCheckInterval});
+    ws.budget = &budget;
+    CcdStepResult r;
+    ccd_step(&obstacle, 1, {&god, &gb}, request, settings, &ws, &r);
+    REQUIRE(r.status == CcdStatus::kOk);
+    if (!r.budget_exhausted) continue;
+    ++stops;
+    // Past the motion's start every stop has a list: its piece's (a stop among
+    // its candidates) or the piece's before (a stop in its descent).
+    if (r.u_hit > 0) {
+      CHECK(r.num_near_pairs >= 0);
+      kept += r.num_near_pairs >= 0;
+    }
+    if (r.num_near_pairs < 0) continue;
+    REQUIRE(r.near_u0 <= r.u_hit);
+    const Pose at = motion_pose(r.motion.nominal, r.u_hit);
+    const NearPairs near = ws.near_pairs(r.num_near_pairs);
+    std::set<std::pair<int, int>> listed;
+    for (int k = 0; k < near.num_pairs; ++k) listed.insert({near[k].god_face, near[k].obstacle_face});
+    for (Eigen::Index gf = 0; gf < god.F.rows(); ++gf) {
+      Vec3 A[3];
+      for (int c = 0; c < 3; ++c) A[c] = transform_point(at, god.V.row(god.F(gf, c)).transpose());
+      for (Eigen::Index of = 0; of < slab.F.rows(); ++of) {
+        const Vec3 B[3] = {slab.V.row(slab.F(of, 0)).transpose(), slab.V.row(slab.F(of, 1)).transpose(),
+                           slab.V.row(slab.F(of, 2)).transpose()};
+        if (triangle_distance(A, B) < r.near_reach - 1e-9)
+          CHECK(listed.count({static_cast<int>(gf), static_cast<int>(of)}) == 1);
+      }
+    }
+  }
+  CHECK(stops > 10);
+  CHECK(kept > 5);
+}
+

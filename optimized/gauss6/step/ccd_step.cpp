@@ -243,8 +243,17 @@ bool search_sub_intervals(StepState* s) {
     // (StartFrame::earliest); those that cannot touch before the
     // sub-interval's end are dropped here. When the buffer is full the rest are
     // tested at once, in traversal order (same result, less pruning).
+    // The near pairs listed before this piece (the last piece's, or the
+    // proximity list's), when they hold up to u0, stay at cand[0 .. kept)
+    // while this piece's candidates go after them: a budget stop inside this
+    // descent, at u0, then still has them for the contact set at its stop pose
+    // (instead of a descent of the trees there, after the budget ran out).
+    const bool kept_list = result->num_near_pairs >= 0 && s->near_u1 >= u0;
+    const int kept = kept_list ? result->num_near_pairs : 0;
+    CcdStepWorkspace::Candidate* const piece = cand + kept;
+    const int piece_capacity = cand_capacity - kept;
     int num_cand = 0;
-    bool listed = true;  // every candidate of this sub-interval is in cand (no overflow, no early stop)
+    bool listed = true;  // every candidate of this sub-interval is in piece (no overflow, no early stop)
     s->ws->swept.next_interval();  // e changed: every cached god box is stale
     const TraversalStatus ts = descend(s, std::min(u1, result->u_hit), [&](int gf, int of, int o) {
       const CcdBody& ob = s->obstacles[o];
@@ -252,8 +261,8 @@ bool search_sub_intervals(StepState* s) {
       if (charge(s, Work::kTrianglePair, 1)) return false;
       const double t = candidate_time(s, s->start.posed_face(*god.mesh, gf, &s->ws->swept), *ob.mesh, of);
       if (t == kDropped) return true;
-      if (num_cand < cand_capacity) {
-        cand[num_cand++] = {{gf, of, o}, t};
+      if (num_cand < piece_capacity) {
+        piece[num_cand++] = {{gf, of, o}, t};
         return true;
       }
       listed = false;
@@ -271,12 +280,13 @@ bool search_sub_intervals(StepState* s) {
       return false;
     }
     if (out_of_budget(*s)) {  // a descent cut short: proven up to the piece's start
-      result->num_near_pairs = -1;  // the candidates' buffer holds part of this piece's: no list
+      if (!kept_list) result->num_near_pairs = -1;  // (else the kept list, which holds at u0)
       stop_on_budget(s, u0);
       return false;
     }
     if (ts == TraversalStatus::kStopped) listed = false;
-    set_near_pairs(s, listed ? num_cand : -1, u0);
+    std::copy(piece, piece + num_cand, cand);  // this piece's list now (kept < piece: a forward copy)
+    set_near_pairs(s, listed ? num_cand : -1, u0, std::min(u1, result->u_hit));
     if (!test_candidates(s, num_cand)) return false;
   }
   return true;
@@ -394,10 +404,11 @@ void stop_on_budget(StepState* s, double u) {
 
 // Whatever the testing finds, u_hit stays <= the end of the window the near
 // pairs were listed for.
-void set_near_pairs(StepState* s, int num_cand, double u0) {
+void set_near_pairs(StepState* s, int num_cand, double u0, double u1) {
   if (s->settings.near_distance <= 0) return;
   s->result->num_near_pairs = num_cand;
   s->result->near_u0 = u0;
+  s->near_u1 = u1;
   s->result->near_reach = s->reach;
 }
 

@@ -54,6 +54,7 @@ struct StepState {
   double searched = 0;
   int num_searched = 0;     // hints[0 .. num_searched) were searched (valid or not)
   double u_cached = 0;      // the proximity list covers [0, u_cached] (0: not used)
+  double near_u1 = 0;       // the near pairs listed (result->num_near_pairs >= 0) hold up to here
   // The proximity cache's list is for this step's meshes and settings, and
   // how far a point may have moved from its pose to X0 (infinite: unknown).
   bool cache_keyed = false;
@@ -136,8 +137,8 @@ inline bool take_node_pair(FillAllowance* left) {
 // over chunks charged to the update's budget (proximity_stages.cpp fill_some:
 // true once complete); without a budget one call.
 bool fill_within_budget(StepState* s, FillAllowance* left);
-// Records cand[0 .. num_cand) as the near pairs for [u0, u_hit] (-1: none).
-void set_near_pairs(StepState* s, int num_cand, double u0);
+// Records cand[0 .. num_cand) as the near pairs for [u0, min(u1, u_hit)] (-1: none).
+void set_near_pairs(StepState* s, int num_cand, double u0, double u1);
 
 // Lists the candidate triangle pairs of obstacle o over the motion enclosed in
 // `enc` from `frame` (the god-object at the range's start), the god boxes

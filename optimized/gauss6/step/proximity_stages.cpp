@@ -404,7 +404,7 @@ void search_cached_pairs(StepState* s, const ProximityCache& pc, const Displacem
     if (t == kDropped) continue;
     cand[num_cand++] = {{c.god_face, c.obstacle_face, c.obstacle}, t};  // fits: the cache has cand's capacity
   }
-  set_near_pairs(s, num_cand, 0.0);
+  set_near_pairs(s, num_cand, 0.0, s->u_cached);
   test_candidates(s, num_cand);  // (the budget's end: stop_on_budget)
 }
 
