@@ -419,6 +419,16 @@ Qed.
 Lemma coord_pos p0 dp t i : coord (vadd p0 (vscale t dp)) i = coord p0 i + t * coord dp i.
 Proof. destruct i as [|[|i]]; reflexivity. Qed.
 
+(* The CcdMotion m holds the exact motion's data: p0, dp, g (index i), R0
+   (a rotation) and [g]x^2 (row i, column j), |g|^2. make_ccd_motion_encloses
+   proves it of make_ccd_motion's. *)
+Definition motion_data m p0 dp g R0 : Prop :=
+  (forall i, (i < 3)%nat -> holds (mp0 m i) (coord p0 i) /\ holds (mdp m i) (coord dp i) /\
+                            holds (mg m i) (coord g i)) /\
+  (forall i j, (i < 3)%nat -> (j < 3)%nat ->
+     holds (mR0 m i j) (ent R0 i j) /\ holds (mK2 m i j) (ent (mmul (K g) (K g)) i j)) /\
+  holds (mg2 m) (dot g g) /\ mmul (mtr R0) R0 = I3.
+
 (* ---- The theorem ----
    enclose_motion_encloses (motion.cpp, enclose_motion): the exact motion
    p(t) = p0 + t dp, R(t) = C(t g) R0 with R0 a rotation, its CcdMotion m
@@ -431,12 +441,8 @@ Proof. destruct i as [|[|i]]; reflexivity. Qed.
    sub-intervals of the motion's [0, 1]. *)
 (* covers optimized/gauss6/ccd/motion.cpp "void enclose_motion(const CcdMotion& m, Interval u, MotionEnclosure* out)" sha256:99ad7aece5205dfe *)
 Theorem enclose_motion_encloses m p0 dp g R0 u0 u1 t :
-  (forall i, (i < 3)%nat -> holds (mp0 m i) (coord p0 i) /\ holds (mdp m i) (coord dp i) /\
-                            holds (mg m i) (coord g i)) ->
-  (forall i j, (i < 3)%nat -> (j < 3)%nat ->
-     holds (mR0 m i j) (ent R0 i j) /\ holds (mK2 m i j) (ent (mmul (K g) (K g)) i j)) ->
-  holds (mg2 m) (dot g g) -> F (lo (mg2 m)) -> - / 8 <= lo (mg2 m) -> hi (mg2 m) <= kMaxGibbsSquared ->
-  mmul (mtr R0) R0 = I3 ->
+  motion_data m p0 dp g R0 ->
+  F (lo (mg2 m)) -> - / 8 <= lo (mg2 m) -> hi (mg2 m) <= kMaxGibbsSquared ->
   F u0 -> F u1 -> 0 <= u0 -> u1 <= 1 -> u0 <= t <= u1 ->
   let a := alpha_enc (mg2 m) u0 u1 in
   let b := beta_enc (mg2 m) u0 u1 in
@@ -446,7 +452,7 @@ Theorem enclose_motion_encloses m p0 dp g R0 u0 u1 t :
      let r := clamp1 (iRe a b m i j) in
      holds r (ent Rt i j) /\ Rabs (ent Rt i j - rmid r) <= rrad r /\ 0 <= rrad r).
 Proof.
-  intros Hv HM Hs Fs Hl Hh O F0 F1 H0 H1 Ht a b Rt. split.
+  intros [Hv [HM [Hs O]]] Fs Hl Hh F0 F1 H0 H1 Ht a b Rt. split.
   - intros i Hi. destruct (Hv i Hi) as [A [B _]]. rewrite coord_pos. unfold ipos.
     apply interval_add_encloses; [exact A|].
     apply interval_mul_encloses; [unfold holds; simpl; lra | exact B].
@@ -614,13 +620,9 @@ Lemma make_ccd_motion_encloses p0 p1 q0 q1 f :
   0 < lo (rr_norm (qw q0) (qx q0) (qy q0) (qz q0)) -> 0 < lo (rw_int f q1 q0) ->
   let m := ccd_motion p0 p1 q0 q1 f in
   let g := gibbs (qmul q1 (qconj q0)) in
-  (forall i, (i < 3)%nat -> holds (mp0 m i) (coord p0 i) /\ holds (mdp m i) (coord (vsub p1 p0) i) /\
-                            holds (mg m i) (coord g i)) /\
-  (forall i j, (i < 3)%nat -> (j < 3)%nat ->
-     holds (mR0 m i j) (ent (Rq q0) i j) /\ holds (mK2 m i j) (ent (mmul (K g) (K g)) i j)) /\
-  holds (mg2 m) (dot g g) /\ mmul (mtr (Rq q0)) (Rq q0) = I3.
+  motion_data m p0 (vsub p1 p0) g (Rq q0).
 Proof.
-  intros Pn Pw m g.
+  intros Pn Pw m g. unfold motion_data.
   destruct (hamilton_encloses q1 q0) as [Hw [Hx [Hy Hz]]].
   set (r := qmul q1 (qconj q0)) in *.
   assert (Hg : forall k, (k < 3)%nat -> holds (gibbs_int f q1 q0 k) (coord g k)).
@@ -696,10 +698,10 @@ Theorem enclose_exact_motion p0 p1 q0 q1 f u0 u1 t :
      holds r (ent Rt i j) /\ Rabs (ent Rt i j - rmid r) <= rrad r /\ 0 <= rrad r).
 Proof.
   intros Pn Pw m Hl Hh F0 F1 H0 H1 Ht g a b Rt.
-  destruct (make_ccd_motion_encloses p0 p1 q0 q1 f Pn Pw) as [Hv [HM [Hs O]]].
   assert (Fs : F (lo (mg2 m)))
     by (unfold m, ccd_motion, g2_int, iadd; cbn [mg2 lo]; unfold next_down, next_up; apply F_opp, F_fl).
-  exact (enclose_motion_encloses m p0 (vsub p1 p0) g (Rq q0) u0 u1 t Hv HM Hs Fs Hl Hh O F0 F1 H0 H1 Ht).
+  exact (enclose_motion_encloses m p0 (vsub p1 p0) g (Rq q0) u0 u1 t (make_ccd_motion_encloses p0 p1 q0 q1 f Pn Pw)
+           Fs Hl Hh F0 F1 H0 H1 Ht).
 Qed.
 Print Assumptions enclose_exact_motion.
 
@@ -714,12 +716,8 @@ Print Assumptions enclose_exact_motion.
 (* covers optimized/gauss6/ccd/motion.cpp "void enclose_motion(const CcdMotion& m, Interval u, MotionEnclosure* out)" sha256:99ad7aece5205dfe *)
 (* covers optimized/gauss6/ccd/motion_bounds.cpp "Aabb swept_box(const MotionEnclosure& e, const Aabb& body)" sha256:17e777d36e576019 *)
 Theorem swept_box_motion m p0 dp g R0 u0 u1 t i lo0 lo1 lo2 hi0 hi1 hi2 r0 r1 r2 :
-  (forall i, (i < 3)%nat -> holds (mp0 m i) (coord p0 i) /\ holds (mdp m i) (coord dp i) /\
-                            holds (mg m i) (coord g i)) ->
-  (forall i j, (i < 3)%nat -> (j < 3)%nat ->
-     holds (mR0 m i j) (ent R0 i j) /\ holds (mK2 m i j) (ent (mmul (K g) (K g)) i j)) ->
-  holds (mg2 m) (dot g g) -> F (lo (mg2 m)) -> - / 8 <= lo (mg2 m) -> hi (mg2 m) <= kMaxGibbsSquared ->
-  mmul (mtr R0) R0 = I3 ->
+  motion_data m p0 dp g R0 ->
+  F (lo (mg2 m)) -> - / 8 <= lo (mg2 m) -> hi (mg2 m) <= kMaxGibbsSquared ->
   F u0 -> F u1 -> 0 <= u0 -> u1 <= 1 -> u0 <= t <= u1 -> (i < 3)%nat ->
   (forall x, In x [lo0; lo1; lo2; hi0; hi1; hi2] -> F x) ->
   lo0 <= r0 <= hi0 -> lo1 <= r1 <= hi1 -> lo2 <= r2 <= hi2 ->
@@ -733,23 +731,10 @@ Theorem swept_box_motion m p0 dp g R0 u0 u1 t i lo0 lo1 lo2 hi0 hi1 hi2 r0 r1 r2
   let q1 := rrad (clamp1 (iRe a b m i 1)) in
   let q2 := rrad (clamp1 (iRe a b m i 2)) in
   let p := ipos m {| lo := u0; hi := u1 |} i in
-  let c0 := fl (fl (/ 2 * lo0) + fl (/ 2 * hi0)) in
-  let c1 := fl (fl (/ 2 * lo1) + fl (/ 2 * hi1)) in
-  let c2 := fl (fl (/ 2 * lo2) + fl (/ 2 * hi2)) in
-  let h0 := next_up (Rmax (fl (hi0 - c0)) (fl (c0 - lo0))) in
-  let h1 := next_up (Rmax (fl (hi1 - c1)) (fl (c1 - lo1))) in
-  let h2 := next_up (Rmax (fl (hi2 - c2)) (fl (c2 - lo2))) in
-  let centre := sum3 (fl (m0 * c0)) (fl (m1 * c1)) (fl (m2 * c2)) in
-  let half := fl (sum3 (fl (Rabs m0 * h0)) (fl (Rabs m1 * h1)) (fl (Rabs m2 * h2))
-                  + sum3 (fl (q0 * fl (Rabs c0 + h0))) (fl (q1 * fl (Rabs c1 + h1))) (fl (q2 * fl (Rabs c2 + h2)))) in
-  let scale := sum3 (fl (fl (Rabs m0 + q0) * fl (Rabs c0 + h0))) (fl (fl (Rabs m1 + q1) * fl (Rabs c1 + h1)))
-                    (fl (fl (Rabs m2 + q2) * fl (Rabs c2 + h2))) in
-  let grow := next_up (fl (half + next_up (fl (next_up (fl (kBoxProductRounding * scale)) + kUnderflowFloor)))) in
-  let local := {| lo := next_down (fl (centre - grow)); hi := next_up (fl (centre + grow)) |} in
-  holds (iadd p local) (coord (vadd p0 (vscale t dp)) i + (ent Rt i 0 * r0 + ent Rt i 1 * r1 + ent Rt i 2 * r2)).
+  holds (swept_world m0 m1 m2 q0 q1 q2 lo0 lo1 lo2 hi0 hi1 hi2 (lo p) (hi p)) (coord (vadd p0 (vscale t dp)) i + (ent Rt i 0 * r0 + ent Rt i 1 * r1 + ent Rt i 2 * r2)).
 Proof.
-  intros Hv HM Hs Fs Hl Hh O F0 F1 H0 H1 Ht Hi HF Hr0 Hr1 Hr2 a b Rt m0 m1 m2 q0 q1 q2 p.
-  destruct (enclose_motion_encloses m p0 dp g R0 u0 u1 t Hv HM Hs Fs Hl Hh O F0 F1 H0 H1 Ht) as [Hp HR].
+  intros Hd Fs Hl Hh F0 F1 H0 H1 Ht Hi HF Hr0 Hr1 Hr2 a b Rt m0 m1 m2 q0 q1 q2 p.
+  destruct (enclose_motion_encloses m p0 dp g R0 u0 u1 t Hd Fs Hl Hh F0 F1 H0 H1 Ht) as [Hp HR].
   destruct (HR i 0%nat Hi ltac:(lia)) as [_ [E0 G0]]. destruct (HR i 1%nat Hi ltac:(lia)) as [_ [E1 G1]].
   destruct (HR i 2%nat Hi ltac:(lia)) as [_ [E2 G2]].
   pose proof (Hp i Hi) as HP. fold p in HP. unfold holds in HP.
