@@ -573,17 +573,7 @@ Proof.
   destruct (closest_lower p a b c q M Fp Fa Fb Fc Mp Ma Mb Mc Hq) as (X & HX & L).
   pose proof (Hmin X HX).
   assert (HM0 : 0 <= M) by (destruct Ma as (A & _); pose proof (Rabs_pos (cx a)); lra).
-  assert (T1 : 9000 * u * scale <= tie scale).
-  { unfold tie. eapply Rle_trans; [|apply Rmax_l]. eapply Rle_trans; [|apply next_up_ge].
-    apply Rmult_le_compat_r; [lra | apply kBoxPoseRounding_ge]. }
-  assert (T2 : kNormFloor <= tie scale) by (unfold tie; apply Rmax_r).
-  assert (HuM : u * M <= u * (4 * scale + bpow radix2 (-490))) by (apply Rmult_le_compat_l; lra).
-  assert (Hb : 480 * (u * bpow radix2 (-490)) + 2 * bpow radix2 (-529) <= / 2 * kNormFloor).
-  { unfold kNormFloor. rewrite bpow_m53, <- bpow_plus.
-    replace (-529)%Z with (-29 + -500)%Z by lia. replace (-53 + -490)%Z with (-43 + -500)%Z by lia. rewrite !bpow_plus.
-    pose proof (bpow_gt_0 radix2 (-500)). simpl (bpow radix2 (-29)). simpl (bpow radix2 (-43)). lra. }
   assert (Fr : F (sep p r)) by (unfold sep, sep_c, norm_c; apply F_fl).
-  assert (0 < kNormFloor) by (unfold kNormFloor; apply bpow_gt_0).
-  apply fl_ge_F; [exact Fr|]. lra.
+  apply (tie_covers _ _ M scale Fr Hs HM0 HMs). lra.
 Qed.
 Print Assumptions tie_closest.

@@ -646,6 +646,30 @@ Qed.
    Upper{scale}).v, kNormFloor). *)
 Definition tie scale := Rmax (next_up (fl (kBoxPoseRounding * scale))) kNormFloor.
 
+(* A double separation x at most 480 u M + 2^-528 above y is within `tie` of
+   it as generate_contacts compares them: x <= fl(y + tie scale), for
+   coordinates within M <= 4 scale + 2^-490 (tie is at least 9000 u scale,
+   which covers the relative part, and at least kNormFloor = 2^-500, which
+   covers the rest). The one step tie_shared_edge and ClosestPoint.v
+   tie_closest share. *)
+Lemma tie_covers x y M scale :
+  F x -> 0 <= scale -> 0 <= M -> M <= 4 * scale + bpow radix2 (-490) ->
+  x <= y + 480 * u * M + 2 * bpow radix2 (-529) -> x <= fl (y + tie scale).
+Proof.
+  intros Fx Hs HM0 HMs H. pose proof u_small.
+  assert (T1 : 9000 * u * scale <= tie scale).
+  { unfold tie. eapply Rle_trans; [|apply Rmax_l]. eapply Rle_trans; [|apply next_up_ge].
+    apply Rmult_le_compat_r; [lra | apply kBoxPoseRounding_ge]. }
+  assert (T2 : kNormFloor <= tie scale) by (unfold tie; apply Rmax_r).
+  assert (HuM : u * M <= u * (4 * scale + bpow radix2 (-490))) by (apply Rmult_le_compat_l; lra).
+  assert (Hb : 480 * (u * bpow radix2 (-490)) + 2 * bpow radix2 (-529) <= / 2 * kNormFloor).
+  { unfold kNormFloor. rewrite bpow_m53, <- bpow_plus.
+    replace (-529)%Z with (-29 + -500)%Z by lia. replace (-53 + -490)%Z with (-43 + -500)%Z by lia. rewrite !bpow_plus.
+    pose proof (bpow_gt_0 radix2 (-500)). simpl (bpow radix2 (-29)). simpl (bpow radix2 (-43)). lra. }
+  assert (0 < kNormFloor) by (unfold kNormFloor; apply bpow_gt_0).
+  apply fl_ge_F; [exact Fx|]. lra.
+Qed.
+
 (* Two faces that share the edge from a to b (either face may see it from b to
    a), each returning for p the point of its edge rule (their branch of that
    edge or of one of its ends: q, q'), coordinates within M <= 4 scale +
@@ -678,17 +702,10 @@ Proof.
       rewrite E0, E1, E2 in S2. exact S2. }
   apply Rabs_le_inv in S1. apply Rabs_le_inv in S2.
   assert (HM0 : 0 <= M) by (assert (Rabs a0 <= M) by (apply HM; simpl; tauto); pose proof (Rabs_pos a0); lra).
-  (* tie >= 9000 u scale and >= 2^-500 *)
-  assert (T1 : 9000 * u * scale <= tie scale).
-  { unfold tie. eapply Rle_trans; [|apply Rmax_l]. eapply Rle_trans; [|apply next_up_ge].
-    apply Rmult_le_compat_r; [lra | apply kBoxPoseRounding_ge]. }
-  assert (T2 : kNormFloor <= tie scale) by (unfold tie; apply Rmax_r).
-  assert (HuM : u * M <= u * (4 * scale + bpow radix2 (-490))) by (apply Rmult_le_compat_l; lra).
-  assert (Hb : 460 * (u * bpow radix2 (-490)) + 2 * bpow radix2 (-531) <= / 2 * kNormFloor).
-  { unfold kNormFloor. rewrite bpow_m53, <- bpow_plus.
-    replace (-531)%Z with (-31 + -500)%Z by lia. replace (-53 + -490)%Z with (-43 + -500)%Z by lia. rewrite !bpow_plus.
-    pose proof (bpow_gt_0 radix2 (-500)). simpl (bpow radix2 (-31)). simpl (bpow radix2 (-43)). lra. }
   assert (Fr : F (sep_c p0 p1 p2 r0 r1 r2)) by (unfold sep_c, norm_c; apply F_fl).
-  apply fl_ge_F; [exact Fr|]. lra.
+  apply (tie_covers _ _ M scale Fr Hs HM0 HMs).
+  assert (0 <= u * M) by (apply Rmult_le_pos; lra).
+  assert (bpow radix2 (-531) <= bpow radix2 (-529)) by (apply bpow_le; lia).
+  lra.
 Qed.
 Print Assumptions tie_shared_edge.

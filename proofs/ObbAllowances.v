@@ -181,12 +181,10 @@ Proof.
   pose proof (up_ge _ _ H). split; [exact H0|]. pose proof (Rabs_pos (r - c)). lra.
 Qed.
 
-(* covers optimized/gauss6/ccd/motion_bounds.cpp "Aabb swept_box(const MotionEnclosure& e, const Aabb& body)" sha256:17e777d36e576019 *)
-Theorem swept_box_encloses m0 m1 m2 q0 q1 q2 lo0 lo1 lo2 hi0 hi1 hi2 R0 R1 R2 r0 r1 r2 plo phi P :
-  (forall x, In x [m0; m1; m2; q0; q1; q2; lo0; lo1; lo2; hi0; hi1; hi2] -> F x) ->
-  0 <= q0 -> 0 <= q1 -> 0 <= q2 ->
-  Rabs (R0 - m0) <= q0 -> Rabs (R1 - m1) <= q1 -> Rabs (R2 - m2) <= q2 ->
-  lo0 <= r0 <= hi0 -> lo1 <= r1 <= hi1 -> lo2 <= r2 <= hi2 -> plo <= P <= phi ->
+(* swept_box's world interval for world coordinate i, computed as the code
+   computes it from row i of R_mid (m0, m1, m2) and R_rad (q0, q1, q2), the
+   body box [lo, hi] and p_i's enclosure [plo, phi]. *)
+Definition swept_world m0 m1 m2 q0 q1 q2 lo0 lo1 lo2 hi0 hi1 hi2 plo phi :=
   let c0 := fl (fl (/ 2 * lo0) + fl (/ 2 * hi0)) in
   let c1 := fl (fl (/ 2 * lo1) + fl (/ 2 * hi1)) in
   let c2 := fl (fl (/ 2 * lo2) + fl (/ 2 * hi2)) in
@@ -200,9 +198,28 @@ Theorem swept_box_encloses m0 m1 m2 q0 q1 q2 lo0 lo1 lo2 hi0 hi1 hi2 R0 R1 R2 r0
                     (fl (fl (Rabs m2 + q2) * fl (Rabs c2 + h2))) in
   let grow := next_up (fl (half + next_up (fl (next_up (fl (kBoxProductRounding * scale)) + kUnderflowFloor)))) in
   let local := {| lo := next_down (fl (centre - grow)); hi := next_up (fl (centre + grow)) |} in
-  holds (iadd {| lo := plo; hi := phi |} local) (P + (R0 * r0 + R1 * r1 + R2 * r2)).
+  iadd {| lo := plo; hi := phi |} local.
+
+(* covers optimized/gauss6/ccd/motion_bounds.cpp "Aabb swept_box(const MotionEnclosure& e, const Aabb& body)" sha256:17e777d36e576019 *)
+Theorem swept_box_encloses m0 m1 m2 q0 q1 q2 lo0 lo1 lo2 hi0 hi1 hi2 R0 R1 R2 r0 r1 r2 plo phi P :
+  (forall x, In x [m0; m1; m2; q0; q1; q2; lo0; lo1; lo2; hi0; hi1; hi2] -> F x) ->
+  0 <= q0 -> 0 <= q1 -> 0 <= q2 ->
+  Rabs (R0 - m0) <= q0 -> Rabs (R1 - m1) <= q1 -> Rabs (R2 - m2) <= q2 ->
+  lo0 <= r0 <= hi0 -> lo1 <= r1 <= hi1 -> lo2 <= r2 <= hi2 -> plo <= P <= phi ->
+  holds (swept_world m0 m1 m2 q0 q1 q2 lo0 lo1 lo2 hi0 hi1 hi2 plo phi) (P + (R0 * r0 + R1 * r1 + R2 * r2)).
 Proof.
-  intros HF Hq0 Hq1 Hq2 HR0 HR1 HR2 Hr0 Hr1 Hr2 HP c0 c1 c2 h0 h1 h2 centre half scale grow local.
+  intros HF Hq0 Hq1 Hq2 HR0 HR1 HR2 Hr0 Hr1 Hr2 HP. unfold swept_world; cbv zeta.
+  set (c0 := fl (fl (/ 2 * lo0) + fl (/ 2 * hi0))). set (c1 := fl (fl (/ 2 * lo1) + fl (/ 2 * hi1))).
+  set (c2 := fl (fl (/ 2 * lo2) + fl (/ 2 * hi2))).
+  set (h0 := next_up (Rmax (fl (hi0 - c0)) (fl (c0 - lo0)))). set (h1 := next_up (Rmax (fl (hi1 - c1)) (fl (c1 - lo1)))).
+  set (h2 := next_up (Rmax (fl (hi2 - c2)) (fl (c2 - lo2)))).
+  set (centre := sum3 (fl (m0 * c0)) (fl (m1 * c1)) (fl (m2 * c2))).
+  set (half := fl (sum3 (fl (Rabs m0 * h0)) (fl (Rabs m1 * h1)) (fl (Rabs m2 * h2))
+                  + sum3 (fl (q0 * fl (Rabs c0 + h0))) (fl (q1 * fl (Rabs c1 + h1))) (fl (q2 * fl (Rabs c2 + h2))))).
+  set (scale := sum3 (fl (fl (Rabs m0 + q0) * fl (Rabs c0 + h0))) (fl (fl (Rabs m1 + q1) * fl (Rabs c1 + h1)))
+                    (fl (fl (Rabs m2 + q2) * fl (Rabs c2 + h2)))).
+  set (grow := next_up (fl (half + next_up (fl (next_up (fl (kBoxProductRounding * scale)) + kUnderflowFloor))))).
+  set (local := {| lo := next_down (fl (centre - grow)); hi := next_up (fl (centre + grow)) |}).
   destruct (half_extent lo0 hi0 c0 r0 Hr0) as [E0 G0]; fold h0 in E0, G0.
   destruct (half_extent lo1 hi1 c1 r1 Hr1) as [E1 G1]; fold h1 in E1, G1.
   destruct (half_extent lo2 hi2 c2 r2 Hr2) as [E2 G2]; fold h2 in E2, G2.

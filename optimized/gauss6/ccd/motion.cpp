@@ -121,6 +121,13 @@ MotionStatus make_ccd_motion(const Pose& x0, const Pose& x1, CcdMotion* m) {
   if (!(rw.lo > 0)) return MotionStatus::kHalfTurn;
   out.g = {div_positive(rx, rw), div_positive(ry, rw), div_positive(rz, rw)};
   out.g2 = sqr(out.g[0]) + sqr(out.g[1]) + sqr(out.g[2]);
+  // The hypotheses of proofs/MotionEnclosure.v enclose_motion_encloses (its
+  // kMaxGibbsSquared, and the lower end at least -1/8): they keep
+  // enclose_motion's denominators 1 + u^2 |g|^2 safely positive. A motion
+  // within kMaxMotionAngle has |g|^2 <= tan(85 deg)^2 ~ 131, enclosed within
+  // rounding of it, so this refuses none of them.
+  constexpr double kMaxGibbsSquared = 1e4, kMinGibbsSquaredLower = -0.125;
+  if (!(out.g2.lo >= kMinGibbsSquaredLower && out.g2.hi <= kMaxGibbsSquared)) return MotionStatus::kHalfTurn;
   for (int i = 0; i < 3; ++i)
     for (int j = 0; j < 3; ++j)
       out.K2[3 * i + j] = (i == j) ? sqr(out.g[i]) - out.g2 : out.g[i] * out.g[j];
@@ -128,6 +135,10 @@ MotionStatus make_ccd_motion(const Pose& x0, const Pose& x1, CcdMotion* m) {
   return MotionStatus::kOk;
 }
 
+// Machine-checked: proofs/MotionEnclosure.v, enclose_motion_encloses (for
+// every u of the interval, p(u) in p, every entry of R(u) in R and within R_rad
+// of R_mid; hypotheses: 0 <= u.lo <= u.hi <= 1, and make_ccd_motion's check
+// of g2), and swept_box_motion (swept_box over it holds every pose).
 void enclose_motion(const CcdMotion& m, Interval u, MotionEnclosure* out) {
   // C(u g) = I + alpha(u) [g]x + beta(u) [g]x^2, alpha = 2u / (1 + u^2 s),
   // beta = 2u^2 / (1 + u^2 s), s = |g|^2, u >= 0.

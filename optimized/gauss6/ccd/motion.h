@@ -88,11 +88,13 @@ struct CcdMotion {
 };
 
 // kOk, or the status of make_cayley_motion (invalid pose, half turn). Also
-// kHalfTurn when the enclosure of scalar(qr) is not safely positive.
+// kHalfTurn when the enclosure of scalar(qr) is not safely positive, or that of
+// |g|^2 not within the range enclose_motion's proof needs (motion.cpp).
 MotionStatus make_ccd_motion(const Pose& x0, const Pose& x1, CcdMotion* motion);
 
 // Enclosure of the motion over a parameter range U = [u0, u1] subset of [0, 1]:
-// for every u in U, R(u) is in R and p(u) in p (world frame).
+// for every u in U, R(u) is in R and p(u) in p (world frame). Machine-checked:
+// proofs/MotionEnclosure.v, enclose_motion_encloses.
 struct MotionEnclosure {
   Interval u;
   IMat3 R;   // entries intersected with [-1, 1] (R(u) is exactly a rotation)
