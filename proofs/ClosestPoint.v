@@ -554,7 +554,7 @@ Definition edge_of (a b c s t : P3) : Prop :=
    2^-528 (closest_upper for G, closest_lower for F), under `tie` (at least
    9000 u scale and 2^-500). M <= 4 scale + 2^-490 as for ContactTie.v
    tie_shared_edge (argued there, not proved). *)
-(* covers optimized/gauss6/contact/contacts.cpp "ContactStatus generate_contacts(const CcdBody* obstacles, int num_obstacles, const CcdBody& god, const Pose& X_WB," sha256:2ff787cd3dd142c4 *)
+(* covers optimized/gauss6/contact/contacts.cpp "ContactStatus generate_contacts(const CcdBody* obstacles, int num_obstacles, const CcdBody& god, const Pose& X_WB," sha256:f7318906decf3db7 *)
 (* covers optimized/gauss6/contact/contacts.cpp "bool held_beside(const Vec3& p, const Side<AtV>& V, int vf, int vc, const Side<AtW>& W, int face, const Vec3& nF," sha256:ffbaa960d7c4b290 *)
 Theorem tie_closest p a b c q a' b' c' r s t M scale :
   fin p -> fin a -> fin b -> fin c -> fin a' -> fin b' -> fin c' ->

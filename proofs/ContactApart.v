@@ -1,11 +1,12 @@
 (* kBoxPoseRounding at generate_contacts' `apart` (contact/contacts.cpp
-   generate_contacts, `scale` and `apart`, lines 444-447; feature_pair's box
-   tests and separations, lines 290-323; boxes_apart, line 189;
-   geometry/distance.cpp closest_point_on_triangle, lines 27-58): two
-   features whose boxes (the min / max of their double corners) are more than
-   `apart` apart along a world axis have a computed separation above the
-   contact distance d, so that skipping them (feature_pair, in the slab)
-   leaves the contact set as it is. The separation is computed as the code
+   generate_contacts, `scale` and `apart`, lines 529-532; feature_pair's box
+   tests (vertex_apart: boxes_apart for a vertex, its upper bounds grown once
+   per triangle pair) and separations, lines 275-339; boxes_apart, line 192;
+   geometry/distance.cpp closest_point_on_triangle): two features whose
+   boxes (the min / max of their double corners) are more than `apart` apart
+   along a world axis have a computed separation above the contact distance
+   d, so that skipping them (feature_pair, every pair the triangles' boxes and
+   axes keep) leaves the contact set as it is. The separation is computed as the code
    computes it: the closest point of a triangle (geometry/distance.cpp
    closest_point_on_triangle, every branch) or of two segments (the points
    g0 + s (g1 - g0) of feature_pair, 0 < s < 1 checked), the difference, its
@@ -333,7 +334,7 @@ Qed.
    separation, the norm of the rounded difference (whichever coordinate the
    axis is, whichever order the sum takes), is above d. *)
 (* covers optimized/gauss6/contact/contacts.cpp "bool boxes_apart(const Vec3& a_lo, const Vec3& a_hi, const Vec3& b_lo, const Vec3& b_hi, double gap)" sha256:f61afe30bf87fbb8 *)
-(* covers optimized/gauss6/contact/contacts.cpp "ContactStatus generate_contacts(const CcdBody* obstacles, int num_obstacles, const CcdBody& god, const Pose& X_WB," sha256:2ff787cd3dd142c4 *)
+(* covers optimized/gauss6/contact/contacts.cpp "ContactStatus generate_contacts(const CcdBody* obstacles, int num_obstacles, const CcdBody& god, const Pose& X_WB," sha256:f7318906decf3db7 *)
 (* allowance kBoxPoseRounding = 1e-12 *)
 Theorem apart_separation d scale M ahi blo P Q y z : F d -> F P -> F Q ->
   bpow radix2 (-500) <= d -> 0 <= scale -> 0 <= M -> M <= 4 * scale + bpow radix2 (-490) ->
@@ -448,7 +449,7 @@ Qed.
    test passing along this axis, either way round, makes the computed
    separation |x - q| (its three coordinates' rounded differences, the
    norm's sum in any order) above d. *)
-(* covers optimized/gauss6/contact/contacts.cpp "void feature_pair(PairKind kind, int k, int j, int gf, int of, const Vec3 (&X)[3], const Vec3 (&Y)[3]," sha256:4052afe13f4ccb2e *)
+(* covers optimized/gauss6/contact/contacts.cpp "void feature_pair(PairKind kind, int k, int j, int gf, int of, const Vec3 (&X)[3], const Vec3 (&Y)[3]," sha256:c5ac50ba849e9759 *)
 Theorem apart_vertex_face d scale M x a b c q lo hi y z : F d -> F x -> F a -> F b -> F c ->
   bpow radix2 (-500) <= d -> 0 <= scale -> M <= 4 * scale + bpow radix2 (-490) ->
   lo <= a <= hi -> lo <= b <= hi -> lo <= c <= hi -> Rabs a <= M -> Rabs b <= M -> Rabs c <= M ->

@@ -678,7 +678,7 @@ Qed.
    comparison sep' <= reach, sep' a double, holds iff sep' <= fl(sep + tie)
    when sep' <= d). The separations are within 460 u M + 2^-530 of each other,
    `tie` at least 9000 u scale and 2^-500. *)
-(* covers optimized/gauss6/contact/contacts.cpp "ContactStatus generate_contacts(const CcdBody* obstacles, int num_obstacles, const CcdBody& god, const Pose& X_WB," sha256:2ff787cd3dd142c4 *)
+(* covers optimized/gauss6/contact/contacts.cpp "ContactStatus generate_contacts(const CcdBody* obstacles, int num_obstacles, const CcdBody& god, const Pose& X_WB," sha256:f7318906decf3db7 *)
 (* covers optimized/gauss6/contact/contacts.cpp "bool held_beside(const Vec3& p, const Side<AtV>& V, int vf, int vc, const Side<AtW>& W, int face, const Vec3& nF," sha256:ffbaa960d7c4b290 *)
 Theorem tie_shared_edge a0 a1 a2 b0 b1 b2 p0 p1 p2 q0 q1 q2 r0 r1 r2 M scale :
   (forall v, In v [a0; a1; a2; b0; b1; b2; p0; p1; p2] -> F v) ->
