@@ -92,34 +92,33 @@ Definition closest_c (p a b c q : P3) : Prop :=
 
 (* ---- The computed separation against the exact distance ---- *)
 
+(* norm3 grows with the magnitudes of its coordinates. *)
+Lemma norm3_le_abs w0 w1 w2 d0 d1 d2 :
+  Rabs w0 <= Rabs d0 -> Rabs w1 <= Rabs d1 -> Rabs w2 <= Rabs d2 -> norm3 w0 w1 w2 <= norm3 d0 d1 d2.
+Proof.
+  intros H0 H1 H2. unfold norm3. apply sqrt_le_1_alt.
+  rewrite <- (abs_sq w0), <- (abs_sq w1), <- (abs_sq w2), <- (abs_sq d0), <- (abs_sq d1), <- (abs_sq d2).
+  pose proof (Rabs_pos w0). pose proof (Rabs_pos w1). pose proof (Rabs_pos w2).
+  assert (Rabs w0 * Rabs w0 <= Rabs d0 * Rabs d0) by (apply Rmult_le_compat; lra).
+  assert (Rabs w1 * Rabs w1 <= Rabs d1 * Rabs d1) by (apply Rmult_le_compat; lra).
+  assert (Rabs w2 * Rabs w2 <= Rabs d2 * Rabs d2) by (apply Rmult_le_compat; lra).
+  lra.
+Qed.
+
 Lemma norm3_le_scaled k w0 w1 w2 d0 d1 d2 : 0 <= k ->
   Rabs w0 <= k * Rabs d0 -> Rabs w1 <= k * Rabs d1 -> Rabs w2 <= k * Rabs d2 ->
   norm3 w0 w1 w2 <= k * norm3 d0 d1 d2.
 Proof.
-  intros Hk H0 H1 H2. unfold norm3.
-  rewrite <- (sqrt_square k) at 1 by lra. rewrite <- sqrt_mult_alt by (apply Rle_0_sqr).
-  apply sqrt_le_1_alt.
-  rewrite <- (abs_sq w0), <- (abs_sq w1), <- (abs_sq w2), <- (abs_sq d0), <- (abs_sq d1), <- (abs_sq d2).
-  pose proof (Rabs_pos w0). pose proof (Rabs_pos w1). pose proof (Rabs_pos w2).
-  assert (Rabs w0 * Rabs w0 <= (k * Rabs d0) * (k * Rabs d0)) by (apply Rmult_le_compat; lra).
-  assert (Rabs w1 * Rabs w1 <= (k * Rabs d1) * (k * Rabs d1)) by (apply Rmult_le_compat; lra).
-  assert (Rabs w2 * Rabs w2 <= (k * Rabs d2) * (k * Rabs d2)) by (apply Rmult_le_compat; lra).
-  nra.
+  intros Hk H0 H1 H2. rewrite <- (Rabs_pos_eq k Hk) at 1. rewrite <- norm3_scale.
+  apply norm3_le_abs; rewrite Rabs_mult, (Rabs_pos_eq k Hk); assumption.
 Qed.
 
 Lemma norm3_ge_scaled k w0 w1 w2 d0 d1 d2 : 0 <= k ->
   k * Rabs d0 <= Rabs w0 -> k * Rabs d1 <= Rabs w1 -> k * Rabs d2 <= Rabs w2 ->
   k * norm3 d0 d1 d2 <= norm3 w0 w1 w2.
 Proof.
-  intros Hk H0 H1 H2. unfold norm3.
-  rewrite <- (sqrt_square k) at 1 by lra. rewrite <- sqrt_mult_alt by (apply Rle_0_sqr).
-  apply sqrt_le_1_alt.
-  rewrite <- (abs_sq w0), <- (abs_sq w1), <- (abs_sq w2), <- (abs_sq d0), <- (abs_sq d1), <- (abs_sq d2).
-  pose proof (Rabs_pos d0). pose proof (Rabs_pos d1). pose proof (Rabs_pos d2).
-  assert ((k * Rabs d0) * (k * Rabs d0) <= Rabs w0 * Rabs w0) by (apply Rmult_le_compat; nra).
-  assert ((k * Rabs d1) * (k * Rabs d1) <= Rabs w1 * Rabs w1) by (apply Rmult_le_compat; nra).
-  assert ((k * Rabs d2) * (k * Rabs d2) <= Rabs w2 * Rabs w2) by (apply Rmult_le_compat; nra).
-  nra.
+  intros Hk H0 H1 H2. rewrite <- (Rabs_pos_eq k Hk) at 1. rewrite <- norm3_scale.
+  apply norm3_le_abs; rewrite Rabs_mult, (Rabs_pos_eq k Hk); assumption.
 Qed.
 
 (* One rounded difference of doubles: within u of the exact one, relatively. *)
